@@ -1,0 +1,1 @@
+//! Schur complement (stub).
