@@ -1,1 +1,73 @@
-fn main() {}
+//! Workspace automation for anim: `cargo xtask <suite>`.
+//!
+//! | suite | what it does |
+//! | --- | --- |
+//! | `conformance [--quick] [--filter S]` | every reference case with metric, error, tolerance and verdict; exit 1 on any failure |
+//! | `stability [--quick] [--filter S]` | the named hard cases of every crate with their outcomes; exit 1 on an unexpected outcome |
+//! | `bench [--filter S]` | the criterion benches under `benches/`, printed as a table and written to `target/xtask/bench.csv` |
+//! | `report [--quick] [--out DIR]` | conformance, stability and work-precision studies written to `docs/report/` (Markdown + SVG) |
+//! | `ci` | what CI runs: format, clippy, tests (with doc tests), docs, quick conformance and stability |
+
+mod bench;
+mod cases;
+mod ci;
+mod registry;
+mod report;
+mod suites;
+
+use std::process::ExitCode;
+
+const USAGE: &str = "usage: cargo xtask <conformance|stability|bench|report|ci> [--quick] [--filter TEXT] [--out DIR]";
+
+#[derive(Debug, Default)]
+struct Args {
+    quick: bool,
+    filter: Option<String>,
+    out: Option<String>,
+}
+
+fn parse(args: &[String]) -> Result<Args, String> {
+    let mut parsed = Args::default();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--quick" => parsed.quick = true,
+            "--filter" => parsed.filter = Some(it.next().ok_or("--filter needs a value")?.clone()),
+            "--out" => parsed.out = Some(it.next().ok_or("--out needs a value")?.clone()),
+            other => return Err(format!("unknown argument '{other}'")),
+        }
+    }
+    Ok(parsed)
+}
+
+fn main() -> ExitCode {
+    let argv: Vec<String> = std::env::args().skip(1).collect();
+    let Some((cmd, rest)) = argv.split_first() else {
+        eprintln!("{USAGE}");
+        return ExitCode::from(2);
+    };
+    let args = match parse(rest) {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("error: {e}\n{USAGE}");
+            return ExitCode::from(2);
+        }
+    };
+    let ctx = registry::Ctx { quick: args.quick };
+    let ok = match cmd.as_str() {
+        "conformance" => suites::conformance(&ctx, args.filter.as_deref()).passed(),
+        "stability" => suites::stability(&ctx, args.filter.as_deref()).passed(),
+        "bench" => bench::run(args.filter.as_deref()),
+        "report" => report::run(&ctx, args.out.as_deref().unwrap_or("docs/report")),
+        "ci" => ci::run(),
+        "help" | "--help" | "-h" => {
+            println!("{USAGE}");
+            true
+        }
+        other => {
+            eprintln!("error: unknown suite '{other}'\n{USAGE}");
+            return ExitCode::from(2);
+        }
+    };
+    if ok { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+}

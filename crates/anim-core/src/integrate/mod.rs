@@ -1,1 +1,480 @@
-//! stub
+//! Time integration of second-order systems `x'' = M^-1 f(t, x, v)` (seed section 2).
+//!
+//! Springs, FEM bodies and articulated rigid bodies are all second-order systems. This module is
+//! the one place their time integrators live; no crate writes its own copy.
+//!
+//! # The two system traits
+//!
+//! - [`SecondOrderSystem`]: a system known by its acceleration `a(t, x, v)`. Enough for every
+//!   explicit method. An articulated robot (acceleration by ABA) implements only this.
+//! - [`MechanicalSystem`]: a system with a diagonal (lumped) mass, a force `f(t, x, v)` and the
+//!   force Jacobians `K = df/dx` and `D = df/dv` (matrix-free, optionally assembled). Needed by the
+//!   implicit methods, which solve `(M - c_v D - c_x K) dv = r` by Newton's method with any
+//!   [`LinearSolver`](crate::linalg::LinearSolver). A zero inverse mass marks a fixed (kinematic)
+//!   degree of freedom: it keeps its velocity.
+//!
+//! # The integrators (seed 2.1, 2.2)
+//!
+//! | integrator | update | order | notes |
+//! | --- | --- | --- | --- |
+//! | [`ExplicitEuler`] | `v1 = v0 + h a(x0)`, `x1 = x0 + h v0` | 1 | energy grows on oscillators |
+//! | [`SymplecticEuler`] | `v1 = v0 + h a(x0)`, `x1 = x0 + h v1` | 1 | symplectic, bounded energy error |
+//! | [`BetaBlend`] | `(M - beta h^2 K) v1 = M v0 + h f(x0)` (seed), solved by Newton on `M(v1 - v0) = h f(x0 + beta h v1)`, `x1 = x0 + h v1` | 1 | `beta = 0` is symplectic Euler, `beta = 1` backward Euler |
+//! | [`PositionVerlet`] | `x1 = 2 x0 - x_-1 + h^2 a(x0)` | 2 | Stormer's form; keeps the previous position |
+//! | [`Leapfrog`] | `v_{1/2} = v_{-1/2} + h a(x0)`, `x1 = x0 + h v_{1/2}` | 2 | keeps the staggered velocity |
+//! | [`VelocityVerlet`] | half kick, drift, half kick | 2 | one force evaluation per step |
+//! | [`ImplicitMidpoint`] | `v1 = v0 + h a((x0+x1)/2, (v0+v1)/2)`, `x1 = x0 + h (v0+v1)/2` | 2 | symplectic, implicit (Newton) |
+//! | [`Rk4`] | classical Runge-Kutta | 4 | not symplectic; the high-order reference |
+//!
+//! The seed names `beta = 1/2` "middle-point". In the seed's form, where the position always
+//! advances with `v1`, every `beta` gives a first-order method: `beta = 1/2` evaluates the force at
+//! the midpoint of the positions but not of the velocities. The second-order implicit midpoint rule
+//! is [`ImplicitMidpoint`].
+//!
+//! With one Newton iteration ([`NewtonParams::linearized`]) [`BetaBlend`] is exactly the seed's
+//! linearised scheme `[I - beta h^2 M^-1 K(x0)] v1 = v0 + h M^-1 f(x0)`: Newton starts from the
+//! point where the force is evaluated at `x0`.
+//!
+//! # Invariants
+//! - No integrator allocates in `step` after the first step of a given size.
+//! - On error the state is left as it was before the step (results are computed into scratch).
+//! - A non-finite position or velocity is reported at the step that produced it.
+//! - The multistep methods (position Verlet, leapfrog, velocity Verlet) keep history between
+//!   steps; if the caller changes the state between steps (a collision response, a reset) they
+//!   notice and restart from the new state.
+
+mod explicit;
+mod implicit;
+mod rk4;
+pub mod study;
+pub mod systems;
+mod verlet;
+
+pub use explicit::{ExplicitEuler, SymplecticEuler};
+pub use implicit::{BetaBlend, ImplicitMidpoint, NewtonParams};
+pub use rk4::Rk4;
+pub use verlet::{Leapfrog, PositionVerlet, VelocityVerlet};
+
+use crate::diagnostics::{Field, NonFinite, check_finite};
+use crate::linalg::{CsrMatrix, LinearSolverKind, SolveError};
+use serde::{Deserialize, Serialize};
+
+/// The integrated state of a second-order system: time, positions and velocities.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct State {
+    /// Simulated time.
+    pub t: f64,
+    /// Generalised positions.
+    pub x: Vec<f64>,
+    /// Generalised velocities.
+    pub v: Vec<f64>,
+}
+
+impl State {
+    /// A state at time 0.
+    ///
+    /// # Panics
+    /// If `x` and `v` differ in length.
+    #[must_use]
+    #[track_caller]
+    pub fn new(x: Vec<f64>, v: Vec<f64>) -> Self {
+        assert_eq!(x.len(), v.len(), "State::new: x and v differ in length");
+        Self { t: 0.0, x, v }
+    }
+
+    /// Number of degrees of freedom.
+    #[must_use]
+    pub fn dof(&self) -> usize {
+        self.x.len()
+    }
+}
+
+/// A system `x'' = a(t, x, v)` known by its acceleration.
+pub trait SecondOrderSystem {
+    /// Number of degrees of freedom.
+    fn dof(&self) -> usize;
+    /// Writes the acceleration `a(t, x, v)`.
+    fn acceleration(&mut self, t: f64, x: &[f64], v: &[f64], a: &mut [f64]);
+    /// Total energy at `(t, x, v)`, where the system defines one.
+    fn energy(&mut self, t: f64, x: &[f64], v: &[f64]) -> Option<f64> {
+        let _ = (t, x, v);
+        None
+    }
+}
+
+/// A system `M x'' = f(t, x, v)` with diagonal mass and force Jacobians: what implicit methods need.
+///
+/// `K = df/dx` and `D = df/dv` must be symmetric for the conjugate-gradient and Cholesky solvers
+/// (conservative forces and symmetric damping give this); the implicit step matrix
+/// `M - c_v D - c_x K` must be positive definite for them, which holds for small enough steps or
+/// when `K` and `D` are negative semi-definite (springs with the definiteness fix, FEM with
+/// projected element Hessians, Rayleigh damping).
+pub trait MechanicalSystem: SecondOrderSystem {
+    /// Writes the diagonal of `M^-1`; `0` marks a fixed degree of freedom (infinite mass).
+    fn inverse_mass(&self, w: &mut [f64]);
+    /// Writes the force `f(t, x, v)`.
+    fn force(&mut self, t: f64, x: &[f64], v: &[f64], f: &mut [f64]);
+    /// Evaluates and caches the Jacobians `K` and `D` at `(t, x, v)` for the calls below.
+    fn linearize(&mut self, t: f64, x: &[f64], v: &[f64]);
+    /// Writes `out = (c_x K + c_v D) dx` with the Jacobians of the last [`linearize`](Self::linearize).
+    fn jacobian_apply(&self, c_x: f64, c_v: f64, dx: &[f64], out: &mut [f64]);
+    /// Writes the diagonal of `c_x K + c_v D` and returns `true`, or `false` if unavailable
+    /// (Jacobi preconditioning then fails with a clear error).
+    fn jacobian_diagonal(&self, c_x: f64, c_v: f64, out: &mut [f64]) -> bool {
+        let _ = (c_x, c_v, out);
+        false
+    }
+    /// Assembles `c_x K + c_v D` into `out` and returns `true`, or `false` if the system is
+    /// matrix-free only (Jacobi, Gauss-Seidel and Cholesky then fail with a clear error).
+    ///
+    /// A system should keep the sparsity pattern of `out` between calls and only rewrite its
+    /// values, so that assembly does not allocate after the first step.
+    fn jacobian_assemble(&self, c_x: f64, c_v: f64, out: &mut CsrMatrix) -> bool {
+        let _ = (c_x, c_v, out);
+        false
+    }
+}
+
+/// What one integrator step did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct StepInfo {
+    /// Newton iterations (0 for explicit methods).
+    pub newton_iterations: usize,
+    /// Linear-solver iterations summed over the Newton iterations.
+    pub linear_iterations: usize,
+    /// Final Newton residual `||g|| / ||g_0||` (0 for explicit methods).
+    pub residual: f64,
+    /// Acceleration (or force) evaluations.
+    pub evaluations: usize,
+}
+
+/// An integrator step that failed. The state is unchanged when one is returned.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum IntegrateError {
+    /// The step produced a NaN or infinity.
+    #[error(transparent)]
+    NonFinite(#[from] NonFinite),
+    /// The time step is not a positive finite number.
+    #[error("time step must be positive and finite, got {dt}")]
+    BadTimeStep {
+        /// The offending step.
+        dt: f64,
+    },
+    /// The state does not match the system's number of degrees of freedom.
+    #[error("state has {state} degrees of freedom (x: {x}, v: {v}) but the system has {system}")]
+    DimensionMismatch {
+        /// `x.len()`.
+        x: usize,
+        /// `v.len()`.
+        v: usize,
+        /// `x.len()` for the message.
+        state: usize,
+        /// `system.dof()`.
+        system: usize,
+    },
+    /// The linear solve inside a Newton iteration failed.
+    #[error("linear solve failed at step {step}, Newton iteration {newton_iteration}: {source}")]
+    LinearSolve {
+        /// Step index.
+        step: u64,
+        /// Newton iteration (0-based).
+        newton_iteration: usize,
+        /// The solver's error.
+        source: SolveError,
+    },
+    /// Newton's method did not reach its tolerance.
+    #[error(
+        "Newton did not converge at step {step}: relative residual {residual:e} after {iterations} iterations"
+    )]
+    NewtonNotConverged {
+        /// Step index.
+        step: u64,
+        /// Iterations performed.
+        iterations: usize,
+        /// Relative residual reached.
+        residual: f64,
+    },
+}
+
+/// Advances a system's [`State`] by one step.
+pub trait Integrator<S: ?Sized> {
+    /// Short name for reports.
+    fn name(&self) -> &'static str;
+    /// Advances `state` by `dt`.
+    ///
+    /// # Errors
+    /// [`IntegrateError`]; `state` is then unchanged.
+    fn step(&mut self, system: &mut S, state: &mut State, dt: f64) -> Result<StepInfo, IntegrateError>;
+    /// Forgets history kept between steps (multistep methods), e.g. after teleporting the state.
+    fn reset(&mut self) {}
+    /// Theoretical order of accuracy of the method.
+    fn order(&self) -> u32;
+    /// Whether the method is symplectic (bounded energy error on Hamiltonian systems).
+    fn symplectic(&self) -> bool;
+}
+
+/// The integrators by name, for scene files, sweeps and the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", deny_unknown_fields)]
+pub enum IntegratorKind {
+    /// [`ExplicitEuler`].
+    ExplicitEuler,
+    /// [`SymplecticEuler`].
+    SymplecticEuler,
+    /// [`BetaBlend`] with `beta = 1`.
+    BackwardEuler,
+    /// [`BetaBlend`] with the given `beta` in `[0, 1]`.
+    BetaBlend {
+        /// Blend factor.
+        beta: f64,
+    },
+    /// [`PositionVerlet`].
+    PositionVerlet,
+    /// [`Leapfrog`].
+    Leapfrog,
+    /// [`VelocityVerlet`].
+    VelocityVerlet,
+    /// [`ImplicitMidpoint`].
+    ImplicitMidpoint,
+    /// [`Rk4`].
+    Rk4,
+}
+
+impl IntegratorKind {
+    /// Every kind the seed names (beta-blend at 0, 1/2 and 1), plus midpoint and RK4.
+    pub const ALL: [IntegratorKind; 10] = [
+        IntegratorKind::ExplicitEuler,
+        IntegratorKind::SymplecticEuler,
+        IntegratorKind::BackwardEuler,
+        IntegratorKind::BetaBlend { beta: 0.0 },
+        IntegratorKind::BetaBlend { beta: 0.5 },
+        IntegratorKind::PositionVerlet,
+        IntegratorKind::Leapfrog,
+        IntegratorKind::VelocityVerlet,
+        IntegratorKind::ImplicitMidpoint,
+        IntegratorKind::Rk4,
+    ];
+
+    /// A display label ("beta-blend(0.5)", "rk4", ...).
+    #[must_use]
+    pub fn label(&self) -> String {
+        match self {
+            IntegratorKind::ExplicitEuler => "explicit-euler".into(),
+            IntegratorKind::SymplecticEuler => "symplectic-euler".into(),
+            IntegratorKind::BackwardEuler => "backward-euler".into(),
+            IntegratorKind::BetaBlend { beta } => format!("beta-blend({beta})"),
+            IntegratorKind::PositionVerlet => "position-verlet".into(),
+            IntegratorKind::Leapfrog => "leapfrog".into(),
+            IntegratorKind::VelocityVerlet => "velocity-verlet".into(),
+            IntegratorKind::ImplicitMidpoint => "implicit-midpoint".into(),
+            IntegratorKind::Rk4 => "rk4".into(),
+        }
+    }
+
+    /// Whether the method needs a [`MechanicalSystem`] (force Jacobians).
+    #[must_use]
+    pub fn is_implicit(&self) -> bool {
+        matches!(
+            self,
+            IntegratorKind::BackwardEuler
+                | IntegratorKind::BetaBlend { .. }
+                | IntegratorKind::ImplicitMidpoint
+        )
+    }
+
+    /// Builds the integrator for a system with `dof` degrees of freedom; implicit methods use
+    /// Newton with a Jacobi-preconditioned CG solve. See [`build_with`](Self::build_with).
+    #[must_use]
+    pub fn build<S: MechanicalSystem + ?Sized>(self, dof: usize) -> Box<dyn Integrator<S> + Send> {
+        self.build_with(dof, NewtonParams::default(), LinearSolverKind::JacobiPcg)
+    }
+
+    /// Builds the integrator with the given Newton parameters and linear solver (both ignored by
+    /// explicit methods).
+    ///
+    /// # Panics
+    /// If a beta-blend `beta` lies outside `[0, 1]` (validate user input with
+    /// [`validate`](Self::validate) first).
+    #[must_use]
+    pub fn build_with<S: MechanicalSystem + ?Sized>(
+        self,
+        dof: usize,
+        newton: NewtonParams,
+        linear: LinearSolverKind,
+    ) -> Box<dyn Integrator<S> + Send> {
+        match self {
+            IntegratorKind::BackwardEuler => Box::new(BetaBlend::new(1.0, newton, linear.build(newton.linear), dof)),
+            IntegratorKind::BetaBlend { beta } => {
+                Box::new(BetaBlend::new(beta, newton, linear.build(newton.linear), dof))
+            }
+            IntegratorKind::ImplicitMidpoint => {
+                Box::new(ImplicitMidpoint::new(newton, linear.build(newton.linear), dof))
+            }
+            explicit => explicit.build_explicit(dof).unwrap_or_else(|| unreachable!("explicit kind")),
+        }
+    }
+
+    /// Builds an explicit integrator for any [`SecondOrderSystem`]; `None` for implicit kinds.
+    #[must_use]
+    pub fn build_explicit<S: SecondOrderSystem + ?Sized>(self, dof: usize) -> Option<Box<dyn Integrator<S> + Send>> {
+        Some(match self {
+            IntegratorKind::ExplicitEuler => Box::new(ExplicitEuler::new(dof)),
+            IntegratorKind::SymplecticEuler => Box::new(SymplecticEuler::new(dof)),
+            IntegratorKind::PositionVerlet => Box::new(PositionVerlet::new(dof)),
+            IntegratorKind::Leapfrog => Box::new(Leapfrog::new(dof)),
+            IntegratorKind::VelocityVerlet => Box::new(VelocityVerlet::new(dof)),
+            IntegratorKind::Rk4 => Box::new(Rk4::new(dof)),
+            IntegratorKind::BackwardEuler | IntegratorKind::BetaBlend { .. } | IntegratorKind::ImplicitMidpoint => {
+                return None;
+            }
+        })
+    }
+
+    /// Checks parameters given by a user (a beta outside `[0, 1]` or not finite).
+    ///
+    /// # Errors
+    /// A message naming the bad value.
+    pub fn validate(&self) -> Result<(), String> {
+        match self {
+            IntegratorKind::BetaBlend { beta } if !(0.0..=1.0).contains(beta) => {
+                Err(format!("beta must lie in [0, 1], got {beta}"))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Checks `dt` and the state's shape against the system.
+pub(crate) fn check_inputs(dof: usize, state: &State, dt: f64) -> Result<(), IntegrateError> {
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Err(IntegrateError::BadTimeStep { dt });
+    }
+    if state.x.len() != dof || state.v.len() != dof {
+        return Err(IntegrateError::DimensionMismatch {
+            x: state.x.len(),
+            v: state.v.len(),
+            state: state.x.len(),
+            system: dof,
+        });
+    }
+    Ok(())
+}
+
+/// Checks new positions and velocities for non-finite values.
+pub(crate) fn validate(step: u64, state: &State, x_new: &[f64], v_new: &[f64]) -> Result<(), IntegrateError> {
+    check_finite(step, Field::Position, x_new, &state.x)?;
+    check_finite(step, Field::Velocity, v_new, &state.v)?;
+    Ok(())
+}
+
+/// Writes new positions and velocities into `state` and advances its time.
+pub(crate) fn apply(state: &mut State, x_new: &[f64], v_new: &[f64], dt: f64) {
+    state.x.copy_from_slice(x_new);
+    state.v.copy_from_slice(v_new);
+    state.t += dt;
+}
+
+/// Checks the new positions and velocities, then commits them to `state`.
+pub(crate) fn commit(
+    step: u64,
+    state: &mut State,
+    x_new: &[f64],
+    v_new: &[f64],
+    dt: f64,
+) -> Result<(), IntegrateError> {
+    validate(step, state, x_new, v_new)?;
+    apply(state, x_new, v_new, dt);
+    Ok(())
+}
+
+/// Resizes a scratch vector (allocates only when the size changes).
+#[inline]
+pub(crate) fn fit(buf: &mut Vec<f64>, n: usize) {
+    if buf.len() != n {
+        buf.resize(n, 0.0);
+    }
+}
+
+/// A snapshot of the state a multistep method last produced, to detect outside changes.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub(crate) struct History {
+    valid: bool,
+    t: f64,
+    x: Vec<f64>,
+    v: Vec<f64>,
+}
+
+impl History {
+    /// Whether `state` is bit for bit the state recorded last.
+    pub(crate) fn matches(&self, state: &State) -> bool {
+        self.valid
+            && self.t.to_bits() == state.t.to_bits()
+            && self.x.len() == state.x.len()
+            && self.x.iter().zip(&state.x).all(|(a, b)| a.to_bits() == b.to_bits())
+            && self.v.iter().zip(&state.v).all(|(a, b)| a.to_bits() == b.to_bits())
+    }
+
+    pub(crate) fn record(&mut self, state: &State) {
+        fit(&mut self.x, state.x.len());
+        fit(&mut self.v, state.v.len());
+        self.x.copy_from_slice(&state.x);
+        self.v.copy_from_slice(&state.v);
+        self.t = state.t;
+        self.valid = true;
+    }
+
+    pub(crate) fn clear(&mut self) {
+        self.valid = false;
+    }
+}
+
+#[cfg(test)]
+mod tests;
+
+/// A second-order system with its integrator, as a [`Solver`](crate::solver::Solver): the bridge
+/// from this module to the workspace's common stepping interface.
+pub struct Simulation<S: ?Sized> {
+    integrator: Box<dyn Integrator<S> + Send>,
+    system: Box<S>,
+}
+
+impl<S: SecondOrderSystem + ?Sized> Simulation<S> {
+    /// Couples a system with an integrator.
+    #[must_use]
+    pub fn new(system: Box<S>, integrator: Box<dyn Integrator<S> + Send>) -> Self {
+        Self { integrator, system }
+    }
+
+    /// The system (model).
+    #[must_use]
+    pub fn system(&self) -> &S {
+        &self.system
+    }
+
+    /// The system, mutably (to change parameters between steps).
+    pub fn system_mut(&mut self) -> &mut S {
+        &mut self.system
+    }
+
+    /// The integrator's name.
+    #[must_use]
+    pub fn integrator_name(&self) -> &'static str {
+        self.integrator.name()
+    }
+}
+
+impl<S: SecondOrderSystem + ?Sized> crate::solver::Solver for Simulation<S> {
+    type State = State;
+    type Error = IntegrateError;
+
+    fn step(&mut self, state: &mut State, dt: f64) -> Result<crate::solver::StepReport, IntegrateError> {
+        let info = self.integrator.step(&mut self.system, state, dt)?;
+        let mut report = crate::solver::StepReport::at_time(state.t);
+        report.iterations = info.newton_iterations;
+        report.residual = (info.newton_iterations > 0).then_some(info.residual);
+        report.energy = self.system.energy(state.t, &state.x, &state.v);
+        Ok(report)
+    }
+}

@@ -30,7 +30,7 @@ pub use svd::{Svd3, polar, polar_f32, svd3, svd3_f32};
 use serde::{Deserialize, Serialize};
 
 /// A square linear operator known by its action.
-pub trait LinearOperator: Sync {
+pub trait LinearOperator {
     /// Number of rows (= columns).
     fn dim(&self) -> usize;
     /// Writes `y = A x`. `x` and `y` have length [`dim`](Self::dim).
@@ -143,6 +143,17 @@ pub enum SolveError {
     /// A factorisation failed (faer's error, as text).
     #[error("factorisation failed: {0}")]
     Factorization(String),
+    /// A dense block is singular to working precision: its LU factorisation met a pivot that is
+    /// zero or tiny relative to the block's largest entry (see [`schur`]).
+    #[error("{block} is singular to working precision (pivot {pivot:e} at elimination step {step})")]
+    Singular {
+        /// Which block ("A", "D", "Schur complement").
+        block: &'static str,
+        /// Elimination step (row of the factored, row-permuted block) of the offending pivot.
+        step: usize,
+        /// The pivot.
+        pivot: f64,
+    },
 }
 
 /// A linear solver an implicit integrator can be handed.

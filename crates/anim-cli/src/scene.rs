@@ -1,0 +1,325 @@
+//! Scene files: a TOML description of what to simulate and how long.
+//!
+//! ```toml
+//! name = "kepler"
+//!
+//! [run]
+//! dt = 0.01          # seconds per step
+//! frames = 300       # frames written
+//! steps_per_frame = 5
+//!
+//! [scene]
+//! kind = "kepler-orbit"
+//! eccentricity = 0.5
+//! integrator = "velocity-verlet"   # or { beta-blend = { beta = 0.5 } }
+//! ```
+//!
+//! Unknown fields are errors (a typo never silently falls back to a default), and every error
+//! names the file and the field or line.
+
+use anim_core::integrate::IntegratorKind;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// A scene file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Scene name, used for the output folder.
+    pub name: String,
+    /// Time stepping and output.
+    pub run: RunParams,
+    /// What is simulated.
+    pub scene: Scene,
+}
+
+/// Time stepping and output parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunParams {
+    /// Time step in seconds (> 0).
+    pub dt: f64,
+    /// Frames to write (>= 1).
+    pub frames: usize,
+    /// Steps between written frames (>= 1). Default 1.
+    #[serde(default = "one")]
+    pub steps_per_frame: usize,
+}
+
+fn one() -> usize {
+    1
+}
+
+/// The simulated systems a scene can name. Later crates add variants.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Scene {
+    /// A damped harmonic oscillator `m x'' = -k x - c x'` with its exact solution.
+    HarmonicOscillator {
+        /// Mass (> 0).
+        mass: f64,
+        /// Stiffness (> 0).
+        stiffness: f64,
+        /// Damping (>= 0). Default 0.
+        #[serde(default)]
+        damping: f64,
+        /// Initial position.
+        x0: f64,
+        /// Initial velocity.
+        v0: f64,
+        /// Integrator.
+        integrator: IntegratorKind,
+    },
+    /// A planet on an ellipse of semi-major axis 1 around a fixed sun (`mu = 1`), with the exact
+    /// solution from Kepler's equation.
+    KeplerOrbit {
+        /// Eccentricity in `[0, 1)`.
+        eccentricity: f64,
+        /// Integrator.
+        integrator: IntegratorKind,
+    },
+}
+
+/// A scene that could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("{path}: cannot read scene file: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML or does not match the scene format.
+    #[error("{path}:{line}:{column}: {message}")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A value is out of its valid range.
+    #[error("{path}: field `{field}`: {message}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// Dotted field path, e.g. `run.dt`.
+        field: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// The scenes built into the binary: `(name, description, TOML text)`.
+pub const BUILTIN: [(&str, &str, &str); 2] = [
+    ("kepler", "a planet on an e = 0.5 ellipse, velocity Verlet, about 3 orbits", KEPLER),
+    ("oscillator", "a lightly damped harmonic oscillator, implicit midpoint", OSCILLATOR),
+];
+
+/// The scene run when no scene is named.
+pub const DEFAULT_SCENE: &str = "kepler";
+
+const KEPLER: &str = r#"name = "kepler"
+
+[run]
+dt = 0.005
+frames = 400
+steps_per_frame = 10
+
+[scene]
+kind = "kepler-orbit"
+eccentricity = 0.5
+integrator = "velocity-verlet"
+"#;
+
+const OSCILLATOR: &str = r#"name = "oscillator"
+
+[run]
+dt = 0.01
+frames = 500
+steps_per_frame = 2
+
+[scene]
+kind = "harmonic-oscillator"
+mass = 1.0
+stiffness = 40.0
+damping = 0.2
+x0 = 1.0
+v0 = 0.0
+integrator = "implicit-midpoint"
+"#;
+
+/// Parses scene text; `path` names the source in errors.
+///
+/// # Errors
+/// [`SceneError::Parse`] with line and column, or [`SceneError::Invalid`] naming the field.
+pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
+    let scene: SceneFile = toml::from_str(text).map_err(|e| {
+        let start = e.span().map_or(0, |s| s.start);
+        // Fields of tagged tables are reported at the table's start; point at the field itself.
+        let start = unknown_field(e.message())
+            .and_then(|name| field_offset(text, start, name))
+            .unwrap_or(start);
+        let (line, column) = line_col(text, start);
+        SceneError::Parse { path: path.to_path_buf(), line, column, message: e.message().trim().to_string() }
+    })?;
+    validate(&scene).map_err(|(field, message)| SceneError::Invalid { path: path.to_path_buf(), field, message })?;
+    Ok(scene)
+}
+
+/// Loads a scene file from disk.
+///
+/// # Errors
+/// [`SceneError`] naming the file.
+pub fn load(path: &Path) -> Result<SceneFile, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    parse(&text, path)
+}
+
+/// Looks up a built-in scene by name.
+#[must_use]
+pub fn builtin(name: &str) -> Option<&'static str> {
+    BUILTIN.iter().find(|(n, _, _)| *n == name).map(|(_, _, text)| *text)
+}
+
+/// The name in serde's "unknown field `NAME`" message.
+fn unknown_field(message: &str) -> Option<&str> {
+    let rest = message.split_once("unknown field `")?.1;
+    Some(rest.split_once('`')?.0)
+}
+
+/// Byte offset of the first line at or after `from` that assigns `name`.
+fn field_offset(text: &str, from: usize, name: &str) -> Option<usize> {
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        let trimmed = line.trim_start();
+        if offset >= from.saturating_sub(line.len())
+            && trimmed.strip_prefix(name).is_some_and(|r| r.trim_start().starts_with('='))
+        {
+            return Some(offset + (line.len() - trimmed.len()));
+        }
+        offset += line.len();
+    }
+    None
+}
+
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+fn positive(field: &'static str, x: f64) -> Result<(), (&'static str, String)> {
+    if x > 0.0 && x.is_finite() { Ok(()) } else { Err((field, format!("must be a positive finite number, got {x}"))) }
+}
+
+fn finite(field: &'static str, x: f64) -> Result<(), (&'static str, String)> {
+    if x.is_finite() { Ok(()) } else { Err((field, format!("must be finite, got {x}"))) }
+}
+
+fn validate(s: &SceneFile) -> Result<(), (&'static str, String)> {
+    if s.name.is_empty() || s.name.contains(['/', '\\']) || s.name.starts_with('.') {
+        return Err(("name", format!("must be a plain non-empty name (used as a folder), got {:?}", s.name)));
+    }
+    positive("run.dt", s.run.dt)?;
+    if s.run.frames == 0 {
+        return Err(("run.frames", "must be at least 1".into()));
+    }
+    if s.run.steps_per_frame == 0 {
+        return Err(("run.steps_per_frame", "must be at least 1".into()));
+    }
+    let integrator = match &s.scene {
+        Scene::HarmonicOscillator { mass, stiffness, damping, x0, v0, integrator } => {
+            positive("scene.mass", *mass)?;
+            positive("scene.stiffness", *stiffness)?;
+            if !(damping.is_finite() && *damping >= 0.0) {
+                return Err(("scene.damping", format!("must be a non-negative finite number, got {damping}")));
+            }
+            finite("scene.x0", *x0)?;
+            finite("scene.v0", *v0)?;
+            integrator
+        }
+        Scene::KeplerOrbit { eccentricity, integrator } => {
+            if !(0.0..1.0).contains(eccentricity) {
+                return Err(("scene.eccentricity", format!("must lie in [0, 1), got {eccentricity}")));
+            }
+            integrator
+        }
+    };
+    integrator.validate().map_err(|m| ("scene.integrator", m))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(text: &str) -> String {
+        parse(text, Path::new("s.toml")).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn builtin_scenes_parse() {
+        for (name, _, text) in BUILTIN {
+            let s = parse(text, Path::new(name)).unwrap();
+            assert_eq!(s.name, name);
+        }
+        assert!(builtin(DEFAULT_SCENE).is_some());
+    }
+
+    #[test]
+    fn unknown_field_is_an_error_naming_file_line_and_field() {
+        let text = KEPLER.replace("eccentricity = 0.5", "eccentricity = 0.5\neccentrcity = 0.2");
+        let msg = err(&text);
+        assert!(msg.starts_with("s.toml:"), "{msg}");
+        assert!(msg.contains("eccentrcity"), "{msg}");
+        let line = text.lines().position(|l| l.starts_with("eccentrcity")).unwrap() + 1;
+        assert!(msg.contains(&format!(":{line}:")), "expected line {line}: {msg}");
+    }
+
+    #[test]
+    fn bad_values_name_their_field() {
+        let cases = [
+            (KEPLER.replace("dt = 0.005", "dt = -1.0"), "run.dt"),
+            (KEPLER.replace("frames = 400", "frames = 0"), "run.frames"),
+            (KEPLER.replace("eccentricity = 0.5", "eccentricity = 1.5"), "scene.eccentricity"),
+            (
+                KEPLER.replace("integrator = \"velocity-verlet\"", "integrator = { beta-blend = { beta = 2.0 } }"),
+                "scene.integrator",
+            ),
+            (OSCILLATOR.replace("mass = 1.0", "mass = 0.0"), "scene.mass"),
+            (OSCILLATOR.replace("damping = 0.2", "damping = -0.2"), "scene.damping"),
+            (KEPLER.replace("name = \"kepler\"", "name = \"../x\""), "name"),
+        ];
+        for (text, field) in cases {
+            let msg = err(&text);
+            assert!(msg.contains(&format!("field `{field}`")), "{field}: {msg}");
+        }
+    }
+
+    #[test]
+    fn unknown_integrator_and_wrong_types_are_parse_errors() {
+        let msg = err(&KEPLER.replace("velocity-verlet", "warp-drive"));
+        assert!(msg.contains("warp-drive") && msg.starts_with("s.toml:"), "{msg}");
+        let msg = err(&KEPLER.replace("frames = 400", "frames = \"many\""));
+        assert!(msg.starts_with("s.toml:"), "{msg}");
+    }
+
+    #[test]
+    fn missing_file_names_the_path() {
+        let msg = load(Path::new("/no/such/scene.toml")).unwrap_err().to_string();
+        assert!(msg.contains("/no/such/scene.toml"), "{msg}");
+    }
+
+    #[test]
+    fn beta_blend_table_form_parses() {
+        let text = KEPLER.replace("integrator = \"velocity-verlet\"", "integrator = { beta-blend = { beta = 0.5 } }");
+        let s = parse(&text, Path::new("s.toml")).unwrap();
+        assert!(matches!(s.scene, Scene::KeplerOrbit { integrator: IntegratorKind::BetaBlend { beta }, .. } if beta == 0.5));
+    }
+}

@@ -1,0 +1,419 @@
+//! Tests of the integrators against analytic solutions and against each other.
+
+use super::study::{advance, fit_order};
+use super::systems::{HarmonicOscillator, KeplerOrbit, LinearChain};
+use super::*;
+use crate::linalg::LinearSolverKind;
+use std::f64::consts::PI;
+
+/// Error of `(x, v)` after 1.3 periods of the unit oscillator started at (1, 0).
+///
+/// Not a whole number of periods: at whole periods symplectic Euler's O(h) error cancels (it is
+/// conjugate to a second-order method by an O(h) change of variables) and shows order 2.
+fn oscillator_error(kind: IntegratorKind, steps: usize) -> f64 {
+    let mut sys = HarmonicOscillator::new(1.0, 1.0);
+    let mut state = State::new(vec![1.0], vec![0.0]);
+    let mut integ = kind.build_with(1, NewtonParams::with_tolerance(1e-13), LinearSolverKind::Cg);
+    let t_end = 2.6 * PI;
+    advance(integ.as_mut(), &mut sys, &mut state, t_end / steps as f64, steps).unwrap();
+    let (xe, ve) = sys.exact(1.0, 0.0, t_end);
+    ((state.x[0] - xe).powi(2) + (state.v[0] - ve).powi(2)).sqrt()
+}
+
+fn theory_order(kind: IntegratorKind) -> f64 {
+    match kind {
+        IntegratorKind::PositionVerlet
+        | IntegratorKind::Leapfrog
+        | IntegratorKind::VelocityVerlet
+        | IntegratorKind::ImplicitMidpoint => 2.0,
+        IntegratorKind::Rk4 => 4.0,
+        _ => 1.0,
+    }
+}
+
+#[test]
+fn every_integrator_converges_at_its_order_on_the_oscillator() {
+    for kind in IntegratorKind::ALL {
+        let steps: &[usize] = if kind == IntegratorKind::Rk4 { &[40, 80, 160, 320] } else { &[400, 800, 1600, 3200] };
+        let dts: Vec<f64> = steps.iter().map(|&n| 2.6 * PI / n as f64).collect();
+        let errs: Vec<f64> = steps.iter().map(|&n| oscillator_error(kind, n)).collect();
+        let order = fit_order(&dts, &errs);
+        assert!(
+            (order - theory_order(kind)).abs() < 0.15,
+            "{}: measured order {order}, errors {errs:?}",
+            kind.label()
+        );
+    }
+}
+
+#[test]
+fn every_integrator_converges_at_its_order_on_the_kepler_orbit() {
+    let orbit = KeplerOrbit::ellipse(0.5);
+    for kind in IntegratorKind::ALL {
+        let steps: &[usize] =
+            if kind == IntegratorKind::Rk4 { &[400, 800, 1600, 3200] } else { &[4000, 8000, 16000, 32000] };
+        let mut dts = Vec::new();
+        let mut errs = Vec::new();
+        for &n in steps {
+            let mut sys = orbit;
+            let (x0, v0) = sys.initial();
+            let mut state = State::new(x0.to_vec(), v0.to_vec());
+            let mut integ = kind.build_with(2, NewtonParams::with_tolerance(1e-13), LinearSolverKind::Cg);
+            let t_end = 1.3 * sys.period();
+            let dt = t_end / n as f64;
+            advance(integ.as_mut(), &mut sys, &mut state, dt, n).unwrap();
+            let (xe, _) = sys.exact(t_end);
+            dts.push(dt);
+            errs.push(((state.x[0] - xe[0]).powi(2) + (state.x[1] - xe[1]).powi(2)).sqrt());
+        }
+        let order = fit_order(&dts, &errs);
+        assert!(
+            (order - theory_order(kind)).abs() < 0.15,
+            "{}: measured order {order}, errors {errs:?}",
+            kind.label()
+        );
+    }
+}
+
+#[test]
+fn kepler_exact_solution_satisfies_the_equations_of_motion() {
+    // Independent check of the reference: energy -1/2, angular momentum sqrt(1 - e^2), and the
+    // acceleration by central differences of the exact velocity equals -x / |x|^3.
+    let orbit = KeplerOrbit::ellipse(0.7);
+    for k in 0..50 {
+        let t = 0.37 * k as f64;
+        let (x, v) = orbit.exact(t);
+        assert!((orbit.energy_of(&x, &v) + 0.5).abs() < 1e-13);
+        assert!((KeplerOrbit::angular_momentum(&x, &v) - (1.0f64 - 0.49).sqrt()).abs() < 1e-13);
+        let h = 1e-5;
+        let (_, vp) = orbit.exact(t + h);
+        let (_, vm) = orbit.exact(t - h);
+        let r3 = (x[0] * x[0] + x[1] * x[1]).powf(1.5);
+        for i in 0..2 {
+            let acc = (vp[i] - vm[i]) / (2.0 * h);
+            assert!((acc + x[i] / r3).abs() < 1e-7, "t = {t}: {acc} vs {}", -x[i] / r3);
+        }
+    }
+}
+
+#[test]
+fn symplectic_methods_keep_energy_bounded_and_explicit_euler_gains_energy() {
+    let steps = 100_000;
+    let dt = 0.05;
+    for kind in IntegratorKind::ALL {
+        let mut sys = HarmonicOscillator::new(1.0, 1.0);
+        let mut state = State::new(vec![1.0], vec![0.0]);
+        let mut integ = kind.build(1);
+        let e0 = 0.5;
+        let mut max_err_first = 0.0f64;
+        let mut max_err_last = 0.0f64;
+        for i in 0..steps {
+            integ.step(&mut sys, &mut state, dt).unwrap();
+            let err = (sys.energy(state.t, &state.x, &state.v).unwrap() - e0).abs();
+            if i < steps / 10 {
+                max_err_first = max_err_first.max(err);
+            } else if i >= steps - steps / 10 {
+                max_err_last = max_err_last.max(err);
+            }
+        }
+        let label = kind.label();
+        if integ.symplectic() {
+            // Bounded: the error over the last tenth is no larger than over the first tenth.
+            assert!(max_err_last <= 1.05 * max_err_first + 1e-12, "{label}: {max_err_first} then {max_err_last}");
+            assert!(max_err_last < 0.05, "{label}: energy error {max_err_last}");
+        }
+        match kind {
+            IntegratorKind::ExplicitEuler => {
+                // (1 + h^2)^n growth: the energy is far from bounded.
+                assert!(max_err_last > 100.0 * max_err_first, "{label}: {max_err_first} then {max_err_last}")
+            }
+            IntegratorKind::BackwardEuler => assert!(state.x[0].abs() < 1e-3, "{label} must dissipate"),
+            _ => {}
+        }
+    }
+}
+
+#[test]
+fn implicit_midpoint_conserves_linear_oscillator_energy_at_large_steps() {
+    let mut sys = HarmonicOscillator::new(2.0, 50.0); // omega = 5
+    let mut state = State::new(vec![0.3], vec![-1.0]);
+    let e0 = sys.energy(0.0, &state.x, &state.v).unwrap();
+    let mut integ = IntegratorKind::ImplicitMidpoint.build_with(1, NewtonParams::default(), LinearSolverKind::Cg);
+    for _ in 0..1000 {
+        integ.step(&mut sys, &mut state, 1.0).unwrap(); // omega h = 5: far past any explicit bound
+    }
+    let e = sys.energy(0.0, &state.x, &state.v).unwrap();
+    assert!(((e - e0) / e0).abs() < 1e-10, "relative energy error {}", (e - e0) / e0);
+}
+
+#[test]
+fn linearized_beta_blend_is_the_seed_formula() {
+    // On a linear system one Newton iteration from (x0, v0) is the seed's scheme
+    // (1 + beta h^2 k / m) v1 = v0 + h f(x0) / m, x1 = x0 + h v1, in closed form.
+    let (m, k, h) = (0.5, 8.0, 0.1);
+    for beta in [0.0, 0.25, 0.5, 1.0] {
+        let mut sys = HarmonicOscillator::new(m, k);
+        let mut state = State::new(vec![0.7], vec![-0.2]);
+        let mut integ =
+            IntegratorKind::BetaBlend { beta }.build_with(1, NewtonParams::linearized(), LinearSolverKind::Cg);
+        let (x0, v0) = (state.x[0], state.v[0]);
+        integ.step(&mut sys, &mut state, h).unwrap();
+        let v1 = (v0 - h * k * x0 / m) / (1.0 + beta * h * h * k / m);
+        let x1 = x0 + h * v1;
+        assert!((state.v[0] - v1).abs() < 1e-13, "beta {beta}: {} vs {v1}", state.v[0]);
+        assert!((state.x[0] - x1).abs() < 1e-13, "beta {beta}: {} vs {x1}", state.x[0]);
+    }
+}
+
+#[test]
+fn beta_zero_is_symplectic_euler_and_beta_one_is_backward_euler() {
+    let run = |kind: IntegratorKind| {
+        let mut sys = KeplerOrbit::ellipse(0.3);
+        let (x0, v0) = sys.initial();
+        let mut state = State::new(x0.to_vec(), v0.to_vec());
+        let mut integ = kind.build_with(2, NewtonParams::with_tolerance(1e-14), LinearSolverKind::Cholesky);
+        advance(integ.as_mut(), &mut sys, &mut state, 0.01, 200).unwrap();
+        state
+    };
+    let a = run(IntegratorKind::BetaBlend { beta: 0.0 });
+    let b = run(IntegratorKind::SymplecticEuler);
+    for i in 0..2 {
+        assert!((a.x[i] - b.x[i]).abs() < 1e-14 && (a.v[i] - b.v[i]).abs() < 1e-14);
+    }
+    let c = run(IntegratorKind::BetaBlend { beta: 1.0 });
+    let d = run(IntegratorKind::BackwardEuler);
+    assert_eq!(c, d);
+}
+
+#[test]
+fn backward_euler_solves_its_nonlinear_equation() {
+    // v1 = v0 + h a(x0 + h v1) must hold to Newton tolerance on the nonlinear orbit.
+    let mut sys = KeplerOrbit::ellipse(0.6);
+    let (x0, v0) = sys.initial();
+    let mut state = State::new(x0.to_vec(), v0.to_vec());
+    let h = 0.05;
+    let mut integ = IntegratorKind::BackwardEuler.build_with(2, NewtonParams::with_tolerance(1e-13), LinearSolverKind::Cg);
+    let info = integ.step(&mut sys, &mut state, h).unwrap();
+    assert!(info.newton_iterations >= 2, "a nonlinear force needs more than one Newton iteration");
+    let mut a = [0.0; 2];
+    sys.acceleration(h, &state.x, &state.v, &mut a);
+    for i in 0..2 {
+        assert!((state.v[i] - (v0[i] + h * a[i])).abs() < 1e-12);
+        assert!((state.x[i] - (x0[i] + h * state.v[i])).abs() < 1e-15);
+    }
+}
+
+#[test]
+fn every_linear_solver_gives_the_same_implicit_step() {
+    let mut results = Vec::new();
+    for linear in LinearSolverKind::ALL {
+        let mut sys = LinearChain::new(6, 1.0, 100.0, 0.1, 9.81).with_damping(0.5);
+        let mut state = sys.rest_state();
+        let mut integ = IntegratorKind::BackwardEuler.build_with(sys.dof(), NewtonParams::with_tolerance(1e-12), linear);
+        advance(integ.as_mut(), &mut sys, &mut state, 0.02, 20).unwrap();
+        results.push((linear, state));
+    }
+    let (_, reference) = &results[results.len() - 1];
+    for (linear, state) in &results {
+        let diff = state.x.iter().zip(&reference.x).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(diff < 1e-8, "{linear:?} differs from Cholesky by {diff}");
+    }
+}
+
+#[test]
+fn fixed_degrees_of_freedom_do_not_move() {
+    for kind in IntegratorKind::ALL {
+        for linear in [LinearSolverKind::JacobiPcg, LinearSolverKind::GaussSeidel] {
+            let mut sys = LinearChain::new(4, 1.0, 50.0, 0.1, 9.81);
+            let mut state = sys.rest_state();
+            let mut integ = kind.build_with(sys.dof(), NewtonParams::default(), linear);
+            advance(integ.as_mut(), &mut sys, &mut state, 0.01, 50).unwrap();
+            assert_eq!(state.x[0], 0.0, "{}", kind.label());
+            assert_eq!(state.v[0], 0.0, "{}", kind.label());
+            assert!(state.x[3] < -0.3 - 1e-3, "{}: the free end must fall, x = {:?}", kind.label(), state.x);
+        }
+    }
+}
+
+#[test]
+fn non_finite_state_is_reported_and_the_state_kept() {
+    struct Blowup;
+    impl SecondOrderSystem for Blowup {
+        fn dof(&self) -> usize {
+            3
+        }
+        fn acceleration(&mut self, _t: f64, x: &[f64], _v: &[f64], a: &mut [f64]) {
+            a[0] = 0.0;
+            a[1] = if x[1] > 1.0 { f64::INFINITY } else { 1.0 };
+            a[2] = 0.0;
+        }
+    }
+    for kind in IntegratorKind::ALL.into_iter().filter(|k| !k.is_implicit()) {
+        let mut integ = kind.build_explicit::<Blowup>(3).unwrap();
+        let mut state = State::new(vec![0.0, 0.9, 0.0], vec![0.0, 1.0, 0.0]);
+        let mut err = None;
+        for _ in 0..100 {
+            let before = state.clone();
+            match integ.step(&mut Blowup, &mut state, 0.1) {
+                Ok(_) => {}
+                Err(e) => {
+                    assert_eq!(state, before, "{}: state changed on error", kind.label());
+                    err = Some(e);
+                    break;
+                }
+            }
+        }
+        match err {
+            Some(IntegrateError::NonFinite(nf)) => assert_eq!(nf.dof, 1, "{}", kind.label()),
+            other => panic!("{}: expected NonFinite, got {other:?}", kind.label()),
+        }
+    }
+}
+
+#[test]
+fn bad_inputs_are_errors() {
+    let mut sys = HarmonicOscillator::new(1.0, 1.0);
+    let mut integ = IntegratorKind::Rk4.build(1);
+    let mut state = State::new(vec![1.0], vec![0.0]);
+    for dt in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(matches!(integ.step(&mut sys, &mut state, dt), Err(IntegrateError::BadTimeStep { .. })));
+    }
+    let mut wrong = State::new(vec![1.0, 2.0], vec![0.0, 0.0]);
+    assert!(matches!(integ.step(&mut sys, &mut wrong, 0.1), Err(IntegrateError::DimensionMismatch { .. })));
+    assert!(IntegratorKind::BetaBlend { beta: 1.5 }.validate().is_err());
+    assert!(IntegratorKind::BetaBlend { beta: 0.5 }.validate().is_ok());
+}
+
+#[test]
+fn multistep_methods_restart_after_an_outside_change() {
+    for kind in [IntegratorKind::PositionVerlet, IntegratorKind::Leapfrog, IntegratorKind::VelocityVerlet] {
+        let mut sys = HarmonicOscillator::new(1.0, 4.0);
+        let mut state = State::new(vec![1.0], vec![0.0]);
+        let mut integ = kind.build(1);
+        advance(integ.as_mut(), &mut sys, &mut state, 0.01, 10).unwrap();
+        // Teleport: the next step must equal a fresh integrator's first step from here.
+        state.x[0] = -0.5;
+        state.v[0] = 2.0;
+        let mut fresh_state = state.clone();
+        integ.step(&mut sys, &mut state, 0.01).unwrap();
+        let mut fresh = kind.build(1);
+        fresh.step(&mut sys, &mut fresh_state, 0.01).unwrap();
+        assert_eq!(state, fresh_state, "{}", kind.label());
+    }
+}
+
+#[test]
+fn explicit_integrators_are_exact_on_constant_acceleration() {
+    // x'' = g: Verlet, leapfrog, velocity Verlet, midpoint and RK4 are exact; Euler is not.
+    struct Fall;
+    impl SecondOrderSystem for Fall {
+        fn dof(&self) -> usize {
+            1
+        }
+        fn acceleration(&mut self, _t: f64, _x: &[f64], _v: &[f64], a: &mut [f64]) {
+            a[0] = -9.81;
+        }
+    }
+    for kind in [IntegratorKind::PositionVerlet, IntegratorKind::Leapfrog, IntegratorKind::VelocityVerlet, IntegratorKind::Rk4] {
+        let mut integ = kind.build_explicit::<Fall>(1).unwrap();
+        let mut state = State::new(vec![2.0], vec![1.5]);
+        advance(integ.as_mut(), &mut Fall, &mut state, 0.1, 10).unwrap();
+        let x = 2.0 + 1.5 - 0.5 * 9.81;
+        let v = 1.5 - 9.81;
+        assert!((state.x[0] - x).abs() < 1e-12 && (state.v[0] - v).abs() < 1e-12, "{}: {state:?}", kind.label());
+    }
+}
+
+#[test]
+fn damped_oscillator_reference_matches_its_ode() {
+    for c in [0.5, 4.0, 9.0] {
+        // m = 1, k = 4: critical damping at c = 4.
+        let sys = HarmonicOscillator::damped(1.0, 4.0, c);
+        for k in 1..20 {
+            let t = 0.13 * k as f64;
+            let h = 1e-5;
+            let (x, v) = sys.exact(0.8, -0.3, t);
+            let (xp, vp) = sys.exact(0.8, -0.3, t + h);
+            let (xm, vm) = sys.exact(0.8, -0.3, t - h);
+            assert!(((xp - xm) / (2.0 * h) - v).abs() < 1e-8);
+            let acc = (vp - vm) / (2.0 * h);
+            assert!((acc - (-4.0 * x - c * v)).abs() < 1e-7, "c = {c}, t = {t}");
+        }
+    }
+}
+
+#[test]
+fn damped_oscillator_converges_with_implicit_methods() {
+    // Exercises the damping Jacobian D in the Newton matrix.
+    let sys0 = HarmonicOscillator::damped(1.0, 4.0, 0.8);
+    for (kind, order) in [(IntegratorKind::BackwardEuler, 1.0), (IntegratorKind::ImplicitMidpoint, 2.0)] {
+        let mut dts = Vec::new();
+        let mut errs = Vec::new();
+        for n in [200usize, 400, 800, 1600] {
+            let mut sys = sys0;
+            let mut state = State::new(vec![1.0], vec![0.0]);
+            let mut integ = kind.build_with(1, NewtonParams::with_tolerance(1e-13), LinearSolverKind::JacobiPcg);
+            let dt = 5.0 / n as f64;
+            advance(integ.as_mut(), &mut sys, &mut state, dt, n).unwrap();
+            let (xe, _) = sys.exact(1.0, 0.0, 5.0);
+            dts.push(dt);
+            errs.push((state.x[0] - xe).abs());
+        }
+        let measured = fit_order(&dts, &errs);
+        assert!((measured - order).abs() < 0.15, "{}: {measured}", kind.label());
+    }
+}
+
+#[test]
+fn chain_settles_to_its_analytic_equilibrium_under_backward_euler() {
+    // Backward Euler dissipates: a damped chain run long enough rests at the static solution.
+    let mut sys = LinearChain::new(10, 0.2, 400.0, 0.1, 9.81).with_damping(2.0);
+    let mut state = sys.rest_state();
+    let mut integ = IntegratorKind::BackwardEuler.build_with(10, NewtonParams::default(), LinearSolverKind::Cholesky);
+    advance(integ.as_mut(), &mut sys, &mut state, 0.05, 4000).unwrap();
+    let eq = sys.equilibrium();
+    for i in 0..10 {
+        assert!((state.x[i] - eq[i]).abs() < 1e-9, "mass {i}: {} vs {}", state.x[i], eq[i]);
+    }
+    // The bottom spring carries one weight: stretch m g / k.
+    assert!(((eq[8] - eq[9]) - (0.1 + 0.2 * 9.81 / 400.0)).abs() < 1e-15);
+}
+
+#[test]
+fn chain_jacobian_matches_finite_differences_and_its_assembly() {
+    let mut sys = LinearChain::new(5, 1.0, 30.0, 0.1, 9.81).with_damping(0.7);
+    let x: Vec<f64> = (0..5).map(|i| -0.11 * i as f64 + 0.01 * (i * i) as f64).collect();
+    let v: Vec<f64> = (0..5).map(|i| 0.3 - 0.1 * i as f64).collect();
+    sys.linearize(0.0, &x, &v);
+    let mut assembled = crate::linalg::CsrMatrix::default();
+    assert!(sys.jacobian_assemble(1.0, 0.0, &mut assembled));
+    let h = 1e-6;
+    for j in 0..5 {
+        let mut e = vec![0.0; 5];
+        e[j] = 1.0;
+        let mut jk = vec![0.0; 5];
+        sys.jacobian_apply(1.0, 0.0, &e, &mut jk);
+        let (mut xp, mut xm) = (x.clone(), x.clone());
+        xp[j] += h;
+        xm[j] -= h;
+        let (mut fp, mut fm) = (vec![0.0; 5], vec![0.0; 5]);
+        sys.force(0.0, &xp, &v, &mut fp);
+        sys.force(0.0, &xm, &v, &mut fm);
+        for i in 0..5 {
+            let fd = (fp[i] - fm[i]) / (2.0 * h);
+            assert!((fd - jk[i]).abs() < 1e-6, "K[{i}][{j}]: fd {fd}, apply {}", jk[i]);
+            assert!((assembled.get(i, j).unwrap_or(0.0) - jk[i]).abs() < 1e-15);
+        }
+        // Damping Jacobian by finite differences in v.
+        let mut jd = vec![0.0; 5];
+        sys.jacobian_apply(0.0, 1.0, &e, &mut jd);
+        let (mut vp, mut vm) = (v.clone(), v.clone());
+        vp[j] += h;
+        vm[j] -= h;
+        sys.force(0.0, &x, &vp, &mut fp);
+        sys.force(0.0, &x, &vm, &mut fm);
+        for i in 0..5 {
+            assert!(((fp[i] - fm[i]) / (2.0 * h) - jd[i]).abs() < 1e-6);
+        }
+    }
+}

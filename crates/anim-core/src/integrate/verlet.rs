@@ -1,0 +1,258 @@
+//! The Verlet family (seed 2.2): position (Stormer) Verlet, leapfrog and velocity Verlet.
+//!
+//! All three are second order and symplectic, and on a force that depends only on position
+//! they produce the same trajectory up to rounding: they differ in what they store between
+//! steps. Position Verlet keeps the previous position, leapfrog the staggered half-step velocity,
+//! velocity Verlet the acceleration at the current position. Each reports a velocity synchronised
+//! with the position (second-order accurate) in [`State::v`].
+//!
+//! For velocity-dependent forces (damping) the acceleration is evaluated with the best velocity
+//! available at that point (the half-step velocity), which keeps the methods second order in the
+//! conservative part and first order in the damping.
+
+use super::{
+    History, IntegrateError, Integrator, SecondOrderSystem, State, StepInfo, apply, check_inputs, commit,
+    fit, validate,
+};
+use serde::{Deserialize, Serialize};
+
+/// Position (Stormer) Verlet: `x1 = 2 x0 - x_-1 + h^2 a(x0)`.
+///
+/// The first step (or the first after the state was changed from outside) starts with the Taylor
+/// step `x1 = x0 + h v0 + h^2/2 a(x0)`. The reported velocity is
+/// `v1 = (x1 - x0) / h + h/2 a(x0)`, second order accurate at `t1` without another force
+/// evaluation.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct PositionVerlet {
+    steps: u64,
+    x_prev: Vec<f64>,
+    history: History,
+    #[serde(skip)]
+    a: Vec<f64>,
+    #[serde(skip)]
+    x_new: Vec<f64>,
+    #[serde(skip)]
+    v_new: Vec<f64>,
+}
+
+impl PositionVerlet {
+    /// An integrator with scratch for `dof` degrees of freedom.
+    #[must_use]
+    pub fn new(dof: usize) -> Self {
+        Self {
+            steps: 0,
+            x_prev: vec![0.0; dof],
+            history: History::default(),
+            a: vec![0.0; dof],
+            x_new: vec![0.0; dof],
+            v_new: vec![0.0; dof],
+        }
+    }
+}
+
+impl<S: SecondOrderSystem + ?Sized> Integrator<S> for PositionVerlet {
+    fn name(&self) -> &'static str {
+        "position-verlet"
+    }
+
+    fn step(&mut self, system: &mut S, state: &mut State, dt: f64) -> Result<StepInfo, IntegrateError> {
+        let n = system.dof();
+        check_inputs(n, state, dt)?;
+        fit(&mut self.a, n);
+        fit(&mut self.x_new, n);
+        fit(&mut self.v_new, n);
+        fit(&mut self.x_prev, n);
+        system.acceleration(state.t, &state.x, &state.v, &mut self.a);
+        let h2 = dt * dt;
+        if self.history.matches(state) {
+            for i in 0..n {
+                self.x_new[i] = 2.0 * state.x[i] - self.x_prev[i] + h2 * self.a[i];
+            }
+        } else {
+            for i in 0..n {
+                self.x_new[i] = state.x[i] + dt * state.v[i] + 0.5 * h2 * self.a[i];
+            }
+        }
+        for i in 0..n {
+            self.v_new[i] = (self.x_new[i] - state.x[i]) / dt + 0.5 * dt * self.a[i];
+        }
+        // x_prev takes x0 only once the new state is known to be finite.
+        validate(self.steps, state, &self.x_new, &self.v_new)?;
+        self.x_prev.copy_from_slice(&state.x);
+        apply(state, &self.x_new, &self.v_new, dt);
+        self.history.record(state);
+        self.steps += 1;
+        Ok(StepInfo { evaluations: 1, ..StepInfo::default() })
+    }
+
+    fn reset(&mut self) {
+        self.history.clear();
+    }
+
+    fn order(&self) -> u32 {
+        2
+    }
+
+    fn symplectic(&self) -> bool {
+        true
+    }
+}
+
+/// Leapfrog: `v_{n+1/2} = v_{n-1/2} + h a(x_n)`, `x_{n+1} = x_n + h v_{n+1/2}` (seed 2.2).
+///
+/// Keeps the staggered velocity between steps; the first step (or the first after an outside
+/// change of the state) starts it with a half kick `v_{1/2} = v_0 + h/2 a(x_0)`. The reported
+/// velocity is synchronised: `v_{n+1} = v_{n+1/2} + h/2 a(x_{n+1})`, computed from the same
+/// force evaluation that the next kick uses, so a step costs one evaluation.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct Leapfrog {
+    steps: u64,
+    v_half: Vec<f64>,
+    history: History,
+    #[serde(skip)]
+    a: Vec<f64>,
+    #[serde(skip)]
+    x_new: Vec<f64>,
+    #[serde(skip)]
+    v_new: Vec<f64>,
+    #[serde(skip)]
+    v_half_new: Vec<f64>,
+}
+
+impl Leapfrog {
+    /// An integrator with scratch for `dof` degrees of freedom.
+    #[must_use]
+    pub fn new(dof: usize) -> Self {
+        let z = || vec![0.0; dof];
+        Self {
+            steps: 0,
+            v_half: z(),
+            history: History::default(),
+            a: z(),
+            x_new: z(),
+            v_new: z(),
+            v_half_new: z(),
+        }
+    }
+}
+
+impl<S: SecondOrderSystem + ?Sized> Integrator<S> for Leapfrog {
+    fn name(&self) -> &'static str {
+        "leapfrog"
+    }
+
+    fn step(&mut self, system: &mut S, state: &mut State, dt: f64) -> Result<StepInfo, IntegrateError> {
+        let n = system.dof();
+        check_inputs(n, state, dt)?;
+        for b in [&mut self.a, &mut self.x_new, &mut self.v_new, &mut self.v_half, &mut self.v_half_new] {
+            fit(b, n);
+        }
+        let mut evaluations = 0;
+        if !self.history.matches(state) {
+            system.acceleration(state.t, &state.x, &state.v, &mut self.a);
+            evaluations += 1;
+            for i in 0..n {
+                self.v_half[i] = state.v[i] + 0.5 * dt * self.a[i];
+            }
+        }
+        for i in 0..n {
+            self.x_new[i] = state.x[i] + dt * self.v_half[i];
+        }
+        system.acceleration(state.t + dt, &self.x_new, &self.v_half, &mut self.a);
+        evaluations += 1;
+        for i in 0..n {
+            self.v_new[i] = self.v_half[i] + 0.5 * dt * self.a[i];
+            self.v_half_new[i] = self.v_half[i] + dt * self.a[i];
+        }
+        commit(self.steps, state, &self.x_new, &self.v_new, dt)?;
+        std::mem::swap(&mut self.v_half, &mut self.v_half_new);
+        self.history.record(state);
+        self.steps += 1;
+        Ok(StepInfo { evaluations, ..StepInfo::default() })
+    }
+
+    fn reset(&mut self) {
+        self.history.clear();
+    }
+
+    fn order(&self) -> u32 {
+        2
+    }
+
+    fn symplectic(&self) -> bool {
+        true
+    }
+}
+
+/// Velocity Verlet (seed 2.2): `v_{1/2} = v0 + h/2 a(x0)`, `x1 = x0 + h v_{1/2}`,
+/// `v1 = v_{1/2} + h/2 a(x1)`.
+///
+/// Keeps `a(x1)` for the next step's first half kick, so a step costs one evaluation (two on
+/// the first step or after an outside change of the state).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct VelocityVerlet {
+    steps: u64,
+    a: Vec<f64>,
+    history: History,
+    #[serde(skip)]
+    a_new: Vec<f64>,
+    #[serde(skip)]
+    x_new: Vec<f64>,
+    #[serde(skip)]
+    v_new: Vec<f64>,
+}
+
+impl VelocityVerlet {
+    /// An integrator with scratch for `dof` degrees of freedom.
+    #[must_use]
+    pub fn new(dof: usize) -> Self {
+        let z = || vec![0.0; dof];
+        Self { steps: 0, a: z(), history: History::default(), a_new: z(), x_new: z(), v_new: z() }
+    }
+}
+
+impl<S: SecondOrderSystem + ?Sized> Integrator<S> for VelocityVerlet {
+    fn name(&self) -> &'static str {
+        "velocity-verlet"
+    }
+
+    fn step(&mut self, system: &mut S, state: &mut State, dt: f64) -> Result<StepInfo, IntegrateError> {
+        let n = system.dof();
+        check_inputs(n, state, dt)?;
+        for b in [&mut self.a, &mut self.a_new, &mut self.x_new, &mut self.v_new] {
+            fit(b, n);
+        }
+        let mut evaluations = 0;
+        if !self.history.matches(state) {
+            system.acceleration(state.t, &state.x, &state.v, &mut self.a);
+            evaluations += 1;
+        }
+        // v_new holds the half-step velocity until the second kick.
+        for i in 0..n {
+            self.v_new[i] = state.v[i] + 0.5 * dt * self.a[i];
+            self.x_new[i] = state.x[i] + dt * self.v_new[i];
+        }
+        system.acceleration(state.t + dt, &self.x_new, &self.v_new, &mut self.a_new);
+        evaluations += 1;
+        for i in 0..n {
+            self.v_new[i] += 0.5 * dt * self.a_new[i];
+        }
+        commit(self.steps, state, &self.x_new, &self.v_new, dt)?;
+        std::mem::swap(&mut self.a, &mut self.a_new);
+        self.history.record(state);
+        self.steps += 1;
+        Ok(StepInfo { evaluations, ..StepInfo::default() })
+    }
+
+    fn reset(&mut self) {
+        self.history.clear();
+    }
+
+    fn order(&self) -> u32 {
+        2
+    }
+
+    fn symplectic(&self) -> bool {
+        true
+    }
+}

@@ -1,0 +1,3 @@
+//! Cases per crate. Each module registers its conformance checks, hard cases and studies.
+
+pub mod core;

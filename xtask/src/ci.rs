@@ -1,0 +1,57 @@
+//! `cargo xtask ci`: what CI runs, in order, stopping at the first failure.
+
+use crate::registry::Ctx;
+use crate::suites;
+use std::process::Command;
+use std::time::Instant;
+
+fn cargo(args: &[&str], env: &[(&str, &str)]) -> bool {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    eprintln!("\n== cargo {}", args.join(" "));
+    let start = Instant::now();
+    let mut cmd = Command::new(cargo);
+    cmd.args(args);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    let ok = match cmd.status() {
+        Ok(status) => status.success(),
+        Err(e) => {
+            eprintln!("could not run cargo: {e}");
+            false
+        }
+    };
+    eprintln!("== {} in {:.0} s", if ok { "ok" } else { "FAILED" }, start.elapsed().as_secs_f64());
+    ok
+}
+
+pub fn run() -> bool {
+    let start = Instant::now();
+    let steps: [(&str, &dyn Fn() -> bool); 6] = [
+        ("format", &|| cargo(&["fmt", "--all", "--", "--check"], &[])),
+        ("clippy", &|| cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"], &[])),
+        ("tests", &|| cargo(&["test", "--workspace"], &[])),
+        ("docs", &|| cargo(&["doc", "--workspace", "--no-deps"], &[("RUSTDOCFLAGS", "-D warnings")])),
+        ("conformance (quick)", &|| suites::conformance(&Ctx { quick: true }, None).passed()),
+        ("stability (quick)", &|| suites::stability(&Ctx { quick: true }, None).passed()),
+    ];
+    let mut failed = Vec::new();
+    for (name, step) in steps {
+        eprintln!("\n### {name}");
+        if !step() {
+            failed.push(name);
+            // Keep going after lint failures so one run shows every problem; stop on test failures.
+            if name == "tests" {
+                break;
+            }
+        }
+    }
+    eprintln!("\nci finished in {:.0} s", start.elapsed().as_secs_f64());
+    if failed.is_empty() {
+        eprintln!("ci: all steps passed");
+        true
+    } else {
+        eprintln!("ci: FAILED steps: {}", failed.join(", "));
+        false
+    }
+}

@@ -1,0 +1,194 @@
+//! The case registry: conformance checks, stability cases and work-precision studies.
+//!
+//! Each crate's cases live in a module of `cases/` with a `register` function; adding a crate
+//! means adding that module and one line to [`all`]. Nothing else in xtask changes.
+
+use std::time::Instant;
+
+/// Options every case receives.
+#[derive(Debug, Clone, Copy)]
+pub struct Ctx {
+    /// Smaller sweeps for CI (`--quick`).
+    pub quick: bool,
+}
+
+/// How a measured value is judged against its reference.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Judge {
+    /// Pass when `|measured - reference| <= tolerance`.
+    Near,
+    /// Pass when `measured <= tolerance` (an error that must be small; reference is informative).
+    AtMost,
+    /// Pass when `measured >= tolerance`.
+    AtLeast,
+}
+
+/// One conformance measurement with its verdict.
+#[derive(Debug, Clone)]
+pub struct Check {
+    pub crate_name: &'static str,
+    pub case: String,
+    pub metric: String,
+    pub measured: f64,
+    pub reference: f64,
+    pub tolerance: f64,
+    pub judge: Judge,
+    /// Where the reference comes from.
+    pub source: &'static str,
+}
+
+impl Check {
+    pub fn passed(&self) -> bool {
+        if !self.measured.is_finite() {
+            return false;
+        }
+        match self.judge {
+            Judge::Near => (self.measured - self.reference).abs() <= self.tolerance,
+            Judge::AtMost => self.measured <= self.tolerance,
+            Judge::AtLeast => self.measured >= self.tolerance,
+        }
+    }
+
+    pub fn rule(&self) -> String {
+        match self.judge {
+            Judge::Near => format!("|m - {}| <= {}", fmt_num(self.reference), fmt_num(self.tolerance)),
+            Judge::AtMost => format!("<= {}", fmt_num(self.tolerance)),
+            Judge::AtLeast => format!(">= {}", fmt_num(self.tolerance)),
+        }
+    }
+}
+
+/// A conformance case: one reference problem, several checks.
+pub struct ConformanceCase {
+    pub crate_name: &'static str,
+    pub name: &'static str,
+    pub run: fn(&Ctx) -> Vec<Check>,
+}
+
+/// What a hard case did.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Outcome {
+    /// Ran to the end within its bounds.
+    Stable(String),
+    /// Diverged and the divergence was detected and reported (never a silent NaN).
+    Diverged(String),
+    /// Refused up front with a clear error.
+    Rejected(String),
+}
+
+impl Outcome {
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Outcome::Stable(_) => "stable",
+            Outcome::Diverged(_) => "diverged (detected)",
+            Outcome::Rejected(_) => "rejected",
+        }
+    }
+
+    pub fn detail(&self) -> &str {
+        match self {
+            Outcome::Stable(s) | Outcome::Diverged(s) | Outcome::Rejected(s) => s,
+        }
+    }
+
+    /// Whether this outcome is of the same kind as `other`.
+    pub fn same_kind(&self, other: &Outcome) -> bool {
+        std::mem::discriminant(self) == std::mem::discriminant(other)
+    }
+}
+
+/// A named hard case with the outcome it is expected to have.
+pub struct StabilityCase {
+    pub crate_name: &'static str,
+    pub name: &'static str,
+    /// Expected outcome kind (the detail text is ignored).
+    pub expected: fn() -> Outcome,
+    pub run: fn(&Ctx) -> Outcome,
+}
+
+/// One point of a work-precision curve.
+#[derive(Debug, Clone, Copy)]
+pub struct Point {
+    /// The swept parameter (time step, resolution, iterations).
+    pub param: f64,
+    /// Median wall time of one run, seconds.
+    pub seconds: f64,
+    /// Error against the reference.
+    pub error: f64,
+}
+
+/// One method's curve.
+#[derive(Debug, Clone)]
+pub struct Series {
+    pub label: String,
+    pub points: Vec<Point>,
+}
+
+/// A work-precision study: error against wall time for several methods on one problem.
+#[derive(Debug, Clone)]
+pub struct StudyResult {
+    pub title: String,
+    /// File stem for the SVG and table.
+    pub slug: String,
+    /// What the error measures.
+    pub error_label: String,
+    /// What the swept parameter is.
+    pub param_label: String,
+    pub series: Vec<Series>,
+}
+
+pub struct Study {
+    pub crate_name: &'static str,
+    pub name: &'static str,
+    pub run: fn(&Ctx) -> StudyResult,
+}
+
+/// Everything registered.
+#[derive(Default)]
+pub struct Registry {
+    pub conformance: Vec<ConformanceCase>,
+    pub stability: Vec<StabilityCase>,
+    pub studies: Vec<Study>,
+}
+
+/// The registry of every crate's cases.
+pub fn all() -> Registry {
+    let mut r = Registry::default();
+    crate::cases::core::register(&mut r);
+    r
+}
+
+/// Median wall time of `f`, in seconds: repeats `f` in batches until each batch lasts at least
+/// `min_batch` seconds, over `batches` batches.
+pub fn median_seconds(batches: usize, min_batch: f64, mut f: impl FnMut()) -> f64 {
+    // Calibrate the repeat count on one call.
+    let start = Instant::now();
+    f();
+    let once = start.elapsed().as_secs_f64().max(1e-9);
+    let reps = ((min_batch / once).ceil() as usize).clamp(1, 1_000_000);
+    let mut times: Vec<f64> = (0..batches)
+        .map(|_| {
+            let start = Instant::now();
+            for _ in 0..reps {
+                f();
+            }
+            start.elapsed().as_secs_f64() / reps as f64
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
+}
+
+/// Formats a number compactly for tables.
+pub fn fmt_num(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else if !x.is_finite() {
+        format!("{x}")
+    } else if x.abs() >= 1e-3 && x.abs() < 1e4 {
+        let s = format!("{x:.4}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("{x:.3e}")
+    }
+}
