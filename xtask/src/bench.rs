@@ -29,7 +29,7 @@ fn parse_bencher(out: &str) -> Vec<Row> {
 
 pub fn run(filter: Option<&str>) -> bool {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let mut args = vec!["bench", "-p", "anim-benches", "--", "--output-format", "bencher"];
+    let mut args = vec!["bench", "-p", "anim-benches", "--benches", "--", "--output-format", "bencher"];
     if let Some(f) = filter {
         args.push(f);
     }

@@ -8,6 +8,7 @@
 //! | `report [--quick] [--out DIR]` | conformance, stability and work-precision studies written to `docs/report/` (Markdown + SVG) |
 //! | `ci` | what CI runs: format, clippy, tests (with doc tests), docs, quick conformance and stability |
 
+mod architecture;
 mod bench;
 mod cases;
 mod ci;
@@ -17,7 +18,8 @@ mod suites;
 
 use std::process::ExitCode;
 
-const USAGE: &str = "usage: cargo xtask <conformance|stability|bench|report|ci> [--quick] [--filter TEXT] [--out DIR]";
+const USAGE: &str =
+    "usage: cargo xtask <conformance|stability|bench|report|ci> [--quick] [--filter TEXT] [--out DIR]";
 
 #[derive(Debug, Default)]
 struct Args {

@@ -71,11 +71,21 @@ fn study_markdown(crate_name: &str, r: &StudyResult) -> String {
     let _ = writeln!(md, "![{}]({}.svg)\n", r.title, r.slug);
     let _ = writeln!(md, "Error: {}.\n", r.error_label);
     let _ = writeln!(md, "Cheapest method meeting each tolerance (measured):\n");
-    let _ = writeln!(md, "| tolerance | method | {} | wall time | error |\n| --- | --- | --- | --- | --- |", r.param_label);
+    let _ = writeln!(
+        md,
+        "| tolerance | method | {} | wall time | error |\n| --- | --- | --- | --- | --- |",
+        r.param_label
+    );
     for tol in TOLERANCES {
         match cheapest(r, tol) {
             Some((label, param, secs, err)) => {
-                let _ = writeln!(md, "| {tol:.0e} | {label} | {} | {} | {} |", fmt_num(param), seconds(secs), fmt_num(err));
+                let _ = writeln!(
+                    md,
+                    "| {tol:.0e} | {label} | {} | {} | {} |",
+                    fmt_num(param),
+                    seconds(secs),
+                    fmt_num(err)
+                );
             }
             None => {
                 let _ = writeln!(md, "| {tol:.0e} | none in the sweep | | | |");
@@ -86,7 +96,14 @@ fn study_markdown(crate_name: &str, r: &StudyResult) -> String {
     let _ = writeln!(md, "| method | {} | wall time | error |\n| --- | --- | --- | --- |", r.param_label);
     for s in &r.series {
         for p in &s.points {
-            let _ = writeln!(md, "| {} | {} | {} | {} |", s.label, fmt_num(p.param), seconds(p.seconds), fmt_num(p.error));
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} |",
+                s.label,
+                fmt_num(p.param),
+                seconds(p.seconds),
+                fmt_num(p.error)
+            );
         }
     }
     let _ = writeln!(md, "\n</details>\n");
@@ -94,7 +111,13 @@ fn study_markdown(crate_name: &str, r: &StudyResult) -> String {
 }
 
 fn seconds(s: f64) -> String {
-    if s < 1e-3 { format!("{:.2} us", s * 1e6) } else if s < 1.0 { format!("{:.2} ms", s * 1e3) } else { format!("{s:.2} s") }
+    if s < 1e-3 {
+        format!("{:.2} us", s * 1e6)
+    } else if s < 1.0 {
+        format!("{:.2} ms", s * 1e3)
+    } else {
+        format!("{s:.2} s")
+    }
 }
 
 const PALETTE: [RGBColor; 10] = [
@@ -112,7 +135,8 @@ const PALETTE: [RGBColor; 10] = [
 
 /// Log-log plot of error against wall time, one line per method.
 pub fn plot(r: &StudyResult, path: &Path) -> Result<(), Box<dyn std::error::Error>> {
-    let pts = || r.series.iter().flat_map(|s| s.points.iter()).filter(|p| p.error > 0.0 && p.error.is_finite());
+    let pts =
+        || r.series.iter().flat_map(|s| s.points.iter()).filter(|p| p.error > 0.0 && p.error.is_finite());
     let (mut tmin, mut tmax, mut emin, mut emax) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for p in pts() {
         tmin = tmin.min(p.seconds);
@@ -140,15 +164,24 @@ pub fn plot(r: &StudyResult, path: &Path) -> Result<(), Box<dyn std::error::Erro
         .draw()?;
     for (i, s) in r.series.iter().enumerate() {
         let color = PALETTE[i % PALETTE.len()];
-        let line: Vec<(f64, f64)> =
-            s.points.iter().filter(|p| p.error > 0.0 && p.error.is_finite()).map(|p| (p.seconds, p.error)).collect();
+        let line: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .filter(|p| p.error > 0.0 && p.error.is_finite())
+            .map(|p| (p.seconds, p.error))
+            .collect();
         chart
             .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))?
             .label(s.label.as_str())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
         chart.draw_series(line.into_iter().map(|p| Circle::new(p, 3, color.filled())))?;
     }
-    chart.configure_series_labels().background_style(WHITE.mix(0.9)).border_style(BLACK).position(SeriesLabelPosition::UpperRight).draw()?;
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()?;
     root.present()?;
     Ok(())
 }
@@ -167,9 +200,15 @@ mod tests {
             series: vec![
                 Series {
                     label: "slow-accurate".into(),
-                    points: vec![Point { param: 0.1, seconds: 1.0, error: 1e-7 }, Point { param: 0.2, seconds: 0.5, error: 1e-5 }],
+                    points: vec![
+                        Point { param: 0.1, seconds: 1.0, error: 1e-7 },
+                        Point { param: 0.2, seconds: 0.5, error: 1e-5 },
+                    ],
                 },
-                Series { label: "fast-rough".into(), points: vec![Point { param: 0.1, seconds: 0.01, error: 1e-3 }] },
+                Series {
+                    label: "fast-rough".into(),
+                    points: vec![Point { param: 0.1, seconds: 0.01, error: 1e-3 }],
+                },
             ],
         }
     }

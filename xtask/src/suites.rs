@@ -92,10 +92,20 @@ pub fn stability(ctx: &Ctx, filter: Option<&str>) -> StabilityRun {
 }
 
 pub fn stability_table(run: &StabilityRun) -> String {
-    let mut s = String::from("| crate | hard case | expected | outcome | detail |\n| --- | --- | --- | --- | --- |\n");
+    let mut s = String::from(
+        "| crate | hard case | expected | outcome | detail |\n| --- | --- | --- | --- | --- |\n",
+    );
     for (krate, name, expected, outcome) in &run.rows {
-        let verdict = if expected.same_kind(outcome) { outcome.kind().to_string() } else { format!("**{}** (unexpected)", outcome.kind()) };
-        s.push_str(&format!("| {krate} | {name} | {} | {verdict} | {} |\n", expected.kind(), outcome.detail().replace('|', "/")));
+        let verdict = if expected.same_kind(outcome) {
+            outcome.kind().to_string()
+        } else {
+            format!("**{}** (unexpected)", outcome.kind())
+        };
+        s.push_str(&format!(
+            "| {krate} | {name} | {} | {verdict} | {} |\n",
+            expected.kind(),
+            outcome.detail().replace('|', "/")
+        ));
     }
     s
 }

@@ -23,7 +23,11 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 #[derive(Parser)]
-#[command(name = "anim", version, about = "Physically based animation: run a scene, write its frames and metrics")]
+#[command(
+    name = "anim",
+    version,
+    about = "Physically based animation: run a scene, write its frames and metrics"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -62,7 +66,8 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
-        Command::Run { scene, out, frames, dt, quiet } => match run(scene.as_deref(), out, frames, dt, quiet) {
+        Command::Run { scene, out, frames, dt, quiet } => match run(scene.as_deref(), out, frames, dt, quiet)
+        {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("error: {e}");
@@ -81,7 +86,9 @@ fn resolve(arg: Option<&str>) -> Result<SceneFile, String> {
         return scene::load(path).map_err(|e| e.to_string());
     }
     match scene::builtin(arg) {
-        Some(text) => scene::parse(text, Path::new(&format!("<built-in scene {arg}>"))).map_err(|e| e.to_string()),
+        Some(text) => {
+            scene::parse(text, Path::new(&format!("<built-in scene {arg}>"))).map_err(|e| e.to_string())
+        }
         None => Err(format!(
             "{arg}: no such scene file, and no built-in scene of that name (built-in: {})",
             scene::BUILTIN.map(|b| b.0).join(", ")
@@ -146,7 +153,13 @@ fn build(scene: &Scene) -> Runnable {
     }
 }
 
-fn run(arg: Option<&str>, out: Option<PathBuf>, frames: Option<usize>, dt: Option<f64>, quiet: bool) -> Result<(), String> {
+fn run(
+    arg: Option<&str>,
+    out: Option<PathBuf>,
+    frames: Option<usize>,
+    dt: Option<f64>,
+    quiet: bool,
+) -> Result<(), String> {
     let mut file = resolve(arg)?;
     if let Some(f) = frames {
         if f == 0 {
@@ -161,7 +174,8 @@ fn run(arg: Option<&str>, out: Option<PathBuf>, frames: Option<usize>, dt: Optio
         file.run.dt = dt;
     }
     let out = out.unwrap_or_else(|| Path::new("anim-out").join(&file.name));
-    std::fs::create_dir_all(&out).map_err(|e| format!("{}: cannot create output folder: {e}", out.display()))?;
+    std::fs::create_dir_all(&out)
+        .map_err(|e| format!("{}: cannot create output folder: {e}", out.display()))?;
     let frames_path = out.join("frames.csv");
     let csv = std::fs::File::create(&frames_path).map_err(|e| format!("{}: {e}", frames_path.display()))?;
     let mut csv = std::io::BufWriter::new(csv);
@@ -169,7 +183,8 @@ fn run(arg: Option<&str>, out: Option<PathBuf>, frames: Option<usize>, dt: Optio
 
     let Runnable { system, mut sim, mut state, exact } = build(&file.scene);
     let n = state.dof();
-    let header: Vec<String> = (0..n).map(|i| format!("x{i}")).chain((0..n).map(|i| format!("v{i}"))).collect();
+    let header: Vec<String> =
+        (0..n).map(|i| format!("x{i}")).chain((0..n).map(|i| format!("v{i}"))).collect();
     writeln!(csv, "frame,t,{},energy,error_vs_exact", header.join(",")).map_err(io_err)?;
 
     let energy0 = sim.system_mut().energy(0.0, &state.x, &state.v);
@@ -208,7 +223,8 @@ fn run(arg: Option<&str>, out: Option<PathBuf>, frames: Option<usize>, dt: Optio
         }
         let values: Vec<String> = state.x.iter().chain(&state.v).map(|v| format!("{v:e}")).collect();
         let opt = |v: Option<f64>| v.map(|v| format!("{v:e}")).unwrap_or_default();
-        writeln!(csv, "{frame},{:e},{},{},{}", state.t, values.join(","), opt(energy), opt(err)).map_err(io_err)?;
+        writeln!(csv, "{frame},{:e},{},{},{}", state.t, values.join(","), opt(energy), opt(err))
+            .map_err(io_err)?;
         if !quiet && !bar_shown && start.elapsed() > Duration::from_secs(1) {
             bar.set_draw_target(ProgressDrawTarget::stderr());
             bar_shown = true;
@@ -252,7 +268,9 @@ fn run(arg: Option<&str>, out: Option<PathBuf>, frames: Option<usize>, dt: Optio
         println!("  wrote {} and {}", frames_path.display(), metrics_path.display());
     }
     match failure {
-        Some(e) => Err(format!("simulation diverged: {e} (frames up to the failure and metrics were written)")),
+        Some(e) => {
+            Err(format!("simulation diverged: {e} (frames up to the failure and metrics were written)"))
+        }
         None => Ok(()),
     }
 }

@@ -162,13 +162,16 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
     let scene: SceneFile = toml::from_str(text).map_err(|e| {
         let start = e.span().map_or(0, |s| s.start);
         // Fields of tagged tables are reported at the table's start; point at the field itself.
-        let start = unknown_field(e.message())
-            .and_then(|name| field_offset(text, start, name))
-            .unwrap_or(start);
+        let start =
+            unknown_field(e.message()).and_then(|name| field_offset(text, start, name)).unwrap_or(start);
         let (line, column) = line_col(text, start);
         SceneError::Parse { path: path.to_path_buf(), line, column, message: e.message().trim().to_string() }
     })?;
-    validate(&scene).map_err(|(field, message)| SceneError::Invalid { path: path.to_path_buf(), field, message })?;
+    validate(&scene).map_err(|(field, message)| SceneError::Invalid {
+        path: path.to_path_buf(),
+        field,
+        message,
+    })?;
     Ok(scene)
 }
 
@@ -177,7 +180,8 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
 /// # Errors
 /// [`SceneError`] naming the file.
 pub fn load(path: &Path) -> Result<SceneFile, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
     parse(&text, path)
 }
 
@@ -216,7 +220,11 @@ fn line_col(text: &str, offset: usize) -> (usize, usize) {
 }
 
 fn positive(field: &'static str, x: f64) -> Result<(), (&'static str, String)> {
-    if x > 0.0 && x.is_finite() { Ok(()) } else { Err((field, format!("must be a positive finite number, got {x}"))) }
+    if x > 0.0 && x.is_finite() {
+        Ok(())
+    } else {
+        Err((field, format!("must be a positive finite number, got {x}")))
+    }
 }
 
 fn finite(field: &'static str, x: f64) -> Result<(), (&'static str, String)> {
@@ -239,7 +247,10 @@ fn validate(s: &SceneFile) -> Result<(), (&'static str, String)> {
             positive("scene.mass", *mass)?;
             positive("scene.stiffness", *stiffness)?;
             if !(damping.is_finite() && *damping >= 0.0) {
-                return Err(("scene.damping", format!("must be a non-negative finite number, got {damping}")));
+                return Err((
+                    "scene.damping",
+                    format!("must be a non-negative finite number, got {damping}"),
+                ));
             }
             finite("scene.x0", *x0)?;
             finite("scene.v0", *v0)?;
@@ -289,7 +300,10 @@ mod tests {
             (KEPLER.replace("frames = 400", "frames = 0"), "run.frames"),
             (KEPLER.replace("eccentricity = 0.5", "eccentricity = 1.5"), "scene.eccentricity"),
             (
-                KEPLER.replace("integrator = \"velocity-verlet\"", "integrator = { beta-blend = { beta = 2.0 } }"),
+                KEPLER.replace(
+                    "integrator = \"velocity-verlet\"",
+                    "integrator = { beta-blend = { beta = 2.0 } }",
+                ),
                 "scene.integrator",
             ),
             (OSCILLATOR.replace("mass = 1.0", "mass = 0.0"), "scene.mass"),
@@ -318,8 +332,11 @@ mod tests {
 
     #[test]
     fn beta_blend_table_form_parses() {
-        let text = KEPLER.replace("integrator = \"velocity-verlet\"", "integrator = { beta-blend = { beta = 0.5 } }");
+        let text = KEPLER
+            .replace("integrator = \"velocity-verlet\"", "integrator = { beta-blend = { beta = 0.5 } }");
         let s = parse(&text, Path::new("s.toml")).unwrap();
-        assert!(matches!(s.scene, Scene::KeplerOrbit { integrator: IntegratorKind::BetaBlend { beta }, .. } if beta == 0.5));
+        assert!(
+            matches!(s.scene, Scene::KeplerOrbit { integrator: IntegratorKind::BetaBlend { beta }, .. } if beta == 0.5)
+        );
     }
 }

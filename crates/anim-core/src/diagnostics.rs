@@ -32,7 +32,9 @@ impl std::fmt::Display for Field {
 
 /// A non-finite value found in a state array.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-#[error("non-finite {field} at step {step}, degree of freedom {dof} (value {value}, last finite value {last_finite})")]
+#[error(
+    "non-finite {field} at step {step}, degree of freedom {dof} (value {value}, last finite value {last_finite})"
+)]
 pub struct NonFinite {
     /// The step (0-based count of completed steps before the failing one) that produced it.
     pub step: u64,
@@ -52,11 +54,7 @@ pub struct NonFinite {
 pub fn first_non_finite(values: &[f64]) -> Option<usize> {
     // A sum is cheap and vectorises; only on failure search for the index.
     let s: f64 = values.iter().fold(0.0, |acc, &v| acc + v * 0.0);
-    if s == 0.0 {
-        None
-    } else {
-        values.iter().position(|v| !v.is_finite())
-    }
+    if s == 0.0 { None } else { values.iter().position(|v| !v.is_finite()) }
 }
 
 /// Checks `new` for non-finite entries; `old` supplies the last finite value for the report.

@@ -38,3 +38,8 @@ pub mod scalar;
 pub mod solver;
 
 pub use glam;
+
+/// The code blocks of the workspace README, compiled and run as doc tests.
+#[doc = include_str!("../../../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

@@ -8,7 +8,9 @@ use crate::registry::{
 use anim_core::glam::{DMat3, DVec3, Mat3};
 use anim_core::integrate::study::{advance, fit_order};
 use anim_core::integrate::systems::{HarmonicOscillator, KeplerOrbit};
-use anim_core::integrate::{IntegrateError, Integrator, IntegratorKind, NewtonParams, SecondOrderSystem, State};
+use anim_core::integrate::{
+    IntegrateError, Integrator, IntegratorKind, NewtonParams, SecondOrderSystem, State,
+};
 use anim_core::lie::{Se3, Twist, so3};
 use anim_core::linalg::{LinearSolverKind, svd3, svd3_f32};
 use rand::{Rng, SeedableRng};
@@ -18,11 +20,31 @@ use std::f64::consts::PI;
 const CRATE: &str = "anim-core";
 
 pub fn register(r: &mut Registry) {
-    r.conformance.push(ConformanceCase { crate_name: CRATE, name: "oscillator convergence order", run: oscillator_orders });
-    r.conformance.push(ConformanceCase { crate_name: CRATE, name: "kepler convergence order", run: kepler_orders });
-    r.conformance.push(ConformanceCase { crate_name: CRATE, name: "energy behaviour over 1e5 steps", run: energy_behaviour });
-    r.conformance.push(ConformanceCase { crate_name: CRATE, name: "SO(3)/SE(3) exp-log identities", run: lie_identities });
-    r.conformance.push(ConformanceCase { crate_name: CRATE, name: "3x3 SVD reconstruction", run: svd_checks });
+    r.conformance.push(ConformanceCase {
+        crate_name: CRATE,
+        name: "oscillator convergence order",
+        run: oscillator_orders,
+    });
+    r.conformance.push(ConformanceCase {
+        crate_name: CRATE,
+        name: "kepler convergence order",
+        run: kepler_orders,
+    });
+    r.conformance.push(ConformanceCase {
+        crate_name: CRATE,
+        name: "energy behaviour over 1e5 steps",
+        run: energy_behaviour,
+    });
+    r.conformance.push(ConformanceCase {
+        crate_name: CRATE,
+        name: "SO(3)/SE(3) exp-log identities",
+        run: lie_identities,
+    });
+    r.conformance.push(ConformanceCase {
+        crate_name: CRATE,
+        name: "3x3 SVD reconstruction",
+        run: svd_checks,
+    });
 
     r.stability.push(StabilityCase {
         crate_name: CRATE,
@@ -79,7 +101,11 @@ pub fn register(r: &mut Registry) {
         run: |_| zero_dt(),
     });
 
-    r.studies.push(Study { crate_name: CRATE, name: "integrators on the harmonic oscillator", run: oscillator_study });
+    r.studies.push(Study {
+        crate_name: CRATE,
+        name: "integrators on the harmonic oscillator",
+        run: oscillator_study,
+    });
     r.studies.push(Study { crate_name: CRATE, name: "integrators on the Kepler orbit", run: kepler_study });
 }
 
@@ -144,7 +170,10 @@ fn order_checks(
             Check {
                 crate_name: CRATE,
                 case: format!("{case} / {}", kind.label()),
-                metric: format!("order (error {} at finest dt)", crate::registry::fmt_num(*errs.last().unwrap_or(&f64::NAN))),
+                metric: format!(
+                    "order (error {} at finest dt)",
+                    crate::registry::fmt_num(*errs.last().unwrap_or(&f64::NAN))
+                ),
                 measured: fit_order(&dts, &errs),
                 reference: theory_order(kind),
                 tolerance: 0.15,
@@ -182,7 +211,13 @@ fn kepler_orders(ctx: &Ctx) -> Vec<Check> {
 }
 
 /// Max |E - E0| over the first and the last tenth of a long run.
-fn energy_window(kind: IntegratorKind, sys: &mut (dyn MechanicalDyn + 'static), mut state: State, dt: f64, steps: usize) -> (f64, f64) {
+fn energy_window(
+    kind: IntegratorKind,
+    sys: &mut (dyn MechanicalDyn + 'static),
+    mut state: State,
+    dt: f64,
+    steps: usize,
+) -> (f64, f64) {
     let mut integ = build(kind, state.dof());
     let e0 = sys.energy(0.0, &state.x, &state.v).unwrap_or(f64::NAN);
     let (mut first, mut last) = (0.0f64, 0.0f64);
@@ -219,7 +254,10 @@ fn energy_behaviour(_ctx: &Ctx) -> Vec<Check> {
             checks.push(Check {
                 crate_name: CRATE,
                 case: format!("oscillator energy, dt = 0.05 / {}", kind.label()),
-                metric: format!("max |dE| last tenth / first tenth (max |dE| = {})", crate::registry::fmt_num(last)),
+                metric: format!(
+                    "max |dE| last tenth / first tenth (max |dE| = {})",
+                    crate::registry::fmt_num(last)
+                ),
                 measured: last / first,
                 reference: 1.0,
                 tolerance: 1.05,
@@ -239,15 +277,25 @@ fn energy_behaviour(_ctx: &Ctx) -> Vec<Check> {
             });
         }
     }
-    for kind in [IntegratorKind::SymplecticEuler, IntegratorKind::VelocityVerlet, IntegratorKind::ImplicitMidpoint] {
+    for kind in
+        [IntegratorKind::SymplecticEuler, IntegratorKind::VelocityVerlet, IntegratorKind::ImplicitMidpoint]
+    {
         let orbit = KeplerOrbit::ellipse(0.5);
         let (x0, v0) = orbit.initial();
-        let (first, last) =
-            energy_window(kind, &mut orbit.clone(), State::new(x0.to_vec(), v0.to_vec()), 2.0 * PI / 2000.0, steps);
+        let (first, last) = energy_window(
+            kind,
+            &mut orbit.clone(),
+            State::new(x0.to_vec(), v0.to_vec()),
+            2.0 * PI / 2000.0,
+            steps,
+        );
         checks.push(Check {
             crate_name: CRATE,
             case: format!("kepler energy, 50 orbits / {}", kind.label()),
-            metric: format!("max |dE| last tenth / first tenth (max |dE| = {})", crate::registry::fmt_num(last)),
+            metric: format!(
+                "max |dE| last tenth / first tenth (max |dE| = {})",
+                crate::registry::fmt_num(last)
+            ),
             measured: last / first,
             reference: 1.0,
             tolerance: 1.05,
@@ -260,7 +308,8 @@ fn energy_behaviour(_ctx: &Ctx) -> Vec<Check> {
 
 fn random_unit(rng: &mut ChaCha8Rng) -> DVec3 {
     loop {
-        let v = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        let v =
+            DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
         let n = v.length();
         if n > 1e-3 && n <= 1.0 {
             return v / n;
@@ -285,12 +334,21 @@ fn lie_identities(_ctx: &Ctx) -> Vec<Check> {
         if w.length() < PI - 1e-6 {
             log_exp = log_exp.max((so3::log(r) - w).length());
         }
-        let xi = Twist::new(DVec3::new(rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0)), w);
+        let xi = Twist::new(
+            DVec3::new(rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0)),
+            w,
+        );
         let back = Se3::exp(xi).log();
         se3_round = se3_round.max((back.v - xi.v).length().max((back.w - xi.w).length()));
     }
     let mut edge = 0.0f64;
-    let axes = [DVec3::X, DVec3::Y, DVec3::Z, DVec3::new(1.0, 1.0, 0.0).normalize(), DVec3::new(1.0, -2.0, 3.0).normalize()];
+    let axes = [
+        DVec3::X,
+        DVec3::Y,
+        DVec3::Z,
+        DVec3::new(1.0, 1.0, 0.0).normalize(),
+        DVec3::new(1.0, -2.0, 3.0).normalize(),
+    ];
     for axis in axes {
         for angle in [0.0, 1e-12, 1e-9, 1e-6, 1.0, PI - 1e-6, PI - 1e-9, PI] {
             let r = so3::exp(axis * angle);
@@ -309,7 +367,11 @@ fn lie_identities(_ctx: &Ctx) -> Vec<Check> {
     };
     vec![
         mk("SO(3) exp(log R) = R, 1e5 random", "max Frobenius error", exp_log),
-        mk("SO(3) exp(log R) = R, angles 0, 1e-12, 1e-9, 1e-6, pi-1e-6, pi-1e-9, pi", "max Frobenius error", edge),
+        mk(
+            "SO(3) exp(log R) = R, angles 0, 1e-12, 1e-9, 1e-6, pi-1e-6, pi-1e-9, pi",
+            "max Frobenius error",
+            edge,
+        ),
         mk("SO(3) log(exp w) = w, |w| < pi, 1e5 random", "max |error|", log_exp),
         mk("SE(3) log(exp xi) = xi, 1e5 random", "max |error|", se3_round),
     ]
@@ -337,7 +399,8 @@ const CATEGORIES: [(Category, &str); 6] = [
 fn sample_matrix(rng: &mut ChaCha8Rng, cat: Category) -> DMat3 {
     let rot = |rng: &mut ChaCha8Rng| so3::exp(random_unit(rng) * rng.random_range(0.0..PI));
     let (u, v) = (rot(rng), rot(rng));
-    let mut s = DVec3::new(rng.random_range(0.1..3.0), rng.random_range(0.1..3.0), rng.random_range(0.1..3.0));
+    let mut s =
+        DVec3::new(rng.random_range(0.1..3.0), rng.random_range(0.1..3.0), rng.random_range(0.1..3.0));
     match cat {
         Category::Random => {
             return DMat3::from_cols_array(&std::array::from_fn(|_| rng.random_range(-1.0..1.0)));
@@ -373,7 +436,9 @@ fn svd_checks(_ctx: &Ctx) -> Vec<Check> {
             let s = svd3(a);
             let rec = s.u * DMat3::from_diagonal(s.sigma) * s.v.transpose();
             e64 = e64.max(frob(rec - a) / frob(a).max(1e-300));
-            orth = orth.max(frob(s.u.transpose() * s.u - DMat3::IDENTITY)).max(frob(s.v.transpose() * s.v - DMat3::IDENTITY));
+            orth = orth
+                .max(frob(s.u.transpose() * s.u - DMat3::IDENTITY))
+                .max(frob(s.v.transpose() * s.v - DMat3::IDENTITY));
             if (s.u.determinant() - 1.0).abs() > 1e-9 || (s.v.determinant() - 1.0).abs() > 1e-9 {
                 bad_det += 1;
             }
@@ -457,7 +522,11 @@ fn stability_bound(kind: IntegratorKind, theory: f64) -> Outcome {
         "max stable omega*dt = {:.4} (theory {theory:.4}, worst relative deviation {:.1e}), i.e. dt <= c sqrt(m/k) with c = {:.4}",
         c_mean, worst, c_mean
     );
-    if worst < 0.02 { Outcome::Stable(detail) } else { Outcome::Diverged(format!("bound off theory: {detail}")) }
+    if worst < 0.02 {
+        Outcome::Stable(detail)
+    } else {
+        Outcome::Diverged(format!("bound off theory: {detail}"))
+    }
 }
 
 fn nan_force() -> Outcome {

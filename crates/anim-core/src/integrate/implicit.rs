@@ -300,9 +300,9 @@ impl NewtonCore {
         } else if g0 > 0.0 {
             let mut iteration = 0;
             loop {
-                info.linear_iterations += self
-                    .solve_linear(system, solver, c_x, c_v)
-                    .map_err(|source| IntegrateError::LinearSolve { step, newton_iteration: iteration, source })?;
+                info.linear_iterations += self.solve_linear(system, solver, c_x, c_v).map_err(|source| {
+                    IntegrateError::LinearSolve { step, newton_iteration: iteration, source }
+                })?;
                 for i in 0..n {
                     self.dv[i] += self.delta[i];
                 }

@@ -305,7 +305,9 @@ impl IntegratorKind {
         linear: LinearSolverKind,
     ) -> Box<dyn Integrator<S> + Send> {
         match self {
-            IntegratorKind::BackwardEuler => Box::new(BetaBlend::new(1.0, newton, linear.build(newton.linear), dof)),
+            IntegratorKind::BackwardEuler => {
+                Box::new(BetaBlend::new(1.0, newton, linear.build(newton.linear), dof))
+            }
             IntegratorKind::BetaBlend { beta } => {
                 Box::new(BetaBlend::new(beta, newton, linear.build(newton.linear), dof))
             }
@@ -318,7 +320,10 @@ impl IntegratorKind {
 
     /// Builds an explicit integrator for any [`SecondOrderSystem`]; `None` for implicit kinds.
     #[must_use]
-    pub fn build_explicit<S: SecondOrderSystem + ?Sized>(self, dof: usize) -> Option<Box<dyn Integrator<S> + Send>> {
+    pub fn build_explicit<S: SecondOrderSystem + ?Sized>(
+        self,
+        dof: usize,
+    ) -> Option<Box<dyn Integrator<S> + Send>> {
         Some(match self {
             IntegratorKind::ExplicitEuler => Box::new(ExplicitEuler::new(dof)),
             IntegratorKind::SymplecticEuler => Box::new(SymplecticEuler::new(dof)),
@@ -326,7 +331,9 @@ impl IntegratorKind {
             IntegratorKind::Leapfrog => Box::new(Leapfrog::new(dof)),
             IntegratorKind::VelocityVerlet => Box::new(VelocityVerlet::new(dof)),
             IntegratorKind::Rk4 => Box::new(Rk4::new(dof)),
-            IntegratorKind::BackwardEuler | IntegratorKind::BetaBlend { .. } | IntegratorKind::ImplicitMidpoint => {
+            IntegratorKind::BackwardEuler
+            | IntegratorKind::BetaBlend { .. }
+            | IntegratorKind::ImplicitMidpoint => {
                 return None;
             }
         })

@@ -286,7 +286,10 @@ impl LinearChain {
     #[track_caller]
     pub fn new(n: usize, mass: f64, stiffness: f64, rest_length: f64, gravity: f64) -> Self {
         assert!(n >= 2, "LinearChain needs at least 2 masses, got {n}");
-        assert!(mass > 0.0 && stiffness > 0.0 && rest_length > 0.0 && gravity >= 0.0, "LinearChain: bad parameters");
+        assert!(
+            mass > 0.0 && stiffness > 0.0 && rest_length > 0.0 && gravity >= 0.0,
+            "LinearChain: bad parameters"
+        );
         Self { n, mass, stiffness, rest_length, gravity, damping: 0.0 }
     }
 

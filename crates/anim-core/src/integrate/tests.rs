@@ -34,7 +34,8 @@ fn theory_order(kind: IntegratorKind) -> f64 {
 #[test]
 fn every_integrator_converges_at_its_order_on_the_oscillator() {
     for kind in IntegratorKind::ALL {
-        let steps: &[usize] = if kind == IntegratorKind::Rk4 { &[40, 80, 160, 320] } else { &[400, 800, 1600, 3200] };
+        let steps: &[usize] =
+            if kind == IntegratorKind::Rk4 { &[40, 80, 160, 320] } else { &[400, 800, 1600, 3200] };
         let dts: Vec<f64> = steps.iter().map(|&n| 2.6 * PI / n as f64).collect();
         let errs: Vec<f64> = steps.iter().map(|&n| oscillator_error(kind, n)).collect();
         let order = fit_order(&dts, &errs);
@@ -119,7 +120,10 @@ fn symplectic_methods_keep_energy_bounded_and_explicit_euler_gains_energy() {
         let label = kind.label();
         if integ.symplectic() {
             // Bounded: the error over the last tenth is no larger than over the first tenth.
-            assert!(max_err_last <= 1.05 * max_err_first + 1e-12, "{label}: {max_err_first} then {max_err_last}");
+            assert!(
+                max_err_last <= 1.05 * max_err_first + 1e-12,
+                "{label}: {max_err_first} then {max_err_last}"
+            );
             assert!(max_err_last < 0.05, "{label}: energy error {max_err_last}");
         }
         match kind {
@@ -138,7 +142,8 @@ fn implicit_midpoint_conserves_linear_oscillator_energy_at_large_steps() {
     let mut sys = HarmonicOscillator::new(2.0, 50.0); // omega = 5
     let mut state = State::new(vec![0.3], vec![-1.0]);
     let e0 = sys.energy(0.0, &state.x, &state.v).unwrap();
-    let mut integ = IntegratorKind::ImplicitMidpoint.build_with(1, NewtonParams::default(), LinearSolverKind::Cg);
+    let mut integ =
+        IntegratorKind::ImplicitMidpoint.build_with(1, NewtonParams::default(), LinearSolverKind::Cg);
     for _ in 0..1000 {
         integ.step(&mut sys, &mut state, 1.0).unwrap(); // omega h = 5: far past any explicit bound
     }
@@ -154,8 +159,11 @@ fn linearized_beta_blend_is_the_seed_formula() {
     for beta in [0.0, 0.25, 0.5, 1.0] {
         let mut sys = HarmonicOscillator::new(m, k);
         let mut state = State::new(vec![0.7], vec![-0.2]);
-        let mut integ =
-            IntegratorKind::BetaBlend { beta }.build_with(1, NewtonParams::linearized(), LinearSolverKind::Cg);
+        let mut integ = IntegratorKind::BetaBlend { beta }.build_with(
+            1,
+            NewtonParams::linearized(),
+            LinearSolverKind::Cg,
+        );
         let (x0, v0) = (state.x[0], state.v[0]);
         integ.step(&mut sys, &mut state, h).unwrap();
         let v1 = (v0 - h * k * x0 / m) / (1.0 + beta * h * h * k / m);
@@ -192,7 +200,11 @@ fn backward_euler_solves_its_nonlinear_equation() {
     let (x0, v0) = sys.initial();
     let mut state = State::new(x0.to_vec(), v0.to_vec());
     let h = 0.05;
-    let mut integ = IntegratorKind::BackwardEuler.build_with(2, NewtonParams::with_tolerance(1e-13), LinearSolverKind::Cg);
+    let mut integ = IntegratorKind::BackwardEuler.build_with(
+        2,
+        NewtonParams::with_tolerance(1e-13),
+        LinearSolverKind::Cg,
+    );
     let info = integ.step(&mut sys, &mut state, h).unwrap();
     assert!(info.newton_iterations >= 2, "a nonlinear force needs more than one Newton iteration");
     let mut a = [0.0; 2];
@@ -209,7 +221,8 @@ fn every_linear_solver_gives_the_same_implicit_step() {
     for linear in LinearSolverKind::ALL {
         let mut sys = LinearChain::new(6, 1.0, 100.0, 0.1, 9.81).with_damping(0.5);
         let mut state = sys.rest_state();
-        let mut integ = IntegratorKind::BackwardEuler.build_with(sys.dof(), NewtonParams::with_tolerance(1e-12), linear);
+        let mut integ =
+            IntegratorKind::BackwardEuler.build_with(sys.dof(), NewtonParams::with_tolerance(1e-12), linear);
         advance(integ.as_mut(), &mut sys, &mut state, 0.02, 20).unwrap();
         results.push((linear, state));
     }
@@ -314,13 +327,22 @@ fn explicit_integrators_are_exact_on_constant_acceleration() {
             a[0] = -9.81;
         }
     }
-    for kind in [IntegratorKind::PositionVerlet, IntegratorKind::Leapfrog, IntegratorKind::VelocityVerlet, IntegratorKind::Rk4] {
+    for kind in [
+        IntegratorKind::PositionVerlet,
+        IntegratorKind::Leapfrog,
+        IntegratorKind::VelocityVerlet,
+        IntegratorKind::Rk4,
+    ] {
         let mut integ = kind.build_explicit::<Fall>(1).unwrap();
         let mut state = State::new(vec![2.0], vec![1.5]);
         advance(integ.as_mut(), &mut Fall, &mut state, 0.1, 10).unwrap();
         let x = 2.0 + 1.5 - 0.5 * 9.81;
         let v = 1.5 - 9.81;
-        assert!((state.x[0] - x).abs() < 1e-12 && (state.v[0] - v).abs() < 1e-12, "{}: {state:?}", kind.label());
+        assert!(
+            (state.x[0] - x).abs() < 1e-12 && (state.v[0] - v).abs() < 1e-12,
+            "{}: {state:?}",
+            kind.label()
+        );
     }
 }
 
@@ -352,7 +374,8 @@ fn damped_oscillator_converges_with_implicit_methods() {
         for n in [200usize, 400, 800, 1600] {
             let mut sys = sys0;
             let mut state = State::new(vec![1.0], vec![0.0]);
-            let mut integ = kind.build_with(1, NewtonParams::with_tolerance(1e-13), LinearSolverKind::JacobiPcg);
+            let mut integ =
+                kind.build_with(1, NewtonParams::with_tolerance(1e-13), LinearSolverKind::JacobiPcg);
             let dt = 5.0 / n as f64;
             advance(integ.as_mut(), &mut sys, &mut state, dt, n).unwrap();
             let (xe, _) = sys.exact(1.0, 0.0, 5.0);
@@ -369,7 +392,8 @@ fn chain_settles_to_its_analytic_equilibrium_under_backward_euler() {
     // Backward Euler dissipates: a damped chain run long enough rests at the static solution.
     let mut sys = LinearChain::new(10, 0.2, 400.0, 0.1, 9.81).with_damping(2.0);
     let mut state = sys.rest_state();
-    let mut integ = IntegratorKind::BackwardEuler.build_with(10, NewtonParams::default(), LinearSolverKind::Cholesky);
+    let mut integ =
+        IntegratorKind::BackwardEuler.build_with(10, NewtonParams::default(), LinearSolverKind::Cholesky);
     advance(integ.as_mut(), &mut sys, &mut state, 0.05, 4000).unwrap();
     let eq = sys.equilibrium();
     for i in 0..10 {

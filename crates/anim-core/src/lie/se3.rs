@@ -84,12 +84,7 @@ impl Twist {
     #[must_use]
     pub fn hat(&self) -> DMat4 {
         let w = so3::hat(self.w);
-        DMat4::from_cols(
-            w.x_axis.extend(0.0),
-            w.y_axis.extend(0.0),
-            w.z_axis.extend(0.0),
-            self.v.extend(0.0),
-        )
+        DMat4::from_cols(w.x_axis.extend(0.0), w.y_axis.extend(0.0), w.z_axis.extend(0.0), self.v.extend(0.0))
     }
 
     /// The inverse of [`hat`](Self::hat): `v` is the top of the last column and `ω` is
@@ -115,10 +110,7 @@ impl Twist {
     #[inline]
     #[must_use]
     pub fn bracket(&self, other: Twist) -> Twist {
-        Self::new(
-            self.w.cross(other.v) - other.w.cross(self.v),
-            self.w.cross(other.w),
-        )
+        Self::new(self.w.cross(other.v) - other.w.cross(self.v), self.w.cross(other.w))
     }
 
     /// The screw of this twist (Murray, Li & Sastry, ch. 2), or `None` for the zero twist.
@@ -232,10 +224,7 @@ impl Se3 {
     #[inline]
     #[must_use]
     pub const fn new(rotation: DMat3, translation: DVec3) -> Self {
-        Self {
-            rotation,
-            translation,
-        }
+        Self { rotation, translation }
     }
 
     /// The pure rotation `q ↦ rotation q`.
@@ -286,10 +275,7 @@ impl Se3 {
     #[inline]
     #[must_use]
     pub fn compose(&self, rhs: &Se3) -> Self {
-        Self::new(
-            self.rotation * rhs.rotation,
-            self.rotation * rhs.translation + self.translation,
-        )
+        Self::new(self.rotation * rhs.rotation, self.rotation * rhs.translation + self.translation)
     }
 
     /// The image of the point `p`: `R p + t`.
@@ -548,18 +534,9 @@ mod tests {
     fn twist_arithmetic() {
         let a = Twist::new(DVec3::new(1.0, 2.0, 3.0), DVec3::new(4.0, 5.0, 6.0));
         let b = Twist::new(DVec3::new(-1.0, 0.5, 2.0), DVec3::new(0.0, -3.0, 1.0));
-        assert_eq!(
-            a + b,
-            Twist::new(DVec3::new(0.0, 2.5, 5.0), DVec3::new(4.0, 2.0, 7.0))
-        );
-        assert_eq!(
-            a - b,
-            Twist::new(DVec3::new(2.0, 1.5, 1.0), DVec3::new(4.0, 8.0, 5.0))
-        );
-        assert_eq!(
-            a * 2.0,
-            Twist::new(DVec3::new(2.0, 4.0, 6.0), DVec3::new(8.0, 10.0, 12.0))
-        );
+        assert_eq!(a + b, Twist::new(DVec3::new(0.0, 2.5, 5.0), DVec3::new(4.0, 2.0, 7.0)));
+        assert_eq!(a - b, Twist::new(DVec3::new(2.0, 1.5, 1.0), DVec3::new(4.0, 8.0, 5.0)));
+        assert_eq!(a * 2.0, Twist::new(DVec3::new(2.0, 4.0, 6.0), DVec3::new(8.0, 10.0, 12.0)));
         assert_eq!(2.0 * a, a.scale(2.0));
         assert_eq!(-a, a.scale(-1.0));
         let mut c = a;
@@ -581,8 +558,7 @@ mod tests {
             assert!(twist_err(a.bracket(b), -b.bracket(a)) <= 1e-15);
             // Jacobi identity.
             let c = random_twist(&mut rng, 3.0);
-            let jacobi =
-                a.bracket(b.bracket(c)) + b.bracket(c.bracket(a)) + c.bracket(a.bracket(b));
+            let jacobi = a.bracket(b.bracket(c)) + b.bracket(c.bracket(a)) + c.bracket(a.bracket(b));
             assert!(twist_norm(jacobi) <= 1e-13, "{jacobi:?}");
         }
     }
@@ -606,22 +582,9 @@ mod tests {
     #[test]
     fn exp_matches_matrix_exponential_reference() {
         let mut rng = ChaCha8Rng::seed_from_u64(22);
-        let mut twists: Vec<Twist> = (0..2000)
-            .map(|_| random_twist(&mut rng, 2.0 * PI))
-            .collect();
-        for theta in [
-            0.0,
-            1e-12,
-            1e-9,
-            1e-4,
-            1e-3 * (1.0 - 1e-12),
-            1e-3 * (1.0 + 1e-12),
-            PI,
-        ] {
-            twists.push(Twist::new(
-                random_vec(&mut rng, 2.0),
-                random_unit(&mut rng) * theta,
-            ));
+        let mut twists: Vec<Twist> = (0..2000).map(|_| random_twist(&mut rng, 2.0 * PI)).collect();
+        for theta in [0.0, 1e-12, 1e-9, 1e-4, 1e-3 * (1.0 - 1e-12), 1e-3 * (1.0 + 1e-12), PI] {
+            twists.push(Twist::new(random_vec(&mut rng, 2.0), random_unit(&mut rng) * theta));
         }
         let mut max_err = 0.0_f64;
         for xi in twists {
@@ -629,9 +592,7 @@ mod tests {
             max_err = max_err.max(err);
             assert!(err <= 1e-13, "{xi:?}: {err:e}");
         }
-        println!(
-            "se3 exp vs 4x4 scaling-and-squaring Taylor reference: max Frobenius error {max_err:e}"
-        );
+        println!("se3 exp vs 4x4 scaling-and-squaring Taylor reference: max Frobenius error {max_err:e}");
     }
 
     #[test]
@@ -658,14 +619,9 @@ mod tests {
     #[test]
     fn log_of_exp_reproduces_the_twist() {
         let mut rng = ChaCha8Rng::seed_from_u64(24);
-        let mut twists: Vec<Twist> = (0..10_000)
-            .map(|_| random_twist(&mut rng, PI - 1e-6))
-            .collect();
+        let mut twists: Vec<Twist> = (0..10_000).map(|_| random_twist(&mut rng, PI - 1e-6)).collect();
         for theta in [0.0, 1e-9, 1e-3, 2.0, PI - 1e-3, PI - 1e-6, PI - 1e-9] {
-            twists.push(Twist::new(
-                random_vec(&mut rng, 2.0),
-                random_unit(&mut rng) * theta,
-            ));
+            twists.push(Twist::new(random_vec(&mut rng, 2.0), random_unit(&mut rng) * theta));
         }
         let mut max_err = 0.0_f64;
         for xi in twists {
@@ -742,10 +698,7 @@ mod tests {
         }
         let t = DVec3::new(1.0, 2.0, 3.0);
         assert_eq!(Se3::from_translation(t).transform_point(DVec3::ZERO), t);
-        assert_eq!(
-            Se3::from_translation(t).transform_vector(DVec3::X),
-            DVec3::X
-        );
+        assert_eq!(Se3::from_translation(t).transform_vector(DVec3::X), DVec3::X);
         let r = so3::exp(DVec3::new(0.0, 0.0, PI / 2.0));
         assert!((Se3::from_rotation(r).transform_point(DVec3::X) - DVec3::Y).length() <= 1e-15);
     }
@@ -783,8 +736,7 @@ mod tests {
             let g = random_se3(&mut rng);
             let xi = random_twist(&mut rng, 2.0 * PI);
             let conjugated = g * Se3::exp(xi) * g.inverse();
-            let err =
-                frobenius4(conjugated.to_homogeneous() - Se3::exp(g.adjoint(xi)).to_homogeneous());
+            let err = frobenius4(conjugated.to_homogeneous() - Se3::exp(g.adjoint(xi)).to_homogeneous());
             assert!(err <= 1e-13, "g exp(ξ) g⁻¹ vs exp(Ad_g ξ): {err:e}");
             // Ad_g ξ is the twist of the matrix g ξ̂ g⁻¹.
             let m = g.to_homogeneous() * xi.hat() * g.inverse().to_homogeneous();
@@ -805,10 +757,7 @@ mod tests {
             assert!(twist_err(mat6_apply(&ad_g, xi), g.adjoint(xi)) <= 1e-13);
             let ad_gh = (g * h).adjoint_matrix();
             let product = mat6_mul(&ad_g, &h.adjoint_matrix());
-            assert!(
-                mat6_max_diff(&ad_gh, &product) <= 1e-13,
-                "Ad_gh != Ad_g Ad_h"
-            );
+            assert!(mat6_max_diff(&ad_gh, &product) <= 1e-13, "Ad_gh != Ad_g Ad_h");
             assert!(twist_err((g * h).adjoint(xi), g.adjoint(h.adjoint(xi))) <= 1e-13);
             // The inverse action.
             assert!(twist_err(g.adjoint_inv(g.adjoint(xi)), xi) <= 1e-13);
@@ -818,10 +767,7 @@ mod tests {
         let g = Se3::from_translation(DVec3::new(1.0, 0.0, 0.0));
         let m = g.adjoint_matrix();
         let xi = Twist::new(DVec3::ZERO, DVec3::Z);
-        assert_eq!(
-            mat6_apply(&m, xi),
-            Twist::new(DVec3::new(0.0, -1.0, 0.0), DVec3::Z)
-        );
+        assert_eq!(mat6_apply(&m, xi), Twist::new(DVec3::new(0.0, -1.0, 0.0), DVec3::Z));
         assert_eq!(m[3][0], 0.0);
         assert_eq!(m[0][0], 1.0);
     }
@@ -830,18 +776,13 @@ mod tests {
     fn screw_round_trips_with_twist() {
         let mut rng = ChaCha8Rng::seed_from_u64(31);
         for _ in 0..1000 {
-            let xi = Twist::new(
-                random_vec(&mut rng, 2.0),
-                random_unit(&mut rng) * rng.random_range(0.1..3.0),
-            );
+            let xi =
+                Twist::new(random_vec(&mut rng, 2.0), random_unit(&mut rng) * rng.random_range(0.1..3.0));
             let Some(screw) = xi.to_screw() else {
                 panic!("no screw for the nonzero twist {xi:?}");
             };
             assert!((screw.axis.length() - 1.0).abs() <= 1e-15);
-            assert!(
-                screw.point.dot(screw.axis).abs() <= 1e-14,
-                "point is closest to origin"
-            );
+            assert!(screw.point.dot(screw.axis).abs() <= 1e-14, "point is closest to origin");
             assert!((screw.magnitude - xi.w.length()).abs() <= 1e-15);
             assert!(twist_err(screw.to_twist(), xi) <= 1e-14);
             assert_eq!(Screw::from_twist(xi), Some(screw));
@@ -859,12 +800,7 @@ mod tests {
         // by θ translates every point of the axis by h θ along it and rotates the rest about it.
         let axis = DVec3::new(1.0, 2.0, 2.0) / 3.0;
         let point = DVec3::new(2.0, -1.0, 0.0); // point · axis = 0
-        let screw = Screw {
-            axis,
-            point,
-            pitch: 0.25,
-            magnitude: 1.0,
-        };
+        let screw = Screw { axis, point, pitch: 0.25, magnitude: 1.0 };
         let theta = 1.3;
         let g = Se3::exp_screw(screw.to_twist(), theta);
         for s in [-2.0, 0.0, 1.5] {
@@ -875,16 +811,7 @@ mod tests {
         assert!((so3::log(g.rotation) - axis * theta).length() <= 1e-14);
         // Zero pitch: the seed's v = -ω × q, a pure rotation about the line.
         let revolute = Twist::new(-axis.cross(point), axis);
-        assert!(
-            twist_err(
-                revolute,
-                Screw {
-                    pitch: 0.0,
-                    ..screw
-                }
-                .to_twist()
-            ) <= 1e-15
-        );
+        assert!(twist_err(revolute, Screw { pitch: 0.0, ..screw }.to_twist()) <= 1e-15);
     }
 
     #[test]
@@ -914,10 +841,7 @@ mod tests {
             panic!("no screw for the nonzero twist {xi:?}");
         };
         let json = serde_json::to_string(&xi)?;
-        assert!(
-            json.starts_with(r#"{"v":["#) && json.contains(r#"],"w":["#),
-            "{json}"
-        );
+        assert!(json.starts_with(r#"{"v":["#) && json.contains(r#"],"w":["#), "{json}");
         let back: Twist = serde_json::from_str(&json)?;
         assert!(twist_err(back, xi) <= 1e-15 * twist_norm(xi));
         let back: Se3 = serde_json::from_str(&serde_json::to_string(&g)?)?;

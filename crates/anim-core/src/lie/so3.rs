@@ -38,11 +38,7 @@ const LOG_SYMMETRIC_COS: f64 = -0.5;
 #[inline]
 #[must_use]
 pub fn hat(w: DVec3) -> DMat3 {
-    DMat3::from_cols(
-        DVec3::new(0.0, w.z, -w.y),
-        DVec3::new(-w.z, 0.0, w.x),
-        DVec3::new(w.y, -w.x, 0.0),
-    )
+    DMat3::from_cols(DVec3::new(0.0, w.z, -w.y), DVec3::new(-w.z, 0.0, w.x), DVec3::new(w.y, -w.x, 0.0))
 }
 
 /// The vector of the antisymmetric part of `m`: `vee(m) = w` with `hat(w) = (m - mᵀ)/2`.
@@ -53,11 +49,7 @@ pub fn hat(w: DVec3) -> DMat3 {
 #[must_use]
 pub fn vee(m: DMat3) -> DVec3 {
     // m_ij is m.col(j)[i]; w = (m_32 - m_23, m_13 - m_31, m_21 - m_12) / 2 (1-based indices).
-    0.5 * DVec3::new(
-        m.y_axis.z - m.z_axis.y,
-        m.z_axis.x - m.x_axis.z,
-        m.x_axis.y - m.y_axis.x,
-    )
+    0.5 * DVec3::new(m.y_axis.z - m.z_axis.y, m.z_axis.x - m.x_axis.z, m.x_axis.y - m.y_axis.x)
 }
 
 /// `c I + a hat(w) + b w wᵀ`, the shape shared by the exponential and both Jacobians
@@ -85,10 +77,7 @@ pub fn exp(w: DVec3) -> DMat3 {
     let theta = theta2.sqrt();
     let (a, b) = if theta < TAYLOR_ANGLE {
         // sin θ/θ and (1 - cos θ)/θ², truncation error O(θ⁶/5040) < 1e-21.
-        (
-            1.0 - theta2 / 6.0 * (1.0 - theta2 / 20.0),
-            0.5 - theta2 / 24.0 * (1.0 - theta2 / 30.0),
-        )
+        (1.0 - theta2 / 6.0 * (1.0 - theta2 / 20.0), 0.5 - theta2 / 24.0 * (1.0 - theta2 / 30.0))
     } else {
         let half_sinc = (0.5 * theta).sin() / theta;
         // 1 - cos θ = 2 sin²(θ/2) has no cancellation for small θ.
@@ -187,11 +176,7 @@ pub fn left_jacobian(w: DVec3) -> DMat3 {
     } else {
         let sin = theta.sin();
         let half_sinc = (0.5 * theta).sin() / theta;
-        (
-            sin / theta,
-            2.0 * half_sinc * half_sinc,
-            (theta - sin) / (theta2 * theta),
-        )
+        (sin / theta, 2.0 * half_sinc * half_sinc, (theta - sin) / (theta2 * theta))
     };
     identity_hat_outer(a, b, c, w)
 }
@@ -227,10 +212,7 @@ pub fn is_rotation(m: DMat3, tol: f64) -> bool {
         return false;
     }
     let gram = m.transpose() * m - DMat3::IDENTITY;
-    let max_gram = gram
-        .to_cols_array()
-        .iter()
-        .fold(0.0_f64, |acc, e| acc.max(e.abs()));
+    let max_gram = gram.to_cols_array().iter().fold(0.0_f64, |acc, e| acc.max(e.abs()));
     max_gram <= tol && (m.determinant() - 1.0).abs() <= tol
 }
 
@@ -358,14 +340,9 @@ mod tests {
             max_err = max_err.max(err);
             // The reference loses about an ulp per squaring (log2(4‖w‖) of them); glam's
             // closed form `from_axis_angle` deviates from it by the same amount.
-            assert!(
-                err <= 4e-15 * theta.max(1.0),
-                "|w| = {theta:e}: error {err:e}"
-            );
+            assert!(err <= 4e-15 * theta.max(1.0), "|w| = {theta:e}: error {err:e}");
         }
-        println!(
-            "so3::exp vs scaling-and-squaring Taylor reference: max Frobenius error {max_err:e}"
-        );
+        println!("so3::exp vs scaling-and-squaring Taylor reference: max Frobenius error {max_err:e}");
     }
 
     #[test]
@@ -437,18 +414,12 @@ mod tests {
         let mut max_err = 0.0_f64;
         for r in log_test_rotations() {
             let w = log(r);
-            assert!(
-                w.length() <= PI + 1e-15,
-                "angle out of [0, π]: {}",
-                w.length()
-            );
+            assert!(w.length() <= PI + 1e-15, "angle out of [0, π]: {}", w.length());
             let err = frobenius(exp(w) - r);
             max_err = max_err.max(err);
             assert!(err <= 1e-12, "exp(log R) != R: {err:e} for R = {r:?}");
         }
-        println!(
-            "so3 exp(log R) = R over 10^4 random + edge rotations: max Frobenius error {max_err:e}"
-        );
+        println!("so3 exp(log R) = R over 10^4 random + edge rotations: max Frobenius error {max_err:e}");
     }
 
     #[test]
@@ -493,11 +464,7 @@ mod tests {
             let r = rotation_by_pi(n);
             let w = log(r);
             assert!((w.length() - PI).abs() <= 1e-15, "|log R| = {}", w.length());
-            assert!(
-                (w.normalize().dot(n).abs() - 1.0).abs() <= 1e-15,
-                "axis {:?} vs {n:?}",
-                w.normalize()
-            );
+            assert!((w.normalize().dot(n).abs() - 1.0).abs() <= 1e-15, "axis {:?} vs {n:?}", w.normalize());
             let err = frobenius(exp(w) - r);
             assert!(err <= 1e-14, "{err:e}");
         }
@@ -520,11 +487,7 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(10);
         for theta in [0.0, 1e-12, 1e-6, 0.5, 2.0, PI - 1e-9, PI] {
             let r = exp_axis_angle(random_unit(&mut rng), theta);
-            assert!(
-                (angle(r) - theta).abs() <= 1e-15,
-                "θ = {theta}: {}",
-                angle(r)
-            );
+            assert!((angle(r) - theta).abs() <= 1e-15, "θ = {theta}: {}", angle(r));
         }
         for _ in 0..1000 {
             let theta = rng.random_range(0.0..PI);
@@ -557,15 +520,8 @@ mod tests {
     #[test]
     fn left_jacobian_matches_its_power_series() {
         let mut rng = ChaCha8Rng::seed_from_u64(12);
-        let mut magnitudes: Vec<f64> = vec![
-            0.0,
-            1e-9,
-            1e-5,
-            TAYLOR_ANGLE * (1.0 - 1e-12),
-            TAYLOR_ANGLE * (1.0 + 1e-12),
-            0.1,
-            PI,
-        ];
+        let mut magnitudes: Vec<f64> =
+            vec![0.0, 1e-9, 1e-5, TAYLOR_ANGLE * (1.0 - 1e-12), TAYLOR_ANGLE * (1.0 + 1e-12), 0.1, PI];
         magnitudes.extend((0..500).map(|_| rng.random_range(0.0..PI)));
         for &theta in &magnitudes {
             let w = random_unit(&mut rng) * theta;
@@ -577,15 +533,8 @@ mod tests {
     #[test]
     fn left_jacobian_inv_inverts_left_jacobian() {
         let mut rng = ChaCha8Rng::seed_from_u64(13);
-        let mut magnitudes: Vec<f64> = vec![
-            0.0,
-            1e-9,
-            1e-5,
-            TAYLOR_ANGLE * (1.0 - 1e-12),
-            TAYLOR_ANGLE * (1.0 + 1e-12),
-            PI,
-            6.0,
-        ];
+        let mut magnitudes: Vec<f64> =
+            vec![0.0, 1e-9, 1e-5, TAYLOR_ANGLE * (1.0 - 1e-12), TAYLOR_ANGLE * (1.0 + 1e-12), PI, 6.0];
         magnitudes.extend((0..1000).map(|_| rng.random_range(0.0..6.0)));
         let mut max_err = 0.0_f64;
         for &theta in &magnitudes {
@@ -593,10 +542,7 @@ mod tests {
             let err = frobenius(left_jacobian_inv(w) * left_jacobian(w) - DMat3::IDENTITY);
             let err2 = frobenius(left_jacobian(w) * left_jacobian_inv(w) - DMat3::IDENTITY);
             max_err = max_err.max(err).max(err2);
-            assert!(
-                err <= 1e-12 && err2 <= 1e-12,
-                "|w| = {theta}: {err:e} {err2:e}"
-            );
+            assert!(err <= 1e-12 && err2 <= 1e-12, "|w| = {theta}: {err:e} {err2:e}");
         }
         println!("so3 J_l^-1 J_l = I for |w| <= 6: max error {max_err:e}");
         // Both sides of the Taylor switch, where a wrong series coefficient would show at

@@ -41,8 +41,7 @@
 //! solves of one size do not allocate.
 
 use super::{
-    IterativeParams, LinearOperator, LinearSolver, SolveError, SolveInfo, SystemMatrix, axpy, dot,
-    norm,
+    IterativeParams, LinearOperator, LinearSolver, SolveError, SolveInfo, SystemMatrix, axpy, dot, norm,
 };
 
 /// The preconditioner `M` of [`Cg`].
@@ -240,12 +239,7 @@ impl LinearSolver for Cg {
         false
     }
 
-    fn solve(
-        &mut self,
-        a: SystemMatrix<'_>,
-        b: &[f64],
-        x: &mut [f64],
-    ) -> Result<SolveInfo, SolveError> {
+    fn solve(&mut self, a: SystemMatrix<'_>, b: &[f64], x: &mut [f64]) -> Result<SolveInfo, SolveError> {
         match a {
             SystemMatrix::Operator(op) => self.solve_operator(op, b, x),
             SystemMatrix::Csr(m) => self.solve_operator(m, b, x),
@@ -443,10 +437,7 @@ mod tests {
         let op = NoDiag(&a);
         let mut x = vec![0.0; 9];
         let mut pcg = Cg::new(Preconditioner::Jacobi, IterativeParams::default());
-        assert_eq!(
-            pcg.solve(SystemMatrix::Operator(&op), &[1.0; 9], &mut x),
-            Err(SolveError::NoDiagonal)
-        );
+        assert_eq!(pcg.solve(SystemMatrix::Operator(&op), &[1.0; 9], &mut x), Err(SolveError::NoDiagonal));
         // Plain CG does not need it.
         let mut cg = Cg::new(Preconditioner::Identity, IterativeParams::default());
         assert!(cg.solve(SystemMatrix::Operator(&op), &[1.0; 9], &mut x).is_ok());
@@ -459,24 +450,29 @@ mod tests {
         let mut b = vec![1.0; 9];
         b[4] = f64::NAN;
         let mut x = vec![0.0; 9];
-        assert_eq!(
-            cg.solve(SystemMatrix::Csr(&a), &b, &mut x),
-            Err(SolveError::NonFinite { iteration: 0 })
-        );
+        assert_eq!(cg.solve(SystemMatrix::Csr(&a), &b, &mut x), Err(SolveError::NonFinite { iteration: 0 }));
         let mut x = vec![0.0; 9];
         x[2] = f64::INFINITY;
         assert_eq!(
             cg.solve(SystemMatrix::Csr(&a), &[1.0; 9], &mut x),
             Err(SolveError::NonFinite { iteration: 0 })
         );
+        // NaN in the matrix shows in the first residual (NaN * 0 = NaN).
         let mut bad = a.clone();
         let k = bad.position(4, 5).expect("stored");
         bad.values_mut()[k] = f64::NAN;
         let mut x = vec![0.0; 9];
-        assert!(matches!(
+        assert_eq!(
             cg.solve(SystemMatrix::Csr(&bad), &[1.0; 9], &mut x),
+            Err(SolveError::NonFinite { iteration: 0 })
+        );
+        // Overflow inside the iteration: p = b, p^T A p = 2e120 * 1e200 = inf.
+        let huge = CsrMatrix::from_triplets(2, 2, &[(0, 0, 1e200), (1, 1, 1e200)]);
+        let mut x = vec![0.0; 2];
+        assert_eq!(
+            cg.solve(SystemMatrix::Csr(&huge), &[1e60, 1e60], &mut x),
             Err(SolveError::NonFinite { iteration: 1 })
-        ));
+        );
     }
 
     #[test]

@@ -69,7 +69,9 @@ pub enum CsrError {
         end: usize,
     },
     /// `row_ptr[nrows]`, `col_idx.len()` and `values.len()` disagree.
-    #[error("entry counts disagree: row_ptr[nrows] = {row_ptr_end}, col_idx has {col_idx_len}, values has {values_len}")]
+    #[error(
+        "entry counts disagree: row_ptr[nrows] = {row_ptr_end}, col_idx has {col_idx_len}, values has {values_len}"
+    )]
     LengthMismatch {
         /// `row_ptr[nrows]`.
         row_ptr_end: usize,
@@ -91,7 +93,9 @@ pub enum CsrError {
         ncols: usize,
     },
     /// Columns of a row are not strictly increasing (unsorted or duplicated).
-    #[error("entry {entry} of row {row} has column {col}, not greater than the previous column {previous} (columns must be sorted without duplicates)")]
+    #[error(
+        "entry {entry} of row {row} has column {col}, not greater than the previous column {previous} (columns must be sorted without duplicates)"
+    )]
     ColumnsNotIncreasing {
         /// Row of the entry.
         row: usize,
@@ -195,11 +199,7 @@ impl CsrMatrix {
         }
         for row in 0..nrows {
             if row_ptr[row + 1] < row_ptr[row] {
-                return Err(CsrError::RowPtrDecreasing {
-                    row,
-                    start: row_ptr[row],
-                    end: row_ptr[row + 1],
-                });
+                return Err(CsrError::RowPtrDecreasing { row, start: row_ptr[row], end: row_ptr[row + 1] });
             }
         }
         let nnz = row_ptr[nrows];
@@ -430,8 +430,7 @@ impl CsrMatrix {
     pub fn to_faer(&self) -> SparseColMat<usize, f64> {
         // The CSR arrays of A^T are the CSC arrays of A.
         let t = self.transpose();
-        let symbolic =
-            SymbolicSparseColMat::new_checked(self.nrows, self.ncols, t.row_ptr, None, t.col_idx);
+        let symbolic = SymbolicSparseColMat::new_checked(self.nrows, self.ncols, t.row_ptr, None, t.col_idx);
         SparseColMat::new(symbolic, t.values)
     }
 
@@ -509,9 +508,7 @@ mod tests {
         count: usize,
     ) -> Vec<(usize, usize, f64)> {
         (0..count)
-            .map(|_| {
-                (rng.random_range(0..nrows), rng.random_range(0..ncols), rng.random_range(-1.0..1.0))
-            })
+            .map(|_| (rng.random_range(0..nrows), rng.random_range(0..ncols), rng.random_range(-1.0..1.0)))
             .collect()
     }
 
@@ -663,16 +660,10 @@ mod tests {
             *r = s;
         }
         for threads in [1, 2, 3] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .expect("thread pool");
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool");
             let mut y = vec![0.0; n];
             pool.install(|| m.mul_vec(&x, &mut y));
-            assert!(
-                y.iter().zip(&reference).all(|(a, b)| a.to_bits() == b.to_bits()),
-                "{threads} threads"
-            );
+            assert!(y.iter().zip(&reference).all(|(a, b)| a.to_bits() == b.to_bits()), "{threads} threads");
         }
     }
 

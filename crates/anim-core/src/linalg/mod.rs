@@ -22,9 +22,10 @@ pub mod stationary;
 pub mod svd;
 
 pub use cg::{Cg, Preconditioner};
-pub use csr::CsrMatrix;
+pub use csr::{CsrError, CsrMatrix};
 pub use direct::SparseCholesky;
-pub use stationary::{GaussSeidel, Jacobi};
+pub use schur::{Eliminate, schur_complement, solve_block, solve_block_diagonal_a};
+pub use stationary::{GaussSeidel, Jacobi, gauss_seidel_sweep, jacobi_sweep};
 pub use svd::{Svd3, polar, polar_f32, svd3, svd3_f32};
 
 use serde::{Deserialize, Serialize};
@@ -117,7 +118,8 @@ pub enum SolveError {
         /// The offending curvature.
         curvature: f64,
     },
-    /// A zero or non-positive diagonal entry (Jacobi, Gauss-Seidel, preconditioner) or pivot.
+    /// An unusable diagonal entry: zero or non-finite for Jacobi and Gauss-Seidel sweeps,
+    /// non-positive (or NaN) for the Jacobi preconditioner and the sparse Cholesky solve.
     #[error("zero or non-positive pivot {value:e} at row {row}")]
     BadPivot {
         /// Row of the pivot.
@@ -143,16 +145,14 @@ pub enum SolveError {
     /// A factorisation failed (faer's error, as text).
     #[error("factorisation failed: {0}")]
     Factorization(String),
-    /// A dense block is singular to working precision: its LU factorisation met a pivot that is
-    /// zero or tiny relative to the block's largest entry (see [`schur`]).
-    #[error("{block} is singular to working precision (pivot {pivot:e} at elimination step {step})")]
+    /// A dense block is singular to working precision: its reciprocal condition number
+    /// `1 / (||X||_1 ||X^-1||_1)` is at most `k * eps` for a `k x k` block (see [`schur`]).
+    #[error("{block} is singular to working precision (reciprocal condition number {rcond:e})")]
     Singular {
         /// Which block ("A", "D", "Schur complement").
         block: &'static str,
-        /// Elimination step (row of the factored, row-permuted block) of the offending pivot.
-        step: usize,
-        /// The pivot.
-        pivot: f64,
+        /// Its reciprocal condition number in the 1-norm (0 when the inverse is not finite).
+        rcond: f64,
     },
 }
 

@@ -29,9 +29,12 @@
 //!
 //! # Singularity
 //!
-//! A matrix `X` (`k x k`) is declared singular to working precision when a pivot `u_ii` of its LU
-//! factorisation satisfies `|u_ii| <= k * eps * ||X||_max` (for a diagonal `A`: an entry
-//! `|a_i| <= n * eps * max_j |a_j|`); the result is [`SolveError::Singular`] naming the block.
+//! A `k x k` matrix `X` is declared singular to working precision when its reciprocal condition
+//! number in the 1-norm, `rcond = 1 / (||X||_1 ||X^-1||_1)`, is at most `k * eps` (or `X^-1` is
+//! not finite); the result is [`SolveError::Singular`] naming the block. `X^-1` is formed from the
+//! LU factors for this test (`2 k^3` extra flops, the same order as the factorisation); a test on
+//! the pivots alone is not reliable (an exactly singular matrix can yield LU pivots far above
+//! `k * eps * ||X||` from rounding). For a diagonal `A`, `rcond = min |a_i| / max |a_i|` exactly.
 //! Non-finite input is [`SolveError::NonFinite`]. Shape mismatches panic.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -50,36 +53,42 @@ pub enum Eliminate {
     D,
 }
 
-/// A dense LU factorisation with partial pivoting, `P X = L U`, checked for tiny pivots.
+/// A dense LU factorisation with partial pivoting, `P X = L U`, checked for singularity.
 struct DenseLu {
     lu: Mat<f64>,
     fwd: Vec<usize>,
     inv: Vec<usize>,
 }
 
+/// `max_j sum_i |x_ij|`, or NaN if an entry is not finite.
+fn norm_1(x: MatRef<'_, f64>) -> f64 {
+    let mut best = 0.0f64;
+    for j in 0..x.ncols() {
+        let mut s = 0.0;
+        for i in 0..x.nrows() {
+            s += x[(i, j)].abs();
+        }
+        if !s.is_finite() {
+            return f64::NAN;
+        }
+        best = best.max(s);
+    }
+    best
+}
+
 impl DenseLu {
     /// Factors `x`, or reports it singular (`block` names it in the error).
     fn new(x: MatRef<'_, f64>, block: &'static str) -> Result<Self, SolveError> {
         let n = x.nrows();
-        let mut max_abs = 0.0f64;
-        for j in 0..n {
-            for i in 0..n {
-                let v = x[(i, j)];
-                if !v.is_finite() {
-                    return Err(SolveError::NonFinite { iteration: 0 });
-                }
-                max_abs = max_abs.max(v.abs());
-            }
+        let x_norm = norm_1(x);
+        if !x_norm.is_finite() {
+            return Err(SolveError::NonFinite { iteration: 0 });
         }
         let mut lu = x.to_owned();
         let mut fwd = vec![0usize; n];
         let mut inv = vec![0usize; n];
-        let mut mem = MemBuffer::new(factor::lu_in_place_scratch::<usize, f64>(
-            n,
-            n,
-            Par::Seq,
-            Default::default(),
-        ));
+        let mut mem =
+            MemBuffer::new(factor::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, Default::default()));
         let _ = factor::lu_in_place(
             lu.as_mut(),
             &mut fwd,
@@ -88,14 +97,16 @@ impl DenseLu {
             MemStack::new(&mut mem),
             Default::default(),
         );
-        let threshold = n as f64 * f64::EPSILON * max_abs;
-        for k in 0..n {
-            let pivot = lu[(k, k)];
-            if !(pivot.abs() > threshold) {
-                return Err(SolveError::Singular { block, step: k, pivot });
-            }
+        let this = Self { lu, fwd, inv };
+        // Reciprocal condition number from the explicit inverse.
+        let mut x_inv = Mat::<f64>::identity(n, n);
+        this.solve_in_place(x_inv.as_mut());
+        let inv_norm = norm_1(x_inv.as_ref());
+        let rcond = if inv_norm.is_finite() && inv_norm > 0.0 { 1.0 / (x_norm * inv_norm) } else { 0.0 };
+        if !(rcond > n as f64 * f64::EPSILON) {
+            return Err(SolveError::Singular { block, rcond });
         }
-        Ok(Self { lu, fwd, inv })
+        Ok(this)
     }
 
     /// Overwrites `rhs` (n x k) with `X^-1 rhs`.
@@ -126,13 +137,28 @@ impl DenseLu {
 
 /// Checks block shapes; returns `(n, m)`.
 #[track_caller]
-fn check_blocks(a: MatRef<'_, f64>, b: MatRef<'_, f64>, c: MatRef<'_, f64>, d: MatRef<'_, f64>) -> (usize, usize) {
+fn check_blocks(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+    d: MatRef<'_, f64>,
+) -> (usize, usize) {
     let n = a.nrows();
     let m = d.nrows();
     assert_eq!(a.ncols(), n, "schur: A must be square, got {} x {}", a.nrows(), a.ncols());
     assert_eq!(d.ncols(), m, "schur: D must be square, got {} x {}", d.nrows(), d.ncols());
-    assert!(b.nrows() == n && b.ncols() == m, "schur: B must be {n} x {m}, got {} x {}", b.nrows(), b.ncols());
-    assert!(c.nrows() == m && c.ncols() == n, "schur: C must be {m} x {n}, got {} x {}", c.nrows(), c.ncols());
+    assert!(
+        b.nrows() == n && b.ncols() == m,
+        "schur: B must be {n} x {m}, got {} x {}",
+        b.nrows(),
+        b.ncols()
+    );
+    assert!(
+        c.nrows() == m && c.ncols() == n,
+        "schur: C must be {m} x {n}, got {} x {}",
+        c.nrows(),
+        c.ncols()
+    );
     (n, m)
 }
 
@@ -249,8 +275,7 @@ pub fn solve_block(
 /// `(x, y)`.
 ///
 /// # Errors
-/// [`SolveError::Singular`] when an entry of `a_diag` is zero or tiny relative to the largest
-/// (block "A"), or when `S` is singular to working precision (block "Schur complement");
+/// [`SolveError::Singular`] when `min |a_i| / max |a_i| <= n * eps` (block "A"), or when `S` is singular to working precision (block "Schur complement");
 /// [`SolveError::NonFinite`] on NaN or infinite input.
 ///
 /// # Panics
@@ -282,15 +307,17 @@ pub fn solve_block_diagonal_a(
     );
     assert_eq!(rhs_a.len(), n, "solve_block_diagonal_a: rhs_a.len() != n");
     assert_eq!(rhs_b.len(), m, "solve_block_diagonal_a: rhs_b.len() != m");
-    let all_finite = a_diag.iter().chain(rhs_a).chain(rhs_b).chain(b.values()).chain(c.values()).all(|v| v.is_finite());
+    let all_finite =
+        a_diag.iter().chain(rhs_a).chain(rhs_b).chain(b.values()).chain(c.values()).all(|v| v.is_finite());
     if !all_finite {
         return Err(SolveError::NonFinite { iteration: 0 });
     }
     let max_abs = a_diag.iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
-    let threshold = n as f64 * f64::EPSILON * max_abs;
-    for (step, &pivot) in a_diag.iter().enumerate() {
-        if !(pivot.abs() > threshold) {
-            return Err(SolveError::Singular { block: "A", step, pivot });
+    let min_abs = a_diag.iter().fold(f64::INFINITY, |acc, v| acc.min(v.abs()));
+    if n > 0 {
+        let rcond = if max_abs > 0.0 { min_abs / max_abs } else { 0.0 };
+        if !(rcond > n as f64 * f64::EPSILON) {
+            return Err(SolveError::Singular { block: "A", rcond });
         }
     }
     // S = D - C A^-1 B: row r of C times rows of B scaled by 1 / a_k.
@@ -409,8 +436,10 @@ mod tests {
         let inv = |x: &Mat<f64>| x.partial_piv_lu().solve(Mat::<f64>::identity(x.nrows(), x.nrows()));
         let sa_ref = &d - &c * inv(&a) * &b;
         let sd_ref = &a - &b * inv(&d) * &c;
-        let sa = schur_complement(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), Eliminate::A).expect("A invertible");
-        let sd = schur_complement(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), Eliminate::D).expect("D invertible");
+        let sa = schur_complement(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), Eliminate::A)
+            .expect("A invertible");
+        let sd = schur_complement(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), Eliminate::D)
+            .expect("D invertible");
         assert_eq!((sa.nrows(), sa.ncols(), sd.nrows(), sd.ncols()), (m, m, n, n));
         for i in 0..m {
             for j in 0..m {
@@ -443,26 +472,76 @@ mod tests {
             let x = random_mat(&mut rng, m, m - 1);
             let y = random_mat(&mut rng, m, m - 1);
             let d = &x * y.transpose();
-            let err = solve_block(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), &[1.0; 4], &[1.0; 3], Eliminate::D)
-                .unwrap_err();
+            let err = solve_block(
+                a.as_ref(),
+                b.as_ref(),
+                c.as_ref(),
+                d.as_ref(),
+                &[1.0; 4],
+                &[1.0; 3],
+                Eliminate::D,
+            )
+            .unwrap_err();
             assert!(matches!(err, SolveError::Singular { block: "D", .. }), "{err:?}");
         }
+        // Exactly singular blocks of several sizes: dyadic entries, so that the dependent row
+        // s * row_p + t * row_q is computed without rounding.
+        for k in [2usize, 3, 5, 10, 30] {
+            for _ in 0..50 {
+                let mut x =
+                    Mat::<f64>::from_fn(k, k, |_, _| rng.random_range(-1024i32..=1024) as f64 / 1024.0);
+                let (p, q) = (0, 1);
+                let r = k - 1; // row 1 itself when k = 2
+                let (sp, sq) =
+                    (rng.random_range(-4i32..=4) as f64 / 4.0, rng.random_range(-4i32..=4) as f64 / 4.0);
+                for j in 0..k {
+                    x[(r, j)] = if r == q { sp * x[(p, j)] } else { sp * x[(p, j)] + sq * x[(q, j)] };
+                }
+                let bk = random_mat(&mut rng, 2, k);
+                let ck = random_mat(&mut rng, k, 2);
+                let a2 = random_square(&mut rng, 2);
+                let err = schur_complement(a2.as_ref(), bk.as_ref(), ck.as_ref(), x.as_ref(), Eliminate::D)
+                    .unwrap_err();
+                assert!(matches!(err, SolveError::Singular { block: "D", .. }), "k = {k}: {err:?}");
+            }
+        }
+        // An ill-conditioned but invertible block (cond = 1e9) is accepted and solved to the
+        // accuracy its condition allows (relative error ~ cond * eps).
+        let mut ill = Mat::<f64>::identity(m, m);
+        ill[(1, 1)] = 1e-9;
+        let rb = [1.0, 1e-9, -1.0];
+        let (x_ill, y_ill) =
+            solve_block(a.as_ref(), b.as_ref(), c.as_ref(), ill.as_ref(), &[1.0; 4], &rb, Eliminate::D)
+                .expect("ill-conditioned but invertible");
+        let (xr, yr) = assembled_solve(&a, &b, &c, &ill, &[1.0; 4], &rb);
+        let scale = xr.iter().chain(&yr).fold(0.0f64, |s, v| s.max(v.abs()));
+        assert!(max_abs_diff(&x_ill, &xr).max(max_abs_diff(&y_ill, &yr)) <= 1e9 * 1e-15 * scale);
         // A zero block.
         let z = Mat::<f64>::zeros(n, n);
-        let err = solve_block(z.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), &[1.0; 4], &[1.0; 3], Eliminate::A)
-            .unwrap_err();
-        assert!(matches!(err, SolveError::Singular { block: "A", step: 0, .. }), "{err:?}");
+        let err =
+            solve_block(z.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), &[1.0; 4], &[1.0; 3], Eliminate::A)
+                .unwrap_err();
+        assert_eq!(err, SolveError::Singular { block: "A", rcond: 0.0 });
         // Invertible blocks but singular M: the complement is reported. With A = I, B = I, C = I,
         // D = I the complement D - C A^-1 B is 0.
         let i3 = Mat::<f64>::identity(3, 3);
-        let err = solve_block(i3.as_ref(), i3.as_ref(), i3.as_ref(), i3.as_ref(), &[1.0; 3], &[1.0; 3], Eliminate::A)
-            .unwrap_err();
+        let err = solve_block(
+            i3.as_ref(),
+            i3.as_ref(),
+            i3.as_ref(),
+            i3.as_ref(),
+            &[1.0; 3],
+            &[1.0; 3],
+            Eliminate::A,
+        )
+        .unwrap_err();
         assert!(matches!(err, SolveError::Singular { block: "Schur complement", .. }), "{err:?}");
         // NaN input.
         let mut nan = a.clone();
         nan[(1, 1)] = f64::NAN;
-        let err = solve_block(nan.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), &[1.0; 4], &[1.0; 3], Eliminate::A)
-            .unwrap_err();
+        let err =
+            solve_block(nan.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), &[1.0; 4], &[1.0; 3], Eliminate::A)
+                .unwrap_err();
         assert_eq!(err, SolveError::NonFinite { iteration: 0 });
     }
 
@@ -500,18 +579,28 @@ mod tests {
                     .collect();
                 CsrMatrix::from_triplets(n, m, &neg)
             };
-            let alpha = Mat::<f64>::from_fn(m, m, |i, k| if i == k { rng.random_range(1e-3..1e-1) } else { 0.0 });
+            let alpha =
+                Mat::<f64>::from_fn(m, m, |i, k| if i == k { rng.random_range(1e-3..1e-1) } else { 0.0 });
             let ra: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
             let rb: Vec<f64> = (0..m).map(|_| rng.random_range(-1.0..1.0)).collect();
-            let (x, y) = solve_block_diagonal_a(&masses, &minus_jt, &j, alpha.as_ref(), &ra, &rb).expect("solvable");
+            let (x, y) =
+                solve_block_diagonal_a(&masses, &minus_jt, &j, alpha.as_ref(), &ra, &rb).expect("solvable");
             let a_dense = Mat::<f64>::from_fn(n, n, |i, k| if i == k { masses[i] } else { 0.0 });
             let (bd, cd) = (dense_from_csr(&minus_jt), dense_from_csr(&j));
             let (xr, yr) = assembled_solve(&a_dense, &bd, &cd, &alpha, &ra, &rb);
             let scale = xr.iter().chain(&yr).fold(1.0f64, |s, v| s.max(v.abs()));
             assert!(max_abs_diff(&x, &xr) <= 1e-11 * scale, "({n}, {m}) x");
             assert!(max_abs_diff(&y, &yr) <= 1e-11 * scale, "({n}, {m}) y");
-            let (x2, y2) = solve_block(a_dense.as_ref(), bd.as_ref(), cd.as_ref(), alpha.as_ref(), &ra, &rb, Eliminate::A)
-                .expect("solvable");
+            let (x2, y2) = solve_block(
+                a_dense.as_ref(),
+                bd.as_ref(),
+                cd.as_ref(),
+                alpha.as_ref(),
+                &ra,
+                &rb,
+                Eliminate::A,
+            )
+            .expect("solvable");
             assert!(max_abs_diff(&x, &x2) <= 1e-11 * scale && max_abs_diff(&y, &y2) <= 1e-11 * scale);
         }
     }
@@ -521,11 +610,13 @@ mod tests {
         let b = CsrMatrix::from_triplets(3, 1, &[(0, 0, 1.0)]);
         let c = CsrMatrix::from_triplets(1, 3, &[(0, 0, 1.0)]);
         let d = Mat::<f64>::zeros(1, 1);
-        let err = solve_block_diagonal_a(&[1.0, 0.0, 2.0], &b, &c, d.as_ref(), &[1.0; 3], &[1.0]).unwrap_err();
-        assert_eq!(err, SolveError::Singular { block: "A", step: 1, pivot: 0.0 });
+        let err =
+            solve_block_diagonal_a(&[1.0, 0.0, 2.0], &b, &c, d.as_ref(), &[1.0; 3], &[1.0]).unwrap_err();
+        assert_eq!(err, SolveError::Singular { block: "A", rcond: 0.0 });
         // S = 0 - 1 * 1 / 1 + 1 = 0 with D = [1].
         let d1 = Mat::<f64>::from_fn(1, 1, |_, _| 1.0);
-        let err = solve_block_diagonal_a(&[1.0, 1.0, 1.0], &b, &c, d1.as_ref(), &[1.0; 3], &[1.0]).unwrap_err();
+        let err =
+            solve_block_diagonal_a(&[1.0, 1.0, 1.0], &b, &c, d1.as_ref(), &[1.0; 3], &[1.0]).unwrap_err();
         assert!(matches!(err, SolveError::Singular { block: "Schur complement", .. }), "{err:?}");
     }
 }

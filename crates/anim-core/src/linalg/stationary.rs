@@ -93,12 +93,7 @@ fn jacobi_rows(
 /// # Panics
 /// If `a` is not square or a vector length differs from its size.
 #[track_caller]
-pub fn jacobi_sweep(
-    a: &CsrMatrix,
-    b: &[f64],
-    x_old: &[f64],
-    x_new: &mut [f64],
-) -> Result<(), SolveError> {
+pub fn jacobi_sweep(a: &CsrMatrix, b: &[f64], x_old: &[f64], x_new: &mut [f64]) -> Result<(), SolveError> {
     check_shapes("jacobi_sweep", a, b, x_old);
     assert_eq!(x_new.len(), a.nrows(), "jacobi_sweep: x_new.len() != nrows");
     let bad = if a.nrows() > PARALLEL_ROW_THRESHOLD {
@@ -232,12 +227,7 @@ impl LinearSolver for Jacobi {
         true
     }
 
-    fn solve(
-        &mut self,
-        a: SystemMatrix<'_>,
-        b: &[f64],
-        x: &mut [f64],
-    ) -> Result<SolveInfo, SolveError> {
+    fn solve(&mut self, a: SystemMatrix<'_>, b: &[f64], x: &mut [f64]) -> Result<SolveInfo, SolveError> {
         if self.x_old.len() != x.len() {
             self.x_old.resize(x.len(), 0.0);
         }
@@ -274,12 +264,7 @@ impl LinearSolver for GaussSeidel {
         true
     }
 
-    fn solve(
-        &mut self,
-        a: SystemMatrix<'_>,
-        b: &[f64],
-        x: &mut [f64],
-    ) -> Result<SolveInfo, SolveError> {
+    fn solve(&mut self, a: SystemMatrix<'_>, b: &[f64], x: &mut [f64]) -> Result<SolveInfo, SolveError> {
         iterate(self.params, "gauss-seidel", a, b, x, &mut self.scratch, gauss_seidel_sweep)
     }
 }
@@ -406,7 +391,17 @@ mod tests {
         let m = CsrMatrix::from_triplets(
             3,
             3,
-            &[(0, 0, 1.0), (0, 1, a), (0, 2, a), (1, 0, a), (1, 1, 1.0), (1, 2, a), (2, 0, a), (2, 1, a), (2, 2, 1.0)],
+            &[
+                (0, 0, 1.0),
+                (0, 1, a),
+                (0, 2, a),
+                (1, 0, a),
+                (1, 1, 1.0),
+                (1, 2, a),
+                (2, 0, a),
+                (2, 1, a),
+                (2, 2, 1.0),
+            ],
         );
         let b = [1.0, 2.0, 3.0];
         let params = IterativeParams::new(1e-10, 60);
@@ -420,11 +415,14 @@ mod tests {
             other => panic!("expected NotConverged, got {other:?}"),
         }
         let mut x = [0.0; 3];
-        let info = GaussSeidel::new(IterativeParams::new(1e-10, 1000))
+        let info = GaussSeidel::new(IterativeParams::new(1e-14, 1000))
             .solve(SystemMatrix::Csr(&m), &b, &mut x)
             .expect("GS converges for SPD");
-        assert!(info.relative_residual <= 1e-10);
-        assert!(max_abs_diff(&x, &dense_solve(&m, &b)) <= 1e-9);
+        assert!(info.relative_residual <= 1e-14);
+        // error <= cond(A) * relative residual * |x| = 13 * 1e-14 * |x|
+        let reference = dense_solve(&m, &b);
+        let scale = reference.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+        assert!(max_abs_diff(&x, &reference) <= 13.0 * 1e-14 * 2.0 * scale);
     }
 
     #[test]
@@ -440,7 +438,10 @@ mod tests {
             );
         }
         let mut x = [0.0; 3];
-        assert_eq!(gauss_seidel_sweep(&a, &[1.0; 3], &mut x), Err(SolveError::BadPivot { row: 1, value: 0.0 }));
+        assert_eq!(
+            gauss_seidel_sweep(&a, &[1.0; 3], &mut x),
+            Err(SolveError::BadPivot { row: 1, value: 0.0 })
+        );
         assert_eq!(x[0], 0.5, "rows before the bad pivot were updated");
     }
 
