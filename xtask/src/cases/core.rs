@@ -110,14 +110,7 @@ pub fn register(r: &mut Registry) {
 }
 
 fn theory_order(kind: IntegratorKind) -> f64 {
-    match kind {
-        IntegratorKind::PositionVerlet
-        | IntegratorKind::Leapfrog
-        | IntegratorKind::VelocityVerlet
-        | IntegratorKind::ImplicitMidpoint => 2.0,
-        IntegratorKind::Rk4 => 4.0,
-        _ => 1.0,
-    }
+    f64::from(kind.order())
 }
 
 fn build(kind: IntegratorKind, dof: usize) -> Box<dyn Integrator<dyn MechanicalDyn> + Send> {
@@ -239,7 +232,7 @@ fn energy_behaviour(_ctx: &Ctx) -> Vec<Check> {
     let steps = 100_000;
     let mut checks = Vec::new();
     for kind in IntegratorKind::ALL {
-        let symplectic = build(kind, 1).symplectic();
+        let symplectic = kind.is_symplectic();
         if !(symplectic || kind == IntegratorKind::ExplicitEuler) {
             continue;
         }

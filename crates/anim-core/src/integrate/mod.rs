@@ -273,6 +273,38 @@ impl IntegratorKind {
         }
     }
 
+    /// Theoretical order of accuracy (1 for the Euler family and every beta-blend, 2 for the
+    /// Verlet family and implicit midpoint, 4 for RK4).
+    #[must_use]
+    pub fn order(&self) -> u32 {
+        match self {
+            IntegratorKind::PositionVerlet
+            | IntegratorKind::Leapfrog
+            | IntegratorKind::VelocityVerlet
+            | IntegratorKind::ImplicitMidpoint => 2,
+            IntegratorKind::Rk4 => 4,
+            IntegratorKind::ExplicitEuler
+            | IntegratorKind::SymplecticEuler
+            | IntegratorKind::BackwardEuler
+            | IntegratorKind::BetaBlend { .. } => 1,
+        }
+    }
+
+    /// Whether the method is symplectic (symplectic Euler, the Verlet family, implicit midpoint,
+    /// and the beta-blend at `beta = 0`, which is symplectic Euler).
+    #[must_use]
+    pub fn is_symplectic(&self) -> bool {
+        match self {
+            IntegratorKind::SymplecticEuler
+            | IntegratorKind::PositionVerlet
+            | IntegratorKind::Leapfrog
+            | IntegratorKind::VelocityVerlet
+            | IntegratorKind::ImplicitMidpoint => true,
+            IntegratorKind::BetaBlend { beta } => *beta == 0.0,
+            IntegratorKind::ExplicitEuler | IntegratorKind::BackwardEuler | IntegratorKind::Rk4 => false,
+        }
+    }
+
     /// Whether the method needs a [`MechanicalSystem`] (force Jacobians).
     #[must_use]
     pub fn is_implicit(&self) -> bool {

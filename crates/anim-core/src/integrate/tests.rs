@@ -21,13 +21,15 @@ fn oscillator_error(kind: IntegratorKind, steps: usize) -> f64 {
 }
 
 fn theory_order(kind: IntegratorKind) -> f64 {
-    match kind {
-        IntegratorKind::PositionVerlet
-        | IntegratorKind::Leapfrog
-        | IntegratorKind::VelocityVerlet
-        | IntegratorKind::ImplicitMidpoint => 2.0,
-        IntegratorKind::Rk4 => 4.0,
-        _ => 1.0,
+    f64::from(kind.order())
+}
+
+#[test]
+fn kinds_agree_with_their_integrators() {
+    for kind in IntegratorKind::ALL {
+        let integ = kind.build::<HarmonicOscillator>(1);
+        assert_eq!(integ.order(), kind.order(), "{}", kind.label());
+        assert_eq!(integ.symplectic(), kind.is_symplectic(), "{}", kind.label());
     }
 }
 
