@@ -39,7 +39,7 @@ enum Command {
     Run {
         /// A scene file (TOML) or the name of a built-in scene (see `anim list`).
         scene: Option<String>,
-        /// Output folder (default: anim-out/<scene name>).
+        /// Output folder (default: `anim-out/<scene name>`).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Override the number of frames.

@@ -69,6 +69,8 @@ pub struct Cg {
     ap: Vec<f64>,
     /// `1 / diag(A)` under Jacobi preconditioning.
     inv_diag: Vec<f64>,
+    /// `b / max|b_i|`.
+    b_scaled: Vec<f64>,
 }
 
 impl Cg {
@@ -83,6 +85,7 @@ impl Cg {
             p: Vec::new(),
             ap: Vec::new(),
             inv_diag: Vec::new(),
+            b_scaled: Vec::new(),
         }
     }
 
@@ -152,6 +155,9 @@ impl Cg {
         dot(&self.r, &self.z)
     }
 
+    /// Solves with `b` and `x` scaled by `1 / max|b_i|`, so that `p^T A p` neither underflows
+    /// (a right-hand side of 1e-200 is a legitimate request) nor overflows; the iteration is
+    /// scale invariant, so the iterates are the same up to rounding.
     fn solve_operator(
         &mut self,
         a: &dyn LinearOperator,
@@ -161,14 +167,33 @@ impl Cg {
         let n = a.dim();
         assert_eq!(b.len(), n, "Cg::solve: b.len() != dim");
         assert_eq!(x.len(), n, "Cg::solve: x.len() != dim");
-        let b_norm = norm(b);
-        if !b_norm.is_finite() {
+        let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if !scale.is_finite() || b.iter().any(|v| v.is_nan()) {
             return Err(SolveError::NonFinite { iteration: 0 });
         }
-        if b_norm == 0.0 {
+        if scale == 0.0 {
             x.fill(0.0);
             return Ok(SolveInfo { iterations: 0, relative_residual: 0.0 });
         }
+        let mut b_scaled = std::mem::take(&mut self.b_scaled);
+        b_scaled.clear();
+        b_scaled.extend(b.iter().map(|v| v / scale));
+        x.iter_mut().for_each(|v| *v /= scale);
+        let result = self.solve_unit(a, &b_scaled, x);
+        x.iter_mut().for_each(|v| *v *= scale);
+        self.b_scaled = b_scaled;
+        result
+    }
+
+    /// Preconditioned CG on a right-hand side with `max|b_i| = 1`.
+    fn solve_unit(
+        &mut self,
+        a: &dyn LinearOperator,
+        b: &[f64],
+        x: &mut [f64],
+    ) -> Result<SolveInfo, SolveError> {
+        let n = a.dim();
+        let b_norm = norm(b);
         self.resize(n);
         if self.preconditioner == Preconditioner::Jacobi {
             self.prepare_jacobi(a, n)?;
@@ -466,8 +491,9 @@ mod tests {
             cg.solve(SystemMatrix::Csr(&bad), &[1.0; 9], &mut x),
             Err(SolveError::NonFinite { iteration: 0 })
         );
-        // Overflow inside the iteration: p = b, p^T A p = 2e120 * 1e200 = inf.
-        let huge = CsrMatrix::from_triplets(2, 2, &[(0, 0, 1e200), (1, 1, 1e200)]);
+        // Overflow inside the iteration: b is scaled to unit size, p = (1, 1),
+        // p^T A p = 2 * 1e308 = inf.
+        let huge = CsrMatrix::from_triplets(2, 2, &[(0, 0, 1e308), (1, 1, 1e308)]);
         let mut x = vec![0.0; 2];
         assert_eq!(
             cg.solve(SystemMatrix::Csr(&huge), &[1e60, 1e60], &mut x),
@@ -511,5 +537,26 @@ mod tests {
         cg.solve(SystemMatrix::Csr(&a), &vec![2.0; n], &mut x).expect("converges");
         let after = [cg.r.as_ptr(), cg.z.as_ptr(), cg.p.as_ptr(), cg.ap.as_ptr(), cg.inv_diag.as_ptr()];
         assert_eq!(ptrs, after);
+    }
+
+    #[test]
+    fn tiny_and_huge_right_hand_sides_solve_like_unit_ones() {
+        // Regression: a backward-Euler step of a decayed stiff oscillator hands CG b ~ 1e-200,
+        // where p^T A p underflowed to 0 and was reported as "not positive definite".
+        let a = poisson_2d(6);
+        let n = a.nrows();
+        let b: Vec<f64> = (0..n).map(|i| 1.0 + (i % 5) as f64).collect();
+        let mut x_unit = vec![0.0; n];
+        let mut solver = Cg::new(Preconditioner::Jacobi, IterativeParams::new(1e-12, 500));
+        solver.solve(SystemMatrix::Csr(&a), &b, &mut x_unit).unwrap();
+        for scale in [1e-200, 1e-300, 1e200] {
+            let bs: Vec<f64> = b.iter().map(|v| v * scale).collect();
+            let mut x = vec![0.0; n];
+            let info = solver.solve(SystemMatrix::Csr(&a), &bs, &mut x).unwrap();
+            assert!(info.relative_residual <= 1e-12, "scale {scale}: {info:?}");
+            for (xi, ui) in x.iter().zip(&x_unit) {
+                assert!((xi / scale - ui).abs() <= 1e-9 * ui.abs(), "scale {scale}: {} vs {ui}", xi / scale);
+            }
+        }
     }
 }
