@@ -180,7 +180,7 @@ pub fn plot(r: &StudyResult, path: &Path) -> Result<(), Box<dyn std::error::Erro
         .configure_series_labels()
         .background_style(WHITE.mix(0.9))
         .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
+        .position(SeriesLabelPosition::LowerRight)
         .draw()?;
     root.present()?;
     Ok(())
