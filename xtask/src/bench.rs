@@ -28,6 +28,9 @@ fn parse_bencher(out: &str) -> Vec<Row> {
 }
 
 pub fn run(filter: Option<&str>) -> bool {
+    if std::env::args().skip(2).any(|a| a == "--peers") {
+        return peers::run();
+    }
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut args = vec!["bench", "-p", "anim-benches", "--benches", "--", "--output-format", "bencher"];
     if let Some(f) = filter {
@@ -79,6 +82,130 @@ fn human(ns: f64) -> String {
         format!("{:.2} ms", ns / 1e6)
     } else {
         format!("{:.2} s", ns / 1e9)
+    }
+}
+
+/// `cargo xtask bench --peers`: our per-step time against peer libraries on the same problem,
+/// same integrator and same thread count, measured side by side in one run.
+mod peers {
+    use crate::cases::springs::peer_symplectic_cloth;
+    use std::io::Write;
+    use std::process::Command;
+
+    const SCRIPT: &str = "xtask/peers/taichi_cloth.py";
+
+    fn python() -> String {
+        std::env::var("PYTHON").unwrap_or_else(|_| "python3".into())
+    }
+
+    /// Whether `import taichi` works, installing it with pip if it does not.
+    fn ensure_taichi() -> Result<(), String> {
+        let works = || {
+            Command::new(python())
+                .args(["-c", "import taichi"])
+                .output()
+                .map(|o| o.status.success())
+                .unwrap_or(false)
+        };
+        if works() {
+            return Ok(());
+        }
+        eprintln!("== taichi not found: {} -m pip install taichi", python());
+        let out = Command::new(python())
+            .args(["-m", "pip", "install", "--quiet", "taichi"])
+            .output()
+            .map_err(|e| format!("could not run pip: {e}"))?;
+        if !out.status.success() || !works() {
+            return Err(format!(
+                "pip install taichi failed (taichi publishes wheels for CPython 3.7 to 3.12 on x86-64 and arm64 only): {}",
+                String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
+            ));
+        }
+        Ok(())
+    }
+
+    /// A value of a flat JSON object line (numbers and strings only; the script prints no nesting).
+    fn field(line: &str, key: &str) -> Option<String> {
+        let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
+        let rest = rest.trim_start();
+        let end = rest.find([',', '}']).unwrap_or(rest.len());
+        Some(rest[..end].trim().trim_matches('"').to_string())
+    }
+
+    pub fn run() -> bool {
+        let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+        let (n, steps, repeats) = (128, 200, 5);
+        println!(
+            "peer benchmark: {n}x{n} cloth (anim_springs::scenes::benchmark_cloth), symplectic Euler, {steps} steps, {threads} threads, median of {repeats}"
+        );
+        let ours = match peer_symplectic_cloth(n, steps, threads, repeats) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("our run failed: {e}");
+                return false;
+            }
+        };
+        let mut rows = vec![("anim-springs".to_string(), ours.per_step_s, ours.sum_z, ours.min_z)];
+        match ensure_taichi() {
+            Err(e) => println!("\nNOTE: Taichi peer SKIPPED: {e}\n"),
+            Ok(()) => {
+                let out = Command::new(python())
+                    .args([SCRIPT, "--n", &n.to_string(), "--steps", &steps.to_string()])
+                    .args(["--repeats", &repeats.to_string(), "--threads", &threads.to_string()])
+                    .output();
+                match out {
+                    Ok(o) if o.status.success() => {
+                        for line in String::from_utf8_lossy(&o.stdout).lines().filter(|l| l.starts_with('{'))
+                        {
+                            let get = |k: &str| {
+                                field(line, k).and_then(|v| v.parse::<f64>().ok()).unwrap_or(f64::NAN)
+                            };
+                            let name = format!(
+                                "taichi {} ({})",
+                                field(line, "taichi").unwrap_or_default(),
+                                field(line, "variant").unwrap_or_default()
+                            );
+                            rows.push((name, get("per_step_s"), get("sum_z"), get("min_z")));
+                        }
+                    }
+                    Ok(o) => {
+                        println!("\nNOTE: Taichi script failed: {}\n", String::from_utf8_lossy(&o.stderr))
+                    }
+                    Err(e) => println!("\nNOTE: could not run {}: {e}\n", python()),
+                }
+            }
+        }
+        println!(
+            "\n| code | per step | ours / theirs | sum z after {steps} steps | min z |\n| --- | --- | --- | --- | --- |"
+        );
+        for (name, t, sum_z, min_z) in &rows {
+            println!(
+                "| {name} | {} | {:.3} | {sum_z:.9} | {min_z:.9} |",
+                super::human(t * 1e9),
+                ours.per_step_s / t
+            );
+        }
+        let mut agree = true;
+        for (name, _, sum_z, min_z) in rows.iter().skip(1) {
+            let dz = ((sum_z - ours.sum_z) / ours.sum_z).abs().max((min_z - ours.min_z).abs());
+            if !(dz < 1e-9) {
+                println!("WARNING: {name} computed a different motion (checksum difference {dz:e})");
+                agree = false;
+            }
+        }
+        let dir = std::path::Path::new("target/xtask");
+        let written = std::fs::create_dir_all(dir).and_then(|_| {
+            let mut f = std::fs::File::create(dir.join("peers.csv"))?;
+            writeln!(f, "code,threads,per_step_s,ours_over_theirs,sum_z,min_z")?;
+            for (name, t, sum_z, min_z) in &rows {
+                writeln!(f, "{name},{threads},{t},{},{sum_z},{min_z}", ours.per_step_s / t)?;
+            }
+            Ok(())
+        });
+        if let Err(e) = written {
+            eprintln!("could not write target/xtask/peers.csv: {e}");
+        }
+        agree
     }
 }
 

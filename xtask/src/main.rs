@@ -36,6 +36,8 @@ fn parse(args: &[String]) -> Result<Args, String> {
             "--quick" => parsed.quick = true,
             "--filter" => parsed.filter = Some(it.next().ok_or("--filter needs a value")?.clone()),
             "--out" => parsed.out = Some(it.next().ok_or("--out needs a value")?.clone()),
+            // `bench --peers`: read by bench.rs from the process arguments.
+            "--peers" => {}
             other => return Err(format!("unknown argument '{other}'")),
         }
     }

@@ -155,6 +155,8 @@ pub struct Registry {
 pub fn all() -> Registry {
     let mut r = Registry::default();
     crate::cases::core::register(&mut r);
+    crate::cases::io::register(&mut r);
+    crate::cases::springs::register(&mut r);
     r
 }
 

@@ -1,21 +1,26 @@
-//! `anim`: runs a scene and writes its frames and a metrics summary.
+//! `anim`: runs a scene and writes its frames, a preview and a metrics summary.
 //!
 //! ```text
-//! anim run                      # the embedded default scene
+//! anim run                      # the embedded default scene (a hanging cloth)
 //! anim run scene.toml           # a scene file
-//! anim run oscillator           # a built-in scene by name
-//! anim run scene.toml --out out --frames 100 --dt 0.001
+//! anim run kepler               # a built-in scene by name
+//! anim run cloth --out out --frames 60 --format obj --stride 2
 //! anim list                     # the built-in scenes
 //! ```
+//!
+//! Every run writes into its output folder: the frames in the scene's natural format (VTK `.vtu`
+//! with a `.pvd` series for meshes, `frames.csv` for systems of a few unknowns) or the one asked
+//! for, `preview.gif` (and `preview.png`, the last frame), and `metrics.json`.
 
+mod runner;
 mod scene;
 
-use anim_core::integrate::systems::{HarmonicOscillator, KeplerOrbit};
-use anim_core::integrate::{IntegrateError, MechanicalSystem, Simulation, State};
-use anim_core::solver::Solver;
+use anim_io::FrameWriter;
+use anim_io::preview::{Canvas, GifWriter};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use scene::{Scene, SceneFile};
+use runner::{OutputFormat, Runner};
+use scene::SceneFile;
 use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -36,24 +41,39 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Run a scene file, or a built-in scene by name, or the default scene when none is given.
-    Run {
-        /// A scene file (TOML) or the name of a built-in scene (see `anim list`).
-        scene: Option<String>,
-        /// Output folder (default: `anim-out/<scene name>`).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Override the number of frames.
-        #[arg(long)]
-        frames: Option<usize>,
-        /// Override the time step in seconds.
-        #[arg(long, allow_hyphen_values = true)]
-        dt: Option<f64>,
-        /// No progress bar or summary on the terminal.
-        #[arg(long)]
-        quiet: bool,
-    },
+    Run(RunArgs),
     /// List the built-in scenes.
     List,
+}
+
+#[derive(clap::Args)]
+struct RunArgs {
+    /// A scene file (TOML) or the name of a built-in scene (see `anim list`).
+    scene: Option<String>,
+    /// Output folder (default: `anim-out/<scene name>`).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Override the number of frames.
+    #[arg(long)]
+    frames: Option<usize>,
+    /// Override the time step in seconds.
+    #[arg(long, allow_hyphen_values = true)]
+    dt: Option<f64>,
+    /// Frame file format (default: the scene's natural one).
+    #[arg(long, value_enum)]
+    format: Option<OutputFormat>,
+    /// Write every N-th frame to files.
+    #[arg(long, default_value_t = 1)]
+    stride: usize,
+    /// Skip the GIF/PNG preview.
+    #[arg(long)]
+    no_preview: bool,
+    /// Preview width in pixels (height is 3/4 of it).
+    #[arg(long, default_value_t = 320)]
+    preview_width: u32,
+    /// No progress bar or summary on the terminal.
+    #[arg(long)]
+    quiet: bool,
 }
 
 fn main() -> ExitCode {
@@ -61,13 +81,12 @@ fn main() -> ExitCode {
     match cli.command {
         Command::List => {
             for (name, description, _) in scene::BUILTIN {
-                let default = if name == scene::DEFAULT_SCENE { " (default)" } else { "" };
+                let default = if name == scene::DEFAULT_SCENE { " [default]" } else { "" };
                 println!("{name:<12} {description}{default}");
             }
             ExitCode::SUCCESS
         }
-        Command::Run { scene, out, frames, dt, quiet } => match run(scene.as_deref(), out, frames, dt, quiet)
-        {
+        Command::Run(args) => match run(&args) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("error: {e}");
@@ -78,16 +97,17 @@ fn main() -> ExitCode {
 }
 
 /// Loads the scene named on the command line: a file if one exists at that path, else a
-/// built-in scene of that name.
-fn resolve(arg: Option<&str>) -> Result<SceneFile, String> {
+/// built-in scene of that name. Returns the scene and the path errors should name.
+fn resolve(arg: Option<&str>) -> Result<(SceneFile, PathBuf), String> {
     let arg = arg.unwrap_or(scene::DEFAULT_SCENE);
     let path = Path::new(arg);
     if path.exists() {
-        return scene::load(path).map_err(|e| e.to_string());
+        return scene::load(path).map(|s| (s, path.to_path_buf())).map_err(|e| e.to_string());
     }
     match scene::builtin(arg) {
         Some(text) => {
-            scene::parse(text, Path::new(&format!("<built-in scene {arg}>"))).map_err(|e| e.to_string())
+            let origin = PathBuf::from(format!("<built-in scene {arg}>"));
+            scene::parse(text, &origin).map(|s| (s, origin)).map_err(|e| e.to_string())
         }
         None => Err(format!(
             "{arg}: no such scene file, and no built-in scene of that name (built-in: {})",
@@ -99,95 +119,172 @@ fn resolve(arg: Option<&str>) -> Result<SceneFile, String> {
 #[derive(Serialize)]
 struct Metrics {
     scene: String,
-    system: &'static str,
-    integrator: &'static str,
+    system: String,
+    method: String,
     status: String,
     dt: f64,
     steps: u64,
     frames: usize,
+    format: OutputFormat,
     simulated_seconds: f64,
     wall_seconds: f64,
+    step_seconds: f64,
+    output_seconds: f64,
+    output_fraction: f64,
     steps_per_second: f64,
     energy_initial: Option<f64>,
     energy_final: Option<f64>,
-    relative_energy_drift: Option<f64>,
+    relative_energy_change: Option<f64>,
     max_error_vs_exact: Option<f64>,
     newton_iterations: usize,
+    files: Vec<String>,
 }
 
-/// The runnable form of a scene: a simulation, its initial state and an optional exact solution.
-struct Runnable {
-    system: &'static str,
-    sim: Simulation<dyn MechanicalSystem + Send>,
-    state: State,
-    exact: Option<Box<dyn Fn(f64) -> Vec<f64>>>,
+/// Frame files, CSV rows and the preview, with the time they cost.
+struct Output {
+    dir: PathBuf,
+    format: OutputFormat,
+    stride: usize,
+    frames: Option<FrameWriter>,
+    csv: Option<std::io::BufWriter<std::fs::File>>,
+    gif: Option<(GifWriter, Canvas, anim_io::preview::Camera, usize)>,
+    seconds: f64,
 }
 
-fn build(scene: &Scene) -> Runnable {
-    match *scene {
-        Scene::HarmonicOscillator { mass, stiffness, damping, x0, v0, integrator } => {
-            let sys = HarmonicOscillator::damped(mass, stiffness, damping);
-            Runnable {
-                system: "harmonic-oscillator",
-                sim: Simulation::new(Box::new(sys), integrator.build(1)),
-                state: State::new(vec![x0], vec![v0]),
-                exact: Some(Box::new(move |t| {
-                    let (x, v) = sys.exact(x0, v0, t);
-                    vec![x, v]
-                })),
+impl Output {
+    fn new(
+        dir: &Path,
+        format: OutputFormat,
+        stride: usize,
+        preview: Option<(u32, usize)>,
+        runner: &dyn Runner,
+    ) -> Result<Self, String> {
+        let mut out = Output {
+            dir: dir.to_path_buf(),
+            format,
+            stride,
+            frames: None,
+            csv: None,
+            gif: None,
+            seconds: 0.0,
+        };
+        let start = Instant::now();
+        if let Some(f) = format.frame_format() {
+            out.frames = Some(FrameWriter::new(dir.join("frames"), f).map_err(|e| e.to_string())?);
+        }
+        if format == OutputFormat::Csv {
+            let path = dir.join("frames.csv");
+            let file = std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let mut csv = std::io::BufWriter::new(file);
+            let n = runner.state().dof();
+            let header: Vec<String> =
+                (0..n).map(|i| format!("x{i}")).chain((0..n).map(|i| format!("v{i}"))).collect();
+            writeln!(csv, "frame,t,{},energy,error_vs_exact", header.join(","))
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            out.csv = Some(csv);
+        }
+        if let Some((width, every)) = preview {
+            let height = (width * 3 / 4).max(1);
+            let path = dir.join("preview.gif");
+            let gif = GifWriter::create(&path, width, height, 4, true).map_err(|e| e.to_string())?;
+            let camera = runner.camera(f64::from(width) / f64::from(height));
+            out.gif = Some((gif, Canvas::new(width, height, [248, 248, 250]), camera, every));
+        }
+        out.seconds += start.elapsed().as_secs_f64();
+        Ok(out)
+    }
+
+    fn frame(
+        &mut self,
+        index: usize,
+        runner: &mut dyn Runner,
+        energy: Option<f64>,
+        err: Option<f64>,
+    ) -> Result<(), String> {
+        let start = Instant::now();
+        if index.is_multiple_of(self.stride) {
+            if let Some(frames) = &mut self.frames {
+                runner.write_frame(frames)?;
+            }
+            if let Some(csv) = &mut self.csv {
+                let s = runner.state();
+                let values: Vec<String> = s.x.iter().chain(&s.v).map(|v| format!("{v:e}")).collect();
+                let opt = |v: Option<f64>| v.map(|v| format!("{v:e}")).unwrap_or_default();
+                writeln!(csv, "{index},{:e},{},{},{}", s.t, values.join(","), opt(energy), opt(err))
+                    .map_err(|e| e.to_string())?;
             }
         }
-        Scene::KeplerOrbit { eccentricity, integrator } => {
-            let sys = KeplerOrbit::ellipse(eccentricity);
-            let (x0, v0) = sys.initial();
-            Runnable {
-                system: "kepler-orbit",
-                sim: Simulation::new(Box::new(sys), integrator.build(2)),
-                state: State::new(x0.to_vec(), v0.to_vec()),
-                exact: Some(Box::new(move |t| {
-                    let (x, v) = sys.exact(t);
-                    vec![x[0], x[1], v[0], v[1]]
-                })),
+        if let Some((gif, canvas, camera, every)) = &mut self.gif
+            && index.is_multiple_of(*every)
+        {
+            canvas.clear();
+            runner.draw(canvas, camera)?;
+            gif.push(canvas).map_err(|e| e.to_string())?;
+        }
+        self.seconds += start.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Closes every file and returns the paths written.
+    fn finish(self) -> Result<(Vec<String>, f64), String> {
+        let start = Instant::now();
+        let mut files = Vec::new();
+        if let Some(frames) = &self.frames {
+            let n = frames.sequence().frames().len();
+            match frames.finish().map_err(|e| e.to_string())? {
+                Some(pvd) => files.push(format!("{} ({n} frames)", pvd.display())),
+                None => files.push(format!(
+                    "{} ({n} .{} frames)",
+                    self.dir.join("frames").display(),
+                    frames.format().extension()
+                )),
             }
         }
+        if let Some(mut csv) = self.csv {
+            csv.flush().map_err(|e| e.to_string())?;
+            files.push(self.dir.join("frames.csv").display().to_string());
+        }
+        if let Some((gif, canvas, _, _)) = self.gif {
+            let png = self.dir.join("preview.png");
+            canvas.save_png(&png).map_err(|e| e.to_string())?;
+            let path = gif.finish().map_err(|e| e.to_string())?;
+            files.push(path.display().to_string());
+            files.push(png.display().to_string());
+        }
+        let _ = self.format;
+        Ok((files, self.seconds + start.elapsed().as_secs_f64()))
     }
 }
 
-fn run(
-    arg: Option<&str>,
-    out: Option<PathBuf>,
-    frames: Option<usize>,
-    dt: Option<f64>,
-    quiet: bool,
-) -> Result<(), String> {
-    let mut file = resolve(arg)?;
-    if let Some(f) = frames {
+fn run(args: &RunArgs) -> Result<(), String> {
+    let (mut file, origin) = resolve(args.scene.as_deref())?;
+    if let Some(f) = args.frames {
         if f == 0 {
             return Err("--frames must be at least 1".into());
         }
         file.run.frames = f;
     }
-    if let Some(dt) = dt {
+    if let Some(dt) = args.dt {
         if !(dt > 0.0 && dt.is_finite()) {
             return Err(format!("--dt must be a positive finite number, got {dt}"));
         }
         file.run.dt = dt;
     }
-    let out = out.unwrap_or_else(|| Path::new("anim-out").join(&file.name));
+    if args.stride == 0 {
+        return Err("--stride must be at least 1".into());
+    }
+    if args.preview_width < 16 || args.preview_width > 4096 {
+        return Err(format!("--preview-width must lie in [16, 4096], got {}", args.preview_width));
+    }
+    let mut runner = runner::build(&file.scene, &origin).map_err(|e| e.to_string())?;
+    let format = args.format.unwrap_or_else(|| runner.natural_format());
+    let out = args.out.clone().unwrap_or_else(|| Path::new("anim-out").join(&file.name));
     std::fs::create_dir_all(&out)
         .map_err(|e| format!("{}: cannot create output folder: {e}", out.display()))?;
-    let frames_path = out.join("frames.csv");
-    let csv = std::fs::File::create(&frames_path).map_err(|e| format!("{}: {e}", frames_path.display()))?;
-    let mut csv = std::io::BufWriter::new(csv);
-    let io_err = |e: std::io::Error| format!("{}: {e}", frames_path.display());
+    // At most about 100 preview frames, whatever the run's length.
+    let preview = (!args.no_preview).then(|| (args.preview_width, file.run.frames.div_ceil(100)));
+    let mut output = Output::new(&out, format, args.stride, preview, runner.as_ref())?;
 
-    let Runnable { system, mut sim, mut state, exact } = build(&file.scene);
-    let n = state.dof();
-    let header: Vec<String> =
-        (0..n).map(|i| format!("x{i}")).chain((0..n).map(|i| format!("v{i}"))).collect();
-    writeln!(csv, "frame,t,{},energy,error_vs_exact", header.join(",")).map_err(io_err)?;
-
-    let energy0 = sim.system_mut().energy(0.0, &state.x, &state.v);
     let total_steps = (file.run.frames * file.run.steps_per_frame) as u64;
     let bar = ProgressBar::with_draw_target(Some(total_steps), ProgressDrawTarget::hidden());
     bar.set_style(
@@ -196,80 +293,92 @@ fn run(
     );
     let start = Instant::now();
     let mut bar_shown = false;
-    let (mut steps, mut max_err, mut newton, mut energy) = (0u64, None::<f64>, 0usize, energy0);
-    let mut status = String::from("completed");
-    let mut failure: Option<IntegrateError> = None;
+    let (mut steps, mut max_err, mut newton) = (0u64, None::<f64>, 0usize);
+    let (mut energy0, mut energy) = (None, None);
+    let mut step_seconds = 0.0;
+    let mut failure = None;
     'frames: for frame in 0..file.run.frames {
+        let t_step = Instant::now();
         for _ in 0..file.run.steps_per_frame {
-            match sim.step(&mut state, file.run.dt) {
+            match runner.step(file.run.dt) {
                 Ok(report) => {
                     newton += report.iterations;
                     energy = report.energy;
+                    if energy0.is_none() {
+                        energy0 = energy;
+                    }
                 }
                 Err(e) => {
-                    status = format!("diverged at step {steps}: {e}");
-                    failure = Some(e);
+                    failure = Some(format!("step {steps}: {e}"));
                     break 'frames;
                 }
             }
             steps += 1;
         }
-        let err = exact.as_ref().map(|f| {
-            let ex = f(state.t);
-            state.x.iter().chain(&state.v).zip(&ex).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt()
-        });
+        step_seconds += t_step.elapsed().as_secs_f64();
+        let err = runner.exact_error();
         if let Some(e) = err {
             max_err = Some(max_err.map_or(e, |m: f64| m.max(e)));
         }
-        let values: Vec<String> = state.x.iter().chain(&state.v).map(|v| format!("{v:e}")).collect();
-        let opt = |v: Option<f64>| v.map(|v| format!("{v:e}")).unwrap_or_default();
-        writeln!(csv, "{frame},{:e},{},{},{}", state.t, values.join(","), opt(energy), opt(err))
-            .map_err(io_err)?;
-        if !quiet && !bar_shown && start.elapsed() > Duration::from_secs(1) {
+        output.frame(frame, runner.as_mut(), energy, err)?;
+        if !args.quiet && !bar_shown && start.elapsed() > Duration::from_secs(1) {
             bar.set_draw_target(ProgressDrawTarget::stderr());
             bar_shown = true;
         }
         bar.set_position(steps);
     }
     bar.finish_and_clear();
-    csv.flush().map_err(io_err)?;
+    let (files, output_seconds) = output.finish()?;
     let wall = start.elapsed().as_secs_f64();
     let metrics = Metrics {
         scene: file.name.clone(),
-        system,
-        integrator: sim.integrator_name(),
-        status,
+        system: runner.system(),
+        method: runner.method(),
+        status: failure.clone().map_or_else(|| "completed".into(), |f| format!("diverged at {f}")),
         dt: file.run.dt,
         steps,
         frames: file.run.frames,
-        simulated_seconds: state.t,
+        format,
+        simulated_seconds: runner.state().t,
         wall_seconds: wall,
-        steps_per_second: steps as f64 / wall.max(1e-12),
+        step_seconds,
+        output_seconds,
+        output_fraction: output_seconds / (output_seconds + step_seconds).max(1e-12),
+        steps_per_second: steps as f64 / step_seconds.max(1e-12),
         energy_initial: energy0,
         energy_final: energy,
-        relative_energy_drift: energy0.zip(energy).map(|(e0, e)| (e - e0) / e0.abs().max(f64::MIN_POSITIVE)),
+        relative_energy_change: energy0.zip(energy).map(|(e0, e)| (e - e0) / e0.abs().max(f64::MIN_POSITIVE)),
         max_error_vs_exact: max_err,
         newton_iterations: newton,
+        files,
     };
     let metrics_path = out.join("metrics.json");
-    let json = serde_json::to_string_pretty(&metrics).map_err(|e| e.to_string())?;
-    std::fs::write(&metrics_path, json + "\n").map_err(|e| format!("{}: {e}", metrics_path.display()))?;
-    if !quiet {
+    anim_io::metrics::write_json(&metrics_path, &metrics).map_err(|e| e.to_string())?;
+    if !args.quiet {
         println!(
-            "{}: {} steps of {} with {} in {:.3} s ({:.0} steps/s)",
-            metrics.scene, steps, metrics.dt, metrics.integrator, wall, metrics.steps_per_second
+            "{}: {} steps of {} s with {} in {:.2} s ({:.0} steps/s); output {:.0}% of the time",
+            metrics.scene,
+            steps,
+            metrics.dt,
+            metrics.method,
+            wall,
+            metrics.steps_per_second,
+            100.0 * metrics.output_fraction
         );
-        if let Some(d) = metrics.relative_energy_drift {
+        if let Some(d) = metrics.relative_energy_change {
             println!("  relative energy change {d:.3e}");
         }
         if let Some(e) = metrics.max_error_vs_exact {
             println!("  max error against the exact solution {e:.3e}");
         }
-        println!("  wrote {} and {}", frames_path.display(), metrics_path.display());
+        for f in &metrics.files {
+            println!("  wrote {f}");
+        }
+        println!("  wrote {}", metrics_path.display());
     }
     match failure {
-        Some(e) => {
-            Err(format!("simulation diverged: {e} (frames up to the failure and metrics were written)"))
+        Some(f) => {
+            Err(format!("simulation diverged at {f} (frames up to the failure and metrics were written)"))
         }
         None => Ok(()),
     }

@@ -1,3 +1,5 @@
 //! Cases per crate. Each module registers its conformance checks, hard cases and studies.
 
 pub mod core;
+pub mod io;
+pub mod springs;

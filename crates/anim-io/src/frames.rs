@@ -1,0 +1,253 @@
+//! Numbered frame sequences (`frame_00000.vtu`, `frame_00001.vtu`, ...) and the writer that
+//! turns one [`UnstructuredGrid`] per frame into files of a chosen format, plus the `.pvd` that
+//! lets ParaView play a `.vtu` sequence against simulation time. Blender's and Houdini's
+//! importers recognise the numbered names of `.ply`/`.obj` sequences.
+
+use crate::IoError;
+use crate::data::{DataArray, Values};
+use crate::ply::Ply;
+use crate::vtk::{CellKind, UnstructuredGrid, VtkEncoding, write_pvd};
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+/// Numbered file names in one folder, and the time of each frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameSequence {
+    dir: PathBuf,
+    stem: String,
+    extension: String,
+    frames: Vec<(f64, PathBuf)>,
+}
+
+impl FrameSequence {
+    /// A sequence `dir/{stem}_{index:05}.{extension}`; creates `dir` if needed.
+    pub fn new(dir: impl Into<PathBuf>, stem: &str, extension: &str) -> Result<Self, IoError> {
+        let dir = dir.into();
+        std::fs::create_dir_all(&dir).map_err(|e| IoError::io(&dir, e))?;
+        Ok(FrameSequence { dir, stem: stem.into(), extension: extension.into(), frames: Vec::new() })
+    }
+
+    /// The file name of frame `index`, e.g. `frame_00042.vtu` (more digits past 99999).
+    pub fn file_name(&self, index: usize) -> String {
+        format!("{}_{index:05}.{}", self.stem, self.extension)
+    }
+
+    /// Records a frame at `time` and returns the path to write it to.
+    pub fn next_path(&mut self, time: f64) -> PathBuf {
+        let name = PathBuf::from(self.file_name(self.frames.len()));
+        let path = self.dir.join(&name);
+        self.frames.push((time, name));
+        path
+    }
+
+    /// The frames so far: time and file name (relative to [`dir`](Self::dir)).
+    pub fn frames(&self) -> &[(f64, PathBuf)] {
+        &self.frames
+    }
+
+    /// The folder the frames go to.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Writes `dir/{name}` as a `.pvd` collection of the frames so far and returns its path.
+    pub fn write_pvd(&self, name: &str) -> Result<PathBuf, IoError> {
+        let path = self.dir.join(name);
+        write_pvd(&path, &self.frames)?;
+        Ok(path)
+    }
+}
+
+/// A frame file format.
+///
+/// | format | geometry | fields |
+/// | --- | --- | --- |
+/// | `Vtu` | points; vertex, line, triangle, tetrahedron cells | all point and cell fields |
+/// | `Ply` | points, triangles (vertex cells add nothing and are not needed) | point fields (a 3-vector `v` as properties `v_x v_y v_z`); cell fields are not written |
+/// | `Obj` | points, triangles, lines | none: fields are not written |
+///
+/// A cell kind the format cannot hold (tetrahedra in PLY or OBJ, lines in PLY) is an error, not a
+/// silent omission: pass [`TetMesh::boundary_triangles`](crate::TetMesh::boundary_triangles)
+/// to show a solid's surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameFormat {
+    /// VTK XML unstructured grid (ParaView), with a `.pvd` for the sequence.
+    Vtu,
+    /// Binary PLY (Blender, Houdini, MeshLab).
+    Ply,
+    /// Wavefront OBJ (any DCC tool).
+    Obj,
+}
+
+impl FrameFormat {
+    /// The file extension without a dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            FrameFormat::Vtu => "vtu",
+            FrameFormat::Ply => "ply",
+            FrameFormat::Obj => "obj",
+        }
+    }
+}
+
+impl FromStr for FrameFormat {
+    type Err = String;
+
+    /// Parses `vtu`, `ply` or `obj` (any case).
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "vtu" | "vtk" => Ok(FrameFormat::Vtu),
+            "ply" => Ok(FrameFormat::Ply),
+            "obj" => Ok(FrameFormat::Obj),
+            _ => Err(format!("unknown frame format `{s}` (expected vtu, ply or obj)")),
+        }
+    }
+}
+
+/// Writes one file per frame into a folder; for `.vtu`, [`finish`](Self::finish) adds
+/// `frames.pvd`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameWriter {
+    sequence: FrameSequence,
+    format: FrameFormat,
+    encoding: VtkEncoding,
+}
+
+impl FrameWriter {
+    /// Frames `dir/frame_NNNNN.{ext}`; creates `dir` if needed.
+    pub fn new(dir: impl Into<PathBuf>, format: FrameFormat) -> Result<Self, IoError> {
+        let sequence = FrameSequence::new(dir, "frame", format.extension())?;
+        Ok(FrameWriter { sequence, format, encoding: VtkEncoding::default() })
+    }
+
+    /// Sets the VTK array encoding (default base64).
+    pub fn with_encoding(mut self, encoding: VtkEncoding) -> Self {
+        self.encoding = encoding;
+        self
+    }
+
+    /// The format of the frames.
+    pub fn format(&self) -> FrameFormat {
+        self.format
+    }
+
+    /// The sequence written so far.
+    pub fn sequence(&self) -> &FrameSequence {
+        &self.sequence
+    }
+
+    /// Writes the next frame at simulation time `time` and returns its path.
+    pub fn write(&mut self, time: f64, frame: &UnstructuredGrid<'_>) -> Result<PathBuf, IoError> {
+        let name = self.sequence.file_name(self.sequence.frames().len());
+        let what = self.sequence.dir().join(&name);
+        frame.check().map_err(|e| IoError::data(what.display(), e))?;
+        match self.format {
+            FrameFormat::Vtu => frame.write(&what, self.encoding)?,
+            FrameFormat::Ply => ply_of(frame).map_err(|e| IoError::data(what.display(), e))?.write(&what)?,
+            FrameFormat::Obj => {
+                let (tris, lines) = surface(frame, true).map_err(|e| IoError::data(what.display(), e))?;
+                let text = match frame.points {
+                    Values::F32(p) => crate::obj::obj_text(p.as_chunks::<3>().0, &tris, &lines),
+                    Values::F64(p) => crate::obj::obj_text(p.as_chunks::<3>().0, &tris, &lines),
+                    Values::I32(_) => Err("integer point coordinates".to_string()),
+                }
+                .map_err(|e| IoError::data(what.display(), e))?;
+                crate::vtk::write_file(&what, &text)?;
+            }
+        }
+        Ok(self.sequence.next_path(time))
+    }
+
+    /// Finishes the sequence: for `.vtu` writes `frames.pvd` and returns its path.
+    pub fn finish(&self) -> Result<Option<PathBuf>, IoError> {
+        match self.format {
+            FrameFormat::Vtu => self.sequence.write_pvd("frames.pvd").map(Some),
+            _ => Ok(None),
+        }
+    }
+}
+
+/// Triangles and lines of a grid; tetrahedra (and lines unless `lines_ok`) are refused.
+/// Triangles and line segments.
+type Surface = (Vec<[usize; 3]>, Vec<[usize; 2]>);
+
+fn surface(g: &UnstructuredGrid<'_>, lines_ok: bool) -> Result<Surface, String> {
+    let mut tris = Vec::new();
+    let mut lines = Vec::new();
+    for block in &g.cells {
+        match block.kind {
+            CellKind::Vertex => {}
+            CellKind::Triangle => tris.extend_from_slice(block.connectivity.as_chunks::<3>().0),
+            CellKind::Line if lines_ok => lines.extend_from_slice(block.connectivity.as_chunks::<2>().0),
+            CellKind::Line => {
+                return Err("PLY frames hold points and triangles, not lines: use vtu or obj".into());
+            }
+            CellKind::Tetra => {
+                return Err("tetrahedra need vtu; for PLY/OBJ pass the boundary triangles".into());
+            }
+        }
+    }
+    Ok((tris, lines))
+}
+
+fn ply_of<'a>(g: &UnstructuredGrid<'a>) -> Result<Ply<'a>, String> {
+    let (tris, _) = surface(g, false)?;
+    let mut ply = Ply::from_values(g.points).owned_triangles(tris);
+    for f in &g.point_data {
+        let names = match f.components {
+            1 => vec![f.name.clone()],
+            3 => ["x", "y", "z"].iter().map(|a| format!("{}_{a}", f.name)).collect(),
+            c => (0..c).map(|k| format!("{}_{k}", f.name)).collect(),
+        };
+        let names = names.into_iter().map(|n| n.replace(char::is_whitespace, "_")).collect();
+        ply =
+            ply.field(names, DataArray { name: f.name.clone(), components: f.components, values: f.values });
+    }
+    Ok(ply)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmp(name: &str) -> PathBuf {
+        std::env::temp_dir().join(format!("anim-io-frames-{}-{name}", std::process::id()))
+    }
+
+    #[test]
+    fn names_pvd_and_format_limits() {
+        let dir = tmp("seq");
+        let pts = [[0.0f64, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let tets = [[0, 1, 2, 3]];
+        let tris = [[0, 1, 2]];
+        let lines = [[0, 3]];
+        let mut w = FrameWriter::new(&dir, FrameFormat::Obj).unwrap();
+        let p = w.write(0.5, &UnstructuredGrid::new(&pts).triangles(&tris).lines(&lines)).unwrap();
+        assert_eq!(p, dir.join("frame_00000.obj"));
+        let text = std::fs::read_to_string(&p).unwrap();
+        assert!(text.contains("f 1 2 3\n") && text.contains("l 1 4\n"), "{text}");
+        let e = w.write(1.0, &UnstructuredGrid::new(&pts).tetrahedra(&tets)).unwrap_err();
+        assert!(e.to_string().contains("tetrahedra need vtu"), "{e}");
+        assert_eq!(w.sequence().frames().len(), 1, "a failed frame is not recorded");
+        assert_eq!(w.finish().unwrap(), None);
+
+        let mut w = FrameWriter::new(&dir, FrameFormat::Ply).unwrap();
+        let e = w.write(0.0, &UnstructuredGrid::new(&pts).lines(&lines)).unwrap_err();
+        assert!(e.to_string().contains("not lines"), "{e}");
+
+        let mut w = FrameWriter::new(&dir, FrameFormat::Vtu).unwrap();
+        for k in 0..2 {
+            w.write(k as f64 * 0.25, &UnstructuredGrid::new(&pts).tetrahedra(&tets)).unwrap();
+        }
+        let pvd = w.finish().unwrap().unwrap();
+        let text = std::fs::read_to_string(pvd).unwrap();
+        assert!(text.contains("timestep=\"0e0\" group=\"\" part=\"0\" file=\"frame_00000.vtu\""), "{text}");
+        assert!(
+            text.contains("timestep=\"2.5e-1\" group=\"\" part=\"0\" file=\"frame_00001.vtu\""),
+            "{text}"
+        );
+        assert_eq!("PLY".parse::<FrameFormat>(), Ok(FrameFormat::Ply));
+        assert!("stl".parse::<FrameFormat>().is_err());
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+}
