@@ -48,13 +48,28 @@ pub struct NonFinite {
     pub last_finite: f64,
 }
 
+/// Arrays at least this long are scanned in parallel (in fixed chunks; the answer is the same).
+const PARALLEL_LEN: usize = 1 << 15;
+const CHUNK: usize = 1 << 13;
+
+/// Whether any entry is NaN or infinite: `v * 0` is `0` for finite `v` and NaN otherwise, and
+/// the sum of those products vectorises.
+#[inline]
+fn has_non_finite(values: &[f64]) -> bool {
+    values.iter().fold(0.0, |acc, &v| acc + v * 0.0) != 0.0
+}
+
 /// Returns the index of the first non-finite entry of `values`, if any.
 #[inline]
 #[must_use]
 pub fn first_non_finite(values: &[f64]) -> Option<usize> {
-    // A sum is cheap and vectorises; only on failure search for the index.
-    let s: f64 = values.iter().fold(0.0, |acc, &v| acc + v * 0.0);
-    if s == 0.0 { None } else { values.iter().position(|v| !v.is_finite()) }
+    use rayon::prelude::*;
+    let bad = if values.len() >= PARALLEL_LEN {
+        values.par_chunks(CHUNK).any(has_non_finite)
+    } else {
+        has_non_finite(values)
+    };
+    if bad { values.iter().position(|v| !v.is_finite()) } else { None }
 }
 
 /// Checks `new` for non-finite entries; `old` supplies the last finite value for the report.
@@ -84,6 +99,12 @@ mod tests {
         assert_eq!(first_non_finite(&[0.0, f64::NAN, 1.0]), Some(1));
         assert_eq!(first_non_finite(&[0.0, 1.0, f64::NEG_INFINITY]), Some(2));
         assert_eq!(first_non_finite(&[f64::MAX, f64::MAX]), None);
+        // Long arrays take the parallel path and still name the first offender.
+        let mut long = vec![1.0; 3 * PARALLEL_LEN + 5];
+        assert_eq!(first_non_finite(&long), None);
+        long[2 * PARALLEL_LEN + 7] = f64::NAN;
+        long[PARALLEL_LEN + 3] = f64::INFINITY;
+        assert_eq!(first_non_finite(&long), Some(PARALLEL_LEN + 3));
     }
 
     #[test]

@@ -1,6 +1,8 @@
 //! Explicit and symplectic Euler (seed 2.1).
 
-use super::{IntegrateError, Integrator, SecondOrderSystem, State, StepInfo, check_inputs, commit, fit};
+use super::{
+    IntegrateError, Integrator, SecondOrderSystem, State, StepInfo, check_inputs, commit, fit, for_chunks2,
+};
 use serde::{Deserialize, Serialize};
 
 /// Explicit (forward) Euler: `v1 = v0 + h a(t0, x0, v0)`, `x1 = x0 + h v0`.
@@ -38,11 +40,14 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for ExplicitEuler {
         fit(&mut self.x_new, n);
         fit(&mut self.v_new, n);
         system.acceleration(state.t, &state.x, &state.v, &mut self.a);
-        for i in 0..n {
-            self.x_new[i] = state.x[i] + dt * state.v[i];
-            self.v_new[i] = state.v[i] + dt * self.a[i];
-        }
-        commit(self.steps, state, &self.x_new, &self.v_new, dt)?;
+        let (x, v, a) = (&state.x, &state.v, &self.a);
+        for_chunks2(&mut self.x_new, &mut self.v_new, |o, xn, vn| {
+            for k in 0..xn.len() {
+                xn[k] = x[o + k] + dt * v[o + k];
+                vn[k] = v[o + k] + dt * a[o + k];
+            }
+        });
+        commit(self.steps, state, &mut self.x_new, &mut self.v_new, dt)?;
         self.steps += 1;
         Ok(StepInfo { evaluations: 1, ..StepInfo::default() })
     }
@@ -92,11 +97,14 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for SymplecticEuler {
         fit(&mut self.x_new, n);
         fit(&mut self.v_new, n);
         system.acceleration(state.t, &state.x, &state.v, &mut self.a);
-        for i in 0..n {
-            self.v_new[i] = state.v[i] + dt * self.a[i];
-            self.x_new[i] = state.x[i] + dt * self.v_new[i];
-        }
-        commit(self.steps, state, &self.x_new, &self.v_new, dt)?;
+        let (x, v, a) = (&state.x, &state.v, &self.a);
+        for_chunks2(&mut self.v_new, &mut self.x_new, |o, vn, xn| {
+            for k in 0..vn.len() {
+                vn[k] = v[o + k] + dt * a[o + k];
+                xn[k] = x[o + k] + dt * vn[k];
+            }
+        });
+        commit(self.steps, state, &mut self.x_new, &mut self.v_new, dt)?;
         self.steps += 1;
         Ok(StepInfo { evaluations: 1, ..StepInfo::default() })
     }

@@ -341,7 +341,7 @@ impl NewtonCore {
             self.x_new[i] = state.x[i] + h * state.v[i] + scheme.zeta * h * self.dv[i];
         }
         validate(step, state, &self.x_new, &self.v_new)?;
-        apply(state, &self.x_new, &self.v_new, h);
+        apply(state, &mut self.x_new, &mut self.v_new, h);
         self.steps += 1;
         Ok(info)
     }

@@ -408,24 +408,62 @@ pub(crate) fn validate(step: u64, state: &State, x_new: &[f64], v_new: &[f64]) -
     Ok(())
 }
 
-/// Writes new positions and velocities into `state` and advances its time.
-pub(crate) fn apply(state: &mut State, x_new: &[f64], v_new: &[f64], dt: f64) {
-    state.x.copy_from_slice(x_new);
-    state.v.copy_from_slice(v_new);
+/// Moves new positions and velocities into `state` by swapping buffers (no copy) and advances
+/// its time. Afterwards `x_new` and `v_new` hold the previous state's arrays as scratch.
+pub(crate) fn apply(state: &mut State, x_new: &mut Vec<f64>, v_new: &mut Vec<f64>, dt: f64) {
+    std::mem::swap(&mut state.x, x_new);
+    std::mem::swap(&mut state.v, v_new);
     state.t += dt;
 }
 
-/// Checks the new positions and velocities, then commits them to `state`.
+/// Checks the new positions and velocities, then moves them into `state`.
 pub(crate) fn commit(
     step: u64,
     state: &mut State,
-    x_new: &[f64],
-    v_new: &[f64],
+    x_new: &mut Vec<f64>,
+    v_new: &mut Vec<f64>,
     dt: f64,
 ) -> Result<(), IntegrateError> {
     validate(step, state, x_new, v_new)?;
     apply(state, x_new, v_new, dt);
     Ok(())
+}
+
+/// Degrees of freedom from which element-wise update loops run in parallel.
+pub(crate) const PARALLEL_DOFS: usize = 1 << 15;
+const CHUNK: usize = 1 << 13;
+
+/// Runs `f(offset, chunk)` over chunks of one output array, in parallel for long arrays.
+#[inline]
+pub(crate) fn for_chunks1<F>(a: &mut [f64], f: F)
+where
+    F: Fn(usize, &mut [f64]) + Sync + Send,
+{
+    if a.len() >= PARALLEL_DOFS {
+        use rayon::prelude::*;
+        a.par_chunks_mut(CHUNK).enumerate().for_each(|(c, ac)| f(c * CHUNK, ac));
+    } else {
+        f(0, a);
+    }
+}
+
+/// Runs `f(offset, a_chunk, b_chunk)` over matching chunks of two output arrays, in parallel
+/// for long arrays. The work is element-wise, so the result does not depend on the thread count.
+#[inline]
+pub(crate) fn for_chunks2<F>(a: &mut [f64], b: &mut [f64], f: F)
+where
+    F: Fn(usize, &mut [f64], &mut [f64]) + Sync + Send,
+{
+    assert_eq!(a.len(), b.len(), "for_chunks2: length mismatch");
+    if a.len() >= PARALLEL_DOFS {
+        use rayon::prelude::*;
+        a.par_chunks_mut(CHUNK)
+            .zip(b.par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(|(c, (ac, bc))| f(c * CHUNK, ac, bc));
+    } else {
+        f(0, a, b);
+    }
 }
 
 /// Resizes a scratch vector (allocates only when the size changes).

@@ -72,7 +72,7 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for Rk4 {
             self.x_new[i] = x[i] + h * v[i] + h * h / 6.0 * (k1 + k2 + k3);
             self.v_new[i] = v[i] + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
         }
-        commit(self.steps, state, &self.x_new, &self.v_new, dt)?;
+        commit(self.steps, state, &mut self.x_new, &mut self.v_new, dt)?;
         self.steps += 1;
         Ok(StepInfo { evaluations: 4, ..StepInfo::default() })
     }

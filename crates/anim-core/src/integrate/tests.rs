@@ -443,3 +443,28 @@ fn chain_jacobian_matches_finite_differences_and_its_assembly() {
         }
     }
 }
+
+#[test]
+fn large_systems_take_the_parallel_path_with_identical_results_for_any_thread_count() {
+    // 40 000 degrees of freedom: above the threshold of the chunked parallel update loops.
+    let run = |threads: usize, kind: IntegratorKind| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mut sys = LinearChain::new(40_000, 0.01, 100.0, 0.01, 9.81);
+            let mut state = sys.rest_state();
+            for (i, v) in state.v.iter_mut().enumerate() {
+                *v = ((i % 13) as f64 - 6.0) * 1e-3;
+            }
+            let mut integ = kind.build(40_000);
+            advance(integ.as_mut(), &mut sys, &mut state, 1e-3, 20).unwrap();
+            state
+        })
+    };
+    for kind in [IntegratorKind::ExplicitEuler, IntegratorKind::SymplecticEuler, IntegratorKind::VelocityVerlet] {
+        let one = run(1, kind);
+        let four = run(4, kind);
+        assert!(one.x.iter().zip(&four.x).all(|(a, b)| a.to_bits() == b.to_bits()), "{}", kind.label());
+        assert!(one.v.iter().zip(&four.v).all(|(a, b)| a.to_bits() == b.to_bits()), "{}", kind.label());
+        assert!(one.x[39_999] < -399.99, "{}: the chain must have sagged", kind.label());
+    }
+}

@@ -11,8 +11,8 @@
 //! conservative part and first order in the damping.
 
 use super::{
-    History, IntegrateError, Integrator, SecondOrderSystem, State, StepInfo, apply, check_inputs, commit,
-    fit, validate,
+    History, IntegrateError, Integrator, SecondOrderSystem, State, StepInfo, check_inputs, commit, fit,
+    for_chunks1, for_chunks2, validate,
 };
 use serde::{Deserialize, Serialize};
 
@@ -78,8 +78,11 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for PositionVerlet {
         }
         // x_prev takes x0 only once the new state is known to be finite.
         validate(self.steps, state, &self.x_new, &self.v_new)?;
-        self.x_prev.copy_from_slice(&state.x);
-        apply(state, &self.x_new, &self.v_new, dt);
+        // x_prev takes x0's buffer, the state takes x_new's, x_new keeps the old x_prev as scratch.
+        std::mem::swap(&mut self.x_prev, &mut state.x);
+        std::mem::swap(&mut state.x, &mut self.x_new);
+        std::mem::swap(&mut state.v, &mut self.v_new);
+        state.t += dt;
         self.history.record(state);
         self.steps += 1;
         Ok(StepInfo { evaluations: 1, ..StepInfo::default() })
@@ -164,7 +167,7 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for Leapfrog {
             self.v_new[i] = self.v_half[i] + 0.5 * dt * self.a[i];
             self.v_half_new[i] = self.v_half[i] + dt * self.a[i];
         }
-        commit(self.steps, state, &self.x_new, &self.v_new, dt)?;
+        commit(self.steps, state, &mut self.x_new, &mut self.v_new, dt)?;
         std::mem::swap(&mut self.v_half, &mut self.v_half_new);
         self.history.record(state);
         self.steps += 1;
@@ -228,16 +231,22 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for VelocityVerlet {
             evaluations += 1;
         }
         // v_new holds the half-step velocity until the second kick.
-        for i in 0..n {
-            self.v_new[i] = state.v[i] + 0.5 * dt * self.a[i];
-            self.x_new[i] = state.x[i] + dt * self.v_new[i];
-        }
+        let (x, v, a) = (&state.x, &state.v, &self.a);
+        for_chunks2(&mut self.v_new, &mut self.x_new, |o, vn, xn| {
+            for k in 0..vn.len() {
+                vn[k] = v[o + k] + 0.5 * dt * a[o + k];
+                xn[k] = x[o + k] + dt * vn[k];
+            }
+        });
         system.acceleration(state.t + dt, &self.x_new, &self.v_new, &mut self.a_new);
         evaluations += 1;
-        for i in 0..n {
-            self.v_new[i] += 0.5 * dt * self.a_new[i];
-        }
-        commit(self.steps, state, &self.x_new, &self.v_new, dt)?;
+        let a_new = &self.a_new;
+        for_chunks1(&mut self.v_new, |o, vn| {
+            for k in 0..vn.len() {
+                vn[k] += 0.5 * dt * a_new[o + k];
+            }
+        });
+        commit(self.steps, state, &mut self.x_new, &mut self.v_new, dt)?;
         std::mem::swap(&mut self.a, &mut self.a_new);
         self.history.record(state);
         self.steps += 1;
