@@ -51,6 +51,13 @@ pub struct NewtonParams {
     pub max_iterations: usize,
     /// Take exactly one iteration from `(x0, v0)`: the seed's linearised scheme. Default `false`.
     pub linearized: bool,
+    /// Backtracking line search on `||g||` from the second iteration on: the step is halved
+    /// until the residual decreases by the Armijo factor `1 - 1e-4 alpha`. Keeps Newton
+    /// converging where the Jacobian is approximate (definiteness fixes) or the force strongly
+    /// nonlinear (contact, folding cloth). Default `true`.
+    pub line_search: bool,
+    /// Halvings tried by the line search before taking the best trial. Default `8`.
+    pub max_halvings: usize,
     /// Stopping rule of the inner iterative linear solve. Default tolerance `1e-10`, 2000
     /// iterations.
     pub linear: IterativeParams,
@@ -62,6 +69,8 @@ impl Default for NewtonParams {
             tolerance: 1e-9,
             max_iterations: 20,
             linearized: false,
+            line_search: true,
+            max_halvings: 8,
             linear: IterativeParams::new(1e-10, 2000),
         }
     }
@@ -132,6 +141,7 @@ struct NewtonCore {
     f: Vec<f64>,
     dv: Vec<f64>,
     delta: Vec<f64>,
+    dv_trial: Vec<f64>,
     rhs: Vec<f64>,
     tmp: Vec<f64>,
     x_e: Vec<f64>,
@@ -154,6 +164,7 @@ impl NewtonCore {
             &mut self.f,
             &mut self.dv,
             &mut self.delta,
+            &mut self.dv_trial,
             &mut self.rhs,
             &mut self.tmp,
             &mut self.x_e,
@@ -298,41 +309,112 @@ impl NewtonCore {
                 self.dv[i] = self.w[i] * self.rhs[i];
             }
         } else if g0 > 0.0 {
-            let mut iteration = 0;
+            // The first iteration is the seed's linearised step from (x0, v0).
+            info.linear_iterations += self
+                .solve_linear(system, solver, c_x, c_v)
+                .map_err(|source| IntegrateError::LinearSolve { step, newton_iteration: 0, source })?;
+            self.dv.copy_from_slice(&self.delta);
+            let mut iteration = 1;
+            // Whether `rhs`, `x_e`, `v_e` already hold g(dv) and its evaluation point.
+            let mut have_g = false;
+            let mut g_norm = 0.0;
             loop {
-                info.linear_iterations += self.solve_linear(system, solver, c_x, c_v).map_err(|source| {
-                    IntegrateError::LinearSolve { step, newton_iteration: iteration, source }
-                })?;
-                for i in 0..n {
-                    self.dv[i] += self.delta[i];
-                }
-                iteration += 1;
                 info.newton_iterations = iteration;
                 if params.linearized {
                     break;
                 }
-                // Residual g(dv) = M dv - h f(x_e, v_e) at the new iterate.
-                for i in 0..n {
-                    self.x_e[i] = state.x[i] + scheme.alpha * h * state.v[i] + scheme.gamma * h * self.dv[i];
-                    self.v_e[i] = state.v[i] + scheme.eta * self.dv[i];
+                if !have_g {
+                    g_norm = residual_at(
+                        system,
+                        state,
+                        scheme,
+                        h,
+                        t_e,
+                        &self.w,
+                        &self.dv,
+                        &mut self.x_e,
+                        &mut self.v_e,
+                        &mut self.f,
+                        &mut self.rhs,
+                    );
+                    info.evaluations += 1;
                 }
-                system.force(t_e, &self.x_e, &self.v_e, &mut self.f);
-                info.evaluations += 1;
-                for i in 0..n {
-                    self.rhs[i] = if self.w[i] > 0.0 { h * self.f[i] - self.dv[i] / self.w[i] } else { 0.0 };
-                }
-                let g = norm(&self.rhs);
-                residual = g / g0;
+                residual = g_norm / g0;
                 if !residual.is_finite() {
                     return Err(IntegrateError::NewtonNotConverged { step, iterations: iteration, residual });
                 }
-                if residual <= params.tolerance || g <= floor {
+                if residual <= params.tolerance || g_norm <= floor {
                     break;
                 }
                 if iteration >= params.max_iterations {
                     return Err(IntegrateError::NewtonNotConverged { step, iterations: iteration, residual });
                 }
                 system.linearize(t_e, &self.x_e, &self.v_e);
+                info.linear_iterations += self.solve_linear(system, solver, c_x, c_v).map_err(|source| {
+                    IntegrateError::LinearSolve { step, newton_iteration: iteration, source }
+                })?;
+                iteration += 1;
+                if !params.line_search {
+                    for i in 0..n {
+                        self.dv[i] += self.delta[i];
+                    }
+                    have_g = false;
+                    continue;
+                }
+                // Backtracking on ||g||: halve the step until the residual decreases enough
+                // (Armijo, 1e-4); if no trial does, take the best one seen.
+                let (mut alpha, mut best_alpha, mut best) = (1.0, 1.0, f64::INFINITY);
+                let mut accepted = false;
+                for _ in 0..=params.max_halvings {
+                    for i in 0..n {
+                        self.dv_trial[i] = self.dv[i] + alpha * self.delta[i];
+                    }
+                    let t = residual_at(
+                        system,
+                        state,
+                        scheme,
+                        h,
+                        t_e,
+                        &self.w,
+                        &self.dv_trial,
+                        &mut self.x_e,
+                        &mut self.v_e,
+                        &mut self.f,
+                        &mut self.tmp,
+                    );
+                    info.evaluations += 1;
+                    if t <= (1.0 - 1e-4 * alpha) * g_norm {
+                        g_norm = t;
+                        accepted = true;
+                        break;
+                    }
+                    if t < best {
+                        (best, best_alpha) = (t, alpha);
+                    }
+                    alpha *= 0.5;
+                }
+                if !accepted {
+                    for i in 0..n {
+                        self.dv_trial[i] = self.dv[i] + best_alpha * self.delta[i];
+                    }
+                    g_norm = residual_at(
+                        system,
+                        state,
+                        scheme,
+                        h,
+                        t_e,
+                        &self.w,
+                        &self.dv_trial,
+                        &mut self.x_e,
+                        &mut self.v_e,
+                        &mut self.f,
+                        &mut self.tmp,
+                    );
+                    info.evaluations += 1;
+                }
+                std::mem::swap(&mut self.dv, &mut self.dv_trial);
+                std::mem::swap(&mut self.rhs, &mut self.tmp);
+                have_g = true;
             }
         }
         info.residual = residual;
@@ -345,6 +427,32 @@ impl NewtonCore {
         self.steps += 1;
         Ok(info)
     }
+}
+
+/// Evaluates the Newton residual `g = h f(x_e, v_e) - M dv` (zero on fixed rows) at `dv`,
+/// leaving the evaluation point in `x_e`, `v_e`; returns `||g||`.
+fn residual_at<S: MechanicalSystem + ?Sized>(
+    system: &mut S,
+    state: &State,
+    scheme: Scheme,
+    h: f64,
+    t_e: f64,
+    w: &[f64],
+    dv: &[f64],
+    x_e: &mut [f64],
+    v_e: &mut [f64],
+    f: &mut [f64],
+    g: &mut [f64],
+) -> f64 {
+    for i in 0..dv.len() {
+        x_e[i] = state.x[i] + scheme.alpha * h * state.v[i] + scheme.gamma * h * dv[i];
+        v_e[i] = state.v[i] + scheme.eta * dv[i];
+    }
+    system.force(t_e, x_e, v_e, f);
+    for i in 0..dv.len() {
+        g[i] = if w[i] > 0.0 { h * f[i] - dv[i] / w[i] } else { 0.0 };
+    }
+    norm(g)
 }
 
 /// The seed's beta-blend (seed 2.1): `[I - beta h^2 M^-1 K] v1 = v0 + h M^-1 f(x0)`,

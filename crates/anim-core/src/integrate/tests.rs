@@ -460,11 +460,66 @@ fn large_systems_take_the_parallel_path_with_identical_results_for_any_thread_co
             state
         })
     };
-    for kind in [IntegratorKind::ExplicitEuler, IntegratorKind::SymplecticEuler, IntegratorKind::VelocityVerlet] {
+    for kind in
+        [IntegratorKind::ExplicitEuler, IntegratorKind::SymplecticEuler, IntegratorKind::VelocityVerlet]
+    {
         let one = run(1, kind);
         let four = run(4, kind);
         assert!(one.x.iter().zip(&four.x).all(|(a, b)| a.to_bits() == b.to_bits()), "{}", kind.label());
         assert!(one.v.iter().zip(&four.v).all(|(a, b)| a.to_bits() == b.to_bits()), "{}", kind.label());
         assert!(one.x[39_999] < -399.99, "{}: the chain must have sagged", kind.label());
     }
+}
+
+#[test]
+fn line_search_rescues_newton_on_a_saturating_spring() {
+    // A saturating spring x'' = -100 atan(x), one backward-Euler step of h = 1 from x0 = 3:
+    // Newton on an arctangent overshoots further each iteration (the classic divergent case);
+    // with backtracking on ||g|| it converges, and the answer satisfies the backward-Euler
+    // equation v1 = v0 + h a(x0 + h v1).
+    struct Duffing {
+        k: f64,
+    }
+    impl SecondOrderSystem for Duffing {
+        fn dof(&self) -> usize {
+            1
+        }
+        fn acceleration(&mut self, _t: f64, x: &[f64], _v: &[f64], a: &mut [f64]) {
+            a[0] = -100.0 * x[0].atan();
+        }
+    }
+    impl MechanicalSystem for Duffing {
+        fn inverse_mass(&self, w: &mut [f64]) {
+            w[0] = 1.0;
+        }
+        fn force(&mut self, t: f64, x: &[f64], v: &[f64], f: &mut [f64]) {
+            self.acceleration(t, x, v, f);
+        }
+        fn linearize(&mut self, _t: f64, x: &[f64], _v: &[f64]) {
+            self.k = -100.0 / (1.0 + x[0] * x[0]);
+        }
+        fn jacobian_apply(&self, c_x: f64, _c_v: f64, dx: &[f64], out: &mut [f64]) {
+            out[0] = c_x * self.k * dx[0];
+        }
+    }
+    let mut report = Vec::new();
+    for line_search in [false, true] {
+        let mut params = NewtonParams::with_tolerance(1e-12);
+        params.line_search = line_search;
+        let mut integ = BetaBlend::new(1.0, params, LinearSolverKind::Cg.build(params.linear), 1);
+        let mut sys = Duffing { k: 0.0 };
+        let mut state = State::new(vec![3.0], vec![0.0]);
+        let (x0, v0, h) = (state.x[0], state.v[0], 1.0);
+        let result = Integrator::<Duffing>::step(&mut integ, &mut sys, &mut state, h);
+        report.push((line_search, result.clone().map(|i| i.newton_iterations)));
+        if !line_search {
+            assert!(result.is_err(), "plain Newton was expected to fail here: {result:?}");
+        } else {
+            let info = result.unwrap();
+            let mut a = [0.0];
+            sys.acceleration(0.0, &[x0 + h * state.v[0]], &[0.0], &mut a);
+            assert!((state.v[0] - (v0 + h * a[0])).abs() < 1e-9 * (1.0 + state.v[0].abs()), "{info:?}");
+        }
+    }
+    println!("atan spring, h = 1, x0 = 3: {report:?}");
 }
