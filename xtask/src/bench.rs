@@ -29,7 +29,7 @@ fn parse_bencher(out: &str) -> Vec<Row> {
 
 pub fn run(filter: Option<&str>) -> bool {
     if std::env::args().skip(2).any(|a| a == "--peers") {
-        return peers::run();
+        return peers::run() & peers_rigid::run();
     }
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut args = vec!["bench", "-p", "anim-benches", "--benches", "--", "--output-format", "bencher"];
@@ -84,6 +84,10 @@ fn human(ns: f64) -> String {
         format!("{:.2} s", ns / 1e9)
     }
 }
+
+/// anim-rigid's peers (Pinocchio), in its own file.
+#[path = "peers_rigid.rs"]
+mod peers_rigid;
 
 /// `cargo xtask bench --peers`: our per-step time against peer libraries on the same problem,
 /// same integrator and same thread count, measured side by side in one run.

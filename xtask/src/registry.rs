@@ -157,6 +157,7 @@ pub fn all() -> Registry {
     crate::cases::core::register(&mut r);
     crate::cases::io::register(&mut r);
     crate::cases::springs::register(&mut r);
+    crate::cases::rigid::register(&mut r);
     r
 }
 

@@ -9,7 +9,7 @@ use std::path::Path;
 use std::time::Instant;
 
 /// Tolerances of the "cheapest method" tables.
-const TOLERANCES: [f64; 4] = [1e-2, 1e-4, 1e-6, 1e-8];
+const TOLERANCES: [f64; 5] = [1e-2, 1e-3, 1e-4, 1e-6, 1e-8];
 
 pub fn run(ctx: &Ctx, out: &str) -> bool {
     let start = Instant::now();

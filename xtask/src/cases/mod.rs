@@ -2,4 +2,5 @@
 
 pub mod core;
 pub mod io;
+pub mod rigid;
 pub mod springs;

@@ -1,0 +1,914 @@
+//! The kinematic tree: joints in topological order, the rigid body each joint moves (its
+//! inertia), and named frames. Built once by [`ModelBuilder`] (or [`crate::urdf`]), never
+//! changed by an algorithm.
+//!
+//! # Layout (Pinocchio's)
+//!
+//! Joint `0` is the **universe**, the fixed world; it is its own parent. Every other joint `i`
+//! has a parent `parent(i) < i`, so one forward sweep `i = 1, 2, ...` visits parents before
+//! children (topological order) and one backward sweep visits children first, which is what
+//! RNEA, CRBA and ABA need. Joint `i` moves the frame
+//!
+//! ```text
+//! parent_M_i(q) = placement_i · X_J(q_i)          (placement: Se3 in the parent joint's frame)
+//! world_M_i(q)  = world_M_parent(i)(q) · parent_M_i(q)
+//! ```
+//!
+//! where `X_J` is the joint's own motion ([`JointType::transform`]). The rigid body attached to
+//! joint `i` (every link it carries, fixed links merged) has one [`Inertia`] expressed in joint
+//! `i`'s frame. A [`Frame`] is a named placement relative to a joint: the joint itself, a link,
+//! a merged fixed joint, or an operational point such as a tool centre.
+//!
+//! # Configuration and velocity
+//!
+//! The configuration `q` has `nq` entries and the velocity `v` has `nv`; they differ for joints
+//! whose configuration space is not a vector space:
+//!
+//! | joint | `nq` | `nv` | `q` | `v` |
+//! | --- | --- | --- | --- | --- |
+//! | revolute | 1 | 1 | angle (rad) | angular rate about the axis |
+//! | prismatic | 1 | 1 | displacement (m) | rate along the axis |
+//! | fixed | 0 | 0 | | |
+//! | spherical | 4 | 3 | unit quaternion `(x, y, z, w)` | angular velocity in the joint (child) frame |
+//! | free | 7 | 6 | translation `(x, y, z)`, unit quaternion `(x, y, z, w)` | twist `(v, ω)` in the joint (child) frame |
+//!
+//! The quaternion order `(x, y, z, w)` and the local-frame velocity are Pinocchio's, so `q` and
+//! `v` vectors can be exchanged with it. Moving on this manifold is [`crate::config::integrate`]
+//! and [`crate::config::difference`].
+
+use anim_core::glam::{DMat3, DQuat, DVec3};
+use anim_core::lie::{Se3, Twist, so3};
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// Index of a joint in [`Model::joints`]; `0` is the universe.
+pub type JointIndex = usize;
+/// Index of a frame in [`Model::frames`]; `0` is the universe frame.
+pub type FrameIndex = usize;
+
+/// Tolerance on the orthonormality of joint and frame placements given to [`ModelBuilder`].
+const PLACEMENT_TOL: f64 = 1e-9;
+
+/// The direction of a revolute or prismatic joint, in the joint's own frame.
+///
+/// The coordinate axes get their own variants so that forward kinematics can use the cheap
+/// rotation `[[c, -s, 0], [s, c, 0], [0, 0, 1]]` instead of Rodrigues' formula (Pinocchio does
+/// the same with `JointModelRZ` and friends).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Axis {
+    /// `+x`.
+    X,
+    /// `+y`.
+    Y,
+    /// `+z`.
+    Z,
+    /// Any other unit vector.
+    Unaligned(DVec3),
+}
+
+impl Axis {
+    /// The axis along `v`, normalised, or `None` when `v` is zero or not finite. A vector that
+    /// is exactly `+x`, `+y` or `+z` after normalisation becomes [`Axis::X`], [`Axis::Y`] or
+    /// [`Axis::Z`].
+    #[must_use]
+    pub fn from_vector(v: DVec3) -> Option<Self> {
+        let n = v.length();
+        if !n.is_finite() || n == 0.0 {
+            return None;
+        }
+        let u = v / n;
+        Some(if u == DVec3::X {
+            Axis::X
+        } else if u == DVec3::Y {
+            Axis::Y
+        } else if u == DVec3::Z {
+            Axis::Z
+        } else {
+            Axis::Unaligned(u)
+        })
+    }
+
+    /// The unit vector of the axis.
+    #[inline]
+    #[must_use]
+    pub fn vector(&self) -> DVec3 {
+        match *self {
+            Axis::X => DVec3::X,
+            Axis::Y => DVec3::Y,
+            Axis::Z => DVec3::Z,
+            Axis::Unaligned(u) => u,
+        }
+    }
+
+    /// The rotation by `angle` about this axis.
+    #[inline]
+    #[must_use]
+    pub fn rotation(&self, angle: f64) -> DMat3 {
+        let (s, c) = angle.sin_cos();
+        match *self {
+            Axis::X => DMat3::from_cols(DVec3::X, DVec3::new(0.0, c, s), DVec3::new(0.0, -s, c)),
+            Axis::Y => DMat3::from_cols(DVec3::new(c, 0.0, -s), DVec3::Y, DVec3::new(s, 0.0, c)),
+            Axis::Z => DMat3::from_cols(DVec3::new(c, s, 0.0), DVec3::new(-s, c, 0.0), DVec3::Z),
+            Axis::Unaligned(u) => {
+                // R = c I + s û + (1 - c) u uᵀ (Rodrigues with ‖u‖ = 1).
+                let t = 1.0 - c;
+                let (x, y, z) = (u.x, u.y, u.z);
+                DMat3::from_cols(
+                    DVec3::new(c + t * x * x, t * x * y + s * z, t * x * z - s * y),
+                    DVec3::new(t * x * y - s * z, c + t * y * y, t * y * z + s * x),
+                    DVec3::new(t * x * z + s * y, t * y * z - s * x, c + t * z * z),
+                )
+            }
+        }
+    }
+}
+
+/// The kind of a joint and its axis.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum JointType {
+    /// Rotation about an axis through the joint origin (URDF `revolute` and `continuous`).
+    Revolute(Axis),
+    /// Translation along an axis (URDF `prismatic`).
+    Prismatic(Axis),
+    /// No motion (URDF `fixed`, or a locked joint). Only present when fixed joints are not
+    /// merged into their parent; the universe is also of this type.
+    Fixed,
+    /// A ball joint: any rotation about the joint origin, `q` a unit quaternion `(x, y, z, w)`.
+    Spherical,
+    /// A free (floating) joint: any rigid motion, `q = (x, y, z, qx, qy, qz, qw)`.
+    Free,
+}
+
+impl JointType {
+    /// Number of configuration entries.
+    #[inline]
+    #[must_use]
+    pub const fn nq(&self) -> usize {
+        match self {
+            JointType::Revolute(_) | JointType::Prismatic(_) => 1,
+            JointType::Fixed => 0,
+            JointType::Spherical => 4,
+            JointType::Free => 7,
+        }
+    }
+
+    /// Number of velocity entries (degrees of freedom).
+    #[inline]
+    #[must_use]
+    pub const fn nv(&self) -> usize {
+        match self {
+            JointType::Revolute(_) | JointType::Prismatic(_) => 1,
+            JointType::Fixed => 0,
+            JointType::Spherical => 3,
+            JointType::Free => 6,
+        }
+    }
+
+    /// A short name: `revolute`, `prismatic`, `fixed`, `spherical` or `free`.
+    #[must_use]
+    pub const fn name(&self) -> &'static str {
+        match self {
+            JointType::Revolute(_) => "revolute",
+            JointType::Prismatic(_) => "prismatic",
+            JointType::Fixed => "fixed",
+            JointType::Spherical => "spherical",
+            JointType::Free => "free",
+        }
+    }
+
+    /// The joint motion `X_J(q)`: the placement of the joint's child frame in the frame the
+    /// joint placement puts it at `q = neutral`. `q` is this joint's slice of the configuration
+    /// (length [`nq`](Self::nq)); quaternions are assumed to be of unit length.
+    #[inline]
+    #[must_use]
+    pub fn transform(&self, q: &[f64]) -> Se3 {
+        match self {
+            JointType::Revolute(axis) => Se3::from_rotation(axis.rotation(q[0])),
+            JointType::Prismatic(axis) => Se3::from_translation(axis.vector() * q[0]),
+            JointType::Fixed => Se3::IDENTITY,
+            JointType::Spherical => Se3::from_rotation(quat_to_matrix(q[0], q[1], q[2], q[3])),
+            JointType::Free => Se3::new(quat_to_matrix(q[3], q[4], q[5], q[6]), DVec3::new(q[0], q[1], q[2])),
+        }
+    }
+
+    /// Column `k` (`k < nv`) of the motion subspace `S`: the twist, in the joint's child frame
+    /// (linear part first), produced by a unit rate of velocity entry `k`. The joint's spatial
+    /// velocity is `S v_joint`; dynamics uses `S` for projections (`τ = Sᵀ f`).
+    ///
+    /// Revolute: `(0, a)`; prismatic: `(a, 0)`; spherical: `(0, e_k)`; free: the `k`-th unit
+    /// twist (`(e_k, 0)` for `k < 3`, `(0, e_{k-3})` otherwise).
+    ///
+    /// # Panics
+    /// When `k >= nv`.
+    #[must_use]
+    #[track_caller]
+    pub fn motion_subspace_column(&self, k: usize) -> Twist {
+        assert!(k < self.nv(), "motion subspace column {k} of a {} joint (nv = {})", self.name(), self.nv());
+        let e = |i: usize| [DVec3::X, DVec3::Y, DVec3::Z][i];
+        match self {
+            JointType::Revolute(axis) => Twist::new(DVec3::ZERO, axis.vector()),
+            JointType::Prismatic(axis) => Twist::new(axis.vector(), DVec3::ZERO),
+            JointType::Fixed => Twist::ZERO,
+            JointType::Spherical => Twist::new(DVec3::ZERO, e(k)),
+            JointType::Free => {
+                if k < 3 {
+                    Twist::new(e(k), DVec3::ZERO)
+                } else {
+                    Twist::new(DVec3::ZERO, e(k - 3))
+                }
+            }
+        }
+    }
+}
+
+/// The rotation matrix of the unit quaternion `(x, y, z, w)`.
+#[inline]
+pub(crate) fn quat_to_matrix(x: f64, y: f64, z: f64, w: f64) -> DMat3 {
+    DMat3::from_quat(DQuat::from_xyzw(x, y, z, w))
+}
+
+/// Position, velocity and effort limits of a one-degree-of-freedom joint. Unbounded entries are
+/// infinite; multi-degree-of-freedom joints carry [`JointLimits::UNBOUNDED`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct JointLimits {
+    /// Lowest position (rad or m); `-inf` when unbounded.
+    pub lower: f64,
+    /// Highest position (rad or m); `+inf` when unbounded.
+    pub upper: f64,
+    /// Largest speed magnitude; `+inf` when unknown.
+    pub velocity: f64,
+    /// Largest effort (N·m or N) magnitude; `+inf` when unknown.
+    pub effort: f64,
+}
+
+impl JointLimits {
+    /// No limits at all.
+    pub const UNBOUNDED: Self = Self {
+        lower: f64::NEG_INFINITY,
+        upper: f64::INFINITY,
+        velocity: f64::INFINITY,
+        effort: f64::INFINITY,
+    };
+
+    /// Position limits `[lower, upper]`, unbounded speed and effort.
+    #[must_use]
+    pub const fn position(lower: f64, upper: f64) -> Self {
+        Self { lower, upper, velocity: f64::INFINITY, effort: f64::INFINITY }
+    }
+
+    /// Whether both position limits are finite.
+    #[must_use]
+    pub fn is_bounded(&self) -> bool {
+        self.lower.is_finite() && self.upper.is_finite()
+    }
+}
+
+impl Default for JointLimits {
+    fn default() -> Self {
+        Self::UNBOUNDED
+    }
+}
+
+/// The mass properties of a rigid body, expressed in some frame `F` (a joint frame in a
+/// [`Model`]): mass, centre of mass and the rotational inertia about the centre of mass with
+/// `F`'s axes. Pinocchio's `Inertia` (mass, lever, inertia) in the same convention.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Inertia {
+    /// Mass (kg), `>= 0`.
+    pub mass: f64,
+    /// Centre of mass in `F` (m).
+    pub com: DVec3,
+    /// Rotational inertia about the centre of mass, axes of `F` (kg·m²), symmetric.
+    pub rotational: DMat3,
+}
+
+impl Inertia {
+    /// No mass.
+    pub const ZERO: Self = Self { mass: 0.0, com: DVec3::ZERO, rotational: DMat3::ZERO };
+
+    /// The inertia of mass `mass` at `com` with rotational inertia `rotational` about it.
+    #[must_use]
+    pub const fn new(mass: f64, com: DVec3, rotational: DMat3) -> Self {
+        Self { mass, com, rotational }
+    }
+
+    /// The same body expressed in the frame `A` given `g = A_M_F`: `com' = g(com)`,
+    /// `I' = R I Rᵀ`.
+    #[must_use]
+    pub fn transformed(&self, g: &Se3) -> Self {
+        Self {
+            mass: self.mass,
+            com: g.transform_point(self.com),
+            rotational: g.rotation * self.rotational * g.rotation.transpose(),
+        }
+    }
+
+    /// The inertia of two bodies rigidly joined (both expressed in the same frame): masses add,
+    /// the centre of mass is the mass-weighted mean, and the rotational inertia about it follows
+    /// the parallel-axis theorem,
+    /// `I = I₁ + I₂ - (m₁ m₂ / (m₁ + m₂)) ĉ²` with `c = c₁ - c₂`.
+    #[must_use]
+    pub fn merged(&self, other: &Inertia) -> Self {
+        let mass = self.mass + other.mass;
+        if mass <= 0.0 {
+            return Self { mass: 0.0, com: DVec3::ZERO, rotational: self.rotational + other.rotational };
+        }
+        let com = (self.com * self.mass + other.com * other.mass) / mass;
+        let d = so3::hat(self.com - other.com);
+        let rotational = self.rotational + other.rotational - d * d * (self.mass * other.mass / mass);
+        Self { mass, com, rotational }
+    }
+}
+
+impl Default for Inertia {
+    fn default() -> Self {
+        Self::ZERO
+    }
+}
+
+/// One joint of a [`Model`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Joint {
+    /// Unique name (the URDF joint name; `universe` for joint 0).
+    pub name: String,
+    /// Kind and axis.
+    pub kind: JointType,
+    /// Parent joint; `parent < own index`, and `0` for the universe itself.
+    pub parent: JointIndex,
+    /// Placement of the joint frame at the neutral configuration, in the parent joint's frame.
+    pub placement: Se3,
+    /// Limits (meaningful for one-degree-of-freedom joints).
+    pub limits: JointLimits,
+    /// First index of this joint in the configuration `q`.
+    pub idx_q: usize,
+    /// First index of this joint in the velocity `v` (and the Jacobian's columns).
+    pub idx_v: usize,
+}
+
+impl Joint {
+    /// Number of configuration entries.
+    #[inline]
+    #[must_use]
+    pub fn nq(&self) -> usize {
+        self.kind.nq()
+    }
+
+    /// Number of velocity entries.
+    #[inline]
+    #[must_use]
+    pub fn nv(&self) -> usize {
+        self.kind.nv()
+    }
+}
+
+/// What a [`Frame`] marks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum FrameKind {
+    /// The frame of a movable joint (identity placement on it).
+    Joint,
+    /// A fixed joint merged into its parent body (and the universe frame).
+    FixedJoint,
+    /// A link (URDF `<link>`).
+    Body,
+    /// An operational point added by the user (a tool centre, a marker).
+    Operational,
+}
+
+/// A named frame rigidly attached to a joint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Frame {
+    /// Name (URDF link or joint name). Names are unique within one [`FrameKind`].
+    pub name: String,
+    /// What it marks.
+    pub kind: FrameKind,
+    /// The joint whose motion carries it.
+    pub parent_joint: JointIndex,
+    /// Placement in the parent joint's frame.
+    pub placement: Se3,
+}
+
+/// Bad input to [`ModelBuilder`].
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ModelError {
+    /// The parent joint index does not exist (yet).
+    #[error("joint '{joint}': parent joint index {parent} does not exist (the model has {count} joints)")]
+    UnknownParent {
+        /// The joint being added.
+        joint: String,
+        /// The parent index given.
+        parent: usize,
+        /// Number of joints so far.
+        count: usize,
+    },
+    /// Two joints with the same name.
+    #[error("joint name '{0}' is used twice")]
+    DuplicateJoint(String),
+    /// Two frames of the same kind with the same name.
+    #[error("{kind:?} frame name '{name}' is used twice")]
+    DuplicateFrame {
+        /// The name.
+        name: String,
+        /// Its kind.
+        kind: FrameKind,
+    },
+    /// A placement with non-finite entries or a rotation block that is not a rotation.
+    #[error("{what} '{name}': placement is not a rigid motion (non-finite or non-orthonormal rotation)")]
+    BadPlacement {
+        /// `joint`, `frame` or `body`.
+        what: &'static str,
+        /// Its name.
+        name: String,
+    },
+    /// Limits with `lower > upper` or NaN, or negative speed/effort limits.
+    #[error(
+        "joint '{joint}': invalid limits (lower {lower}, upper {upper}, velocity {velocity}, effort {effort})"
+    )]
+    BadLimits {
+        /// The joint.
+        joint: String,
+        /// Lower position limit.
+        lower: f64,
+        /// Upper position limit.
+        upper: f64,
+        /// Speed limit.
+        velocity: f64,
+        /// Effort limit.
+        effort: f64,
+    },
+    /// A negative or non-finite mass, or a non-finite centre of mass or inertia.
+    #[error("body on joint '{joint}': invalid inertia (mass {mass})")]
+    BadInertia {
+        /// The joint the body is attached to.
+        joint: String,
+        /// Its mass.
+        mass: f64,
+    },
+}
+
+/// An articulated rigid-body model: the kinematic tree, its limits, the bodies' inertias and
+/// named frames. Immutable; every algorithm takes `&Model` and writes into a [`crate::Data`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Model {
+    name: String,
+    joints: Vec<Joint>,
+    inertias: Vec<Inertia>,
+    frames: Vec<Frame>,
+    children: Vec<Vec<JointIndex>>,
+    nq: usize,
+    nv: usize,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+}
+
+impl Model {
+    /// The model's name (the URDF robot name).
+    #[must_use]
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Number of joints including the universe (Pinocchio's `njoints`).
+    #[inline]
+    #[must_use]
+    pub fn njoints(&self) -> usize {
+        self.joints.len()
+    }
+
+    /// Size of the configuration vector `q`.
+    #[inline]
+    #[must_use]
+    pub fn nq(&self) -> usize {
+        self.nq
+    }
+
+    /// Size of the velocity vector `v` (degrees of freedom, Jacobian columns).
+    #[inline]
+    #[must_use]
+    pub fn nv(&self) -> usize {
+        self.nv
+    }
+
+    /// Every joint in topological order; index `0` is the universe.
+    #[inline]
+    #[must_use]
+    pub fn joints(&self) -> &[Joint] {
+        &self.joints
+    }
+
+    /// Joint `i`.
+    ///
+    /// # Panics
+    /// When `i >= njoints()`.
+    #[inline]
+    #[must_use]
+    #[track_caller]
+    pub fn joint(&self, i: JointIndex) -> &Joint {
+        &self.joints[i]
+    }
+
+    /// The parent of joint `i` (`0` for the universe itself).
+    #[inline]
+    #[must_use]
+    #[track_caller]
+    pub fn parent(&self, i: JointIndex) -> JointIndex {
+        self.joints[i].parent
+    }
+
+    /// The children of joint `i`, in increasing index order.
+    #[inline]
+    #[must_use]
+    #[track_caller]
+    pub fn children(&self, i: JointIndex) -> &[JointIndex] {
+        &self.children[i]
+    }
+
+    /// The inertia of the body carried by each joint, in that joint's frame (index `0`: the
+    /// links fixed to the world).
+    #[inline]
+    #[must_use]
+    pub fn inertias(&self) -> &[Inertia] {
+        &self.inertias
+    }
+
+    /// Every frame; index `0` is the universe.
+    #[inline]
+    #[must_use]
+    pub fn frames(&self) -> &[Frame] {
+        &self.frames
+    }
+
+    /// Frame `f`.
+    ///
+    /// # Panics
+    /// When `f >= frames().len()`.
+    #[inline]
+    #[must_use]
+    #[track_caller]
+    pub fn frame(&self, f: FrameIndex) -> &Frame {
+        &self.frames[f]
+    }
+
+    /// The index of the joint named `name`.
+    #[must_use]
+    pub fn joint_id(&self, name: &str) -> Option<JointIndex> {
+        self.joints.iter().position(|j| j.name == name)
+    }
+
+    /// The index of the first frame named `name` (any kind). Link and joint names may coincide
+    /// in a URDF; [`frame_id_of_kind`](Self::frame_id_of_kind) disambiguates.
+    #[must_use]
+    pub fn frame_id(&self, name: &str) -> Option<FrameIndex> {
+        self.frames.iter().position(|f| f.name == name)
+    }
+
+    /// The index of the frame named `name` of kind `kind`.
+    #[must_use]
+    pub fn frame_id_of_kind(&self, name: &str, kind: FrameKind) -> Option<FrameIndex> {
+        self.frames.iter().position(|f| f.name == name && f.kind == kind)
+    }
+
+    /// Lower position limit per configuration entry (`-inf` where unbounded, `-1` on
+    /// quaternion entries).
+    #[inline]
+    #[must_use]
+    pub fn lower_limits(&self) -> &[f64] {
+        &self.lower
+    }
+
+    /// Upper position limit per configuration entry (`+inf` where unbounded, `1` on quaternion
+    /// entries).
+    #[inline]
+    #[must_use]
+    pub fn upper_limits(&self) -> &[f64] {
+        &self.upper
+    }
+
+    /// The joints from the first one below the universe down to `joint` itself (its *support*),
+    /// root first. Empty for the universe.
+    #[must_use]
+    pub fn support(&self, joint: JointIndex) -> Vec<JointIndex> {
+        let mut chain = Vec::new();
+        let mut j = joint;
+        while j != 0 {
+            chain.push(j);
+            j = self.joints[j].parent;
+        }
+        chain.reverse();
+        chain
+    }
+
+    /// Whether joint `ancestor` is `joint` or one of its ancestors (the universe is an ancestor
+    /// of every joint).
+    #[must_use]
+    pub fn is_ancestor(&self, ancestor: JointIndex, joint: JointIndex) -> bool {
+        let mut j = joint;
+        loop {
+            if j == ancestor {
+                return true;
+            }
+            if j == 0 {
+                return false;
+            }
+            j = self.joints[j].parent;
+        }
+    }
+
+    /// Total mass of every body.
+    #[must_use]
+    pub fn total_mass(&self) -> f64 {
+        self.inertias.iter().map(|i| i.mass).sum()
+    }
+}
+
+/// Builds a [`Model`] joint by joint, in topological order (a parent before its children).
+///
+/// ```
+/// use anim_core::glam::DVec3;
+/// use anim_core::lie::Se3;
+/// use anim_rigid::{Axis, FrameKind, Inertia, JointLimits, JointType, ModelBuilder};
+///
+/// let mut b = ModelBuilder::new("two-link");
+/// let j1 = b.add_joint(0, "shoulder", JointType::Revolute(Axis::Z), Se3::IDENTITY, JointLimits::UNBOUNDED)?;
+/// let j2 = b.add_joint(j1, "elbow", JointType::Revolute(Axis::Z),
+///     Se3::from_translation(DVec3::X), JointLimits::position(-2.0, 2.0))?;
+/// b.append_body(j2, &Inertia::new(1.0, DVec3::X * 0.5, Default::default()), &Se3::IDENTITY)?;
+/// b.add_frame("tip", FrameKind::Operational, j2, Se3::from_translation(DVec3::X))?;
+/// let model = b.build();
+/// assert_eq!((model.njoints(), model.nq(), model.nv()), (3, 2, 2));
+/// # Ok::<(), anim_rigid::ModelError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct ModelBuilder {
+    model: Model,
+}
+
+impl ModelBuilder {
+    /// A model with only the universe joint and the `universe` frame.
+    #[must_use]
+    pub fn new(name: &str) -> Self {
+        let universe = Joint {
+            name: "universe".into(),
+            kind: JointType::Fixed,
+            parent: 0,
+            placement: Se3::IDENTITY,
+            limits: JointLimits::UNBOUNDED,
+            idx_q: 0,
+            idx_v: 0,
+        };
+        let frame = Frame {
+            name: "universe".into(),
+            kind: FrameKind::FixedJoint,
+            parent_joint: 0,
+            placement: Se3::IDENTITY,
+        };
+        Self {
+            model: Model {
+                name: name.to_string(),
+                joints: vec![universe],
+                inertias: vec![Inertia::ZERO],
+                frames: vec![frame],
+                children: vec![Vec::new()],
+                nq: 0,
+                nv: 0,
+                lower: Vec::new(),
+                upper: Vec::new(),
+            },
+        }
+    }
+
+    /// The model built so far (to look up indices while building).
+    #[must_use]
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// Adds joint `name` of type `kind` under `parent`, at `placement` in the parent joint's
+    /// frame, with `limits` (ignored for joints that are not one-degree-of-freedom), and a
+    /// [`FrameKind::Joint`] frame on it. Returns its index.
+    ///
+    /// # Errors
+    /// An unknown parent, a name already used, a placement that is not a rigid motion, or bad
+    /// limits.
+    pub fn add_joint(
+        &mut self,
+        parent: JointIndex,
+        name: &str,
+        kind: JointType,
+        placement: Se3,
+        limits: JointLimits,
+    ) -> Result<JointIndex, ModelError> {
+        let m = &mut self.model;
+        if parent >= m.joints.len() {
+            return Err(ModelError::UnknownParent { joint: name.into(), parent, count: m.joints.len() });
+        }
+        if m.joints.iter().any(|j| j.name == name) {
+            return Err(ModelError::DuplicateJoint(name.into()));
+        }
+        check_placement(&placement, "joint", name)?;
+        let one_dof = kind.nq() == 1;
+        let limits = if one_dof { limits } else { JointLimits::UNBOUNDED };
+        if limits.lower.is_nan()
+            || limits.upper.is_nan()
+            || limits.lower > limits.upper
+            || limits.lower == f64::INFINITY
+            || limits.upper == f64::NEG_INFINITY
+            || !(limits.velocity >= 0.0)
+            || !(limits.effort >= 0.0)
+        {
+            return Err(ModelError::BadLimits {
+                joint: name.into(),
+                lower: limits.lower,
+                upper: limits.upper,
+                velocity: limits.velocity,
+                effort: limits.effort,
+            });
+        }
+        let index = m.joints.len();
+        m.joints.push(Joint { name: name.into(), kind, parent, placement, limits, idx_q: m.nq, idx_v: m.nv });
+        m.inertias.push(Inertia::ZERO);
+        m.children.push(Vec::new());
+        m.children[parent].push(index);
+        match kind {
+            JointType::Revolute(_) | JointType::Prismatic(_) => {
+                m.lower.push(limits.lower);
+                m.upper.push(limits.upper);
+            }
+            JointType::Fixed => {}
+            JointType::Spherical => {
+                m.lower.extend([-1.0; 4]);
+                m.upper.extend([1.0; 4]);
+            }
+            JointType::Free => {
+                m.lower.extend([f64::NEG_INFINITY; 3]);
+                m.upper.extend([f64::INFINITY; 3]);
+                m.lower.extend([-1.0; 4]);
+                m.upper.extend([1.0; 4]);
+            }
+        }
+        m.nq += kind.nq();
+        m.nv += kind.nv();
+        m.frames.push(Frame {
+            name: name.into(),
+            kind: FrameKind::Joint,
+            parent_joint: index,
+            placement: Se3::IDENTITY,
+        });
+        Ok(index)
+    }
+
+    /// Adds the body `inertia`, given in a frame `B` with `placement = joint_M_B`, to the body
+    /// carried by `joint` (Pinocchio's `appendBodyToJoint`).
+    ///
+    /// # Errors
+    /// An unknown joint, a negative or non-finite mass, non-finite inertia, or a bad placement.
+    pub fn append_body(
+        &mut self,
+        joint: JointIndex,
+        inertia: &Inertia,
+        placement: &Se3,
+    ) -> Result<(), ModelError> {
+        let m = &mut self.model;
+        let Some(j) = m.joints.get(joint) else {
+            return Err(ModelError::UnknownParent {
+                joint: "(body)".into(),
+                parent: joint,
+                count: m.joints.len(),
+            });
+        };
+        check_placement(placement, "body", &j.name)?;
+        if !(inertia.mass >= 0.0)
+            || !inertia.mass.is_finite()
+            || !inertia.com.is_finite()
+            || !inertia.rotational.is_finite()
+        {
+            return Err(ModelError::BadInertia { joint: j.name.clone(), mass: inertia.mass });
+        }
+        let moved = inertia.transformed(placement);
+        m.inertias[joint] = m.inertias[joint].merged(&moved);
+        Ok(())
+    }
+
+    /// Adds frame `name` of kind `kind` on `parent_joint` at `placement` (in the joint's
+    /// frame). Returns its index.
+    ///
+    /// # Errors
+    /// An unknown joint, a name already used by a frame of the same kind, or a bad placement.
+    pub fn add_frame(
+        &mut self,
+        name: &str,
+        kind: FrameKind,
+        parent_joint: JointIndex,
+        placement: Se3,
+    ) -> Result<FrameIndex, ModelError> {
+        let m = &mut self.model;
+        if parent_joint >= m.joints.len() {
+            return Err(ModelError::UnknownParent {
+                joint: name.into(),
+                parent: parent_joint,
+                count: m.joints.len(),
+            });
+        }
+        if m.frames.iter().any(|f| f.name == name && f.kind == kind) {
+            return Err(ModelError::DuplicateFrame { name: name.into(), kind });
+        }
+        check_placement(&placement, "frame", name)?;
+        m.frames.push(Frame { name: name.into(), kind, parent_joint, placement });
+        Ok(m.frames.len() - 1)
+    }
+
+    /// The finished model.
+    #[must_use]
+    pub fn build(self) -> Model {
+        self.model
+    }
+}
+
+fn check_placement(g: &Se3, what: &'static str, name: &str) -> Result<(), ModelError> {
+    if g.translation.is_finite() && so3::is_rotation(g.rotation, PLACEMENT_TOL) {
+        Ok(())
+    } else {
+        Err(ModelError::BadPlacement { what, name: name.into() })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn axis_rotations_match_rodrigues() {
+        for axis in [Axis::X, Axis::Y, Axis::Z, Axis::Unaligned(DVec3::new(1.0, -2.0, 0.5).normalize())] {
+            for angle in [-2.5, -0.3, 0.0, 0.7, 3.1] {
+                let r = axis.rotation(angle);
+                let reference = so3::exp(axis.vector() * angle);
+                let err = (r - reference).to_cols_array().iter().fold(0.0_f64, |a, e| a.max(e.abs()));
+                assert!(err < 1e-15, "{axis:?} {angle}: {err}");
+            }
+        }
+    }
+
+    #[test]
+    fn axis_from_vector_snaps_and_rejects() {
+        assert_eq!(Axis::from_vector(DVec3::new(0.0, 0.0, 2.0)), Some(Axis::Z));
+        assert_eq!(Axis::from_vector(DVec3::ZERO), None);
+        assert_eq!(Axis::from_vector(DVec3::new(f64::NAN, 0.0, 1.0)), None);
+        assert!(matches!(Axis::from_vector(DVec3::new(0.0, -1.0, 0.0)), Some(Axis::Unaligned(_))));
+    }
+
+    #[test]
+    fn merged_inertia_matches_point_masses() {
+        // Two unit point masses at ±x: mass 2, com 0, inertia diag(0, 2, 2).
+        let a = Inertia::new(1.0, DVec3::X, DMat3::ZERO);
+        let b = Inertia::new(1.0, -DVec3::X, DMat3::ZERO);
+        let m = a.merged(&b);
+        assert_eq!(m.mass, 2.0);
+        assert_eq!(m.com, DVec3::ZERO);
+        assert!(
+            (m.rotational - DMat3::from_diagonal(DVec3::new(0.0, 2.0, 2.0))).abs_diff_eq(DMat3::ZERO, 1e-15)
+        );
+        assert_eq!(Inertia::ZERO.merged(&Inertia::ZERO), Inertia::ZERO);
+    }
+
+    #[test]
+    fn builder_rejects_bad_input() {
+        let mut b = ModelBuilder::new("m");
+        assert!(matches!(
+            b.add_joint(3, "j", JointType::Fixed, Se3::IDENTITY, JointLimits::UNBOUNDED),
+            Err(ModelError::UnknownParent { .. })
+        ));
+        let j =
+            b.add_joint(0, "j", JointType::Revolute(Axis::Z), Se3::IDENTITY, JointLimits::UNBOUNDED).unwrap();
+        assert!(matches!(
+            b.add_joint(j, "j", JointType::Fixed, Se3::IDENTITY, JointLimits::UNBOUNDED),
+            Err(ModelError::DuplicateJoint(_))
+        ));
+        assert!(matches!(
+            b.add_joint(
+                j,
+                "k",
+                JointType::Revolute(Axis::X),
+                Se3::IDENTITY,
+                JointLimits::position(1.0, -1.0)
+            ),
+            Err(ModelError::BadLimits { .. })
+        ));
+        let skew = Se3::new(DMat3::from_diagonal(DVec3::new(1.0, 2.0, 1.0)), DVec3::ZERO);
+        assert!(matches!(
+            b.add_joint(j, "k", JointType::Fixed, skew, JointLimits::UNBOUNDED),
+            Err(ModelError::BadPlacement { .. })
+        ));
+        assert!(matches!(
+            b.append_body(j, &Inertia::new(-1.0, DVec3::ZERO, DMat3::ZERO), &Se3::IDENTITY),
+            Err(ModelError::BadInertia { .. })
+        ));
+        let s = b
+            .add_joint(j, "ball", JointType::Spherical, Se3::IDENTITY, JointLimits::position(0.0, 1.0))
+            .unwrap();
+        let m = b.build();
+        assert_eq!(m.joint(s).limits, JointLimits::UNBOUNDED);
+        assert_eq!((m.nq(), m.nv()), (5, 4));
+        assert_eq!(m.support(s), vec![1, 2]);
+        assert!(m.is_ancestor(1, 2) && !m.is_ancestor(2, 1) && m.is_ancestor(0, 2));
+        assert_eq!(m.children(0), &[1]);
+    }
+}
