@@ -126,7 +126,7 @@ pub fn build(scene: &Scene, file: &Path) -> Result<Box<dyn Runner>, SceneError> 
                 s.linear_solver = l;
             }
             let method = if s.integrator.is_implicit() {
-                format!("{} / {:?}", s.integrator.label(), s.linear_solver)
+                format!("{} / {}", s.integrator.label(), s.linear_solver.name())
             } else {
                 s.integrator.label()
             };

@@ -653,6 +653,7 @@ fn cloth_study(ctx: &Ctx) -> StudyResult {
             let name = match linear {
                 LinearSolverKind::Cg => "cg",
                 LinearSolverKind::JacobiPcg => "jacobi-pcg",
+                LinearSolverKind::JacobiPcgAssembled => "jacobi-pcg-assembled",
                 LinearSolverKind::Jacobi => "jacobi",
                 LinearSolverKind::GaussSeidel => "gauss-seidel",
                 LinearSolverKind::Cholesky => "cholesky",

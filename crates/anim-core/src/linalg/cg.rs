@@ -59,6 +59,8 @@ pub enum Preconditioner {
 pub struct Cg {
     preconditioner: Preconditioner,
     params: IterativeParams,
+    /// Ask callers for the assembled matrix instead of the matrix-free operator.
+    assembled: bool,
     /// Residual `r = b - A x`.
     r: Vec<f64>,
     /// Preconditioned residual `z = M^-1 r`.
@@ -80,6 +82,7 @@ impl Cg {
         Self {
             preconditioner,
             params,
+            assembled: false,
             r: Vec::new(),
             z: Vec::new(),
             p: Vec::new(),
@@ -87,6 +90,15 @@ impl Cg {
             inv_diag: Vec::new(),
             b_scaled: Vec::new(),
         }
+    }
+
+    /// The same solver, asking for the assembled (CSR) matrix: the product then runs over stored
+    /// entries instead of the system's matrix-free product, which pays when assembly is cheap
+    /// and the product is applied many times.
+    #[must_use]
+    pub fn assembled(mut self) -> Self {
+        self.assembled = true;
+        self
     }
 
     /// The preconditioner.
@@ -254,14 +266,16 @@ impl Cg {
 
 impl LinearSolver for Cg {
     fn name(&self) -> &'static str {
-        match self.preconditioner {
-            Preconditioner::Identity => "cg",
-            Preconditioner::Jacobi => "jacobi-pcg",
+        match (self.preconditioner, self.assembled) {
+            (Preconditioner::Identity, false) => "cg",
+            (Preconditioner::Jacobi, false) => "jacobi-pcg",
+            (Preconditioner::Identity, true) => "cg-assembled",
+            (Preconditioner::Jacobi, true) => "jacobi-pcg-assembled",
         }
     }
 
     fn needs_matrix(&self) -> bool {
-        false
+        self.assembled
     }
 
     fn solve(&mut self, a: SystemMatrix<'_>, b: &[f64], x: &mut [f64]) -> Result<SolveInfo, SolveError> {

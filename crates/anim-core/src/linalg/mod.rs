@@ -162,7 +162,8 @@ pub enum SolveError {
 /// size, `solve` does not allocate (direct solvers re-factor into their existing storage where
 /// faer allows).
 pub trait LinearSolver: Send {
-    /// Short name for reports ("cg", "jacobi-pcg", "jacobi", "gauss-seidel", "cholesky").
+    /// Short name for reports ("cg", "jacobi-pcg", "jacobi-pcg-assembled", "jacobi",
+    /// "gauss-seidel", "cholesky").
     fn name(&self) -> &'static str;
     /// Whether this solver needs [`SystemMatrix::Csr`].
     fn needs_matrix(&self) -> bool;
@@ -181,6 +182,8 @@ pub enum LinearSolverKind {
     Cg,
     /// Jacobi-preconditioned conjugate gradients, matrix-free (needs the operator diagonal).
     JacobiPcg,
+    /// Jacobi-preconditioned conjugate gradients on the assembled matrix.
+    JacobiPcgAssembled,
     /// Jacobi sweeps on the assembled matrix.
     Jacobi,
     /// Gauss-Seidel sweeps on the assembled matrix.
@@ -191,13 +194,27 @@ pub enum LinearSolverKind {
 
 impl LinearSolverKind {
     /// Every kind, in a fixed order.
-    pub const ALL: [LinearSolverKind; 5] = [
+    pub const ALL: [LinearSolverKind; 6] = [
         LinearSolverKind::Cg,
         LinearSolverKind::JacobiPcg,
+        LinearSolverKind::JacobiPcgAssembled,
         LinearSolverKind::Jacobi,
         LinearSolverKind::GaussSeidel,
         LinearSolverKind::Cholesky,
     ];
+
+    /// The name used in scene files and reports (kebab case, as serialised).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            LinearSolverKind::Cg => "cg",
+            LinearSolverKind::JacobiPcg => "jacobi-pcg",
+            LinearSolverKind::JacobiPcgAssembled => "jacobi-pcg-assembled",
+            LinearSolverKind::Jacobi => "jacobi",
+            LinearSolverKind::GaussSeidel => "gauss-seidel",
+            LinearSolverKind::Cholesky => "cholesky",
+        }
+    }
 
     /// Builds the solver with the given stopping rule (ignored by the direct solver).
     #[must_use]
@@ -205,6 +222,9 @@ impl LinearSolverKind {
         match self {
             LinearSolverKind::Cg => Box::new(Cg::new(Preconditioner::Identity, params)),
             LinearSolverKind::JacobiPcg => Box::new(Cg::new(Preconditioner::Jacobi, params)),
+            LinearSolverKind::JacobiPcgAssembled => {
+                Box::new(Cg::new(Preconditioner::Jacobi, params).assembled())
+            }
             LinearSolverKind::Jacobi => Box::new(Jacobi::new(params)),
             LinearSolverKind::GaussSeidel => Box::new(GaussSeidel::new(params)),
             LinearSolverKind::Cholesky => Box::new(SparseCholesky::new()),
@@ -245,5 +265,28 @@ pub fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
     assert_eq!(x.len(), y.len(), "axpy: length mismatch");
     for (yi, xi) in y.iter_mut().zip(x) {
         *yi += alpha * xi;
+    }
+}
+
+#[cfg(test)]
+mod kind_tests {
+    use super::*;
+
+    #[test]
+    fn kind_names_match_serde_and_the_built_solvers() {
+        for kind in LinearSolverKind::ALL {
+            let json = serde_json::to_string(&kind).unwrap();
+            assert_eq!(json, format!("\"{}\"", kind.name()));
+            let solver = kind.build(IterativeParams::default());
+            assert_eq!(solver.name(), kind.name());
+            let assembled = matches!(
+                kind,
+                LinearSolverKind::JacobiPcgAssembled
+                    | LinearSolverKind::Jacobi
+                    | LinearSolverKind::GaussSeidel
+                    | LinearSolverKind::Cholesky
+            );
+            assert_eq!(solver.needs_matrix(), assembled, "{kind:?}");
+        }
     }
 }
