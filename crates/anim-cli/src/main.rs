@@ -14,6 +14,7 @@
 
 mod runner;
 mod scene;
+mod view;
 
 use anim_io::FrameWriter;
 use anim_io::preview::{Canvas, GifWriter};
@@ -26,6 +27,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
+use view::{Snapshot, View};
 
 #[derive(Parser)]
 #[command(
@@ -131,6 +133,7 @@ struct Metrics {
     step_seconds: f64,
     output_seconds: f64,
     output_fraction: f64,
+    writer_busy_seconds: f64,
     steps_per_second: f64,
     energy_initial: Option<f64>,
     energy_final: Option<f64>,
@@ -140,77 +143,39 @@ struct Metrics {
     files: Vec<String>,
 }
 
-/// Frame files, CSV rows and the preview, with the time they cost.
+/// What the writer thread produces: the files written and its own busy time.
+type WriterResult = Result<(Vec<String>, f64), String>;
+
+/// Frame files, CSV rows and the preview, written on a thread of their own so that the run
+/// loop keeps stepping while a frame is encoded. Snapshots travel through a bounded channel: a
+/// writer that falls behind slows the run instead of piling up memory.
 struct Output {
+    sender: Option<std::sync::mpsc::SyncSender<(usize, Snapshot)>>,
+    returned: std::sync::mpsc::Receiver<Snapshot>,
+    worker: Option<std::thread::JoinHandle<WriterResult>>,
+    spare: Vec<Snapshot>,
+}
+
+/// The writer thread's state.
+struct Writer {
     dir: PathBuf,
-    format: OutputFormat,
     stride: usize,
+    view: View,
     frames: Option<FrameWriter>,
     csv: Option<std::io::BufWriter<std::fs::File>>,
     gif: Option<(GifWriter, Canvas, anim_io::preview::Camera, usize)>,
-    seconds: f64,
 }
 
-impl Output {
-    fn new(
-        dir: &Path,
-        format: OutputFormat,
-        stride: usize,
-        preview: Option<(u32, usize)>,
-        runner: &dyn Runner,
-    ) -> Result<Self, String> {
-        let mut out = Output {
-            dir: dir.to_path_buf(),
-            format,
-            stride,
-            frames: None,
-            csv: None,
-            gif: None,
-            seconds: 0.0,
-        };
-        let start = Instant::now();
-        if let Some(f) = format.frame_format() {
-            out.frames = Some(FrameWriter::new(dir.join("frames"), f).map_err(|e| e.to_string())?);
-        }
-        if format == OutputFormat::Csv {
-            let path = dir.join("frames.csv");
-            let file = std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-            let mut csv = std::io::BufWriter::new(file);
-            let n = runner.state().dof();
-            let header: Vec<String> =
-                (0..n).map(|i| format!("x{i}")).chain((0..n).map(|i| format!("v{i}"))).collect();
-            writeln!(csv, "frame,t,{},energy,error_vs_exact", header.join(","))
-                .map_err(|e| format!("{}: {e}", path.display()))?;
-            out.csv = Some(csv);
-        }
-        if let Some((width, every)) = preview {
-            let height = (width * 3 / 4).max(1);
-            let path = dir.join("preview.gif");
-            let gif = GifWriter::create(&path, width, height, 4, true).map_err(|e| e.to_string())?;
-            let camera = runner.camera(f64::from(width) / f64::from(height));
-            out.gif = Some((gif, Canvas::new(width, height, [248, 248, 250]), camera, every));
-        }
-        out.seconds += start.elapsed().as_secs_f64();
-        Ok(out)
-    }
-
-    fn frame(
-        &mut self,
-        index: usize,
-        runner: &mut dyn Runner,
-        energy: Option<f64>,
-        err: Option<f64>,
-    ) -> Result<(), String> {
-        let start = Instant::now();
+impl Writer {
+    fn frame(&mut self, index: usize, s: &Snapshot) -> Result<(), String> {
         if index.is_multiple_of(self.stride) {
             if let Some(frames) = &mut self.frames {
-                runner.write_frame(frames)?;
+                self.view.write_frame(frames, s)?;
             }
             if let Some(csv) = &mut self.csv {
-                let s = runner.state();
                 let values: Vec<String> = s.x.iter().chain(&s.v).map(|v| format!("{v:e}")).collect();
                 let opt = |v: Option<f64>| v.map(|v| format!("{v:e}")).unwrap_or_default();
-                writeln!(csv, "{index},{:e},{},{},{}", s.t, values.join(","), opt(energy), opt(err))
+                writeln!(csv, "{index},{:e},{},{},{}", s.t, values.join(","), opt(s.energy), opt(s.error))
                     .map_err(|e| e.to_string())?;
             }
         }
@@ -218,16 +183,13 @@ impl Output {
             && index.is_multiple_of(*every)
         {
             canvas.clear();
-            runner.draw(canvas, camera)?;
+            self.view.draw(canvas, camera, s)?;
             gif.push(canvas).map_err(|e| e.to_string())?;
         }
-        self.seconds += start.elapsed().as_secs_f64();
         Ok(())
     }
 
-    /// Closes every file and returns the paths written.
-    fn finish(self) -> Result<(Vec<String>, f64), String> {
-        let start = Instant::now();
+    fn finish(self) -> Result<Vec<String>, String> {
         let mut files = Vec::new();
         if let Some(frames) = &self.frames {
             let n = frames.sequence().frames().len();
@@ -251,8 +213,87 @@ impl Output {
             files.push(path.display().to_string());
             files.push(png.display().to_string());
         }
-        let _ = self.format;
-        Ok((files, self.seconds + start.elapsed().as_secs_f64()))
+        Ok(files)
+    }
+}
+
+impl Output {
+    fn new(
+        dir: &Path,
+        format: OutputFormat,
+        stride: usize,
+        preview: Option<(u32, usize)>,
+        runner: &dyn Runner,
+    ) -> Result<Self, String> {
+        let view = View::new(runner.geometry());
+        let mut writer = Writer { dir: dir.to_path_buf(), stride, view, frames: None, csv: None, gif: None };
+        if let Some(f) = format.frame_format() {
+            writer.frames = Some(FrameWriter::new(dir.join("frames"), f).map_err(|e| e.to_string())?);
+        }
+        if format == OutputFormat::Csv {
+            let path = dir.join("frames.csv");
+            let file = std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let mut csv = std::io::BufWriter::new(file);
+            let n = runner.state().dof();
+            let header: Vec<String> =
+                (0..n).map(|i| format!("x{i}")).chain((0..n).map(|i| format!("v{i}"))).collect();
+            writeln!(csv, "frame,t,{},energy,error_vs_exact", header.join(","))
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            writer.csv = Some(csv);
+        }
+        if let Some((width, every)) = preview {
+            let height = (width * 3 / 4).max(1);
+            let path = dir.join("preview.gif");
+            let gif = GifWriter::create(&path, width, height, 4, true).map_err(|e| e.to_string())?;
+            let camera = writer.view.camera(f64::from(width) / f64::from(height));
+            writer.gif = Some((gif, Canvas::new(width, height, [248, 248, 250]), camera, every));
+        }
+        let (sender, receiver) = std::sync::mpsc::sync_channel::<(usize, Snapshot)>(4);
+        let (give_back, returned) = std::sync::mpsc::channel::<Snapshot>();
+        let worker = std::thread::Builder::new()
+            .name("anim-writer".into())
+            .spawn(move || {
+                let mut busy = 0.0;
+                let mut result = Ok(());
+                for (index, snapshot) in receiver {
+                    let start = Instant::now();
+                    if result.is_ok() {
+                        result = writer.frame(index, &snapshot);
+                    }
+                    busy += start.elapsed().as_secs_f64();
+                    // Hand the buffers back for reuse; the run may already have ended.
+                    let _ = give_back.send(snapshot);
+                }
+                result?;
+                let start = Instant::now();
+                let files = writer.finish()?;
+                Ok((files, busy + start.elapsed().as_secs_f64()))
+            })
+            .map_err(|e| format!("cannot start the writer thread: {e}"))?;
+        Ok(Output { sender: Some(sender), returned, worker: Some(worker), spare: Vec::new() })
+    }
+
+    /// Queues frame `index` of the runner's current state.
+    fn frame(&mut self, index: usize, runner: &dyn Runner, energy: Option<f64>) -> Result<(), String> {
+        self.spare.extend(self.returned.try_iter());
+        let mut snapshot = self.spare.pop().unwrap_or_default();
+        runner.snapshot(energy, &mut snapshot);
+        let sent = self.sender.as_ref().map(|s| s.send((index, snapshot)));
+        match sent {
+            Some(Ok(())) => Ok(()),
+            // The writer stopped early: its error is reported by `finish`.
+            _ => Err("the frame writer stopped".into()),
+        }
+    }
+
+    /// Waits for the writer and returns the files written and the writer's busy time.
+    fn finish(mut self) -> WriterResult {
+        drop(self.sender.take());
+        match self.worker.take().map(std::thread::JoinHandle::join) {
+            Some(Ok(result)) => result,
+            Some(Err(_)) => Err("the frame writer panicked".into()),
+            None => Err("the frame writer was not started".into()),
+        }
     }
 }
 
@@ -316,11 +357,13 @@ fn run(args: &RunArgs) -> Result<(), String> {
             steps += 1;
         }
         step_seconds += t_step.elapsed().as_secs_f64();
-        let err = runner.exact_error();
-        if let Some(e) = err {
+        if let Some(e) = runner.exact_error() {
             max_err = Some(max_err.map_or(e, |m: f64| m.max(e)));
         }
-        output.frame(frame, runner.as_mut(), energy, err)?;
+        if let Err(e) = output.frame(frame, runner.as_ref(), energy) {
+            failure = Some(format!("frame {frame}: {e}"));
+            break;
+        }
         if !args.quiet && !bar_shown && start.elapsed() > Duration::from_secs(1) {
             bar.set_draw_target(ProgressDrawTarget::stderr());
             bar_shown = true;
@@ -328,8 +371,11 @@ fn run(args: &RunArgs) -> Result<(), String> {
         bar.set_position(steps);
     }
     bar.finish_and_clear();
-    let (files, output_seconds) = output.finish()?;
+    let (files, writer_seconds) = output.finish()?;
     let wall = start.elapsed().as_secs_f64();
+    // What output added to the run: everything that was not stepping (the writer overlaps
+    // with stepping; what it could not hide shows here).
+    let output_seconds = (wall - step_seconds).max(0.0);
     let metrics = Metrics {
         scene: file.name.clone(),
         system: runner.system(),
@@ -343,7 +389,8 @@ fn run(args: &RunArgs) -> Result<(), String> {
         wall_seconds: wall,
         step_seconds,
         output_seconds,
-        output_fraction: output_seconds / (output_seconds + step_seconds).max(1e-12),
+        output_fraction: output_seconds / wall.max(1e-12),
+        writer_busy_seconds: writer_seconds,
         steps_per_second: steps as f64 / step_seconds.max(1e-12),
         energy_initial: energy0,
         energy_final: energy,

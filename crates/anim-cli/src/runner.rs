@@ -2,11 +2,11 @@
 //! frame writers and the preview treat every crate's scenes alike.
 
 use crate::scene::{Scene, SceneError};
+use crate::view::{Geometry, Snapshot, frame_box};
 use anim_core::integrate::systems::{HarmonicOscillator, KeplerOrbit};
 use anim_core::integrate::{MechanicalSystem, Simulation, State};
 use anim_core::solver::{Solver, StepReport};
-use anim_io::preview::{Camera, Canvas, Colors, MeshStyle};
-use anim_io::{DataArray, FrameFormat, FrameWriter, UnstructuredGrid};
+use anim_io::FrameFormat;
 use anim_springs::{SpringSimulation, scenes as spring_scenes};
 use std::path::Path;
 
@@ -26,12 +26,17 @@ pub trait Runner {
     }
     /// The frame format that suits the scene.
     fn natural_format(&self) -> OutputFormat;
-    /// Writes the current state as one frame of a mesh/particle sequence.
-    fn write_frame(&self, frames: &mut FrameWriter) -> Result<(), String>;
-    /// A camera that keeps the whole motion in view, chosen from the initial state.
-    fn camera(&self, aspect: f64) -> Camera;
-    /// Draws the current state.
-    fn draw(&mut self, canvas: &mut Canvas, camera: &Camera) -> Result<(), String>;
+    /// How the scene is drawn and written (fixed for the run).
+    fn geometry(&self) -> Geometry;
+    /// Copies the current state out for the writer.
+    fn snapshot(&self, energy: Option<f64>, out: &mut Snapshot) {
+        let s = self.state();
+        out.t = s.t;
+        out.x.clone_from(&s.x);
+        out.v.clone_from(&s.v);
+        out.energy = energy;
+        out.error = self.exact_error();
+    }
 }
 
 /// Frame formats the command line offers.
@@ -82,7 +87,6 @@ pub fn build(scene: &Scene, file: &Path) -> Result<Box<dyn Runner>, SceneError> 
                     let e = exact(s.t);
                     ((s.x[0] - e[0]).powi(2) + (s.v[0] - e[1]).powi(2)).sqrt()
                 }),
-                trail: Vec::new(),
                 extent: (
                     [-1.5 * x0.abs().max(1e-3), -0.3 * x0.abs().max(1e-3)],
                     [1.5 * x0.abs().max(1e-3), 0.3 * x0.abs().max(1e-3)],
@@ -103,7 +107,6 @@ pub fn build(scene: &Scene, file: &Path) -> Result<Box<dyn Runner>, SceneError> 
                     let e = [x[0], x[1], v[0], v[1]];
                     s.x.iter().chain(&s.v).zip(e).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt()
                 }),
-                trail: Vec::new(),
                 extent: ([-1.0 - eccentricity - 0.1, -b - 0.1], [1.0 - eccentricity + 0.1, b + 0.1]),
             })
         }
@@ -146,16 +149,8 @@ struct OdeRunner {
     method: String,
     state: State,
     exact: Box<dyn Fn(&State) -> f64>,
-    /// Past positions in the plane, for the preview.
-    trail: Vec<[f64; 3]>,
     /// Plane region shown by the preview.
     extent: ([f64; 2], [f64; 2]),
-}
-
-impl OdeRunner {
-    fn point(&self) -> [f64; 3] {
-        [self.state.x[0], self.state.x.get(1).copied().unwrap_or(0.0), 0.0]
-    }
 }
 
 impl Runner for OdeRunner {
@@ -183,39 +178,8 @@ impl Runner for OdeRunner {
         OutputFormat::Csv
     }
 
-    fn write_frame(&self, frames: &mut FrameWriter) -> Result<(), String> {
-        let p = [self.point()];
-        let v = [[self.state.v[0], self.state.v.get(1).copied().unwrap_or(0.0), 0.0]];
-        let grid = UnstructuredGrid::new(&p).vertices(&[0]).point_field(DataArray::vectors("velocity", &v));
-        frames.write(self.state.t, &grid).map(|_| ()).map_err(|e| e.to_string())
-    }
-
-    fn camera(&self, aspect: f64) -> Camera {
-        Camera::top_down_2d(self.extent.0, self.extent.1, aspect)
-    }
-
-    fn draw(&mut self, canvas: &mut Canvas, camera: &Camera) -> Result<(), String> {
-        let p = self.point();
-        if self.trail.len() < 4096 {
-            self.trail.push(p);
-        }
-        let segments: Vec<[usize; 2]> = (1..self.trail.len()).map(|i| [i - 1, i]).collect();
-        let e = |r: Result<(), anim_io::IoError>| r.map_err(|e| e.to_string());
-        e(canvas.draw_lines(camera, &self.trail, &segments, 1.5, Colors::Uniform([150, 150, 170])))?;
-        let scale = (self.extent.1[0] - self.extent.0[0]).max(self.extent.1[1] - self.extent.0[1]);
-        if self.name == "kepler-orbit" {
-            e(canvas.draw_particles(
-                camera,
-                &[[0.0, 0.0, -0.1]],
-                0.06 * scale,
-                Colors::Uniform([240, 180, 40]),
-            ))?;
-        } else {
-            // The spring from the wall at the left edge to the mass.
-            let anchor = [self.extent.0[0], 0.0, 0.0];
-            e(canvas.draw_lines(camera, &[anchor, p], &[[0, 1]], 2.0, Colors::Uniform([90, 90, 90])))?;
-        }
-        e(canvas.draw_particles(camera, &[p], 0.03 * scale, Colors::Uniform([60, 110, 200])))
+    fn geometry(&self) -> Geometry {
+        Geometry::Planar { extent: self.extent, sun: self.name == "kepler-orbit" }
     }
 }
 
@@ -225,61 +189,26 @@ struct SpringRunner {
     method: String,
     sim: SpringSimulation,
     state: State,
-    positions: Vec<[f64; 3]>,
-    edges: Vec<[usize; 2]>,
-    vertices: Vec<usize>,
-    /// The region the preview shows, from the initial state.
-    frame_box: ([f64; 3], [f64; 3]),
 }
 
 impl SpringRunner {
     fn new(name: String, method: String, sim: SpringSimulation, state: State) -> Self {
-        let network = sim.network();
-        let edges = network.springs().iter().map(|s| [s.i, s.j]).collect();
-        let vertices = (0..network.num_particles()).collect();
-        let mut runner = Self {
-            name,
-            method,
-            sim,
-            state,
-            positions: Vec::new(),
-            edges,
-            vertices,
-            frame_box: ([0.0; 3], [0.0; 3]),
-        };
-        runner.refresh();
-        runner.frame_box = runner.initial_frame_box();
-        runner
+        Self { name, method, sim, state }
     }
 
-    /// The initial bounding box widened sideways by a third of its size and extended down along
-    /// gravity (-z) by its size (or to the ground): where the motion of the built-in scenes stays.
-    fn initial_frame_box(&self) -> ([f64; 3], [f64; 3]) {
-        let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-        for p in &self.positions {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
-        let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-3);
-        for k in 0..2 {
-            lo[k] -= size / 3.0;
-            hi[k] += size / 3.0;
-        }
-        lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
-        if let Some(z) = self.ground() {
-            lo[2] = z;
-        }
-        (lo, hi)
+    fn ground(&self) -> Option<f64> {
+        self.sim.network().model().colliders().iter().find_map(|c| match c.shape {
+            anim_springs::Shape::Plane { point, normal: [0.0, 0.0, 1.0] } => Some(point[2]),
+            _ => None,
+        })
     }
 
-    fn refresh(&mut self) {
-        self.sim.network().positions_into(&self.state.x, &mut self.positions);
-    }
-
-    fn has_surface(&self) -> bool {
-        !self.sim.network().triangles().is_empty()
+    fn mean_spring_length(&self) -> f64 {
+        let springs = self.sim.network().springs();
+        if springs.is_empty() {
+            return 0.01;
+        }
+        springs.iter().map(|s| s.rest_length).sum::<f64>() / springs.len() as f64
     }
 }
 
@@ -297,77 +226,23 @@ impl Runner for SpringRunner {
     }
 
     fn step(&mut self, dt: f64) -> Result<StepReport, String> {
-        let report = self.sim.step(&mut self.state, dt).map_err(|e| e.to_string())?;
-        self.refresh();
-        Ok(report)
+        self.sim.step(&mut self.state, dt).map_err(|e| e.to_string())
     }
 
     fn natural_format(&self) -> OutputFormat {
         OutputFormat::Vtu
     }
 
-    fn write_frame(&self, frames: &mut FrameWriter) -> Result<(), String> {
-        let n = self.positions.len();
-        let v: Vec<[f64; 3]> =
-            (0..n).map(|i| [self.state.v[3 * i], self.state.v[3 * i + 1], self.state.v[3 * i + 2]]).collect();
-        let mut grid = UnstructuredGrid::new(&self.positions).point_field(DataArray::vectors("velocity", &v));
-        let triangles = self.sim.network().triangles();
-        grid = if self.has_surface() {
-            grid.triangles(triangles)
-        } else if frames.format() == FrameFormat::Ply {
-            grid.vertices(&self.vertices)
-        } else {
-            grid.lines(&self.edges)
-        };
-        frames.write(self.state.t, &grid).map(|_| ()).map_err(|e| e.to_string())
-    }
-
-    fn camera(&self, aspect: f64) -> Camera {
-        let _ = aspect;
-        let (lo, hi) = self.frame_box;
-        Camera::framing(lo, hi, [0.55, 1.0, -0.45], [0.0, 0.0, 1.0])
-    }
-
-    fn draw(&mut self, canvas: &mut Canvas, camera: &Camera) -> Result<(), String> {
-        let e = |r: Result<(), anim_io::IoError>| r.map_err(|e| e.to_string());
-        if let Some(z) = self.ground() {
-            // A floor under the framed region (not beyond it: corners behind the camera would
-            // clip the whole quad).
-            let (lo, hi) = self.frame_box;
-            let quad = [[lo[0], lo[1], z], [hi[0], lo[1], z], [hi[0], hi[1], z], [lo[0], hi[1], z]];
-            let style =
-                MeshStyle { color: [200, 200, 195], back_color: [200, 200, 195], ..MeshStyle::default() };
-            e(canvas.draw_mesh(camera, &quad, &[[0, 1, 2], [0, 2, 3]], &style))?;
+    fn geometry(&self) -> Geometry {
+        let network = self.sim.network();
+        let ground = self.ground();
+        Geometry::Particles {
+            triangles: network.triangles().to_vec(),
+            edges: network.springs().iter().map(|s| [s.i, s.j]).collect(),
+            radius: 0.15 * self.mean_spring_length(),
+            ground,
+            frame_box: frame_box(&self.state.x, ground),
         }
-        if self.has_surface() {
-            e(canvas.draw_mesh(
-                camera,
-                &self.positions,
-                self.sim.network().triangles(),
-                &MeshStyle::default(),
-            ))
-        } else {
-            e(canvas.draw_lines(camera, &self.positions, &self.edges, 1.0, Colors::Uniform([70, 70, 90])))?;
-            let radius = 0.15 * self.mean_spring_length();
-            e(canvas.draw_particles(camera, &self.positions, radius, Colors::Uniform([200, 90, 60])))
-        }
-    }
-}
-
-impl SpringRunner {
-    fn ground(&self) -> Option<f64> {
-        self.sim.network().model().colliders().iter().find_map(|c| match c.shape {
-            anim_springs::Shape::Plane { point, normal: [0.0, 0.0, 1.0] } => Some(point[2]),
-            _ => None,
-        })
-    }
-
-    fn mean_spring_length(&self) -> f64 {
-        let springs = self.sim.network().springs();
-        if springs.is_empty() {
-            return 0.01;
-        }
-        springs.iter().map(|s| s.rest_length).sum::<f64>() / springs.len() as f64
     }
 }
 
@@ -375,6 +250,9 @@ impl SpringRunner {
 mod tests {
     use super::*;
     use crate::scene;
+    use crate::view::View;
+    use anim_io::FrameWriter;
+    use anim_io::preview::Canvas;
 
     fn runner_of(name: &str) -> Box<dyn Runner> {
         let text = scene::builtin(name).unwrap();
@@ -399,11 +277,14 @@ mod tests {
             let format = runner.natural_format();
             let frame_format = format.frame_format().unwrap_or(FrameFormat::Vtu);
             let mut frames = FrameWriter::new(dir.join(name), frame_format).unwrap();
-            runner.write_frame(&mut frames).unwrap();
+            let mut view = View::new(runner.geometry());
+            let mut snap = Snapshot::default();
+            runner.snapshot(None, &mut snap);
+            view.write_frame(&mut frames, &snap).unwrap();
             assert_eq!(frames.sequence().frames().len(), 1, "{name}");
             let mut canvas = Canvas::new(64, 48, [255, 255, 255]);
-            let camera = runner.camera(64.0 / 48.0);
-            runner.draw(&mut canvas, &camera).unwrap();
+            let camera = view.camera(64.0 / 48.0);
+            view.draw(&mut canvas, &camera, &snap).unwrap();
             let drawn = canvas.pixels().iter().filter(|p| **p != [255, 255, 255]).count();
             assert!(drawn > 20, "{name}: only {drawn} pixels drawn");
         }

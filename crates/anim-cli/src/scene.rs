@@ -133,7 +133,11 @@ pub enum SceneError {
 
 /// The scenes built into the binary: `(name, description, TOML text)`.
 pub const BUILTIN: [(&str, &str, &str); 5] = [
-    ("cloth", "a 32x32 cloth pinned at two corners falls and swings, backward Euler + Jacobi-PCG", CLOTH),
+    (
+        "cloth",
+        "a 32x32 cloth pinned at two corners falls and swings, backward Euler + sparse Cholesky",
+        CLOTH,
+    ),
     ("rope", "a rope pinned at one end swings down, velocity Verlet", ROPE),
     ("jelly", "a jelly cube dropped on the ground bounces, backward Euler + sparse Cholesky", JELLY),
     ("kepler", "a planet on an e = 0.5 ellipse, velocity Verlet, about 3 orbits", KEPLER),

@@ -1,0 +1,218 @@
+//! What a scene looks like, apart from how it is stepped: its [`Geometry`] (fixed for the run)
+//! and per-frame [`Snapshot`]s. A [`View`] turns the two into frame files and preview images; it
+//! is `Send`, so the run loop hands snapshots to a writer thread and keeps stepping.
+
+use anim_io::preview::{Camera, Canvas, Colors, MeshStyle};
+use anim_io::{DataArray, FrameFormat, FrameWriter, UnstructuredGrid};
+
+/// The state at one frame, copied out of the simulation.
+#[derive(Debug, Clone, Default)]
+pub struct Snapshot {
+    /// Simulated time.
+    pub t: f64,
+    /// Positions (flat).
+    pub x: Vec<f64>,
+    /// Velocities (flat).
+    pub v: Vec<f64>,
+    /// Total energy, where defined.
+    pub energy: Option<f64>,
+    /// Error against an exact solution, where one exists.
+    pub error: Option<f64>,
+}
+
+/// How a scene is drawn and written; fixed for the run.
+#[derive(Debug, Clone)]
+pub enum Geometry {
+    /// A point moving in the plane (1 or 2 coordinates), with its trail; `sun` draws the
+    /// attracting centre at the origin, otherwise a spring from the left edge.
+    Planar {
+        /// Region shown.
+        extent: ([f64; 2], [f64; 2]),
+        /// Whether to draw a sun at the origin (else a wall spring).
+        sun: bool,
+    },
+    /// 3-D particles (flat `x = [x0, y0, z0, x1, ...]`) with optional surface triangles and
+    /// springs drawn as lines.
+    Particles {
+        /// Surface triangles (drawn shaded when present).
+        triangles: Vec<[usize; 3]>,
+        /// Line segments (springs), drawn when there is no surface.
+        edges: Vec<[usize; 2]>,
+        /// Particle disc radius in world units (0: none drawn).
+        radius: f64,
+        /// Height of a ground plane `z = h`, if any.
+        ground: Option<f64>,
+        /// Region kept in view.
+        frame_box: ([f64; 3], [f64; 3]),
+    },
+}
+
+/// Frame files and preview images from snapshots.
+pub struct View {
+    geometry: Geometry,
+    trail: Vec<[f64; 3]>,
+    positions: Vec<[f64; 3]>,
+    velocities: Vec<[f64; 3]>,
+    vertices: Vec<usize>,
+}
+
+fn triples(flat: &[f64], out: &mut Vec<[f64; 3]>) {
+    out.clear();
+    out.extend(flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+}
+
+fn planar(flat: &[f64]) -> [f64; 3] {
+    [flat.first().copied().unwrap_or(0.0), flat.get(1).copied().unwrap_or(0.0), 0.0]
+}
+
+fn io<T>(r: Result<T, anim_io::IoError>) -> Result<T, String> {
+    r.map_err(|e| e.to_string())
+}
+
+impl View {
+    /// A view of `geometry`.
+    pub fn new(geometry: Geometry) -> Self {
+        Self {
+            geometry,
+            trail: Vec::new(),
+            positions: Vec::new(),
+            velocities: Vec::new(),
+            vertices: Vec::new(),
+        }
+    }
+
+    /// Writes the snapshot as the next frame of a mesh/particle sequence.
+    pub fn write_frame(&mut self, frames: &mut FrameWriter, s: &Snapshot) -> Result<(), String> {
+        match &self.geometry {
+            Geometry::Planar { .. } => {
+                let p = [planar(&s.x)];
+                let v = [planar(&s.v)];
+                let grid =
+                    UnstructuredGrid::new(&p).vertices(&[0]).point_field(DataArray::vectors("velocity", &v));
+                io(frames.write(s.t, &grid)).map(|_| ())
+            }
+            Geometry::Particles { triangles, edges, .. } => {
+                triples(&s.x, &mut self.positions);
+                triples(&s.v, &mut self.velocities);
+                if self.vertices.len() != self.positions.len() {
+                    self.vertices = (0..self.positions.len()).collect();
+                }
+                let mut grid = UnstructuredGrid::new(&self.positions)
+                    .point_field(DataArray::vectors("velocity", &self.velocities));
+                grid = if !triangles.is_empty() {
+                    grid.triangles(triangles)
+                } else if frames.format() == FrameFormat::Ply || edges.is_empty() {
+                    grid.vertices(&self.vertices)
+                } else {
+                    grid.lines(edges)
+                };
+                io(frames.write(s.t, &grid)).map(|_| ())
+            }
+        }
+    }
+
+    /// A camera that keeps the whole motion in view.
+    pub fn camera(&self, aspect: f64) -> Camera {
+        match &self.geometry {
+            Geometry::Planar { extent, .. } => Camera::top_down_2d(extent.0, extent.1, aspect),
+            Geometry::Particles { frame_box, .. } => {
+                Camera::framing(frame_box.0, frame_box.1, [0.55, 1.0, -0.45], [0.0, 0.0, 1.0])
+            }
+        }
+    }
+
+    /// Draws the snapshot.
+    pub fn draw(&mut self, canvas: &mut Canvas, camera: &Camera, s: &Snapshot) -> Result<(), String> {
+        match &self.geometry {
+            Geometry::Planar { extent, sun } => {
+                let p = planar(&s.x);
+                if self.trail.len() < 4096 {
+                    self.trail.push(p);
+                }
+                let segments: Vec<[usize; 2]> = (1..self.trail.len()).map(|i| [i - 1, i]).collect();
+                io(canvas.draw_lines(camera, &self.trail, &segments, 1.5, Colors::Uniform([150, 150, 170])))?;
+                let scale = (extent.1[0] - extent.0[0]).max(extent.1[1] - extent.0[1]);
+                if *sun {
+                    io(canvas.draw_particles(
+                        camera,
+                        &[[0.0, 0.0, -0.1]],
+                        0.06 * scale,
+                        Colors::Uniform([240, 180, 40]),
+                    ))?;
+                } else {
+                    let anchor = [extent.0[0], 0.0, 0.0];
+                    io(canvas.draw_lines(
+                        camera,
+                        &[anchor, p],
+                        &[[0, 1]],
+                        2.0,
+                        Colors::Uniform([90, 90, 90]),
+                    ))?;
+                }
+                io(canvas.draw_particles(camera, &[p], 0.03 * scale, Colors::Uniform([60, 110, 200])))
+            }
+            Geometry::Particles { triangles, edges, radius, ground, frame_box } => {
+                triples(&s.x, &mut self.positions);
+                if let Some(z) = ground {
+                    // A floor under the framed region (not beyond it: corners behind the
+                    // camera would clip the whole quad).
+                    let (lo, hi) = frame_box;
+                    let quad =
+                        [[lo[0], lo[1], *z], [hi[0], lo[1], *z], [hi[0], hi[1], *z], [lo[0], hi[1], *z]];
+                    let style = MeshStyle {
+                        color: [200, 200, 195],
+                        back_color: [200, 200, 195],
+                        ..MeshStyle::default()
+                    };
+                    io(canvas.draw_mesh(camera, &quad, &[[0, 1, 2], [0, 2, 3]], &style))?;
+                }
+                if !triangles.is_empty() {
+                    io(canvas.draw_mesh(camera, &self.positions, triangles, &MeshStyle::default()))
+                } else {
+                    io(canvas.draw_lines(
+                        camera,
+                        &self.positions,
+                        edges,
+                        1.0,
+                        Colors::Uniform([70, 70, 90]),
+                    ))?;
+                    if *radius > 0.0 {
+                        io(canvas.draw_particles(
+                            camera,
+                            &self.positions,
+                            *radius,
+                            Colors::Uniform([200, 90, 60]),
+                        ))?;
+                    }
+                    Ok(())
+                }
+            }
+        }
+    }
+}
+
+/// The initial bounding box of 3-D particles widened sideways by a third of its size and
+/// extended down along gravity (-z) by its size, or to the ground: where the motion of the
+/// built-in scenes stays.
+pub fn frame_box(x: &[f64], ground: Option<f64>) -> ([f64; 3], [f64; 3]) {
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in x.chunks_exact(3) {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if lo[0] > hi[0] {
+        return ([-1.0; 3], [1.0; 3]);
+    }
+    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-3);
+    for k in 0..2 {
+        lo[k] -= size / 3.0;
+        hi[k] += size / 3.0;
+    }
+    lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
+    if let Some(z) = ground {
+        lo[2] = z;
+    }
+    (lo, hi)
+}
