@@ -150,7 +150,7 @@ pub fn plot(r: &StudyResult, path: &Path) -> Result<(), Box<dyn std::error::Erro
     let root = SVGBackend::new(path, (900, 600)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
-        .caption(&r.title, ("sans-serif", 18))
+        .caption(&r.title, ("sans-serif", if r.title.len() > 90 { 12 } else { 18 }))
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(70)
@@ -163,18 +163,33 @@ pub fn plot(r: &StudyResult, path: &Path) -> Result<(), Box<dyn std::error::Erro
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()?;
     for (i, s) in r.series.iter().enumerate() {
+        // Ten colours; beyond them the same colours come back dashed, then with square markers.
         let color = PALETTE[i % PALETTE.len()];
+        let round = i / PALETTE.len();
         let line: Vec<(f64, f64)> = s
             .points
             .iter()
             .filter(|p| p.error > 0.0 && p.error.is_finite())
             .map(|p| (p.seconds, p.error))
             .collect();
-        chart
-            .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))?
-            .label(s.label.as_str())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
-        chart.draw_series(line.into_iter().map(|p| Circle::new(p, 3, color.filled())))?;
+        let style = color.stroke_width(2);
+        let legend_len = if round == 1 { 7 } else { 20 };
+        let legend = move |(x, y): (i32, i32)| PathElement::new(vec![(x, y), (x + legend_len, y)], style);
+        if round == 1 {
+            chart
+                .draw_series(DashedLineSeries::new(line.clone(), 6, 4, style))?
+                .label(s.label.as_str())
+                .legend(legend);
+        } else {
+            chart.draw_series(LineSeries::new(line.clone(), style))?.label(s.label.as_str()).legend(legend);
+        }
+        if round >= 2 {
+            chart.draw_series(line.into_iter().map(|(x, y)| {
+                Rectangle::new([(x / 1.04, y / 1.15), (x * 1.04, y * 1.15)], color.filled())
+            }))?;
+        } else {
+            chart.draw_series(line.into_iter().map(|p| Circle::new(p, 3, color.filled())))?;
+        }
     }
     chart
         .configure_series_labels()
@@ -211,6 +226,29 @@ mod tests {
                 },
             ],
         }
+    }
+
+    #[test]
+    fn many_series_get_distinct_styles() {
+        let series: Vec<Series> = (0..25)
+            .map(|i| Series {
+                label: format!("method-{i}"),
+                points: vec![
+                    Point { param: 0.1, seconds: 1e-3 * (i + 1) as f64, error: 1e-2 / (i + 1) as f64 },
+                    Point { param: 0.05, seconds: 2e-3 * (i + 1) as f64, error: 1e-3 / (i + 1) as f64 },
+                ],
+            })
+            .collect();
+        let r = StudyResult { series, ..tiny() };
+        let dir = std::env::temp_dir().join(format!("anim-report-many-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("many.svg");
+        plot(&r, &path).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        assert!(svg.contains("method-24"));
+        // Series 10..19 are dashed (many short segments), series 20.. carry square markers.
+        assert!(svg.matches("<rect").count() > 2 * 5, "square markers expected");
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
