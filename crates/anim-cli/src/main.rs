@@ -67,6 +67,9 @@ struct RunArgs {
     /// Write every N-th frame to files.
     #[arg(long, default_value_t = 1)]
     stride: usize,
+    /// Skinning method for skinned-character scenes (default: the scene's).
+    #[arg(long, value_enum)]
+    skinning: Option<scene::SkinningChoice>,
     /// Skip the GIF/PNG preview.
     #[arg(long)]
     no_preview: bool,
@@ -317,7 +320,7 @@ fn run(args: &RunArgs) -> Result<(), String> {
     if args.preview_width < 16 || args.preview_width > 4096 {
         return Err(format!("--preview-width must lie in [16, 4096], got {}", args.preview_width));
     }
-    let mut runner = runner::build(&file.scene, &origin).map_err(|e| e.to_string())?;
+    let mut runner = runner::build(&file.scene, &origin, args.skinning).map_err(|e| e.to_string())?;
     let format = args.format.unwrap_or_else(|| runner.natural_format());
     let out = args.out.clone().unwrap_or_else(|| Path::new("anim-out").join(&file.name));
     std::fs::create_dir_all(&out)

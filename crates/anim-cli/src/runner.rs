@@ -1,12 +1,14 @@
 //! The runnable form of a scene: one [`Runner`] per kind of system, so that the run loop, the
 //! frame writers and the preview treat every crate's scenes alike.
 
-use crate::scene::{Scene, SceneError};
+use crate::scene::{Scene, SceneError, SkinningChoice};
 use crate::view::{Geometry, Snapshot, frame_box};
 use anim_core::integrate::systems::{HarmonicOscillator, KeplerOrbit};
 use anim_core::integrate::{MechanicalSystem, Simulation, State};
 use anim_core::solver::{Solver, StepReport};
 use anim_io::FrameFormat;
+use anim_skin::scenes::SkinScene;
+use anim_skin::{CharacterData, SkinningMethod};
 use anim_springs::{SpringSimulation, scenes as spring_scenes};
 use std::path::Path;
 
@@ -69,7 +71,12 @@ impl OutputFormat {
 }
 
 /// Builds the runner of a scene; `base` is the scene file's folder, for relative paths.
-pub fn build(scene: &Scene, file: &Path) -> Result<Box<dyn Runner>, SceneError> {
+pub fn build(
+    scene: &Scene,
+    file_path: &Path,
+    skinning: Option<SkinningChoice>,
+) -> Result<Box<dyn Runner>, SceneError> {
+    let file = file_path;
     Ok(match *scene {
         Scene::HarmonicOscillator { mass, stiffness, damping, x0, v0, integrator } => {
             let sys = HarmonicOscillator::damped(mass, stiffness, damping);
@@ -109,6 +116,35 @@ pub fn build(scene: &Scene, file: &Path) -> Result<Box<dyn Runner>, SceneError> 
                 }),
                 extent: ([-1.0 - eccentricity - 0.1, -b - 0.1], [1.0 - eccentricity + 0.1, b + 0.1]),
             })
+        }
+        Scene::Skinning { ref preset, ref file, method } => {
+            let scene = match (preset, file) {
+                (Some(p), None) if p == "twisted-cylinder" => anim_skin::scenes::twisted_cylinder(None)
+                    .map_err(|e| SceneError::invalid(file_path, "scene.preset", e.to_string()))?,
+                (Some(p), None) => {
+                    return Err(SceneError::invalid(
+                        file_path,
+                        "scene.preset",
+                        format!("unknown preset `{p}` (one of {})", anim_skin::scenes::NAMES.join(", ")),
+                    ));
+                }
+                (None, Some(f)) => {
+                    let path = file_path.parent().map_or_else(|| f.clone(), |dir| dir.join(f));
+                    anim_skin::scenes::from_gltf(&path)
+                        .map_err(|e| SceneError::invalid(file_path, "scene.file", e.to_string()))?
+                }
+                _ => {
+                    return Err(SceneError::invalid(
+                        file_path,
+                        "scene.preset",
+                        "give exactly one of `preset` and `file`".into(),
+                    ));
+                }
+            };
+            let default = if preset.is_some() { SkinningChoice::Both } else { SkinningChoice::Dqs };
+            let runner = SkinRunner::new(scene, skinning.or(method).unwrap_or(default))
+                .map_err(|e| SceneError::invalid(file_path, "scene.method", e))?;
+            Box::new(runner)
         }
         Scene::Springs { ref preset, resolution, integrator, linear_solver } => {
             let mut s = match spring_scenes::by_name(preset, resolution) {
@@ -183,6 +219,116 @@ impl Runner for OdeRunner {
     }
 }
 
+/// A skinned character posed at the run's time; with two methods, LBS is drawn left of DQS.
+struct SkinRunner {
+    name: String,
+    scene: SkinScene,
+    methods: Vec<(SkinningMethod, CharacterData, f64)>,
+    state: State,
+    triangles: Vec<[usize; 3]>,
+    scratch: Vec<[f64; 3]>,
+}
+
+impl SkinRunner {
+    fn new(scene: SkinScene, choice: SkinningChoice) -> Result<Self, String> {
+        let methods = match choice {
+            SkinningChoice::Lbs => vec![SkinningMethod::Lbs],
+            SkinningChoice::Dqs => vec![SkinningMethod::Dqs],
+            SkinningChoice::Both => vec![SkinningMethod::Lbs, SkinningMethod::Dqs],
+        };
+        let mut data = scene.data();
+        scene.pose(&mut data, 0.0, SkinningMethod::Lbs).map_err(|e| e.to_string())?;
+        let mut rest = Vec::new();
+        data.positions(&mut rest);
+        let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+        for p in &rest {
+            lo = lo.min(p[0]);
+            hi = hi.max(p[0]);
+        }
+        let width = if hi > lo { hi - lo } else { 1.0 };
+        let count = methods.len() as f64;
+        let methods: Vec<(SkinningMethod, CharacterData, f64)> = methods
+            .into_iter()
+            .enumerate()
+            .map(|(k, m)| (m, scene.data(), (k as f64 - 0.5 * (count - 1.0)) * 1.4 * width))
+            .collect();
+        let base: Vec<[usize; 3]> =
+            scene.character.triangles().iter().map(|t| t.map(|i| i as usize)).collect();
+        let n = rest.len();
+        let triangles =
+            (0..methods.len()).flat_map(|k| base.iter().map(move |t| t.map(|i| i + k * n))).collect();
+        let dof = 3 * n * methods.len();
+        let mut runner = Self {
+            name: format!("skinning/{}", scene.name),
+            scene,
+            methods,
+            state: State::new(vec![0.0; dof], vec![0.0; dof]),
+            triangles,
+            scratch: Vec::new(),
+        };
+        runner.pose_all(0.0)?;
+        Ok(runner)
+    }
+
+    /// Poses every method at `t` into the state (velocities by difference with the last pose).
+    fn pose_all(&mut self, t: f64) -> Result<(), String> {
+        let dt = t - self.state.t;
+        let mut at = 0;
+        for (method, data, offset) in &mut self.methods {
+            self.scene.pose(data, t, *method).map_err(|e| e.to_string())?;
+            data.positions(&mut self.scratch);
+            for p in &self.scratch {
+                let q = [p[0] + *offset, p[1], p[2]];
+                for k in 0..3 {
+                    self.state.v[at + k] = if dt > 0.0 { (q[k] - self.state.x[at + k]) / dt } else { 0.0 };
+                    self.state.x[at + k] = q[k];
+                }
+                at += 3;
+            }
+        }
+        self.state.t = t;
+        Ok(())
+    }
+}
+
+impl Runner for SkinRunner {
+    fn system(&self) -> String {
+        self.name.clone()
+    }
+
+    fn method(&self) -> String {
+        self.methods
+            .iter()
+            .map(|(m, _, _)| format!("{m:?}").to_lowercase())
+            .collect::<Vec<_>>()
+            .join(" beside ")
+    }
+
+    fn state(&self) -> &State {
+        &self.state
+    }
+
+    fn step(&mut self, dt: f64) -> Result<StepReport, String> {
+        let t = self.state.t + dt;
+        self.pose_all(t)?;
+        Ok(StepReport::at_time(t))
+    }
+
+    fn natural_format(&self) -> OutputFormat {
+        OutputFormat::Obj
+    }
+
+    fn geometry(&self) -> Geometry {
+        Geometry::Particles {
+            triangles: self.triangles.clone(),
+            edges: Vec::new(),
+            radius: 0.0,
+            ground: None,
+            frame_box: frame_box(&self.state.x, None, false),
+        }
+    }
+}
+
 /// A spring network: cloth drawn as a shaded mesh, ropes and lattices as springs and particles.
 struct SpringRunner {
     name: String,
@@ -241,7 +387,7 @@ impl Runner for SpringRunner {
             edges: network.springs().iter().map(|s| [s.i, s.j]).collect(),
             radius: 0.15 * self.mean_spring_length(),
             ground,
-            frame_box: frame_box(&self.state.x, ground),
+            frame_box: frame_box(&self.state.x, ground, true),
         }
     }
 }
@@ -257,7 +403,7 @@ mod tests {
     fn runner_of(name: &str) -> Box<dyn Runner> {
         let text = scene::builtin(name).unwrap();
         let file = scene::parse(text, Path::new(name)).unwrap();
-        build(&file.scene, Path::new(name)).unwrap()
+        build(&file.scene, Path::new(name), None).unwrap()
     }
 
     #[test]
@@ -295,14 +441,14 @@ mod tests {
     fn unknown_preset_and_bad_resolution_name_their_fields() {
         let text = scene::builtin("cloth").unwrap().replace("hanging-cloth", "flying-carpet");
         let file = scene::parse(&text, Path::new("s.toml")).unwrap();
-        let msg = build(&file.scene, Path::new("s.toml")).err().unwrap().to_string();
+        let msg = build(&file.scene, Path::new("s.toml"), None).err().unwrap().to_string();
         assert!(
             msg.contains("s.toml") && msg.contains("`scene.preset`") && msg.contains("flying-carpet"),
             "{msg}"
         );
         let text = scene::builtin("cloth").unwrap().replace("resolution = 32", "resolution = 1");
         let file = scene::parse(&text, Path::new("s.toml")).unwrap();
-        let msg = build(&file.scene, Path::new("s.toml")).err().unwrap().to_string();
+        let msg = build(&file.scene, Path::new("s.toml"), None).err().unwrap().to_string();
         assert!(msg.contains("`scene.resolution`"), "{msg}");
     }
 

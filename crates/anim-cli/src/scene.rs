@@ -79,6 +79,19 @@ pub enum Scene {
         /// Integrator.
         integrator: IntegratorKind,
     },
+    /// A skinned character posed over time (anim-skin): the built-in twisted cylinder or any
+    /// skinned glTF 2.0 file (`.gltf` or `.glb`), by linear blend or dual-quaternion skinning.
+    Skinning {
+        /// A built-in character (`twisted-cylinder`); exactly one of `preset` and `file`.
+        #[serde(default)]
+        preset: Option<String>,
+        /// A glTF file, relative to the scene file's folder.
+        #[serde(default)]
+        file: Option<PathBuf>,
+        /// `lbs`, `dqs`, or `both` (side by side). Default: both for the cylinder, dqs for files.
+        #[serde(default)]
+        method: Option<SkinningChoice>,
+    },
     /// A mass-spring scene of anim-springs (`hanging-cloth`, `swinging-rope`, `jelly-drop`,
     /// `benchmark-cloth`), with its own integrator and solver unless overridden.
     Springs {
@@ -94,6 +107,18 @@ pub enum Scene {
         #[serde(default)]
         linear_solver: Option<LinearSolverKind>,
     },
+}
+
+/// Which skinning to show.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum SkinningChoice {
+    /// Linear blend skinning.
+    Lbs,
+    /// Dual-quaternion skinning.
+    Dqs,
+    /// Both, side by side (LBS left, DQS right).
+    Both,
 }
 
 /// A scene that could not be loaded.
@@ -132,7 +157,7 @@ pub enum SceneError {
 }
 
 /// The scenes built into the binary: `(name, description, TOML text)`.
-pub const BUILTIN: [(&str, &str, &str); 5] = [
+pub const BUILTIN: [(&str, &str, &str); 6] = [
     (
         "cloth",
         "a 32x32 cloth pinned at two corners falls and swings, backward Euler + sparse Cholesky",
@@ -140,6 +165,7 @@ pub const BUILTIN: [(&str, &str, &str); 5] = [
     ),
     ("rope", "a rope pinned at one end swings down, velocity Verlet", ROPE),
     ("jelly", "a jelly cube dropped on the ground bounces, backward Euler + sparse Cholesky", JELLY),
+    ("twist", "a cylinder twisted 180 degrees: LBS's candy-wrapper collapse beside DQS", TWIST),
     ("kepler", "a planet on an e = 0.5 ellipse, velocity Verlet, about 3 orbits", KEPLER),
     ("oscillator", "a lightly damped harmonic oscillator, implicit midpoint", OSCILLATOR),
 ];
@@ -182,6 +208,19 @@ steps_per_frame = 2
 [scene]
 kind = "springs"
 preset = "jelly-drop"
+"#;
+
+const TWIST: &str = r#"name = "twist"
+
+[run]
+dt = 0.02
+frames = 100
+steps_per_frame = 1
+
+[scene]
+kind = "skinning"
+preset = "twisted-cylinder"
+method = "both"
 "#;
 
 const KEPLER: &str = r#"name = "kepler"
@@ -329,6 +368,12 @@ fn validate(s: &SceneFile) -> Result<(), (&'static str, String)> {
                 return Err(("scene.eccentricity", format!("must lie in [0, 1), got {eccentricity}")));
             }
             integrator
+        }
+        Scene::Skinning { preset, file, .. } => {
+            if preset.is_some() == file.is_some() {
+                return Err(("scene.preset", "give exactly one of `preset` and `file`".into()));
+            }
+            return Ok(());
         }
         Scene::Springs { integrator, .. } => match integrator {
             Some(i) => i,

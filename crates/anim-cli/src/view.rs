@@ -191,10 +191,10 @@ impl View {
     }
 }
 
-/// The initial bounding box of 3-D particles widened sideways by a third of its size and
-/// extended down along gravity (-z) by its size, or to the ground: where the motion of the
-/// built-in scenes stays.
-pub fn frame_box(x: &[f64], ground: Option<f64>) -> ([f64; 3], [f64; 3]) {
+/// The initial bounding box of 3-D particles widened sideways by a third of its size and, when
+/// `falls`, extended down along gravity (-z) by its size or to the ground: where the motion of
+/// the built-in scenes stays.
+pub fn frame_box(x: &[f64], ground: Option<f64>, falls: bool) -> ([f64; 3], [f64; 3]) {
     let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
     for p in x.chunks_exact(3) {
         for k in 0..3 {
@@ -210,7 +210,9 @@ pub fn frame_box(x: &[f64], ground: Option<f64>) -> ([f64; 3], [f64; 3]) {
         lo[k] -= size / 3.0;
         hi[k] += size / 3.0;
     }
-    lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
+    if falls {
+        lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
+    }
     if let Some(z) = ground {
         lo[2] = z;
     }

@@ -3,4 +3,5 @@
 pub mod core;
 pub mod io;
 pub mod rigid;
+pub mod skin;
 pub mod springs;

@@ -1,0 +1,90 @@
+//! Criterion benches of anim-skin: LBS and DQS on a 100,000-vertex mesh with 4 influences per
+//! vertex, on 1 thread and on all threads, with throughput in vertex-influences, next to a
+//! memory-bandwidth bound over the same bytes.
+//!
+//! The bound ("stream" rows): one pass that reads exactly the arrays skinning reads (rest
+//! positions and normals, 6 x f64; joints 4 x u16; weights 4 x f64) and writes the arrays it
+//! writes (6 x f64), doing one add per input value, with the same chunked rayon loop. Skinning
+//! within 2x of it is memory bound to within 2x.
+
+use anim_core::glam::{DMat4, DQuat, DVec3};
+use anim_skin::{Skinned, SkinnedMesh, SkinningMethod, skin};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use rayon::prelude::*;
+use std::hint::black_box;
+
+const N: usize = 100_000;
+const K: usize = 4;
+const JOINTS: usize = 64;
+
+fn mesh() -> (SkinnedMesh, Vec<DMat4>) {
+    let mut s = 99u64;
+    let mut rnd = move || {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let pos: Vec<[f64; 3]> = (0..N).map(|_| [rnd(), rnd(), rnd()]).collect();
+    let nrm: Vec<[f64; 3]> = (0..N).map(|_| [0.0, 0.0, 1.0]).collect();
+    let js: Vec<u16> = (0..N * K).map(|_| (rnd() * JOINTS as f64) as u16).collect();
+    let ws: Vec<f64> = (0..N * K).map(|_| rnd() + 0.1).collect();
+    let mesh = SkinnedMesh::new(&pos, Some(&nrm), K, &js, &ws, vec![], JOINTS)
+        .unwrap_or_else(|e| panic!("bench mesh: {e}"));
+    let m = (0..JOINTS)
+        .map(|j| {
+            DMat4::from_rotation_translation(DQuat::from_rotation_y(0.1 * j as f64), DVec3::splat(j as f64))
+        })
+        .collect();
+    (mesh, m)
+}
+
+fn stream(mesh: &SkinnedMesh, out: &mut Skinned) {
+    const C: usize = anim_skin::skinning::CHUNK;
+    let (js, ws) = (mesh.joints(), mesh.weights());
+    out.x
+        .par_chunks_mut(C)
+        .zip(out.y.par_chunks_mut(C))
+        .zip(out.z.par_chunks_mut(C))
+        .zip(out.nx.par_chunks_mut(C))
+        .zip(out.ny.par_chunks_mut(C))
+        .zip(out.nz.par_chunks_mut(C))
+        .enumerate()
+        .for_each(|(c, (((((ox, oy), oz), onx), ony), onz))| {
+            for i in 0..ox.len() {
+                let v = c * C + i;
+                let w: f64 = ws[v * K..v * K + K].iter().sum::<f64>()
+                    + js[v * K..v * K + K].iter().map(|&j| f64::from(j)).sum::<f64>();
+                ox[i] = mesh.x[v] + w;
+                oy[i] = mesh.y[v] + w;
+                oz[i] = mesh.z[v] + w;
+                onx[i] = mesh.nx[v] + w;
+                ony[i] = mesh.ny[v] + w;
+                onz[i] = mesh.nz[v] + w;
+            }
+        });
+}
+
+fn skinning(c: &mut Criterion) {
+    let (mesh, m) = mesh();
+    let mut out = Skinned::new(&mesh);
+    let all = rayon::current_num_threads();
+    let mut g = c.benchmark_group("skin 100k vertices x 4 influences");
+    g.throughput(Throughput::Elements((N * K) as u64));
+    for threads in [1, all] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap_or_else(|e| panic!("pool: {e}"));
+        for (label, method) in [("lbs", SkinningMethod::Lbs), ("dqs", SkinningMethod::Dqs)] {
+            g.bench_function(format!("{label} {threads} thread(s)"), |b| {
+                b.iter(|| pool.install(|| skin(&mesh, black_box(&m), method, &mut out)))
+            });
+        }
+        g.bench_function(format!("stream bound {threads} thread(s)"), |b| {
+            b.iter(|| pool.install(|| stream(black_box(&mesh), &mut out)))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, skinning);
+criterion_main!(benches);

@@ -1,0 +1,146 @@
+//! Posed vertices of the glTF test assets against the independent numpy reference
+//! (`testdata/reference.py`), plus loader error paths.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use anim_skin::{SkinningMethod, scenes};
+use std::path::PathBuf;
+
+fn testdata(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("testdata").join(name)
+}
+
+/// Max over vertices of |p - q| divided by the max |q|.
+fn rel_err(a: &[[f64; 3]], b: &[Vec<f64>]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let scale = b.iter().map(|q| (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt()).fold(0.0, f64::max);
+    let err = a
+        .iter()
+        .zip(b)
+        .map(|(p, q)| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt())
+        .fold(0.0, f64::max);
+    err / scale
+}
+
+#[test]
+fn posed_vertices_match_numpy_reference() {
+    let text = std::fs::read_to_string(testdata("reference_poses.json")).unwrap();
+    let r: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let files = r["files"].as_object().unwrap();
+    assert_eq!(files.len(), 3);
+    for (file, poses) in files {
+        let scene = scenes::from_gltf(testdata(file)).unwrap();
+        assert!(scene.warnings.is_empty(), "{file}: {:?}", scene.warnings);
+        assert_eq!(scene.character.meshes[0].mesh.influences(), 8);
+        let mut data = scene.data();
+        let (mut p, mut n) = (Vec::new(), Vec::new());
+        for pose in poses.as_array().unwrap() {
+            let t = pose["t"].as_f64().unwrap();
+            scene.pose(&mut data, t, SkinningMethod::Lbs).unwrap();
+            data.positions(&mut p);
+            data.normals(&mut n);
+            let want: Vec<Vec<f64>> = serde_json::from_value(pose["positions"].clone()).unwrap();
+            let want_n: Vec<Vec<f64>> = serde_json::from_value(pose["normals"].clone()).unwrap();
+            let e = rel_err(&p, &want);
+            let en = rel_err(&n, &want_n);
+            assert!(e <= 1e-5, "{file} t = {t}: position relative error {e:e}");
+            assert!(en <= 1e-5, "{file} t = {t}: normal relative error {en:e}");
+        }
+    }
+}
+
+#[test]
+fn mesh_node_transform_is_ignored_and_pose_moves() {
+    // The mesh node is translated by 5 along x; glTF says skinning ignores it.
+    let scene = scenes::from_gltf(testdata("skin.glb")).unwrap();
+    let mut data = scene.data();
+    scene.pose(&mut data, 0.0, SkinningMethod::Lbs).unwrap();
+    let mut p = Vec::new();
+    data.positions(&mut p);
+    assert!(p.iter().all(|v| v[0].abs() < 1.0));
+}
+
+#[test]
+fn dqs_rejects_scaled_joints_of_the_asset() {
+    let scene = scenes::from_gltf(testdata("skin_embedded.gltf")).unwrap();
+    let mut data = scene.data();
+    // At t = 2 joint 4 is scaled (1.5, 0.8, 1.2): DQS must refuse, not pose wrongly.
+    let e = scene.pose(&mut data, 2.0, SkinningMethod::Dqs).unwrap_err();
+    assert!(matches!(e, anim_skin::SkinError::NonRigidJoint { joint: 4, .. }), "{e}");
+    // At t = 0 every joint is rigid: DQS runs.
+    scene.pose(&mut data, 0.0, SkinningMethod::Dqs).unwrap();
+}
+
+fn write_temp(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("anim-skin-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn edited(f: impl FnOnce(&mut serde_json::Value)) -> String {
+    let text = std::fs::read_to_string(testdata("skin_embedded.gltf")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    f(&mut v);
+    v.to_string()
+}
+
+#[test]
+fn loader_errors_name_file_element_and_cause() {
+    let missing = anim_skin::gltf_io::load(testdata("nope.gltf")).unwrap_err();
+    assert!(missing.to_string().contains("nope.gltf"), "{missing}");
+
+    let p = write_temp(
+        "morph.gltf",
+        &edited(|v| {
+            v["meshes"][0]["primitives"][0]["targets"] = serde_json::json!([{"POSITION": 0}]);
+        }),
+    );
+    let e = anim_skin::gltf_io::load(&p).unwrap_err();
+    assert_eq!(e.element, "mesh 0 primitive 0");
+    assert!(e.cause.contains("morph"), "{e}");
+
+    let p = write_temp(
+        "draco.gltf",
+        &edited(|v| {
+            v["extensionsUsed"] = serde_json::json!(["KHR_draco_mesh_compression"]);
+        }),
+    );
+    let e = anim_skin::gltf_io::load(&p).unwrap_err();
+    assert!(e.cause.contains("KHR_draco_mesh_compression"), "{e}");
+
+    let p = write_temp(
+        "required.gltf",
+        &edited(|v| {
+            v["extensionsUsed"] = serde_json::json!(["EXT_foo"]);
+            v["extensionsRequired"] = serde_json::json!(["EXT_foo"]);
+        }),
+    );
+    assert!(anim_skin::gltf_io::load(&p).is_err());
+
+    let p = write_temp(
+        "sparse.gltf",
+        &edited(|v| {
+            v["accessors"][0]["sparse"] = serde_json::json!({"count": 1,
+            "indices": {"bufferView": 2, "componentType": 5123},
+            "values": {"bufferView": 0}});
+        }),
+    );
+    let e = anim_skin::gltf_io::load(&p).unwrap_err();
+    assert!(e.cause.contains("sparse"), "{e}");
+
+    // A joint index beyond the skin with a non-zero weight: JOINTS_1's accessor is retyped so
+    // joint bytes are read from the float weights (garbage indices), an error not a panic.
+    let p = write_temp(
+        "badjoint.gltf",
+        &edited(|v| {
+            let w0 = v["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"].clone();
+            v["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = w0.clone();
+            let i = w0.as_u64().unwrap() as usize;
+            v["accessors"][i]["componentType"] = serde_json::json!(5121);
+        }),
+    );
+    let e = anim_skin::gltf_io::load(&p).unwrap_err();
+    assert!(e.to_string().contains("mesh 0 primitive 0"), "{e}");
+}
