@@ -29,7 +29,7 @@ fn parse_bencher(out: &str) -> Vec<Row> {
 
 pub fn run(filter: Option<&str>) -> bool {
     if std::env::args().skip(2).any(|a| a == "--peers") {
-        return peers::run() & peers_rigid::run();
+        return peers::run() & peers_rigid::run() & peers_pbd::run();
     }
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut args = vec!["bench", "-p", "anim-benches", "--benches", "--", "--output-format", "bencher"];
@@ -88,6 +88,10 @@ fn human(ns: f64) -> String {
 /// anim-rigid's peers (Pinocchio), in its own file.
 #[path = "peers_rigid.rs"]
 mod peers_rigid;
+
+/// anim-pbd's peers (pyPBD, Newton), in its own file.
+#[path = "peers_pbd.rs"]
+mod peers_pbd;
 
 /// `cargo xtask bench --peers`: our per-step time against peer libraries on the same problem,
 /// same integrator and same thread count, measured side by side in one run.

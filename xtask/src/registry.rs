@@ -158,6 +158,7 @@ pub fn all() -> Registry {
     crate::cases::io::register(&mut r);
     crate::cases::springs::register(&mut r);
     crate::cases::rigid::register(&mut r);
+    crate::cases::pbd::register(&mut r);
     crate::cases::skin::register(&mut r);
     r
 }

@@ -7,6 +7,7 @@ use anim_core::integrate::systems::{HarmonicOscillator, KeplerOrbit};
 use anim_core::integrate::{MechanicalSystem, Simulation, State};
 use anim_core::solver::{Solver, StepReport};
 use anim_io::FrameFormat;
+use anim_pbd::PbdSimulation;
 use anim_skin::scenes::SkinScene;
 use anim_skin::{CharacterData, SkinningMethod};
 use anim_springs::{SpringSimulation, scenes as spring_scenes};
@@ -145,6 +146,24 @@ pub fn build(
             let runner = SkinRunner::new(scene, skinning.or(method).unwrap_or(default))
                 .map_err(|e| SceneError::invalid(file_path, "scene.method", e))?;
             Box::new(runner)
+        }
+        Scene::Pbd { ref preset, resolution } => {
+            let s = match anim_pbd::scenes::by_name(preset, resolution) {
+                Some(Ok(s)) => s,
+                Some(Err(e)) => return Err(SceneError::invalid(file, "scene.resolution", e.to_string())),
+                None => {
+                    return Err(SceneError::invalid(
+                        file,
+                        "scene.preset",
+                        format!("unknown preset `{preset}` (one of {})", anim_pbd::scenes::NAMES.join(", ")),
+                    ));
+                }
+            };
+            let method = format!("{:?} / {:?}", s.params.method, s.params.solver).to_lowercase();
+            let name = format!("pbd/{}", s.name);
+            let (sim, state) =
+                s.into_simulation().map_err(|e| SceneError::invalid(file, "scene.preset", e.to_string()))?;
+            Box::new(PbdRunner { name, method, sim, state })
         }
         Scene::Springs { ref preset, resolution, integrator, linear_solver } => {
             let mut s = match spring_scenes::by_name(preset, resolution) {
@@ -324,7 +343,78 @@ impl Runner for SkinRunner {
             edges: Vec::new(),
             radius: 0.0,
             ground: None,
+            spheres: Vec::new(),
             frame_box: frame_box(&self.state.x, None, false),
+        }
+    }
+}
+
+/// A position-based-dynamics model: cloth and soft bodies drawn as shaded surfaces, ropes as
+/// segments and particles.
+struct PbdRunner {
+    name: String,
+    method: String,
+    sim: PbdSimulation,
+    state: State,
+}
+
+impl Runner for PbdRunner {
+    fn system(&self) -> String {
+        self.name.clone()
+    }
+
+    fn method(&self) -> String {
+        self.method.clone()
+    }
+
+    fn state(&self) -> &State {
+        &self.state
+    }
+
+    fn step(&mut self, dt: f64) -> Result<StepReport, String> {
+        self.sim.step(&mut self.state, dt).map_err(|e| e.to_string())
+    }
+
+    fn natural_format(&self) -> OutputFormat {
+        OutputFormat::Vtu
+    }
+
+    fn geometry(&self) -> Geometry {
+        let model = self.sim.model();
+        let mut triangles = model.triangles().to_vec();
+        if triangles.is_empty() && !model.tets().is_empty() {
+            let positions = self.state.x.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            let mesh = anim_io::TetMesh { positions, tets: model.tets().to_vec() };
+            triangles = mesh.boundary_triangles();
+        }
+        let (mut ground, mut spheres) = (None, Vec::new());
+        for c in model.colliders().iter().filter(|c| c.body.is_none()) {
+            match c.shape {
+                anim_pbd::Shape::Plane { point, normal: [0.0, 0.0, 1.0] } => ground = Some(point[2]),
+                anim_pbd::Shape::Sphere { center, radius } => spheres.push((center, radius)),
+                _ => {}
+            }
+        }
+        let edges = model.edges().to_vec();
+        let mean = if edges.is_empty() {
+            0.01
+        } else {
+            edges
+                .iter()
+                .map(|[i, j]| {
+                    let (a, b) = (&self.state.x[3 * i..3 * i + 3], &self.state.x[3 * j..3 * j + 3]);
+                    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+                })
+                .sum::<f64>()
+                / edges.len() as f64
+        };
+        Geometry::Particles {
+            triangles,
+            edges,
+            radius: 0.2 * mean,
+            ground,
+            spheres,
+            frame_box: frame_box(&self.state.x, ground, true),
         }
     }
 }
@@ -382,11 +472,21 @@ impl Runner for SpringRunner {
     fn geometry(&self) -> Geometry {
         let network = self.sim.network();
         let ground = self.ground();
+        let spheres = network
+            .model()
+            .colliders()
+            .iter()
+            .filter_map(|c| match c.shape {
+                anim_springs::Shape::Sphere { center, radius } => Some((center, radius)),
+                _ => None,
+            })
+            .collect();
         Geometry::Particles {
             triangles: network.triangles().to_vec(),
             edges: network.springs().iter().map(|s| [s.i, s.j]).collect(),
             radius: 0.15 * self.mean_spring_length(),
             ground,
+            spheres,
             frame_box: frame_box(&self.state.x, ground, true),
         }
     }

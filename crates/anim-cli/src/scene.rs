@@ -92,6 +92,15 @@ pub enum Scene {
         #[serde(default)]
         method: Option<SkinningChoice>,
     },
+    /// A position-based-dynamics scene of anim-pbd (`cloth-drape`, `flag`, `rope`, `soft-blob`,
+    /// `balloon`, `benchmark-cloth`) with its own solver settings.
+    Pbd {
+        /// The preset's name.
+        preset: String,
+        /// Resolution (the preset's default when absent).
+        #[serde(default)]
+        resolution: Option<usize>,
+    },
     /// A mass-spring scene of anim-springs (`hanging-cloth`, `swinging-rope`, `jelly-drop`,
     /// `benchmark-cloth`), with its own integrator and solver unless overridden.
     Springs {
@@ -157,7 +166,7 @@ pub enum SceneError {
 }
 
 /// The scenes built into the binary: `(name, description, TOML text)`.
-pub const BUILTIN: [(&str, &str, &str); 6] = [
+pub const BUILTIN: [(&str, &str, &str); 10] = [
     (
         "cloth",
         "a 32x32 cloth pinned at two corners falls and swings, backward Euler + sparse Cholesky",
@@ -165,6 +174,10 @@ pub const BUILTIN: [(&str, &str, &str); 6] = [
     ),
     ("rope", "a rope pinned at one end swings down, velocity Verlet", ROPE),
     ("jelly", "a jelly cube dropped on the ground bounces, backward Euler + sparse Cholesky", JELLY),
+    ("drape", "XPBD cloth falling onto a sphere and draping over it", DRAPE),
+    ("flag", "an XPBD flag on a swaying pole in the wind", FLAG),
+    ("blob", "a soft tetrahedral blob (XPBD) falling on the ground", BLOB),
+    ("pbd-rope", "a 100-link XPBD rope swinging against obstacles", PBD_ROPE),
     ("twist", "a cylinder twisted 180 degrees: LBS's candy-wrapper collapse beside DQS", TWIST),
     ("kepler", "a planet on an e = 0.5 ellipse, velocity Verlet, about 3 orbits", KEPLER),
     ("oscillator", "a lightly damped harmonic oscillator, implicit midpoint", OSCILLATOR),
@@ -208,6 +221,54 @@ steps_per_frame = 2
 [scene]
 kind = "springs"
 preset = "jelly-drop"
+"#;
+
+const DRAPE: &str = r#"name = "drape"
+
+[run]
+dt = 0.016666666666666666
+frames = 120
+steps_per_frame = 1
+
+[scene]
+kind = "pbd"
+preset = "cloth-drape"
+"#;
+
+const FLAG: &str = r#"name = "flag"
+
+[run]
+dt = 0.016666666666666666
+frames = 120
+steps_per_frame = 1
+
+[scene]
+kind = "pbd"
+preset = "flag"
+"#;
+
+const BLOB: &str = r#"name = "blob"
+
+[run]
+dt = 0.016666666666666666
+frames = 120
+steps_per_frame = 1
+
+[scene]
+kind = "pbd"
+preset = "soft-blob"
+"#;
+
+const PBD_ROPE: &str = r#"name = "pbd-rope"
+
+[run]
+dt = 0.016666666666666666
+frames = 120
+steps_per_frame = 1
+
+[scene]
+kind = "pbd"
+preset = "rope"
 "#;
 
 const TWIST: &str = r#"name = "twist"
@@ -369,6 +430,7 @@ fn validate(s: &SceneFile) -> Result<(), (&'static str, String)> {
             }
             integrator
         }
+        Scene::Pbd { .. } => return Ok(()),
         Scene::Skinning { preset, file, .. } => {
             if preset.is_some() == file.is_some() {
                 return Err(("scene.preset", "give exactly one of `preset` and `file`".into()));

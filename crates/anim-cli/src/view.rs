@@ -42,6 +42,8 @@ pub enum Geometry {
         radius: f64,
         /// Height of a ground plane `z = h`, if any.
         ground: Option<f64>,
+        /// Static spheres (colliders): centre and radius.
+        spheres: Vec<([f64; 3], f64)>,
         /// Region kept in view.
         frame_box: ([f64; 3], [f64; 3]),
     },
@@ -151,8 +153,11 @@ impl View {
                 }
                 io(canvas.draw_particles(camera, &[p], 0.03 * scale, Colors::Uniform([60, 110, 200])))
             }
-            Geometry::Particles { triangles, edges, radius, ground, frame_box } => {
+            Geometry::Particles { triangles, edges, radius, ground, spheres, frame_box } => {
                 triples(&s.x, &mut self.positions);
+                for (c, r) in spheres {
+                    io(canvas.draw_particles(camera, &[*c], *r, Colors::Uniform([190, 190, 180])))?;
+                }
                 if let Some(z) = ground {
                     // A floor under the framed region (not beyond it: corners behind the
                     // camera would clip the whole quad).

@@ -2,6 +2,7 @@
 
 pub mod core;
 pub mod io;
+pub mod pbd;
 pub mod rigid;
 pub mod skin;
 pub mod springs;

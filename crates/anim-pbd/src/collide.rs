@@ -1,0 +1,417 @@
+//! Obstacles: kinematic bodies (moved by a prescribed motion, not by the simulation) and the
+//! collider shapes (plane, sphere, box, capsule) from which line (8) of the PBD loop,
+//! `generateCollisionConstraints(x_i -> p_i)`, makes inequality constraints every step.
+//!
+//! # Contacts
+//!
+//! For every free particle and every collider, the signed distance `phi(p)` of the predicted
+//! position `p` to the shape is evaluated; if `phi(p) < thickness + margin + |p - x|` (a
+//! speculative margin, [`PbdParams::contact_margin`](crate::PbdParams::contact_margin)), a
+//! contact constraint
+//!
+//! ```text
+//! C(p) = n . (p - q) - thickness >= 0
+//! ```
+//!
+//! is generated with `q` the closest surface point and `n` the outward normal at `q`, both frozen
+//! for the step (Müller et al. 2007, section 3.4, the "static" case; the shapes are solid, so the
+//! closest point also resolves a particle that crossed the surface during the step, unless it
+//! passed through a shape thinner than its motion). A contact is always rigid (compliance 0) and
+//! inactive while `C >= 0`; the margin lets it catch a particle that the internal constraints push
+//! into the shape during the iterations.
+//!
+//! **Friction** is positional (Macklin et al. 2014, "Unified particle physics", eq. 24): after a
+//! projection that pushed the particle out by `d`, its tangential motion relative to the obstacle
+//! over the step, `dx_t`, is removed entirely when `|dx_t| < mu_s d` (static friction) and
+//! shortened by `min(mu_k d, |dx_t|)` otherwise (kinetic friction). A particle resting on a
+//! surface under gravity `g` therefore sticks while its tangential speed is below
+//! `mu_s g h` and slides with deceleration `mu_k g`.
+//!
+//! Limitation: the friction test runs in every iteration against that iteration's normal
+//! correction. When a large step is solved by many iterations of one substep, internal
+//! constraints that keep pulling a particle into a curved surface can keep it inside the static
+//! cone, and a stretched cloth can stay locked on a frictional sphere (measured by
+//! `cargo xtask stability`: 54% to 76% stretch at dt = 1/30 with 10 iterations and 1 substep,
+//! 11% to 12% with 1 iteration and 10 substeps). Use substeps for such scenes (the drape scene
+//! uses 4 and ends below 3%); friction from accumulated multipliers (Müller et al. 2020) would
+//! remove this and is not implemented.
+//!
+//! **Restitution** is applied in the loop's `velocityUpdate` (line 16) as in Müller et al. 2020
+//! ("Detailed rigid body simulation with extended position based dynamics", eq. 34): a contact
+//! whose normal velocity before the solve, `v_n^-`, was approaching faster than `2 |g| h` leaves
+//! with `v_n = -e v_n^-`; slower contacts get `v_n = 0` (no jitter at rest).
+//!
+//! # Moving obstacles
+//!
+//! A collider or an attachment may belong to a [`KinematicBody`], whose pose follows a
+//! [`BodyMotion`] of time (or a target set between steps with
+//! [`PbdSimulation::set_body_target`](crate::PbdSimulation::set_body_target)). Within a step the
+//! pose moves linearly from its start to its end; substeps see the interpolated pose and friction
+//! acts relative to the body's velocity at the contact point (the seed's `x^obs, v^obs`).
+
+use anim_core::glam::{DQuat, DVec3};
+use serde::{Deserialize, Serialize};
+
+/// A rigid pose: `world = position + rotation * local`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Pose {
+    /// Translation.
+    pub position: DVec3,
+    /// Rotation (unit quaternion).
+    pub rotation: DQuat,
+}
+
+impl Default for Pose {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
+}
+
+impl Pose {
+    /// No translation, no rotation.
+    pub const IDENTITY: Pose = Pose { position: DVec3::ZERO, rotation: DQuat::IDENTITY };
+
+    /// A translation.
+    #[must_use]
+    pub fn from_translation(p: [f64; 3]) -> Self {
+        Self { position: DVec3::from_array(p), rotation: DQuat::IDENTITY }
+    }
+
+    /// Maps a local point to world space.
+    #[inline]
+    #[must_use]
+    pub fn apply(&self, local: DVec3) -> DVec3 {
+        self.position + self.rotation * local
+    }
+
+    /// Maps a world point to the local frame.
+    #[inline]
+    #[must_use]
+    pub fn inverse_apply(&self, world: DVec3) -> DVec3 {
+        self.rotation.inverse() * (world - self.position)
+    }
+
+    /// Linear interpolation of the position and spherical interpolation of the rotation.
+    #[must_use]
+    pub fn lerp(&self, other: &Pose, s: f64) -> Pose {
+        Pose {
+            position: self.position.lerp(other.position, s),
+            rotation: self.rotation.slerp(other.rotation, s),
+        }
+    }
+}
+
+/// How a kinematic body moves: a function of time from its initial pose.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BodyMotion {
+    /// It stays where it is.
+    Fixed,
+    /// Constant linear velocity (m/s) and angular velocity (rad/s, about its own origin).
+    Constant {
+        /// Linear velocity.
+        velocity: [f64; 3],
+        /// Angular velocity.
+        angular_velocity: [f64; 3],
+    },
+    /// Translation `amplitude * sin(2 pi frequency t)`.
+    Oscillate {
+        /// Amplitude (m) per axis.
+        amplitude: [f64; 3],
+        /// Frequency (Hz).
+        frequency: f64,
+    },
+}
+
+/// A body that moves by prescription and carries colliders and attachment points.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct KinematicBody {
+    /// Pose at time 0.
+    pub pose: Pose,
+    /// Motion from that pose.
+    pub motion: BodyMotion,
+}
+
+impl KinematicBody {
+    /// A body at `pose` following `motion`.
+    #[must_use]
+    pub fn new(pose: Pose, motion: BodyMotion) -> Self {
+        Self { pose, motion }
+    }
+
+    /// Pose at time `t`.
+    #[must_use]
+    pub fn pose_at(&self, t: f64) -> Pose {
+        match self.motion {
+            BodyMotion::Fixed => self.pose,
+            BodyMotion::Constant { velocity, angular_velocity } => {
+                let w = DVec3::from_array(angular_velocity);
+                let angle = w.length() * t;
+                let rot =
+                    if angle > 0.0 { DQuat::from_axis_angle(w.normalize(), angle) } else { DQuat::IDENTITY };
+                Pose {
+                    position: self.pose.position + t * DVec3::from_array(velocity),
+                    rotation: (rot * self.pose.rotation).normalize(),
+                }
+            }
+            BodyMotion::Oscillate { amplitude, frequency } => Pose {
+                position: self.pose.position
+                    + DVec3::from_array(amplitude) * (std::f64::consts::TAU * frequency * t).sin(),
+                rotation: self.pose.rotation,
+            },
+        }
+    }
+}
+
+/// A collider's geometry, in the frame of its body (or in world space).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Shape {
+    /// The half-space below a plane: solid where `(x - point) . normal < 0`.
+    Plane {
+        /// A point of the plane.
+        point: [f64; 3],
+        /// Outward normal (normalised when the model is built).
+        normal: [f64; 3],
+    },
+    /// A solid ball.
+    Sphere {
+        /// Centre.
+        center: [f64; 3],
+        /// Radius (> 0).
+        radius: f64,
+    },
+    /// A solid box.
+    Box {
+        /// Centre.
+        center: [f64; 3],
+        /// Half the edge lengths (each > 0).
+        half_extents: [f64; 3],
+    },
+    /// A solid capsule: the points within `radius` of the segment `a b`.
+    Capsule {
+        /// First end of the axis.
+        a: [f64; 3],
+        /// Second end of the axis.
+        b: [f64; 3],
+        /// Radius (> 0).
+        radius: f64,
+    },
+}
+
+impl Shape {
+    /// Signed distance of local point `p` and the outward unit normal of the closest surface
+    /// point (`phi < 0` inside).
+    #[must_use]
+    pub fn signed_distance(&self, p: DVec3) -> (f64, DVec3) {
+        match *self {
+            Shape::Plane { point, normal } => {
+                let n = DVec3::from_array(normal);
+                ((p - DVec3::from_array(point)).dot(n), n)
+            }
+            Shape::Sphere { center, radius } => {
+                let d = p - DVec3::from_array(center);
+                let len = d.length();
+                let n = if len > 0.0 { d / len } else { DVec3::Z };
+                (len - radius, n)
+            }
+            Shape::Capsule { a, b, radius } => {
+                let (a, b) = (DVec3::from_array(a), DVec3::from_array(b));
+                let ab = b - a;
+                let t = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+                let d = p - (a + t * ab);
+                let len = d.length();
+                let n = if len > 0.0 {
+                    d / len
+                } else {
+                    // On the axis: any direction perpendicular to it.
+                    ab.any_orthonormal_vector()
+                };
+                (len - radius, n)
+            }
+            Shape::Box { center, half_extents } => {
+                let h = DVec3::from_array(half_extents);
+                let d = p - DVec3::from_array(center);
+                let q = d.abs() - h;
+                if q.max_element() > 0.0 {
+                    let outside = q.max(DVec3::ZERO);
+                    let len = outside.length();
+                    let n = (outside * d.signum()) / len;
+                    (len, n)
+                } else {
+                    // Inside: the nearest face.
+                    let (axis, depth) = if q.x >= q.y && q.x >= q.z {
+                        (DVec3::X, q.x)
+                    } else if q.y >= q.z {
+                        (DVec3::Y, q.y)
+                    } else {
+                        (DVec3::Z, q.z)
+                    };
+                    let sign = if d.dot(axis) >= 0.0 { 1.0 } else { -1.0 };
+                    (depth, axis * sign)
+                }
+            }
+        }
+    }
+}
+
+/// A collider: a shape on an optional kinematic body, with its contact parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Collider {
+    /// The geometry (in the body's frame when `body` is set).
+    pub shape: Shape,
+    /// The kinematic body carrying it, if any.
+    pub body: Option<usize>,
+    /// Distance kept between particle centres and the surface (m, >= 0; a particle radius).
+    pub thickness: f64,
+    /// Static friction coefficient `mu_s >= 0`.
+    pub static_friction: f64,
+    /// Kinetic friction coefficient `0 <= mu_k` (at most `mu_s` is physical but not required).
+    pub kinetic_friction: f64,
+    /// Coefficient of restitution `e` in `[0, 1]`.
+    pub restitution: f64,
+}
+
+impl Collider {
+    /// A collider with the given shape, no thickness, no friction and no restitution.
+    #[must_use]
+    pub fn new(shape: Shape) -> Self {
+        Self {
+            shape,
+            body: None,
+            thickness: 0.0,
+            static_friction: 0.0,
+            kinetic_friction: 0.0,
+            restitution: 0.0,
+        }
+    }
+
+    /// The ground plane `z = height` (z up, the scenes' convention).
+    #[must_use]
+    pub fn ground(height: f64) -> Self {
+        Self::new(Shape::Plane { point: [0.0, 0.0, height], normal: [0.0, 0.0, 1.0] })
+    }
+
+    /// A sphere.
+    #[must_use]
+    pub fn sphere(center: [f64; 3], radius: f64) -> Self {
+        Self::new(Shape::Sphere { center, radius })
+    }
+
+    /// An axis-aligned box (rotate it by putting it on a body).
+    #[must_use]
+    pub fn cuboid(center: [f64; 3], half_extents: [f64; 3]) -> Self {
+        Self::new(Shape::Box { center, half_extents })
+    }
+
+    /// A capsule around the segment `a b`.
+    #[must_use]
+    pub fn capsule(a: [f64; 3], b: [f64; 3], radius: f64) -> Self {
+        Self::new(Shape::Capsule { a, b, radius })
+    }
+
+    /// Sets the thickness.
+    #[must_use]
+    pub fn with_thickness(mut self, thickness: f64) -> Self {
+        self.thickness = thickness;
+        self
+    }
+
+    /// Sets static and kinetic friction.
+    #[must_use]
+    pub fn with_friction(mut self, static_friction: f64, kinetic_friction: f64) -> Self {
+        self.static_friction = static_friction;
+        self.kinetic_friction = kinetic_friction;
+        self
+    }
+
+    /// Sets the restitution.
+    #[must_use]
+    pub fn with_restitution(mut self, e: f64) -> Self {
+        self.restitution = e;
+        self
+    }
+
+    /// Puts the collider on kinematic body `body`.
+    #[must_use]
+    pub fn on_body(mut self, body: usize) -> Self {
+        self.body = Some(body);
+        self
+    }
+
+    /// Checks the parameters; the reason on failure.
+    pub(crate) fn validate(&self, bodies: usize) -> Result<Collider, String> {
+        let finite3 = |v: [f64; 3]| v.iter().all(|c| c.is_finite());
+        let mut c = *self;
+        match &mut c.shape {
+            Shape::Plane { point, normal } => {
+                let n = DVec3::from_array(*normal);
+                if !finite3(*point) || !finite3(*normal) || !(n.length() > 0.0) {
+                    return Err(format!(
+                        "plane needs a finite point and a non-zero normal, got {point:?}, {normal:?}"
+                    ));
+                }
+                *normal = n.normalize().to_array();
+            }
+            Shape::Sphere { center, radius } => {
+                if !(finite3(*center) && *radius > 0.0 && radius.is_finite()) {
+                    return Err(format!("sphere needs a finite centre and a positive radius, got {radius}"));
+                }
+            }
+            Shape::Box { center, half_extents } => {
+                if !finite3(*center) || !half_extents.iter().all(|h| *h > 0.0 && h.is_finite()) {
+                    return Err(format!("box needs positive half extents, got {half_extents:?}"));
+                }
+            }
+            Shape::Capsule { a, b, radius } => {
+                if !(finite3(*a) && finite3(*b) && *radius > 0.0 && radius.is_finite()) {
+                    return Err(format!("capsule needs finite ends and a positive radius, got {radius}"));
+                }
+                if DVec3::from_array(*a) == DVec3::from_array(*b) {
+                    return Err("capsule ends coincide (use a sphere)".into());
+                }
+            }
+        }
+        let nonneg = |v: f64| v >= 0.0 && v.is_finite();
+        if !nonneg(c.thickness) {
+            return Err(format!("thickness must be non-negative and finite, got {}", c.thickness));
+        }
+        if !nonneg(c.static_friction) || !nonneg(c.kinetic_friction) {
+            return Err(format!(
+                "friction coefficients must be non-negative and finite, got {} and {}",
+                c.static_friction, c.kinetic_friction
+            ));
+        }
+        if !(0.0..=1.0).contains(&c.restitution) {
+            return Err(format!("restitution must lie in [0, 1], got {}", c.restitution));
+        }
+        if let Some(b) = c.body
+            && b >= bodies
+        {
+            return Err(format!("body {b} does not exist (the model has {bodies} kinematic bodies)"));
+        }
+        Ok(c)
+    }
+}
+
+/// A contact generated at line (8) of the loop; lives for one (sub)step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Contact {
+    /// The particle.
+    pub particle: u32,
+    /// The collider.
+    pub collider: u32,
+    /// Outward normal at the contact point.
+    pub normal: DVec3,
+    /// `n . q + thickness`: the constraint is `n . p - offset >= 0`.
+    pub offset: f64,
+    /// Obstacle displacement at the contact point over the substep.
+    pub obstacle_dx: DVec3,
+    /// Normal velocity relative to the obstacle before the solve.
+    pub vn_pre: f64,
+    /// Accumulated normal correction (PBD) or multiplier (XPBD) this substep.
+    pub lambda: f64,
+    /// The last correction (parallel sweeps compute it, then apply it).
+    pub dx: DVec3,
+}
