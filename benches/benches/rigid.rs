@@ -1,12 +1,17 @@
-//! Criterion benches of anim-rigid's kinematics on the Franka Panda (fingers locked, 7 DoF):
-//! forward kinematics, frame placements, joint Jacobians, one frame Jacobian, and the analytic
-//! and numerical IK, over 1024 pre-generated random configurations.
-//! `cargo xtask bench --peers` compares FK and Jacobians with Pinocchio's C++.
+//! Criterion benches of anim-rigid on the Franka Panda (fingers locked, 7 DoF): forward
+//! kinematics, frame placements, joint Jacobians, one frame Jacobian, the analytic and numerical
+//! IK; and the dynamics (RNEA, CRBA, ABA, the Cholesky forward dynamics, one simulation step) on
+//! the Panda and the 32-joint chain of `crates/anim-rigid/testdata/chain32.urdf`, over 1024
+//! pre-generated random inputs. `cargo xtask bench --peers` compares FK, Jacobians, RNEA, CRBA
+//! and ABA with Pinocchio's C++.
 
+use anim_core::solver::Solver;
 use anim_rigid::config::random_configuration;
+use anim_rigid::sim::{RigidIntegrator, RigidSimulation, SimParams};
 use anim_rigid::{
-    AnalyticIk, Data, IkParams, Jacobian, Model, NumericalIk, ReferenceFrame, UrdfOptions,
-    compute_joint_jacobians, forward_kinematics, frame_jacobian, frames_forward_kinematics, load_urdf,
+    AnalyticIk, Data, IkParams, Jacobian, Model, NumericalIk, ReferenceFrame, UrdfOptions, aba,
+    compute_joint_jacobians, crba, crba_local, crba_world, forward_dynamics_cholesky, forward_kinematics,
+    frame_jacobian, frames_forward_kinematics, load_urdf, rnea,
 };
 use criterion::{Criterion, criterion_group, criterion_main};
 use rand::{Rng, SeedableRng};
@@ -100,5 +105,91 @@ fn kinematics(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, kinematics);
+/// One input of the dynamics kernels: (q, v, a, tau).
+type Sample = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// Random (q, v, a, tau) with the ranges of the Pinocchio peer program.
+fn samples(model: &Model) -> Vec<Sample> {
+    let mut rng = ChaCha8Rng::seed_from_u64(6);
+    let nv = model.nv();
+    (0..1024)
+        .map(|_| {
+            let q = random_configuration(model, &mut || rng.random::<f64>());
+            let mut r = |s: f64| (0..nv).map(|_| rng.random_range(-s..s)).collect::<Vec<f64>>();
+            (q, r(2.0), r(3.0), r(10.0))
+        })
+        .collect()
+}
+
+fn dynamics(c: &mut Criterion) {
+    let chain32 =
+        load_urdf(testdata("chain32.urdf"), &UrdfOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let ur5 =
+        load_urdf(testdata("ur5_robot.urdf"), &UrdfOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let chain8 = anim_rigid::scenes::pendulum_chain_model(&[0.1; 8], 0.1).unwrap_or_else(|e| panic!("{e}"));
+    let chain16 = anim_rigid::scenes::pendulum_chain_model(&[0.1; 16], 0.1).unwrap_or_else(|e| panic!("{e}"));
+    for (name, model) in
+        [("panda", panda()), ("ur5", ur5), ("chain8", chain8), ("chain16", chain16), ("chain32", chain32)]
+    {
+        let inputs = samples(&model);
+        let mut data = Data::new(&model);
+        let last = model.nv() - 1;
+        let mut g = c.benchmark_group(format!("rigid/{name}"));
+        let mut i = 0;
+        g.bench_function("rnea", |b| {
+            b.iter(|| {
+                i = (i + 1) & 1023;
+                let (q, v, a, _) = &inputs[i];
+                black_box(rnea(&model, &mut data, black_box(q), black_box(v), black_box(a))[last])
+            })
+        });
+        g.bench_function("crba", |b| {
+            b.iter(|| {
+                i = (i + 1) & 1023;
+                black_box(crba(&model, &mut data, black_box(&inputs[i].0))[(0, last)])
+            })
+        });
+        g.bench_function("crba_local", |b| {
+            b.iter(|| {
+                i = (i + 1) & 1023;
+                black_box(crba_local(&model, &mut data, black_box(&inputs[i].0))[(0, last)])
+            })
+        });
+        g.bench_function("crba_world", |b| {
+            b.iter(|| {
+                i = (i + 1) & 1023;
+                black_box(crba_world(&model, &mut data, black_box(&inputs[i].0))[(0, last)])
+            })
+        });
+        g.bench_function("aba", |b| {
+            b.iter(|| {
+                i = (i + 1) & 1023;
+                let (q, v, _, tau) = &inputs[i];
+                black_box(aba(&model, &mut data, black_box(q), black_box(v), black_box(tau))[last])
+            })
+        });
+        g.bench_function("forward_dynamics_cholesky", |b| {
+            b.iter(|| {
+                i = (i + 1) & 1023;
+                let (q, v, _, tau) = &inputs[i];
+                let ddq =
+                    forward_dynamics_cholesky(&model, &mut data, black_box(q), black_box(v), black_box(tau));
+                black_box(ddq.map(|x| x[last]).unwrap_or(f64::NAN))
+            })
+        });
+        for integrator in [RigidIntegrator::Rk4, RigidIntegrator::ImplicitMidpoint] {
+            let mut sim = RigidSimulation::new(model.clone(), SimParams::default(), integrator)
+                .unwrap_or_else(|e| panic!("{e}"));
+            let (q, v, _, _) = inputs[0].clone();
+            let mut state =
+                sim.initial_state(q, v.iter().map(|x| 0.1 * x).collect()).unwrap_or_else(|e| panic!("{e}"));
+            g.bench_function(format!("step {} (1 ms, with energy and momentum)", integrator.label()), |b| {
+                b.iter(|| black_box(sim.step(&mut state, 1e-3).map(|r| r.time).unwrap_or(f64::NAN)))
+            });
+        }
+        g.finish();
+    }
+}
+
+criterion_group!(benches, kinematics, dynamics);
 criterion_main!(benches);

@@ -1,12 +1,16 @@
 //! `cargo xtask bench --peers`, anim-rigid part: forward kinematics and joint Jacobians on the
-//! Franka Panda (fingers locked, 7 DoF) and the UR5, ns per call, against Pinocchio's C++
-//! library from the `pin` wheel (header-only, `g++ -O3 -march=native`), measured side by side.
+//! Franka Panda (fingers locked, 7 DoF) and the UR5, and RNEA, CRBA and ABA on the Panda, the UR5
+//! and the 32-joint chain of `crates/anim-rigid/testdata/chain32.urdf`, ns per call, against
+//! Pinocchio's C++ library from the `pin` wheel (header-only, `g++ -O3 -march=native`), measured
+//! side by side.
 //!
-//! The C++ program (`xtask/peers/pinocchio/kinematics_bench.cpp`) builds its Pinocchio model from
-//! a text file written here from anim-rigid's model of the same URDF, with the joint types
-//! Pinocchio's URDF parser chooses (the two models agree to 1e-16: `tests/pinocchio.rs`); the
-//! wheel ships no urdfdom headers, so its URDF parser cannot be compiled against. Needs Python
-//! with `pin==4.1.0` and `cmeel-eigen` (installed with pip when missing) and g++.
+//! The C++ programs (`xtask/peers/pinocchio/kinematics_bench.cpp`, `dynamics_bench.cpp`) build
+//! their Pinocchio model from a text file written here from anim-rigid's model of the same URDF,
+//! with the joint types Pinocchio's URDF parser chooses and each body's inertia (the two models
+//! agree to 1e-15: `tests/pinocchio.rs`, `tests/pinocchio_dynamics.rs`); the wheel ships no
+//! urdfdom headers, so its URDF parser cannot be compiled against. Pinocchio's CRBA and ABA are
+//! timed in both of its conventions (LOCAL, its default, and WORLD) and compared with the faster
+//! one. Needs Python with `pin==4.1.0` and `cmeel-eigen` (installed with pip when missing) and g++.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -14,11 +18,13 @@ use std::process::Command;
 use std::time::Instant;
 
 use anim_rigid::{
-    Axis, Data, JointType, Model, UrdfOptions, compute_joint_jacobians, forward_kinematics, load_urdf,
+    Axis, Data, JointType, Model, UrdfOptions, aba, compute_joint_jacobians, crba, forward_kinematics,
+    load_urdf, rnea,
 };
 
-/// The timing program, relative to the xtask crate.
-const SOURCE: &str = "peers/pinocchio/kinematics_bench.cpp";
+/// The timing programs, relative to the xtask crate, and their binaries under `target/xtask`.
+const KINEMATICS: (&str, &str) = ("peers/pinocchio/kinematics_bench.cpp", "pinocchio_kinematics_bench");
+const DYNAMICS: (&str, &str) = ("peers/pinocchio/dynamics_bench.cpp", "pinocchio_dynamics_bench");
 const CALLS_PER_BATCH: usize = 20_000;
 const BATCHES: usize = 15;
 const CONFIGS: usize = 1024;
@@ -60,12 +66,12 @@ fn ensure_prefix() -> Result<PathBuf, String> {
     })
 }
 
-/// Compiles the timing program (cached while the binary is newer than the source).
-fn build(prefix: &Path) -> Result<PathBuf, String> {
-    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join(SOURCE);
+/// Compiles a timing program (cached while the binary is newer than the source).
+fn build(prefix: &Path, (source, name): (&str, &str)) -> Result<PathBuf, String> {
+    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join(source);
     let dir = Path::new("target/xtask");
     std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
-    let bin = dir.join("pinocchio_kinematics_bench");
+    let bin = dir.join(name);
     let fresh = match (
         std::fs::metadata(&bin).and_then(|m| m.modified()),
         std::fs::metadata(&source).and_then(|m| m.modified()),
@@ -104,10 +110,11 @@ fn build(prefix: &Path) -> Result<PathBuf, String> {
     Ok(bin)
 }
 
-/// The model as the timing program reads it: one line per joint.
+/// The model as the timing programs read it: one line per joint, with the body's inertia
+/// (mass, centre of mass, rotational inertia about it, row-major) after the limits.
 fn model_file(model: &Model, path: &Path) -> Result<(), String> {
     let mut s = String::new();
-    for j in &model.joints()[1..] {
+    for (i, j) in model.joints().iter().enumerate().skip(1) {
         let (code, axis) = match j.kind {
             JointType::Revolute(Axis::X) => ("RX", Axis::X.vector()),
             JointType::Revolute(Axis::Y) => ("RY", Axis::Y.vector()),
@@ -125,14 +132,31 @@ fn model_file(model: &Model, path: &Path) -> Result<(), String> {
         for x in r {
             s.push_str(&format!(" {x:e}"));
         }
-        s.push_str(&format!(" {:e} {:e} {:e} {:e} {:e}\n", t.x, t.y, t.z, j.limits.lower, j.limits.upper));
+        s.push_str(&format!(" {:e} {:e} {:e} {:e} {:e}", t.x, t.y, t.z, j.limits.lower, j.limits.upper));
+        let inertia = &model.inertias()[i];
+        s.push_str(&format!(
+            " {:e} {:e} {:e} {:e}",
+            inertia.mass, inertia.com.x, inertia.com.y, inertia.com.z
+        ));
+        for x in inertia.rotational.transpose().to_cols_array() {
+            s.push_str(&format!(" {x:e}"));
+        }
+        s.push('\n');
     }
     std::fs::write(path, s).map_err(|e| e.to_string())
 }
 
-/// Our median ns per call of `f` over pre-generated configurations, the same protocol as the
-/// C++ program (batches of calls cycling through 1024 configurations, median of 15 batches).
-fn time_ours(model: &Model, mut f: impl FnMut(&Model, &mut Data, &[f64]) -> f64) -> f64 {
+/// One pre-generated input of the timed kernels.
+struct Sample {
+    q: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+    tau: Vec<f64>,
+}
+
+/// Our median ns per call of `f` over pre-generated inputs, the same protocol as the C++
+/// programs (batches of calls cycling through 1024 inputs, median of 15 batches).
+fn time_ours(model: &Model, mut f: impl FnMut(&Model, &mut Data, &Sample) -> f64) -> f64 {
     let mut state = 42u64;
     let mut uniform = || {
         state ^= state << 13;
@@ -140,15 +164,22 @@ fn time_ours(model: &Model, mut f: impl FnMut(&Model, &mut Data, &[f64]) -> f64)
         state ^= state << 17;
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
-    let qs: Vec<Vec<f64>> =
-        (0..CONFIGS).map(|_| anim_rigid::config::random_configuration(model, &mut uniform)).collect();
+    let nv = model.nv();
+    let samples: Vec<Sample> = (0..CONFIGS)
+        .map(|_| Sample {
+            q: anim_rigid::config::random_configuration(model, &mut uniform),
+            v: (0..nv).map(|_| 4.0 * uniform() - 2.0).collect(),
+            a: (0..nv).map(|_| 6.0 * uniform() - 3.0).collect(),
+            tau: (0..nv).map(|_| 20.0 * uniform() - 10.0).collect(),
+        })
+        .collect();
     let mut data = Data::new(model);
     let mut sink = 0.0;
     let mut times: Vec<f64> = (0..BATCHES)
         .map(|_| {
             let start = Instant::now();
             for i in 0..CALLS_PER_BATCH {
-                sink += f(model, &mut data, std::hint::black_box(&qs[i % CONFIGS]));
+                sink += f(model, &mut data, std::hint::black_box(&samples[i % CONFIGS]));
             }
             start.elapsed().as_secs_f64() * 1e9 / CALLS_PER_BATCH as f64
         })
@@ -158,6 +189,25 @@ fn time_ours(model: &Model, mut f: impl FnMut(&Model, &mut Data, &[f64]) -> f64)
     times[times.len() / 2]
 }
 
+/// Runs a peer program on a model file; `(kernel, ns)` pairs, or a note why not.
+fn run_peer(bin: &Path, file: &Path) -> Result<Vec<(String, f64)>, String> {
+    let o = Command::new(bin)
+        .arg(file)
+        .arg(CALLS_PER_BATCH.to_string())
+        .output()
+        .map_err(|e| format!("could not run {}: {e}", bin.display()))?;
+    if !o.status.success() {
+        return Err(format!("Pinocchio program failed: {}", String::from_utf8_lossy(&o.stderr)));
+    }
+    Ok(String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .filter_map(|line| {
+            let ns = field(line, "ns_per_call")?.parse::<f64>().ok()?;
+            Some((field(line, "kernel")?, ns))
+        })
+        .collect())
+}
+
 fn field(line: &str, key: &str) -> Option<String> {
     let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
     let rest = rest.trim_start();
@@ -165,22 +215,31 @@ fn field(line: &str, key: &str) -> Option<String> {
     Some(rest[..end].trim().trim_matches('"').to_string())
 }
 
+/// One row of the table: robot, kernel, ours, Pinocchio (best convention), Pinocchio detail.
+type Row = (String, &'static str, f64, f64, String);
+
 /// Runs the comparison and prints the table; false if our side could not run.
 pub fn run() -> bool {
     let testdata = Path::new(env!("CARGO_MANIFEST_DIR")).join("../crates/anim-rigid/testdata");
-    let robots: [(&str, &str, &[&str]); 2] = [
-        ("panda", "panda.urdf", &["panda_finger_joint1", "panda_finger_joint2"]),
-        ("ur5", "ur5_robot.urdf", &[]),
+    // (name, URDF, locked joints, time kinematics, time dynamics)
+    let robots: [(&str, &str, &[&str], bool, bool); 3] = [
+        ("panda", "panda.urdf", &["panda_finger_joint1", "panda_finger_joint2"], true, true),
+        ("ur5", "ur5_robot.urdf", &[], true, true),
+        ("chain32", "chain32.urdf", &[], false, true),
     ];
     println!(
-        "\npeer benchmark: anim-rigid vs Pinocchio (C++, header-only, g++ -O3 -march=native), ns per call: median of {BATCHES} batches of {CALLS_PER_BATCH} calls over {CONFIGS} random configurations, best of {ROUNDS} alternating rounds"
+        "\npeer benchmark: anim-rigid vs Pinocchio (C++, header-only, g++ -O3 -march=native), ns per call: median of {BATCHES} batches of {CALLS_PER_BATCH} calls over {CONFIGS} random inputs, best of {ROUNDS} alternating rounds"
     );
-    let peer = ensure_prefix().and_then(|p| build(&p));
-    if let Err(e) = &peer {
-        println!("\nNOTE: Pinocchio peer SKIPPED: {e}\n");
+    let prefix = ensure_prefix();
+    let kin_peer = prefix.clone().and_then(|p| build(&p, KINEMATICS));
+    let dyn_peer = prefix.and_then(|p| build(&p, DYNAMICS));
+    for peer in [&kin_peer, &dyn_peer] {
+        if let Err(e) = peer {
+            println!("\nNOTE: Pinocchio peer SKIPPED: {e}\n");
+        }
     }
-    let mut rows: Vec<(String, &str, f64, f64)> = Vec::new();
-    for (name, urdf, locked) in robots {
+    let mut rows: Vec<Row> = Vec::new();
+    for (name, urdf, locked, kinematics, dynamics) in robots {
         let mut options = UrdfOptions::default();
         for j in locked {
             options = options.lock_joint(j, 0.0);
@@ -192,62 +251,85 @@ pub fn run() -> bool {
                 return false;
             }
         };
-        // Three alternating rounds, the fastest of each side: the machine is shared, and the
-        // minimum over rounds is the least disturbed measurement.
-        let (mut fk, mut jac) = (f64::INFINITY, f64::INFINITY);
-        let mut theirs = (f64::INFINITY, f64::INFINITY);
         let file = Path::new("target/xtask").join(format!("pinocchio_model_{name}.txt"));
-        let peer_model = match &peer {
-            Ok(_) => model_file(&model, &file),
-            Err(e) => Err(e.clone()),
-        };
-        if let (Ok(_), Err(e)) = (&peer, &peer_model) {
+        let peer_model = model_file(&model, &file);
+        if let Err(e) = &peer_model {
             println!("NOTE: {name}: {e}");
         }
+        // Three alternating rounds, the fastest of each side: the machine is shared, and the
+        // minimum over rounds is the least disturbed measurement.
+        let mut ours = [f64::INFINITY; 5];
+        let mut theirs: std::collections::BTreeMap<String, f64> = std::collections::BTreeMap::new();
         for _ in 0..ROUNDS {
-            fk = fk.min(time_ours(&model, |m, d, q| {
-                forward_kinematics(m, d, q);
-                d.world_placements[m.njoints() - 1].translation.x
-            }));
-            jac = jac.min(time_ours(&model, |m, d, q| {
-                compute_joint_jacobians(m, d, q);
-                d.jacobian.column(m.nv() - 1).v.x
-            }));
-            let (Ok(bin), Ok(())) = (&peer, &peer_model) else { continue };
-            match Command::new(bin).arg(&file).arg(CALLS_PER_BATCH.to_string()).output() {
-                Ok(o) if o.status.success() => {
-                    for line in String::from_utf8_lossy(&o.stdout).lines() {
-                        let ns = field(line, "ns_per_call")
-                            .and_then(|v| v.parse::<f64>().ok())
-                            .unwrap_or(f64::NAN);
-                        match field(line, "kernel").as_deref() {
-                            Some("forward_kinematics") => theirs.0 = theirs.0.min(ns),
-                            Some("compute_joint_jacobians") => theirs.1 = theirs.1.min(ns),
-                            _ => {}
+            if kinematics {
+                ours[0] = ours[0].min(time_ours(&model, |m, d, s| {
+                    forward_kinematics(m, d, &s.q);
+                    d.world_placements[m.njoints() - 1].translation.x
+                }));
+                ours[1] = ours[1].min(time_ours(&model, |m, d, s| {
+                    compute_joint_jacobians(m, d, &s.q);
+                    d.jacobian.column(m.nv() - 1).v.x
+                }));
+            }
+            if dynamics {
+                ours[2] = ours[2].min(time_ours(&model, |m, d, s| rnea(m, d, &s.q, &s.v, &s.a)[m.nv() - 1]));
+                ours[3] = ours[3].min(time_ours(&model, |m, d, s| crba(m, d, &s.q)[(0, m.nv() - 1)]));
+                ours[4] = ours[4].min(time_ours(&model, |m, d, s| aba(m, d, &s.q, &s.v, &s.tau)[m.nv() - 1]));
+            }
+            if peer_model.is_err() {
+                continue;
+            }
+            let peers = [(kinematics, &kin_peer), (dynamics, &dyn_peer)];
+            for (wanted, peer) in peers {
+                let (true, Ok(bin)) = (wanted, peer) else { continue };
+                match run_peer(bin, &file) {
+                    Ok(pairs) => {
+                        for (kernel, ns) in pairs {
+                            let e = theirs.entry(kernel).or_insert(f64::INFINITY);
+                            *e = e.min(ns);
                         }
                     }
+                    Err(e) => println!("NOTE: {e}"),
                 }
-                Ok(o) => println!("NOTE: Pinocchio program failed: {}", String::from_utf8_lossy(&o.stderr)),
-                Err(e) => println!("NOTE: could not run {}: {e}", bin.display()),
             }
         }
-        if !theirs.0.is_finite() {
-            theirs = (f64::NAN, f64::NAN);
+        let get = |k: &str| theirs.get(k).copied().unwrap_or(f64::NAN);
+        if kinematics {
+            rows.push((
+                name.to_string(),
+                "forward_kinematics",
+                ours[0],
+                get("forward_kinematics"),
+                String::new(),
+            ));
+            rows.push((
+                name.to_string(),
+                "compute_joint_jacobians",
+                ours[1],
+                get("compute_joint_jacobians"),
+                String::new(),
+            ));
         }
-        rows.push((name.to_string(), "forward_kinematics", fk, theirs.0));
-        rows.push((name.to_string(), "compute_joint_jacobians", jac, theirs.1));
+        if dynamics {
+            rows.push((name.to_string(), "rnea", ours[2], get("rnea"), String::new()));
+            for (k, kernel) in [(3, "crba"), (4, "aba")] {
+                let (local, world) = (get(&format!("{kernel}_local")), get(&format!("{kernel}_world")));
+                let detail = format!("LOCAL {local:.1} ns, WORLD {world:.1} ns");
+                rows.push((name.to_string(), kernel, ours[k], local.min(world), detail));
+            }
+        }
     }
     println!(
-        "\n| robot | kernel | anim-rigid | Pinocchio | ours / theirs |\n| --- | --- | --- | --- | --- |"
+        "\n| robot | kernel | anim-rigid | Pinocchio | ours / theirs | Pinocchio by convention |\n| --- | --- | --- | --- | --- | --- |"
     );
-    for (robot, kernel, ours, theirs) in &rows {
-        println!("| {robot} | {kernel} | {ours:.1} ns | {theirs:.1} ns | {:.3} |", ours / theirs);
+    for (robot, kernel, ours, theirs, detail) in &rows {
+        println!("| {robot} | {kernel} | {ours:.1} ns | {theirs:.1} ns | {:.3} | {detail} |", ours / theirs);
     }
     let dir = Path::new("target/xtask");
     let written = std::fs::create_dir_all(dir).and_then(|_| {
         let mut f = std::fs::File::create(dir.join("peers_rigid.csv"))?;
         writeln!(f, "robot,kernel,ours_ns,pinocchio_ns,ours_over_theirs")?;
-        for (robot, kernel, ours, theirs) in &rows {
+        for (robot, kernel, ours, theirs, _) in &rows {
             writeln!(f, "{robot},{kernel},{ours},{theirs},{}", ours / theirs)?;
         }
         Ok(())

@@ -146,7 +146,7 @@ impl Index<(usize, usize)> for Jacobian {
 
 /// The world columns of joint `joint` at the placement `world_m_i`, written into `out`.
 #[inline(always)]
-fn world_columns(kind: &JointType, world_m_i: &Se3, out: &mut [Twist]) {
+pub(crate) fn world_columns(kind: &JointType, world_m_i: &Se3, out: &mut [Twist]) {
     let r = &world_m_i.rotation;
     let t = world_m_i.translation;
     match kind {

@@ -435,6 +435,9 @@ pub enum ModelError {
         /// Effort limit.
         effort: f64,
     },
+    /// A gravity vector with a non-finite component.
+    #[error("gravity {0:?} is not finite")]
+    BadGravity([f64; 3]),
     /// A negative or non-finite mass, or a non-finite centre of mass or inertia.
     #[error("body on joint '{joint}': invalid inertia (mass {mass})")]
     BadInertia {
@@ -458,6 +461,15 @@ pub struct Model {
     nv: usize,
     lower: Vec<f64>,
     upper: Vec<f64>,
+    #[serde(default = "default_gravity")]
+    gravity: DVec3,
+}
+
+/// Standard gravity along `-z`, `(0, 0, -9.81)` m/s² (Pinocchio's default).
+pub const DEFAULT_GRAVITY: DVec3 = DVec3::new(0.0, 0.0, -9.81);
+
+fn default_gravity() -> DVec3 {
+    DEFAULT_GRAVITY
 }
 
 impl Model {
@@ -618,6 +630,32 @@ impl Model {
     pub fn total_mass(&self) -> f64 {
         self.inertias.iter().map(|i| i.mass).sum()
     }
+
+    /// The gravitational acceleration in the world frame (m/s²); default [`DEFAULT_GRAVITY`].
+    /// The dynamics algorithms ([`crate::dynamics`]) include it.
+    #[inline]
+    #[must_use]
+    pub fn gravity(&self) -> DVec3 {
+        self.gravity
+    }
+
+    /// Sets the gravitational acceleration (a parameter, changed between queries by the caller,
+    /// never by an algorithm). `DVec3::ZERO` switches gravity off.
+    ///
+    /// # Panics
+    /// When `g` is not finite.
+    #[track_caller]
+    pub fn set_gravity(&mut self, g: DVec3) {
+        assert!(g.is_finite(), "gravity must be finite, got {g}");
+        self.gravity = g;
+    }
+
+    /// Whether every joint's configuration is a vector space (revolute, prismatic and fixed
+    /// joints only), so that `nq == nv` and `q` moves by plain addition.
+    #[must_use]
+    pub fn is_euclidean(&self) -> bool {
+        self.joints.iter().all(|j| j.nq() == j.nv())
+    }
 }
 
 /// Builds a [`Model`] joint by joint, in topological order (a parent before its children).
@@ -672,8 +710,21 @@ impl ModelBuilder {
                 nv: 0,
                 lower: Vec::new(),
                 upper: Vec::new(),
+                gravity: DEFAULT_GRAVITY,
             },
         }
+    }
+
+    /// Sets the model's gravity (default [`DEFAULT_GRAVITY`]).
+    ///
+    /// # Errors
+    /// [`ModelError::BadGravity`] when `g` is not finite.
+    pub fn gravity(&mut self, g: DVec3) -> Result<&mut Self, ModelError> {
+        if !g.is_finite() {
+            return Err(ModelError::BadGravity(g.to_array()));
+        }
+        self.model.gravity = g;
+        Ok(self)
     }
 
     /// The model built so far (to look up indices while building).

@@ -1,7 +1,7 @@
 //! glTF 2.0 input through the `gltf` crate: `.gltf` with external or embedded (base64 data URI)
 //! buffers, and `.glb`.
 //!
-//! What is read: the node hierarchy (every node becomes a [`Joint`](crate::Joint), parents
+//! What is read: the node hierarchy (every node becomes a [`Joint`], parents
 //! first; `matrix` nodes are decomposed into TRS and rejected if they shear), skins (joints and
 //! inverse bind matrices, identity when absent), every triangle primitive of every skinned mesh
 //! node (`POSITION`, `NORMAL`, indices, `JOINTS_0/WEIGHTS_0` and `JOINTS_1/WEIGHTS_1` for up to 8

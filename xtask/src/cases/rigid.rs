@@ -2,7 +2,11 @@
 //! Pinocchio on the Panda and the UR5; Jacobians against finite differences; the three forms of
 //! forward kinematics; Paden-Kahan subproblems on random solvable instances; analytic IK
 //! solutions reproducing their targets. Stability: IK at singularities, unreachable targets,
-//! workspace-boundary targets, and the numerical IK success rate on the Panda.
+//! workspace-boundary targets, and the numerical IK success rate on the Panda. The dynamics
+//! cases (RNEA, CRBA, ABA against Pinocchio, cross-checks, steppers, the T-handle, the
+//! work-precision study) are in `rigid/dynamics.rs`.
+
+mod dynamics;
 
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
@@ -103,6 +107,7 @@ pub fn register(r: &mut Registry) {
         expected: || Outcome::Stable(String::new()),
         run: panda_success_rate,
     });
+    dynamics::register(r);
 }
 
 fn testdata(file: &str) -> PathBuf {

@@ -36,6 +36,34 @@ pub fn puma() -> Model {
 /// A tree with every joint type: free base, unaligned revolute, spherical, prismatic, a fixed
 /// joint kept as a joint, and two branches.
 pub fn mixed() -> Model {
+    mixed_builder().build()
+}
+
+/// [`mixed`] with a body of positive mass and a full (off-diagonal) inertia on every joint, so
+/// that its mass matrix is positive definite: the dynamics test tree.
+pub fn mixed_massive() -> Model {
+    let mut b = mixed_builder();
+    let n = b.model().njoints();
+    for j in 1..n {
+        let k = j as f64;
+        let i_c = anim_core::glam::DMat3::from_cols(
+            DVec3::new(0.05 + 0.01 * k, 0.004 * k.sin(), -0.003),
+            DVec3::new(0.004 * k.sin(), 0.04 + 0.005 * k, 0.002 * k.cos()),
+            DVec3::new(-0.003, 0.002 * k.cos(), 0.03 + 0.002 * k),
+        );
+        let placement = Se3::new(anim_core::lie::so3::exp(DVec3::new(0.2 * k, -0.1, 0.3)), DVec3::ZERO);
+        b.append_body(j, &Inertia::new(0.5 + 0.3 * k, DVec3::new(0.1, -0.05 * k, 0.02), i_c), &placement)
+            .unwrap();
+    }
+    b.build()
+}
+
+/// The 32-joint serial chain written by `testdata/make_pinocchio_dynamics_reference.py`.
+pub fn chain32() -> Model {
+    load_urdf(testdata("chain32.urdf"), &UrdfOptions::default()).unwrap()
+}
+
+fn mixed_builder() -> ModelBuilder {
     let mut b = ModelBuilder::new("mixed");
     let rot = anim_core::lie::so3::exp(DVec3::new(0.3, -0.2, 0.5));
     let free = b
@@ -104,7 +132,7 @@ pub fn mixed() -> Model {
     .unwrap();
     b.append_body(slide, &Inertia::new(1.0, DVec3::X, anim_core::glam::DMat3::IDENTITY), &Se3::IDENTITY)
         .unwrap();
-    b.build()
+    b
 }
 
 pub fn se3_err(a: &Se3, b: &Se3) -> f64 {
