@@ -8,6 +8,7 @@ use anim_core::integrate::{MechanicalSystem, Simulation, State};
 use anim_core::solver::{Solver, StepReport};
 use anim_io::FrameFormat;
 use anim_pbd::PbdSimulation;
+use anim_rigid::sim::{RigidSimulation, RigidState};
 use anim_skin::scenes::SkinScene;
 use anim_skin::{CharacterData, SkinningMethod};
 use anim_springs::{SpringSimulation, scenes as spring_scenes};
@@ -146,6 +147,23 @@ pub fn build(
             let runner = SkinRunner::new(scene, skinning.or(method).unwrap_or(default))
                 .map_err(|e| SceneError::invalid(file_path, "scene.method", e))?;
             Box::new(runner)
+        }
+        Scene::Rigid { ref preset } => {
+            let scene = match anim_rigid::scenes::by_name(preset) {
+                Some(Ok(s)) => s,
+                Some(Err(e)) => return Err(SceneError::invalid(file, "scene.preset", e.to_string())),
+                None => {
+                    return Err(SceneError::invalid(
+                        file,
+                        "scene.preset",
+                        format!(
+                            "unknown preset `{preset}` (one of {})",
+                            anim_rigid::scenes::NAMES.join(", ")
+                        ),
+                    ));
+                }
+            };
+            Box::new(RigidRunner::new(scene).map_err(|e| SceneError::invalid(file, "scene.preset", e))?)
         }
         Scene::Pbd { ref preset, resolution } => {
             let s = match anim_pbd::scenes::by_name(preset, resolution) {
@@ -415,6 +433,98 @@ impl Runner for PbdRunner {
             ground,
             spheres,
             frame_box: frame_box(&self.state.x, ground, true),
+        }
+    }
+}
+
+/// An articulated or free rigid body (anim-rigid), drawn as the segments its scene names; the
+/// frame files and the preview see the segments' endpoints as particles.
+struct RigidRunner {
+    name: String,
+    method: String,
+    sim: RigidSimulation,
+    rigid: RigidState,
+    data: anim_rigid::Data,
+    segments: Vec<(anim_rigid::model::FrameIndex, anim_rigid::model::FrameIndex)>,
+    points: Vec<[anim_core::glam::DVec3; 2]>,
+    display: State,
+}
+
+impl RigidRunner {
+    fn new(scene: anim_rigid::scenes::RigidScene) -> Result<Self, String> {
+        let name = format!("rigid/{}", scene.name);
+        let method = format!("{:?}", scene.integrator).to_lowercase();
+        let segments = scene.segments.clone();
+        let data = anim_rigid::Data::new(&scene.model);
+        let (sim, rigid) = scene.into_simulation().map_err(|e| e.to_string())?;
+        let n = 6 * segments.len();
+        let mut runner = Self {
+            name,
+            method,
+            sim,
+            rigid,
+            data,
+            segments,
+            points: Vec::new(),
+            display: State::new(vec![0.0; n], vec![0.0; n]),
+        };
+        runner.refresh(0.0);
+        Ok(runner)
+    }
+
+    /// Segment endpoints into the display state (velocities by difference over `dt`).
+    fn refresh(&mut self, dt: f64) {
+        anim_rigid::scenes::segment_points(
+            self.sim.model(),
+            &mut self.data,
+            &self.rigid.q,
+            &self.segments,
+            &mut self.points,
+        );
+        for (k, p) in self.points.iter().flatten().enumerate() {
+            for (c, value) in p.to_array().into_iter().enumerate() {
+                let i = 3 * k + c;
+                self.display.v[i] = if dt > 0.0 { (value - self.display.x[i]) / dt } else { 0.0 };
+                self.display.x[i] = value;
+            }
+        }
+        self.display.t = self.rigid.t;
+    }
+}
+
+impl Runner for RigidRunner {
+    fn system(&self) -> String {
+        self.name.clone()
+    }
+
+    fn method(&self) -> String {
+        self.method.clone()
+    }
+
+    fn state(&self) -> &State {
+        &self.display
+    }
+
+    fn step(&mut self, dt: f64) -> Result<StepReport, String> {
+        let report = self.sim.step(&mut self.rigid, dt).map_err(|e| e.to_string())?;
+        self.refresh(dt);
+        Ok(report)
+    }
+
+    fn natural_format(&self) -> OutputFormat {
+        OutputFormat::Vtu
+    }
+
+    fn geometry(&self) -> Geometry {
+        let edges: Vec<[usize; 2]> = (0..self.segments.len()).map(|k| [2 * k, 2 * k + 1]).collect();
+        let longest = self.points.iter().map(|[a, b]| (*a - *b).length()).fold(0.0, f64::max);
+        Geometry::Particles {
+            triangles: Vec::new(),
+            edges,
+            radius: 0.06 * longest.max(1e-3),
+            ground: None,
+            spheres: Vec::new(),
+            frame_box: frame_box(&self.display.x, None, true),
         }
     }
 }

@@ -92,6 +92,11 @@ pub enum Scene {
         #[serde(default)]
         method: Option<SkinningChoice>,
     },
+    /// A rigid-body scene of anim-rigid (`panda-swing`, `pendulum-chain`, `t-handle`).
+    Rigid {
+        /// The preset's name.
+        preset: String,
+    },
     /// A position-based-dynamics scene of anim-pbd (`cloth-drape`, `flag`, `rope`, `soft-blob`,
     /// `balloon`, `benchmark-cloth`) with its own solver settings.
     Pbd {
@@ -166,7 +171,7 @@ pub enum SceneError {
 }
 
 /// The scenes built into the binary: `(name, description, TOML text)`.
-pub const BUILTIN: [(&str, &str, &str); 10] = [
+pub const BUILTIN: [(&str, &str, &str); 13] = [
     (
         "cloth",
         "a 32x32 cloth pinned at two corners falls and swings, backward Euler + sparse Cholesky",
@@ -178,6 +183,9 @@ pub const BUILTIN: [(&str, &str, &str); 10] = [
     ("flag", "an XPBD flag on a swaying pole in the wind", FLAG),
     ("blob", "a soft tetrahedral blob (XPBD) falling on the ground", BLOB),
     ("pbd-rope", "a 100-link XPBD rope swinging against obstacles", PBD_ROPE),
+    ("panda", "the Franka Panda swinging under gravity with zero torque (RK4)", PANDA),
+    ("chain", "a 32-link pendulum chain (RK4)", CHAIN),
+    ("t-handle", "a spinning T-handle flipping about its intermediate axis (free-body midpoint)", T_HANDLE),
     ("twist", "a cylinder twisted 180 degrees: LBS's candy-wrapper collapse beside DQS", TWIST),
     ("kepler", "a planet on an e = 0.5 ellipse, velocity Verlet, about 3 orbits", KEPLER),
     ("oscillator", "a lightly damped harmonic oscillator, implicit midpoint", OSCILLATOR),
@@ -269,6 +277,42 @@ steps_per_frame = 1
 [scene]
 kind = "pbd"
 preset = "rope"
+"#;
+
+const PANDA: &str = r#"name = "panda"
+
+[run]
+dt = 0.001
+frames = 100
+steps_per_frame = 30
+
+[scene]
+kind = "rigid"
+preset = "panda-swing"
+"#;
+
+const CHAIN: &str = r#"name = "chain"
+
+[run]
+dt = 0.0005
+frames = 100
+steps_per_frame = 60
+
+[scene]
+kind = "rigid"
+preset = "pendulum-chain"
+"#;
+
+const T_HANDLE: &str = r#"name = "t-handle"
+
+[run]
+dt = 0.001
+frames = 120
+steps_per_frame = 200
+
+[scene]
+kind = "rigid"
+preset = "t-handle"
 "#;
 
 const TWIST: &str = r#"name = "twist"
@@ -430,7 +474,7 @@ fn validate(s: &SceneFile) -> Result<(), (&'static str, String)> {
             }
             integrator
         }
-        Scene::Pbd { .. } => return Ok(()),
+        Scene::Pbd { .. } | Scene::Rigid { .. } => return Ok(()),
         Scene::Skinning { preset, file, .. } => {
             if preset.is_some() == file.is_some() {
                 return Err(("scene.preset", "give exactly one of `preset` and `file`".into()));
