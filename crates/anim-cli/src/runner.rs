@@ -149,34 +149,23 @@ pub fn build(
             Box::new(runner)
         }
         Scene::Rigid { ref preset } => {
-            let scene = match anim_rigid::scenes::by_name(preset) {
-                Some(Ok(s)) => s,
-                Some(Err(e)) => return Err(SceneError::invalid(file, "scene.preset", e.to_string())),
-                None => {
-                    return Err(SceneError::invalid(
-                        file,
-                        "scene.preset",
-                        format!(
-                            "unknown preset `{preset}` (one of {})",
-                            anim_rigid::scenes::NAMES.join(", ")
-                        ),
-                    ));
-                }
-            };
+            let scene = preset_scene(
+                file,
+                "scene.preset",
+                preset,
+                &anim_rigid::scenes::NAMES,
+                anim_rigid::scenes::by_name(preset),
+            )?;
             Box::new(RigidRunner::new(scene).map_err(|e| SceneError::invalid(file, "scene.preset", e))?)
         }
         Scene::Pbd { ref preset, resolution } => {
-            let s = match anim_pbd::scenes::by_name(preset, resolution) {
-                Some(Ok(s)) => s,
-                Some(Err(e)) => return Err(SceneError::invalid(file, "scene.resolution", e.to_string())),
-                None => {
-                    return Err(SceneError::invalid(
-                        file,
-                        "scene.preset",
-                        format!("unknown preset `{preset}` (one of {})", anim_pbd::scenes::NAMES.join(", ")),
-                    ));
-                }
-            };
+            let s = preset_scene(
+                file,
+                "scene.resolution",
+                preset,
+                &anim_pbd::scenes::NAMES,
+                anim_pbd::scenes::by_name(preset, resolution),
+            )?;
             let method = format!("{:?} / {:?}", s.params.method, s.params.solver).to_lowercase();
             let name = format!("pbd/{}", s.name);
             let (sim, state) =
@@ -184,17 +173,13 @@ pub fn build(
             Box::new(PbdRunner { name, method, sim, state })
         }
         Scene::Springs { ref preset, resolution, integrator, linear_solver } => {
-            let mut s = match spring_scenes::by_name(preset, resolution) {
-                Some(Ok(s)) => s,
-                Some(Err(e)) => return Err(SceneError::invalid(file, "scene.resolution", e.to_string())),
-                None => {
-                    return Err(SceneError::invalid(
-                        file,
-                        "scene.preset",
-                        format!("unknown preset `{preset}` (one of {})", spring_scenes::NAMES.join(", ")),
-                    ));
-                }
-            };
+            let mut s = preset_scene(
+                file,
+                "scene.resolution",
+                preset,
+                &spring_scenes::NAMES,
+                spring_scenes::by_name(preset, resolution),
+            )?;
             if let Some(i) = integrator {
                 s.integrator = i;
             }
@@ -213,6 +198,26 @@ pub fn build(
             Box::new(SpringRunner::new(name, method, sim, state))
         }
     })
+}
+
+/// The scene a crate's `by_name` found for `preset`: an unknown name is an error on
+/// `scene.preset` listing the known ones; a build error is reported on `field`.
+fn preset_scene<T, E: std::fmt::Display>(
+    file: &Path,
+    field: &'static str,
+    preset: &str,
+    names: &[&str],
+    found: Option<Result<T, E>>,
+) -> Result<T, SceneError> {
+    match found {
+        Some(Ok(scene)) => Ok(scene),
+        Some(Err(e)) => Err(SceneError::invalid(file, field, e.to_string())),
+        None => Err(SceneError::invalid(
+            file,
+            "scene.preset",
+            format!("unknown preset `{preset}` (one of {})", names.join(", ")),
+        )),
+    }
 }
 
 /// A system of a few unknowns with an exact solution, drawn in the plane.
