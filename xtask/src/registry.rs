@@ -160,6 +160,10 @@ pub fn all() -> Registry {
     crate::cases::rigid::register(&mut r);
     crate::cases::pbd::register(&mut r);
     crate::cases::skin::register(&mut r);
+    crate::cases::material::register(&mut r);
+    crate::cases::fem::register(&mut r);
+    crate::cases::mpm::register(&mut r);
+    crate::cases::fluid::register(&mut r);
     r
 }
 

@@ -1,7 +1,11 @@
 //! Cases per crate. Each module registers its conformance checks, hard cases and studies.
 
 pub mod core;
+pub mod fem;
+pub mod fluid;
 pub mod io;
+pub mod material;
+pub mod mpm;
 pub mod pbd;
 pub mod rigid;
 pub mod skin;

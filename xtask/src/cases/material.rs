@@ -1,0 +1,5 @@
+//! anim-material cases.
+
+use crate::registry::Registry;
+
+pub fn register(_r: &mut Registry) {}
