@@ -29,7 +29,12 @@ fn parse_bencher(out: &str) -> Vec<Row> {
 
 pub fn run(filter: Option<&str>) -> bool {
     if std::env::args().skip(2).any(|a| a == "--peers") {
-        return peers::run() & peers_rigid::run() & peers_pbd::run();
+        return peers::run()
+            & peers_rigid::run()
+            & peers_pbd::run()
+            & peers_fem::run()
+            & peers_mpm::run()
+            & peers_fluid::run();
     }
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut args = vec!["bench", "-p", "anim-benches", "--benches", "--", "--output-format", "bencher"];
@@ -92,6 +97,18 @@ mod peers_rigid;
 /// anim-pbd's peers (pyPBD, Newton), in its own file.
 #[path = "peers_pbd.rs"]
 mod peers_pbd;
+
+/// anim-fem's peers, in its own file.
+#[path = "peers_fem.rs"]
+mod peers_fem;
+
+/// anim-mpm's peers (Taichi MLS-MPM), in its own file.
+#[path = "peers_mpm.rs"]
+mod peers_mpm;
+
+/// anim-fluid's peers (the seed's C routines, Taichi stable fluids), in its own file.
+#[path = "peers_fluid.rs"]
+mod peers_fluid;
 
 /// `cargo xtask bench --peers`: our per-step time against peer libraries on the same problem,
 /// same integrator and same thread count, measured side by side in one run.

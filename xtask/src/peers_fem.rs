@@ -1,0 +1,5 @@
+//! `cargo xtask bench --peers`, anim-fem part.
+
+pub fn run() -> bool {
+    true
+}

@@ -1,0 +1,5 @@
+//! `cargo xtask bench --peers`, anim-fluid part.
+
+pub fn run() -> bool {
+    true
+}

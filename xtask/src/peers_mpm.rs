@@ -1,0 +1,5 @@
+//! `cargo xtask bench --peers`, anim-mpm part.
+
+pub fn run() -> bool {
+    true
+}
