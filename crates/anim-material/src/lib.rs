@@ -81,4 +81,68 @@ pub trait Hyperelastic<T: Scalar, const D: usize>: Send + Sync {
     fn energy(&self, lame: &Lame<T>, f: &Mat<T, D>) -> T;
     /// First Piola-Kirchhoff stress `P(F) = dpsi/dF`.
     fn pk1(&self, lame: &Lame<T>, f: &Mat<T, D>) -> Mat<T, D>;
+    /// The stress derivative `dP/dF` (the fourth-order elasticity tensor of the model).
+    fn dpdf(&self, lame: &Lame<T>, f: &Mat<T, D>) -> Tangent<T, D>;
+}
+
+/// The fourth-order tensor `dP/dF`: `d[k][l]` is the `D x D` matrix `dP/dF_kl`, so that for a
+/// perturbation `dF`, `dP = sum_kl d[k][l] dF_kl`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tangent<T: Scalar, const D: usize> {
+    /// `d[k][l] = dP / dF_kl`.
+    pub d: [[Mat<T, D>; D]; D],
+}
+
+impl<T: Scalar, const D: usize> Tangent<T, D> {
+    /// The directional derivative `dP[dF] = sum_kl d[k][l] dF_kl`.
+    #[must_use]
+    pub fn apply(&self, df: &Mat<T, D>) -> Mat<T, D> {
+        let mut out = Mat::<T, D>::zeros();
+        for k in 0..D {
+            for l in 0..D {
+                out += self.d[k][l] * df[(k, l)];
+            }
+        }
+        out
+    }
+}
+
+impl<T: Scalar> Tangent<T, 3> {
+    /// The tensor as a 9 x 9 matrix on column-major `vec(F)` (`vec(F)[k + 3 l] = F_kl`):
+    /// `vec(dP) = M vec(dF)`.
+    #[must_use]
+    pub fn to_matrix(&self) -> SMatrix<T, 9, 9> {
+        let mut m = SMatrix::<T, 9, 9>::zeros();
+        for k in 0..3 {
+            for l in 0..3 {
+                let col = k + 3 * l;
+                for i in 0..3 {
+                    for j in 0..3 {
+                        m[(i + 3 * j, col)] = self.d[k][l][(i, j)];
+                    }
+                }
+            }
+        }
+        m
+    }
+}
+
+impl<T: Scalar> Tangent<T, 2> {
+    /// The tensor as a 4 x 4 matrix on column-major `vec(F)` (`vec(F)[k + 2 l] = F_kl`):
+    /// `vec(dP) = M vec(dF)`.
+    #[must_use]
+    pub fn to_matrix(&self) -> SMatrix<T, 4, 4> {
+        let mut m = SMatrix::<T, 4, 4>::zeros();
+        for k in 0..2 {
+            for l in 0..2 {
+                let col = k + 2 * l;
+                for i in 0..2 {
+                    for j in 0..2 {
+                        m[(i + 2 * j, col)] = self.d[k][l][(i, j)];
+                    }
+                }
+            }
+        }
+        m
+    }
 }
