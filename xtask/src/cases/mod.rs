@@ -1,6 +1,7 @@
 //! Cases per crate. Each module registers its conformance checks, hard cases and studies.
 
 pub mod core;
+pub mod determinism;
 pub mod fem;
 pub mod fluid;
 pub mod io;

@@ -1,0 +1,160 @@
+//! Determinism across thread counts: each crate's main scene run on rayon pools of 1, 2 and 4
+//! threads must end in the same state, bit for bit. The metric is the number of state values
+//! whose bits differ from the 1-thread run (must be 0).
+
+use crate::registry::{Check, ConformanceCase, Ctx, Judge, Registry};
+use anim_core::integrate::systems::LinearChain;
+use anim_core::integrate::{IntegratorKind, State, study::advance};
+use anim_core::solver::Solver;
+
+const THREADS: [usize; 3] = [1, 2, 4];
+const SOURCE: &str = "the same run on 1 thread";
+
+pub fn register(r: &mut Registry) {
+    r.conformance.push(ConformanceCase {
+        crate_name: "anim-core",
+        name: "determinism: 40k-dof chain on 1, 2, 4 threads",
+        run: core_chain,
+    });
+    r.conformance.push(ConformanceCase {
+        crate_name: "anim-springs",
+        name: "determinism: 110 x 110 hanging cloth on 1, 2, 4 threads",
+        run: springs_cloth,
+    });
+    r.conformance.push(ConformanceCase {
+        crate_name: "anim-pbd",
+        name: "determinism: cloth drape on 1, 2, 4 threads",
+        run: pbd_drape,
+    });
+    r.conformance.push(ConformanceCase {
+        crate_name: "anim-rigid",
+        name: "determinism: Panda swing on 1, 2, 4 threads",
+        run: rigid_panda,
+    });
+}
+
+/// Number of positions in `a` and `b` whose bits differ (a length mismatch counts every value).
+pub fn differing_bits(a: &[f64], b: &[f64]) -> usize {
+    if a.len() != b.len() {
+        return a.len().max(b.len());
+    }
+    a.iter().zip(b).filter(|(x, y)| x.to_bits() != y.to_bits()).count()
+}
+
+/// Runs `run` on pools of 1, 2 and 4 threads and turns the flattened final states into checks
+/// against the 1-thread run.
+pub fn across_threads(
+    crate_name: &'static str,
+    case: &str,
+    run: impl Fn() -> Result<Vec<f64>, String> + Sync,
+) -> Vec<Check> {
+    let mut finals = Vec::new();
+    for threads in THREADS {
+        let result = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| e.to_string())
+            .and_then(|pool| pool.install(&run));
+        finals.push((threads, result));
+    }
+    let reference = match &finals[0].1 {
+        Ok(v) => v.clone(),
+        Err(e) => {
+            return vec![Check {
+                crate_name,
+                case: format!("{case} (1 thread failed: {e})"),
+                metric: "values differing".into(),
+                measured: f64::NAN,
+                reference: 0.0,
+                tolerance: 0.0,
+                judge: Judge::AtMost,
+                source: SOURCE,
+            }];
+        }
+    };
+    finals[1..]
+        .iter()
+        .map(|(threads, result)| {
+            let measured = match result {
+                Ok(v) => differing_bits(&reference, v) as f64,
+                Err(_) => f64::NAN,
+            };
+            Check {
+                crate_name,
+                case: format!("{case}: {threads} threads vs 1 ({} values)", reference.len()),
+                metric: "values whose bits differ".into(),
+                measured,
+                reference: 0.0,
+                tolerance: 0.0,
+                judge: Judge::AtMost,
+                source: SOURCE,
+            }
+        })
+        .collect()
+}
+
+fn flat(state: &State) -> Vec<f64> {
+    state.x.iter().chain(&state.v).copied().collect()
+}
+
+fn core_chain(ctx: &Ctx) -> Vec<Check> {
+    let steps = if ctx.quick { 20 } else { 200 };
+    let mut out = Vec::new();
+    for kind in
+        [IntegratorKind::SymplecticEuler, IntegratorKind::VelocityVerlet, IntegratorKind::ImplicitMidpoint]
+    {
+        out.extend(across_threads("anim-core", &format!("chain, {}", kind.label()), || {
+            // 40,000 unknowns: above the threshold of the chunked parallel update loops.
+            let mut sys = LinearChain::new(40_000, 0.01, 100.0, 0.01, 9.81);
+            let mut state = sys.rest_state();
+            for (i, v) in state.v.iter_mut().enumerate() {
+                *v = ((i % 13) as f64 - 6.0) * 1e-3;
+            }
+            let mut integ = kind.build(40_000);
+            advance(integ.as_mut(), &mut sys, &mut state, 1e-3, steps).map_err(|e| e.to_string())?;
+            Ok(flat(&state))
+        }));
+    }
+    out
+}
+
+fn springs_cloth(ctx: &Ctx) -> Vec<Check> {
+    let steps = if ctx.quick { 5 } else { 50 };
+    across_threads("anim-springs", "hanging cloth 110 x 110", || {
+        // 36,300 unknowns: above the threshold of anim-core's parallel update loops.
+        let scene = anim_springs::scenes::hanging_cloth(Some(110)).map_err(|e| e.to_string())?;
+        let dt = scene.dt;
+        let (mut sim, mut state) = scene.into_simulation().map_err(|e| e.to_string())?;
+        for _ in 0..steps {
+            sim.step(&mut state, dt).map_err(|e| e.to_string())?;
+        }
+        Ok(flat(&state))
+    })
+}
+
+fn pbd_drape(ctx: &Ctx) -> Vec<Check> {
+    let steps = if ctx.quick { 30 } else { 300 };
+    across_threads("anim-pbd", "cloth drape", || {
+        let scene = anim_pbd::scenes::cloth_drape(None).map_err(|e| e.to_string())?;
+        let dt = scene.dt;
+        let (mut sim, mut state) = scene.into_simulation().map_err(|e| e.to_string())?;
+        for _ in 0..steps {
+            sim.step(&mut state, dt).map_err(|e| e.to_string())?;
+        }
+        Ok(flat(&state))
+    })
+}
+
+fn rigid_panda(ctx: &Ctx) -> Vec<Check> {
+    // The rigid steppers are serial; the case guards against a parallel path changing that.
+    let steps = if ctx.quick { 100 } else { 1000 };
+    across_threads("anim-rigid", "Panda swing", || {
+        let scene = anim_rigid::scenes::panda_swing().map_err(|e| e.to_string())?;
+        let dt = scene.dt;
+        let (mut sim, mut state) = scene.into_simulation().map_err(|e| e.to_string())?;
+        for _ in 0..steps {
+            sim.step(&mut state, dt).map_err(|e| e.to_string())?;
+        }
+        Ok(state.q.iter().chain(&state.v).copied().collect())
+    })
+}
