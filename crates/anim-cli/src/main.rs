@@ -6,6 +6,8 @@
 //! anim run kepler               # a built-in scene by name
 //! anim run cloth --out out --frames 60 --format obj --stride 2
 //! anim list                     # the built-in scenes
+//! anim run cloth --checkpoint-every 50   # also keep out/checkpoint.anim current
+//! anim resume anim-out/cloth/checkpoint.anim   # continue from it, bit for bit
 //! ```
 //!
 //! Every run writes into its output folder: the frames in the scene's natural format (VTK `.vtu`
@@ -44,8 +46,26 @@ struct Cli {
 enum Command {
     /// Run a scene file, or a built-in scene by name, or the default scene when none is given.
     Run(RunArgs),
+    /// Continue a run from a checkpoint written with `--checkpoint-every`: the frames after it are
+    /// bit for bit those of an uninterrupted run.
+    Resume(ResumeArgs),
     /// List the built-in scenes.
     List,
+}
+
+#[derive(clap::Args)]
+struct ResumeArgs {
+    /// The checkpoint file (`<out>/checkpoint.anim`).
+    checkpoint: PathBuf,
+    /// Output folder (default: the one the checkpointed run wrote to).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Total number of frames of the run (default: the checkpointed run's).
+    #[arg(long)]
+    frames: Option<usize>,
+    /// No progress bar or summary on the terminal.
+    #[arg(long)]
+    quiet: bool,
 }
 
 #[derive(clap::Args)]
@@ -79,6 +99,10 @@ struct RunArgs {
     /// No progress bar or summary on the terminal.
     #[arg(long)]
     quiet: bool,
+    /// Every N frames, replace `<out>/checkpoint.anim` (atomically) with the run's state;
+    /// `anim resume` continues from it.
+    #[arg(long)]
+    checkpoint_every: Option<usize>,
 }
 
 fn main() -> ExitCode {
@@ -91,13 +115,18 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
-        Command::Run(args) => match run(&args) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("error: {e}");
-                ExitCode::FAILURE
-            }
-        },
+        Command::Run(args) => finish(fresh(&args).and_then(execute)),
+        Command::Resume(args) => finish(resumed(&args).and_then(execute)),
+    }
+}
+
+fn finish(result: Result<(), String>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
     }
 }
 
@@ -143,7 +172,58 @@ struct Metrics {
     relative_energy_change: Option<f64>,
     max_error_vs_exact: Option<f64>,
     newton_iterations: usize,
+    resumed_from_frame: Option<usize>,
+    checkpoints_written: usize,
     files: Vec<String>,
+}
+
+/// The checkpoint of a run: the scene and output settings it was started with, how far it got,
+/// and the runner's state. Written as `<out>/checkpoint.anim` (kind [`CHECKPOINT_KIND`]).
+#[derive(Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RunCheckpoint {
+    scene: SceneFile,
+    /// The path scene errors and relative file names refer to.
+    origin: PathBuf,
+    skinning: Option<scene::SkinningChoice>,
+    out: PathBuf,
+    format: OutputFormat,
+    stride: usize,
+    preview_width: Option<u32>,
+    checkpoint_every: Option<usize>,
+    /// Frames completed.
+    frame: usize,
+    steps: u64,
+    /// Times of the frame files written so far.
+    written_times: Vec<f64>,
+    energy_initial: Option<f64>,
+    max_error: Option<f64>,
+    newton_iterations: usize,
+    runner: serde_json::Value,
+}
+
+const CHECKPOINT_KIND: &str = "anim-run";
+const CHECKPOINT_FILE: &str = "checkpoint.anim";
+
+/// A run ready to go: fresh from a scene, or resumed from a checkpoint.
+struct Session {
+    file: SceneFile,
+    origin: PathBuf,
+    skinning: Option<scene::SkinningChoice>,
+    out: PathBuf,
+    format: OutputFormat,
+    stride: usize,
+    preview_width: Option<u32>,
+    checkpoint_every: Option<usize>,
+    quiet: bool,
+    runner: Box<dyn Runner>,
+    start_frame: usize,
+    steps: u64,
+    written_times: Vec<f64>,
+    energy_initial: Option<f64>,
+    max_error: Option<f64>,
+    newton_iterations: usize,
+    resumed: bool,
 }
 
 /// What the writer thread produces: the files written and its own busy time.
@@ -221,19 +301,30 @@ impl Writer {
 }
 
 impl Output {
+    /// The writer of a run; `continuing` holds the times of the frame files an earlier part of
+    /// the run wrote (resumed runs continue the numbering and append to `frames.csv`).
     fn new(
         dir: &Path,
         format: OutputFormat,
         stride: usize,
         preview: Option<(u32, usize)>,
         runner: &dyn Runner,
+        continuing: Option<&[f64]>,
     ) -> Result<Self, String> {
         let view = View::new(runner.geometry());
         let mut writer = Writer { dir: dir.to_path_buf(), stride, view, frames: None, csv: None, gif: None };
         if let Some(f) = format.frame_format() {
-            writer.frames = Some(FrameWriter::new(dir.join("frames"), f).map_err(|e| e.to_string())?);
+            let frames = FrameWriter::continuing(dir.join("frames"), f, continuing.unwrap_or(&[]));
+            writer.frames = Some(frames.map_err(|e| e.to_string())?);
         }
-        if format == OutputFormat::Csv {
+        if format == OutputFormat::Csv && continuing.is_some() {
+            let path = dir.join("frames.csv");
+            let file = std::fs::OpenOptions::new()
+                .append(true)
+                .open(&path)
+                .map_err(|e| format!("{}: cannot append to the run's frames: {e}", path.display()))?;
+            writer.csv = Some(std::io::BufWriter::new(file));
+        } else if format == OutputFormat::Csv {
             let path = dir.join("frames.csv");
             let file = std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
             let mut csv = std::io::BufWriter::new(file);
@@ -300,7 +391,8 @@ impl Output {
     }
 }
 
-fn run(args: &RunArgs) -> Result<(), String> {
+/// A fresh run of the scene named on the command line.
+fn fresh(args: &RunArgs) -> Result<Session, String> {
     let (mut file, origin) = resolve(args.scene.as_deref())?;
     if let Some(f) = args.frames {
         if f == 0 {
@@ -320,58 +412,167 @@ fn run(args: &RunArgs) -> Result<(), String> {
     if args.preview_width < 16 || args.preview_width > 4096 {
         return Err(format!("--preview-width must lie in [16, 4096], got {}", args.preview_width));
     }
-    let mut runner = runner::build(&file.scene, &origin, args.skinning).map_err(|e| e.to_string())?;
+    if args.checkpoint_every == Some(0) {
+        return Err("--checkpoint-every must be at least 1".into());
+    }
+    let runner = runner::build(&file.scene, &origin, args.skinning).map_err(|e| e.to_string())?;
     let format = args.format.unwrap_or_else(|| runner.natural_format());
     let out = args.out.clone().unwrap_or_else(|| Path::new("anim-out").join(&file.name));
+    Ok(Session {
+        file,
+        origin,
+        skinning: args.skinning,
+        out,
+        format,
+        stride: args.stride,
+        preview_width: (!args.no_preview).then_some(args.preview_width),
+        checkpoint_every: args.checkpoint_every,
+        quiet: args.quiet,
+        runner,
+        start_frame: 0,
+        steps: 0,
+        written_times: Vec::new(),
+        energy_initial: None,
+        max_error: None,
+        newton_iterations: 0,
+        resumed: false,
+    })
+}
+
+/// A run continued from a checkpoint: the scene is rebuilt from the checkpoint's copy and the
+/// runner's state restored.
+fn resumed(args: &ResumeArgs) -> Result<Session, String> {
+    let (header, ckpt): (_, RunCheckpoint) =
+        anim_io::read_checkpoint(&args.checkpoint).map_err(|e| e.to_string())?;
+    if header.kind != CHECKPOINT_KIND {
+        return Err(format!(
+            "{}: a checkpoint of kind `{}`, not of an `anim run` (`{CHECKPOINT_KIND}`)",
+            args.checkpoint.display(),
+            header.kind
+        ));
+    }
+    let mut file = ckpt.scene;
+    if let Some(f) = args.frames {
+        if f <= ckpt.frame {
+            return Err(format!("--frames {f}: the checkpoint is already at frame {}", ckpt.frame));
+        }
+        file.run.frames = f;
+    }
+    let mut runner = runner::build(&file.scene, &ckpt.origin, ckpt.skinning).map_err(|e| e.to_string())?;
+    runner.restore(&ckpt.runner).map_err(|e| format!("{}: {e}", args.checkpoint.display()))?;
+    Ok(Session {
+        file,
+        origin: ckpt.origin,
+        skinning: ckpt.skinning,
+        out: args.out.clone().unwrap_or(ckpt.out),
+        format: ckpt.format,
+        stride: ckpt.stride,
+        preview_width: ckpt.preview_width,
+        checkpoint_every: ckpt.checkpoint_every,
+        quiet: args.quiet,
+        runner,
+        start_frame: ckpt.frame,
+        steps: ckpt.steps,
+        written_times: ckpt.written_times,
+        energy_initial: ckpt.energy_initial,
+        max_error: ckpt.max_error,
+        newton_iterations: ckpt.newton_iterations,
+        resumed: true,
+    })
+}
+
+impl Session {
+    /// Writes `<out>/checkpoint.anim` for the frames completed so far (`frame` of them).
+    fn checkpoint(&self, frame: usize) -> Result<PathBuf, String> {
+        let ckpt = RunCheckpoint {
+            scene: self.file.clone(),
+            origin: self.origin.clone(),
+            skinning: self.skinning,
+            out: self.out.clone(),
+            format: self.format,
+            stride: self.stride,
+            preview_width: self.preview_width,
+            checkpoint_every: self.checkpoint_every,
+            frame,
+            steps: self.steps,
+            written_times: self.written_times.clone(),
+            energy_initial: self.energy_initial,
+            max_error: self.max_error,
+            newton_iterations: self.newton_iterations,
+            runner: self.runner.save(),
+        };
+        let path = self.out.join(CHECKPOINT_FILE);
+        anim_io::write_checkpoint(&path, CHECKPOINT_KIND, &ckpt).map_err(|e| e.to_string())?;
+        Ok(path)
+    }
+}
+
+fn execute(mut s: Session) -> Result<(), String> {
+    let out = s.out.clone();
     std::fs::create_dir_all(&out)
         .map_err(|e| format!("{}: cannot create output folder: {e}", out.display()))?;
+    let run = s.file.run.clone();
     // At most about 100 preview frames, whatever the run's length.
-    let preview = (!args.no_preview).then(|| (args.preview_width, file.run.frames.div_ceil(100)));
-    let mut output = Output::new(&out, format, args.stride, preview, runner.as_ref())?;
+    let preview = s.preview_width.map(|w| (w, run.frames.div_ceil(100)));
+    let continuing = s.resumed.then_some(s.written_times.as_slice());
+    let mut output = Output::new(&out, s.format, s.stride, preview, s.runner.as_ref(), continuing)?;
+    let writes_files = s.format.frame_format().is_some();
 
-    let total_steps = (file.run.frames * file.run.steps_per_frame) as u64;
+    let first_step = s.steps;
+    let total_steps = (run.frames * run.steps_per_frame) as u64;
     let bar = ProgressBar::with_draw_target(Some(total_steps), ProgressDrawTarget::hidden());
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {elapsed} elapsed, eta {eta}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
+    bar.set_position(s.steps);
     let start = Instant::now();
     let mut bar_shown = false;
-    let (mut steps, mut max_err, mut newton) = (0u64, None::<f64>, 0usize);
-    let (mut energy0, mut energy) = (None, None);
+    let mut energy = None;
     let mut step_seconds = 0.0;
     let mut failure = None;
-    'frames: for frame in 0..file.run.frames {
+    let mut checkpoints = 0usize;
+    'frames: for frame in s.start_frame..run.frames {
         let t_step = Instant::now();
-        for _ in 0..file.run.steps_per_frame {
-            match runner.step(file.run.dt) {
+        for _ in 0..run.steps_per_frame {
+            match s.runner.step(run.dt) {
                 Ok(report) => {
-                    newton += report.iterations;
+                    s.newton_iterations += report.iterations;
                     energy = report.energy;
-                    if energy0.is_none() {
-                        energy0 = energy;
+                    if s.energy_initial.is_none() {
+                        s.energy_initial = energy;
                     }
                 }
                 Err(e) => {
-                    failure = Some(format!("step {steps}: {e}"));
+                    failure = Some(format!("step {}: {e}", s.steps));
                     break 'frames;
                 }
             }
-            steps += 1;
+            s.steps += 1;
         }
         step_seconds += t_step.elapsed().as_secs_f64();
-        if let Some(e) = runner.exact_error() {
-            max_err = Some(max_err.map_or(e, |m: f64| m.max(e)));
+        if let Some(e) = s.runner.exact_error() {
+            s.max_error = Some(s.max_error.map_or(e, |m: f64| m.max(e)));
         }
-        if let Err(e) = output.frame(frame, runner.as_ref(), energy) {
+        if let Err(e) = output.frame(frame, s.runner.as_ref(), energy) {
             failure = Some(format!("frame {frame}: {e}"));
             break;
         }
-        if !args.quiet && !bar_shown && start.elapsed() > Duration::from_secs(1) {
+        if writes_files && frame.is_multiple_of(s.stride) {
+            s.written_times.push(s.runner.state().t);
+        }
+        if let Some(every) = s.checkpoint_every
+            && (frame + 1).is_multiple_of(every)
+            && frame + 1 < run.frames
+        {
+            s.checkpoint(frame + 1)?;
+            checkpoints += 1;
+        }
+        if !s.quiet && !bar_shown && start.elapsed() > Duration::from_secs(1) {
             bar.set_draw_target(ProgressDrawTarget::stderr());
             bar_shown = true;
         }
-        bar.set_position(steps);
+        bar.set_position(s.steps);
     }
     bar.finish_and_clear();
     let (files, writer_seconds) = output.finish()?;
@@ -379,36 +580,43 @@ fn run(args: &RunArgs) -> Result<(), String> {
     // What output added to the run: everything that was not stepping (the writer overlaps
     // with stepping; what it could not hide shows here).
     let output_seconds = (wall - step_seconds).max(0.0);
+    let steps_here = s.steps - first_step;
+    let energy0 = s.energy_initial;
     let metrics = Metrics {
-        scene: file.name.clone(),
-        system: runner.system(),
-        method: runner.method(),
+        scene: s.file.name.clone(),
+        system: s.runner.system(),
+        method: s.runner.method(),
         status: failure.clone().map_or_else(|| "completed".into(), |f| format!("diverged at {f}")),
-        dt: file.run.dt,
-        steps,
-        frames: file.run.frames,
-        format,
-        simulated_seconds: runner.state().t,
+        dt: run.dt,
+        steps: s.steps,
+        frames: run.frames,
+        format: s.format,
+        simulated_seconds: s.runner.state().t,
         wall_seconds: wall,
         step_seconds,
         output_seconds,
         output_fraction: output_seconds / wall.max(1e-12),
         writer_busy_seconds: writer_seconds,
-        steps_per_second: steps as f64 / step_seconds.max(1e-12),
+        steps_per_second: steps_here as f64 / step_seconds.max(1e-12),
         energy_initial: energy0,
         energy_final: energy,
         relative_energy_change: energy0.zip(energy).map(|(e0, e)| (e - e0) / e0.abs().max(f64::MIN_POSITIVE)),
-        max_error_vs_exact: max_err,
-        newton_iterations: newton,
+        max_error_vs_exact: s.max_error,
+        newton_iterations: s.newton_iterations,
+        resumed_from_frame: s.resumed.then_some(s.start_frame),
+        checkpoints_written: checkpoints,
         files,
     };
     let metrics_path = out.join("metrics.json");
     anim_io::metrics::write_json(&metrics_path, &metrics).map_err(|e| e.to_string())?;
-    if !args.quiet {
+    if !s.quiet {
+        if let Some(f) = metrics.resumed_from_frame {
+            println!("resumed at frame {f} (step {first_step})");
+        }
         println!(
             "{}: {} steps of {} s with {} in {:.2} s ({:.0} steps/s); output {:.0}% of the time",
             metrics.scene,
-            steps,
+            steps_here,
             metrics.dt,
             metrics.method,
             wall,
@@ -423,6 +631,9 @@ fn run(args: &RunArgs) -> Result<(), String> {
         }
         for f in &metrics.files {
             println!("  wrote {f}");
+        }
+        if checkpoints > 0 {
+            println!("  wrote {} ({checkpoints} times)", out.join(CHECKPOINT_FILE).display());
         }
         println!("  wrote {}", metrics_path.display());
     }

@@ -47,6 +47,15 @@ pub enum IoError {
         /// What is wrong.
         cause: String,
     },
+    /// A checkpoint file that cannot be resumed from: not a checkpoint, another version,
+    /// truncated, corrupted, or a payload that does not parse.
+    #[error("{}: {problem}", path.display())]
+    Checkpoint {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        problem: crate::checkpoint::CheckpointProblem,
+    },
     /// An encoder (PNG, GIF, CSV, JSON) failed.
     #[error("{}: {cause}", path.display())]
     Encode {

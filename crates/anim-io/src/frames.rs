@@ -32,6 +32,14 @@ impl FrameSequence {
         format!("{}_{index:05}.{}", self.stem, self.extension)
     }
 
+    /// Continues a sequence whose first frames, at `times`, were written earlier (a run resumed
+    /// from a checkpoint): the next frame is numbered `times.len()` and the `.pvd` lists all.
+    #[must_use]
+    pub fn continuing(mut self, times: &[f64]) -> Self {
+        self.frames = times.iter().enumerate().map(|(k, &t)| (t, PathBuf::from(self.file_name(k)))).collect();
+        self
+    }
+
     /// Records a frame at `time` and returns the path to write it to.
     pub fn next_path(&mut self, time: f64) -> PathBuf {
         let name = PathBuf::from(self.file_name(self.frames.len()));
@@ -117,6 +125,13 @@ impl FrameWriter {
     /// Frames `dir/frame_NNNNN.{ext}`; creates `dir` if needed.
     pub fn new(dir: impl Into<PathBuf>, format: FrameFormat) -> Result<Self, IoError> {
         let sequence = FrameSequence::new(dir, "frame", format.extension())?;
+        Ok(FrameWriter { sequence, format, encoding: VtkEncoding::default() })
+    }
+
+    /// Continues a sequence in `dir` whose first frames, at `times`, were written earlier (see
+    /// [`FrameSequence::continuing`]).
+    pub fn continuing(dir: impl Into<PathBuf>, format: FrameFormat, times: &[f64]) -> Result<Self, IoError> {
+        let sequence = FrameSequence::new(dir, "frame", format.extension())?.continuing(times);
         Ok(FrameWriter { sequence, format, encoding: VtkEncoding::default() })
     }
 
@@ -244,6 +259,15 @@ mod tests {
         assert!(text.contains("timestep=\"0e0\" group=\"\" part=\"0\" file=\"frame_00000.vtu\""), "{text}");
         assert!(
             text.contains("timestep=\"2.5e-1\" group=\"\" part=\"0\" file=\"frame_00001.vtu\""),
+            "{text}"
+        );
+        // A resumed run continues the numbering and its .pvd lists the earlier frames too.
+        let mut w = FrameWriter::continuing(&dir, FrameFormat::Vtu, &[0.0, 0.25]).unwrap();
+        let p = w.write(0.5, &UnstructuredGrid::new(&pts).tetrahedra(&tets)).unwrap();
+        assert_eq!(p, dir.join("frame_00002.vtu"));
+        let text = std::fs::read_to_string(w.finish().unwrap().unwrap()).unwrap();
+        assert!(
+            text.contains("file=\"frame_00000.vtu\"") && text.contains("file=\"frame_00002.vtu\""),
             "{text}"
         );
         assert_eq!("PLY".parse::<FrameFormat>(), Ok(FrameFormat::Ply));

@@ -59,6 +59,7 @@
 //! # }
 //! ```
 
+pub mod checkpoint;
 mod data;
 mod error;
 pub mod frames;
@@ -72,6 +73,7 @@ pub mod tetgen;
 mod text;
 pub mod vtk;
 
+pub use checkpoint::{CheckpointHeader, CheckpointProblem, read_checkpoint, write_atomic, write_checkpoint};
 pub use data::{DataArray, Element, Real, Values};
 pub use error::IoError;
 pub use frames::{FrameFormat, FrameSequence, FrameWriter};

@@ -193,6 +193,9 @@ impl PbdParams {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum PbdError {
+    /// A checkpointed memory that does not belong to this simulation.
+    #[error("checkpoint does not fit this simulation: {0}")]
+    Checkpoint(String),
     /// A solver setting is out of range.
     #[error("{name} {requirement}, got {value}")]
     BadParameter {
@@ -462,6 +465,52 @@ impl PbdSimulation {
     #[must_use]
     pub fn steps(&self) -> u64 {
         self.steps
+    }
+
+    /// What the simulation carries from one step to the next (step count, the external forces
+    /// set with [`PbdSimulation::set_external_force`], pending body targets), for checkpoints:
+    /// with the [`State`], it continues a run bit for bit.
+    #[must_use]
+    pub fn memory(&self) -> serde_json::Value {
+        let forces: Vec<[f64; 3]> = self.forces.iter().map(|f| f.to_array()).collect();
+        let targets = serde_json::to_value(&self.targets).unwrap_or(serde_json::Value::Null);
+        serde_json::json!({ "steps": self.steps, "forces": forces, "targets": targets })
+    }
+
+    /// Restores what [`PbdSimulation::memory`] returned.
+    ///
+    /// # Errors
+    /// [`PbdError::Checkpoint`] when `memory` does not fit this model (missing fields, another
+    /// particle or body count).
+    pub fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), PbdError> {
+        let bad = |m: &str| PbdError::Checkpoint(m.to_string());
+        let steps =
+            memory.get("steps").and_then(serde_json::Value::as_u64).ok_or_else(|| bad("no step count"))?;
+        let forces: Vec<[f64; 3]> = memory
+            .get("forces")
+            .map(|f| serde_json::from_value(f.clone()))
+            .ok_or_else(|| bad("no external forces"))?
+            .map_err(|e| bad(&format!("external forces: {e}")))?;
+        let targets: Vec<Option<Pose>> = memory
+            .get("targets")
+            .map(|t| serde_json::from_value(t.clone()))
+            .ok_or_else(|| bad("no body targets"))?
+            .map_err(|e| bad(&format!("body targets: {e}")))?;
+        if forces.len() != self.forces.len() || targets.len() != self.targets.len() {
+            return Err(bad(&format!(
+                "{} forces and {} body targets for a model of {} particles and {} bodies",
+                forces.len(),
+                targets.len(),
+                self.forces.len(),
+                self.targets.len()
+            )));
+        }
+        for (to, from) in self.forces.iter_mut().zip(forces) {
+            *to = DVec3::from_array(from);
+        }
+        self.targets = targets;
+        self.steps = steps;
+        Ok(())
     }
 
     /// Sets the pose kinematic body `body` reaches at the end of the next step (it moves linearly

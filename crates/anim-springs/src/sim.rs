@@ -23,6 +23,9 @@ pub const DEFAULT_MAX_STRETCH: f64 = 10.0;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum SpringError {
+    /// A checkpointed memory that does not belong to this simulation.
+    #[error("checkpoint does not fit this simulation: {0}")]
+    Checkpoint(String),
     /// The integrator parameters are invalid (a beta outside `[0, 1]`).
     #[error("invalid integrator: {0}")]
     BadIntegrator(String),
@@ -153,6 +156,29 @@ impl SpringSimulation {
     #[must_use]
     pub fn last_step_info(&self) -> StepInfo {
         self.last
+    }
+
+    /// What the simulation carries from one step to the next (step count, the integrator's
+    /// memory), for checkpoints: with the [`State`], it continues a run bit for bit.
+    #[must_use]
+    pub fn memory(&self) -> serde_json::Value {
+        serde_json::json!({ "steps": self.steps, "integrator": self.integrator.memory() })
+    }
+
+    /// Restores what [`SpringSimulation::memory`] returned.
+    ///
+    /// # Errors
+    /// [`SpringError::Checkpoint`] when `memory` is not a memory of this simulation's method.
+    pub fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), SpringError> {
+        let steps = memory
+            .get("steps")
+            .and_then(serde_json::Value::as_u64)
+            .ok_or_else(|| SpringError::Checkpoint("no step count".into()))?;
+        let integrator =
+            memory.get("integrator").ok_or_else(|| SpringError::Checkpoint("no integrator".into()))?;
+        self.integrator.restore_memory(integrator).map_err(|e| SpringError::Checkpoint(e.to_string()))?;
+        self.steps = steps;
+        Ok(())
     }
 
     /// Advances by one step without computing the report's energy and momenta (the fast path).

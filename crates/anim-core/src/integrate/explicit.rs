@@ -29,6 +29,8 @@ impl ExplicitEuler {
 }
 
 impl<S: SecondOrderSystem + ?Sized> Integrator<S> for ExplicitEuler {
+    super::serde_memory!("explicit-euler");
+
     fn name(&self) -> &'static str {
         "explicit-euler"
     }
@@ -86,6 +88,8 @@ impl SymplecticEuler {
 }
 
 impl<S: SecondOrderSystem + ?Sized> Integrator<S> for SymplecticEuler {
+    super::serde_memory!("symplectic-euler");
+
     fn name(&self) -> &'static str {
         "symplectic-euler"
     }

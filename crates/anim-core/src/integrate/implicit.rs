@@ -158,6 +158,24 @@ struct NewtonCore {
 }
 
 impl NewtonCore {
+    /// The only state kept between steps is the step count (every solve starts from zero).
+    fn memory(&self, method: &'static str) -> serde_json::Value {
+        serde_json::json!({ "method": method, "memory": { "steps": self.steps } })
+    }
+
+    fn restore_memory(
+        &mut self,
+        method: &'static str,
+        memory: &serde_json::Value,
+    ) -> Result<(), IntegrateError> {
+        let memory = super::memory_of(method, memory)?;
+        let steps = memory.get("steps").and_then(serde_json::Value::as_u64).ok_or_else(|| {
+            IntegrateError::Memory { method, cause: format!("expected {{\"steps\": <count>}}, got {memory}") }
+        })?;
+        self.steps = steps;
+        Ok(())
+    }
+
     fn resize(&mut self, n: usize) {
         for b in [
             &mut self.w,
@@ -497,6 +515,14 @@ impl BetaBlend {
 }
 
 impl<S: MechanicalSystem + ?Sized> Integrator<S> for BetaBlend {
+    fn memory(&self) -> serde_json::Value {
+        self.core.memory(Integrator::<S>::name(self))
+    }
+
+    fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), IntegrateError> {
+        self.core.restore_memory(if self.beta == 1.0 { "backward-euler" } else { "beta-blend" }, memory)
+    }
+
     fn name(&self) -> &'static str {
         if self.beta == 1.0 { "backward-euler" } else { "beta-blend" }
     }
@@ -539,6 +565,14 @@ impl ImplicitMidpoint {
 }
 
 impl<S: MechanicalSystem + ?Sized> Integrator<S> for ImplicitMidpoint {
+    fn memory(&self) -> serde_json::Value {
+        self.core.memory(Integrator::<S>::name(self))
+    }
+
+    fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), IntegrateError> {
+        self.core.restore_memory("implicit-midpoint", memory)
+    }
+
     fn name(&self) -> &'static str {
         "implicit-midpoint"
     }

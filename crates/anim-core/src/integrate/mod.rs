@@ -153,6 +153,14 @@ pub struct StepInfo {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum IntegrateError {
+    /// A checkpointed integrator memory that does not belong to this method.
+    #[error("integrator memory is not a memory of {method}: {cause}")]
+    Memory {
+        /// The method that was asked to restore it.
+        method: &'static str,
+        /// Why it does not fit.
+        cause: String,
+    },
     /// The step produced a NaN or infinity.
     #[error(transparent)]
     NonFinite(#[from] NonFinite),
@@ -209,6 +217,17 @@ pub trait Integrator<S: ?Sized> {
     fn step(&mut self, system: &mut S, state: &mut State, dt: f64) -> Result<StepInfo, IntegrateError>;
     /// Forgets history kept between steps (multistep methods), e.g. after teleporting the state.
     fn reset(&mut self) {}
+    /// What the method carries from one step to the next (its step count and, for the
+    /// multistep methods, the previous positions, the staggered velocity or the last
+    /// acceleration), as a self-describing value for checkpoints. Scratch buffers are not part
+    /// of it: a fresh integrator given this memory continues bit for bit like the one that
+    /// produced it.
+    fn memory(&self) -> serde_json::Value;
+    /// Restores what [`Integrator::memory`] of the same method returned.
+    ///
+    /// # Errors
+    /// [`IntegrateError::Memory`] when `memory` is not a memory of this method.
+    fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), IntegrateError>;
     /// Theoretical order of accuracy of the method.
     fn order(&self) -> u32;
     /// Whether the method is symplectic (bounded energy error on Hamiltonian systems).
@@ -474,6 +493,39 @@ pub(crate) fn fit(buf: &mut Vec<f64>, n: usize) {
     }
 }
 
+/// `Integrator::memory` and `Integrator::restore_memory` for a method whose serde form is its
+/// memory (scratch fields are `#[serde(skip)]` and refilled by the next step).
+macro_rules! serde_memory {
+    ($name:literal) => {
+        fn memory(&self) -> serde_json::Value {
+            let own = serde_json::to_value(self).unwrap_or(serde_json::Value::Null);
+            serde_json::json!({ "method": $name, "memory": own })
+        }
+
+        fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), IntegrateError> {
+            let own = crate::integrate::memory_of($name, memory)?;
+            *self = serde::Deserialize::deserialize(own)
+                .map_err(|e| IntegrateError::Memory { method: $name, cause: e.to_string() })?;
+            Ok(())
+        }
+    };
+}
+pub(crate) use serde_memory;
+
+/// The `"memory"` part of a saved memory after checking that its `"method"` is `method`.
+pub(crate) fn memory_of<'a>(
+    method: &'static str,
+    saved: &'a serde_json::Value,
+) -> Result<&'a serde_json::Value, IntegrateError> {
+    match saved.get("method").and_then(serde_json::Value::as_str) {
+        Some(m) if m == method => {
+            saved.get("memory").ok_or(IntegrateError::Memory { method, cause: "no \"memory\" field".into() })
+        }
+        Some(other) => Err(IntegrateError::Memory { method, cause: format!("it was saved by {other}") }),
+        None => Err(IntegrateError::Memory { method, cause: "no \"method\" field".into() }),
+    }
+}
+
 /// A snapshot of the state a multistep method last produced, to detect outside changes.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub(crate) struct History {
@@ -539,6 +591,20 @@ impl<S: SecondOrderSystem + ?Sized> Simulation<S> {
     #[must_use]
     pub fn integrator_name(&self) -> &'static str {
         self.integrator.name()
+    }
+
+    /// The integrator's memory between steps, for checkpoints (see [`Integrator::memory`]).
+    #[must_use]
+    pub fn memory(&self) -> serde_json::Value {
+        self.integrator.memory()
+    }
+
+    /// Restores the integrator's memory from a checkpoint.
+    ///
+    /// # Errors
+    /// [`IntegrateError::Memory`] when `memory` belongs to another method.
+    pub fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), IntegrateError> {
+        self.integrator.restore_memory(memory)
     }
 }
 

@@ -32,6 +32,8 @@ impl Rk4 {
 }
 
 impl<S: SecondOrderSystem + ?Sized> Integrator<S> for Rk4 {
+    super::serde_memory!("rk4");
+
     fn name(&self) -> &'static str {
         "rk4"
     }

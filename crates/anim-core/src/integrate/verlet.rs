@@ -51,6 +51,8 @@ impl PositionVerlet {
 }
 
 impl<S: SecondOrderSystem + ?Sized> Integrator<S> for PositionVerlet {
+    super::serde_memory!("position-verlet");
+
     fn name(&self) -> &'static str {
         "position-verlet"
     }
@@ -140,6 +142,8 @@ impl Leapfrog {
 }
 
 impl<S: SecondOrderSystem + ?Sized> Integrator<S> for Leapfrog {
+    super::serde_memory!("leapfrog");
+
     fn name(&self) -> &'static str {
         "leapfrog"
     }
@@ -215,6 +219,8 @@ impl VelocityVerlet {
 }
 
 impl<S: SecondOrderSystem + ?Sized> Integrator<S> for VelocityVerlet {
+    super::serde_memory!("velocity-verlet");
+
     fn name(&self) -> &'static str {
         "velocity-verlet"
     }

@@ -182,6 +182,9 @@ impl SimParams {
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum SimError {
+    /// A checkpointed memory that does not belong to this simulation.
+    #[error("checkpoint does not fit this simulation: {0}")]
+    Checkpoint(String),
     /// A parameter out of its range.
     #[error("parameter '{name}' = {value}: {requirement}")]
     BadParameter {

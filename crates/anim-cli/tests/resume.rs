@@ -1,0 +1,135 @@
+//! `anim run --checkpoint-every` and `anim resume`: the frames after a resume are those of an
+//! uninterrupted run, bit for bit (CSV rows print every value in its shortest round-trip form,
+//! so equal text is equal bits); damaged checkpoints are clear errors.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn anim(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_anim")).args(args).output().expect("the anim binary runs")
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("anim-cli-resume-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn csv_rows(dir: &Path) -> Vec<String> {
+    std::fs::read_to_string(dir.join("frames.csv")).unwrap().lines().map(str::to_string).collect()
+}
+
+#[test]
+fn a_resumed_run_writes_the_frames_of_an_uninterrupted_one() {
+    for scene in ["kepler", "oscillator"] {
+        let whole = temp(&format!("{scene}-whole"));
+        let parts = temp(&format!("{scene}-parts"));
+        let w = whole.to_str().unwrap();
+        let p = parts.to_str().unwrap();
+        let out = anim(&["run", scene, "--frames", "40", "--out", w, "--no-preview", "--quiet"]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        // The first part checkpoints at frame 25, then dies (simulated by stopping at 30 and
+        // resuming from the checkpoint, which is at 25: frames 25..30 are written again).
+        let out = anim(&[
+            "run",
+            scene,
+            "--frames",
+            "30",
+            "--out",
+            p,
+            "--no-preview",
+            "--quiet",
+            "--checkpoint-every",
+            "25",
+        ]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let ckpt = parts.join("checkpoint.anim");
+        assert!(ckpt.exists());
+        // Keep the rows up to the checkpoint, as a crash right after it would have left them.
+        let rows = csv_rows(&parts);
+        std::fs::write(parts.join("frames.csv"), rows[..26].join("\n") + "\n").unwrap();
+        let out = anim(&["resume", ckpt.to_str().unwrap(), "--frames", "40", "--quiet"]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(csv_rows(&whole), csv_rows(&parts), "{scene}");
+        let metrics = std::fs::read_to_string(parts.join("metrics.json")).unwrap();
+        assert!(metrics.contains("\"resumed_from_frame\": 25"), "{metrics}");
+        std::fs::remove_dir_all(&whole).ok();
+        std::fs::remove_dir_all(&parts).ok();
+    }
+}
+
+#[test]
+fn mesh_frames_continue_their_numbering_and_series() {
+    let dir = temp("cloth");
+    let d = dir.to_str().unwrap();
+    let out = anim(&[
+        "run",
+        "rope",
+        "--frames",
+        "4",
+        "--out",
+        d,
+        "--no-preview",
+        "--quiet",
+        "--checkpoint-every",
+        "2",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let ckpt = dir.join("checkpoint.anim");
+    let out = anim(&["resume", ckpt.to_str().unwrap(), "--frames", "6", "--quiet"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let pvd = std::fs::read_to_string(dir.join("frames/frames.pvd")).unwrap();
+    // Frames 0 and 1 from the first part, 2..5 from the resumed one (2 and 3 rewritten).
+    for k in 0..6 {
+        assert!(pvd.contains(&format!("frame_{k:05}.vtu")), "frame {k} missing from {pvd}");
+    }
+    assert!(!pvd.contains("frame_00006.vtu"), "{pvd}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn damaged_or_foreign_checkpoints_are_clear_errors() {
+    let dir = temp("damaged");
+    let d = dir.to_str().unwrap();
+    let out = anim(&[
+        "run",
+        "kepler",
+        "--frames",
+        "4",
+        "--out",
+        d,
+        "--no-preview",
+        "--quiet",
+        "--checkpoint-every",
+        "2",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let ckpt = dir.join("checkpoint.anim");
+    let good = std::fs::read(&ckpt).unwrap();
+    let cases: [(&str, Vec<u8>, &str); 3] = [
+        ("truncated", good[..good.len() / 2].to_vec(), "truncated"),
+        (
+            "wrong version",
+            String::from_utf8(good.clone())
+                .unwrap()
+                .replacen("\"version\":1", "\"version\":9", 1)
+                .into_bytes(),
+            "version 9",
+        ),
+        ("not a checkpoint", b"name = \"kepler\"\n".to_vec(), "not an anim checkpoint"),
+    ];
+    for (what, bytes, expect) in cases {
+        let path = dir.join(format!("{}.anim", what.replace(' ', "-")));
+        std::fs::write(&path, bytes).unwrap();
+        let out = anim(&["resume", path.to_str().unwrap(), "--quiet"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{what}");
+        assert!(
+            err.contains(expect) && err.contains(path.file_name().unwrap().to_str().unwrap()),
+            "{what}: {err}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
