@@ -26,7 +26,7 @@ pub use csr::{CsrError, CsrMatrix};
 pub use direct::SparseCholesky;
 pub use schur::{Eliminate, schur_complement, solve_block, solve_block_diagonal_a};
 pub use stationary::{GaussSeidel, Jacobi, gauss_seidel_sweep, jacobi_sweep};
-pub use svd::{Svd3, polar, polar_f32, svd3, svd3_f32};
+pub use svd::{Svd3, polar, polar_f32, svd3, svd3_f32, svd3_real};
 
 use serde::{Deserialize, Serialize};
 

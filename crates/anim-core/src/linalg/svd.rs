@@ -246,6 +246,15 @@ fn polar_cols<T: Real>(a: &Cols<T>) -> (Cols<T>, Cols<T>) {
     (r, s)
 }
 
+/// The SVD kernel for either precision on column arrays (`a[j][i]` is row `i` of column `j`):
+/// returns `(u, sigma, v)` in the same layout, with the conventions of [`svd3`]. This is the
+/// entry point for callers that do not use glam types (e.g. nalgebra matrices in `anim-material`).
+#[must_use]
+pub fn svd3_real<T: Real>(a: &[[T; 3]; 3]) -> ([[T; 3]; 3], [T; 3], [[T; 3]; 3]) {
+    let (u, sigma, v, _) = svd3_cols(a);
+    (u, sigma, v)
+}
+
 /// SVD of a `f64` matrix: `a = u * diag(sigma) * v^T` with rotations `u`, `v` and
 /// `sigma.x >= sigma.y >= |sigma.z|` (see the [module docs](self)).
 #[must_use]

@@ -1,0 +1,600 @@
+//! Unit tests: derivatives against finite differences, invariances, rest state, small-strain
+//! agreement, f32 against f64, the 2x2 SVD, the PSD projection and parameter validation.
+
+use crate::decomposition::{determinant, polar, svd, svd2};
+use crate::*;
+use nalgebra::{Rotation2, Rotation3, SVector, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// The Lamé parameters of the checks: E = 1e4, nu = 0.3 (mu ~ 3846, lambda ~ 5769).
+fn lame64() -> Lame<f64> {
+    Lame::from_young_poisson(1e4, 0.3).unwrap_or(Lame { mu: f64::NAN, lambda: f64::NAN })
+}
+
+fn rotation<const D: usize>(rng: &mut ChaCha8Rng) -> Mat<f64, D> {
+    if D == 2 {
+        let r = Rotation2::new(rng.random_range(-std::f64::consts::PI..std::f64::consts::PI));
+        Mat::<f64, D>::from_fn(|i, j| r.matrix()[(i, j)])
+    } else {
+        let axis: Vector3<f64> = Vector3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
+        let r = Rotation3::new(axis * (3.0 / axis.norm().max(1e-3)) * rng.random_range(0.0..1.0));
+        Mat::<f64, D>::from_fn(|i, j| r.matrix()[(i, j)])
+    }
+}
+
+/// Test deformation gradients by kind.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Kind {
+    /// `R1 diag(s) R2^T`, `s` in [0.5, 2].
+    General,
+    /// A pure rotation.
+    Rotation,
+    /// Diagonal stretches, with repeated values half of the time.
+    Stretch,
+    /// `det F ~ 1e-3` (smallest singular value 1e-3).
+    NearSingular,
+    /// `det F < 0` (reflection on the last singular value).
+    Inverted,
+    /// `det F = 0` exactly in the singular values.
+    Degenerate,
+}
+
+const KINDS: [Kind; 6] =
+    [Kind::General, Kind::Rotation, Kind::Stretch, Kind::NearSingular, Kind::Inverted, Kind::Degenerate];
+
+fn sample<const D: usize>(kind: Kind, rng: &mut ChaCha8Rng) -> Mat<f64, D> {
+    let mut s = SVector::<f64, D>::from_fn(|_, _| rng.random_range(0.5..2.0));
+    let (r1, r2) = (rotation::<D>(rng), rotation::<D>(rng));
+    match kind {
+        Kind::General => r1 * Mat::from_diagonal(&s) * r2.transpose(),
+        Kind::Rotation => r1,
+        Kind::Stretch => {
+            if rng.random_bool(0.5) {
+                s[1] = s[0];
+            }
+            Mat::from_diagonal(&s)
+        }
+        Kind::NearSingular => {
+            s[D - 1] = 1e-3;
+            r1 * Mat::from_diagonal(&s) * r2.transpose()
+        }
+        Kind::Inverted => {
+            // Keep sigma_{d-2} + sigma_{d-1} away from 0, where the corotated rotation is
+            // not differentiable.
+            // The negative value is the smallest in magnitude, so the others are >= 1.
+            for k in 0..D - 1 {
+                s[k] = rng.random_range(1.0..2.0);
+            }
+            s[D - 1] = -rng.random_range(0.05..0.6);
+            r1 * Mat::from_diagonal(&s) * r2.transpose()
+        }
+        Kind::Degenerate => {
+            s[D - 1] = 0.0;
+            r1 * Mat::from_diagonal(&s) * r2.transpose()
+        }
+    }
+}
+
+fn unit<const D: usize>(k: usize, l: usize) -> Mat<f64, D> {
+    let mut e = Mat::<f64, D>::zeros();
+    e[(k, l)] = 1.0;
+    e
+}
+
+/// Fourth-order central difference of `g` along `dir` with step `h`.
+fn fd4<R>(g: impl Fn(f64) -> R, h: f64) -> R
+where
+    R: std::ops::Sub<Output = R> + std::ops::Mul<f64, Output = R> + Copy,
+{
+    ((g(h) - g(-h)) * 8.0 - (g(2.0 * h) - g(-2.0 * h))) * (1.0 / (12.0 * h))
+}
+
+/// Step for finite differences: 1e-3 of the smallest singular value (at least 1e-6).
+fn step<const D: usize>(f: &Mat<f64, D>) -> f64 {
+    let s = svd(f).sigma;
+    1e-3 * s[D - 1].abs().clamp(1e-3, 1.0)
+}
+
+/// Largest FD relative errors of (P vs FD psi, dP/dF vs FD P), normalised by
+/// `max(|analytic|_F, mu + lambda)` (the stress scale; P vanishes at rest and under rotation).
+fn fd_errors<M: Hyperelastic<f64, D>, const D: usize>(
+    m: &M,
+    lame: &Lame<f64>,
+    f: &Mat<f64, D>,
+) -> (f64, f64) {
+    let scale = lame.mu + lame.lambda.abs();
+    let h = step(f);
+    let p = m.pk1(lame, f);
+    let t = m.dpdf(lame, f);
+    let mut p_fd = Mat::<f64, D>::zeros();
+    let mut t_err = 0.0f64;
+    let mut t_fd = Tangent::<f64, D>::zeros();
+    for k in 0..D {
+        for l in 0..D {
+            let e = unit::<D>(k, l);
+            p_fd[(k, l)] = fd4(|x| m.energy(lame, &(f + e * x)), h);
+            t_fd.d[k][l] = fd4(|x| m.pk1(lame, &(f + e * x)), h);
+        }
+    }
+    let p_err = (p - p_fd).norm() / p.norm().max(scale);
+    for k in 0..D {
+        for l in 0..D {
+            t_err = t_err.max((t.d[k][l] - t_fd.d[k][l]).norm());
+        }
+    }
+    (p_err, t_err / t.norm().max(scale))
+}
+
+fn defined_under_inversion(name: &str) -> bool {
+    name != "NeoHookean"
+}
+
+fn check_fd<M: Hyperelastic<f64, D>, const D: usize>(m: &M, name: &str, seed: u64) {
+    let lame = lame64();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    for kind in KINDS {
+        if matches!(kind, Kind::Inverted | Kind::Degenerate) && !defined_under_inversion(name) {
+            continue;
+        }
+        let mut worst = (0.0f64, 0.0f64);
+        for _ in 0..12 {
+            let f = sample::<D>(kind, &mut rng);
+            let (pe, te) = fd_errors(m, &lame, &f);
+            assert!(pe <= 1e-6, "{name} D={D} {kind:?}: P vs FD psi {pe:e} at {f}");
+            assert!(te <= 1e-6, "{name} D={D} {kind:?}: dP/dF vs FD P {te:e} at {f}");
+            worst = (worst.0.max(pe), worst.1.max(te));
+        }
+        println!("{name} D={D} {kind:?}: P {:.1e}, dP/dF {:.1e}", worst.0, worst.1);
+    }
+}
+
+macro_rules! per_model {
+    ($f:ident) => {
+        $f(LinearElastic, "LinearElastic");
+        $f(StVenantKirchhoff, "StVenantKirchhoff");
+        $f(CorotatedLinear, "CorotatedLinear");
+        $f(NeoHookean, "NeoHookean");
+        $f(FixedCorotated, "FixedCorotated");
+        $f(StableNeoHookean, "StableNeoHookean");
+    };
+}
+
+trait AllImpls:
+    Hyperelastic<f64, 2> + Hyperelastic<f64, 3> + Hyperelastic<f32, 2> + Hyperelastic<f32, 3> + Copy
+{
+}
+impl<M: Hyperelastic<f64, 2> + Hyperelastic<f64, 3> + Hyperelastic<f32, 2> + Hyperelastic<f32, 3> + Copy>
+    AllImpls for M
+{
+}
+
+#[test]
+fn derivatives_match_finite_differences() {
+    fn run<M: AllImpls>(m: M, name: &str) {
+        check_fd::<M, 2>(&m, name, 1);
+        check_fd::<M, 3>(&m, name, 2);
+    }
+    per_model!(run);
+}
+
+#[test]
+fn rest_state_has_zero_energy_and_stress() {
+    fn run<M: AllImpls>(m: M, name: &str) {
+        fn one<M: Hyperelastic<f64, D>, const D: usize>(m: &M, name: &str) {
+            let lame = lame64();
+            let id = Mat::<f64, D>::identity();
+            let e = m.energy(&lame, &id);
+            let p = m.pk1(&lame, &id);
+            // Rounding only: the energy is a difference of O(mu) terms.
+            assert!(e.abs() <= 1e-12 * lame.mu, "{name} D={D}: psi(I) = {e:e}");
+            assert!(p.norm() <= 1e-12 * lame.mu, "{name} D={D}: P(I) = {p}");
+        }
+        one::<M, 2>(&m, name);
+        one::<M, 3>(&m, name);
+    }
+    per_model!(run);
+}
+
+#[test]
+fn rotation_invariance() {
+    fn run<M: AllImpls>(m: M, name: &str) {
+        fn one<M: Hyperelastic<f64, D>, const D: usize>(m: &M, name: &str, seed: u64) {
+            let lame = lame64();
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let mut linear_violation = 0.0f64;
+            for kind in KINDS {
+                if matches!(kind, Kind::Inverted | Kind::Degenerate) && !defined_under_inversion(name) {
+                    continue;
+                }
+                for _ in 0..20 {
+                    let f = sample::<D>(kind, &mut rng);
+                    let q = rotation::<D>(&mut rng);
+                    let (e0, e1) = (m.energy(&lame, &f), m.energy(&lame, &(q * f)));
+                    let (p0, p1) = (m.pk1(&lame, &f), m.pk1(&lame, &(q * f)));
+                    let scale = lame.mu + lame.lambda;
+                    let de = (e0 - e1).abs() / e0.abs().max(scale);
+                    let dp = (q * p0 - p1).norm() / p0.norm().max(scale);
+                    if name == "LinearElastic" {
+                        linear_violation = linear_violation.max(de);
+                    } else {
+                        assert!(de <= 1e-12, "{name} D={D} {kind:?}: psi(QF) - psi(F) {de:e}");
+                        assert!(dp <= 1e-12, "{name} D={D} {kind:?}: P(QF) - Q P(F) {dp:e}");
+                    }
+                }
+            }
+            if name == "LinearElastic" {
+                // Small strain is not rotation invariant: a rotation changes the energy.
+                assert!(linear_violation > 1e-2, "linear elasticity unexpectedly invariant");
+            }
+        }
+        one::<M, 2>(&m, name, 3);
+        one::<M, 3>(&m, name, 4);
+    }
+    per_model!(run);
+}
+
+#[test]
+fn pure_rotation_is_stress_free() {
+    fn run<M: AllImpls>(m: M, name: &str) {
+        fn one<M: Hyperelastic<f64, D>, const D: usize>(m: &M, name: &str, seed: u64) {
+            let lame = lame64();
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            for _ in 0..20 {
+                let q = rotation::<D>(&mut rng);
+                let p = m.pk1(&lame, &q);
+                if name == "LinearElastic" {
+                    continue;
+                }
+                assert!(p.norm() <= 1e-11 * lame.mu, "{name} D={D}: P(Q) = {p}");
+            }
+        }
+        one::<M, 2>(&m, name, 5);
+        one::<M, 3>(&m, name, 6);
+    }
+    per_model!(run);
+}
+
+/// Every model linearises to linear elasticity at rest: the tangents at `F = I` agree, and
+/// `P(I + eps H) - P_lin(I + eps H) = O(eps^2)`.
+#[test]
+fn small_strain_agrees_with_linear_elasticity() {
+    fn run<M: AllImpls>(m: M, name: &str) {
+        fn one<M: Hyperelastic<f64, D>, const D: usize>(m: &M, name: &str, seed: u64) {
+            let lame = lame64();
+            let scale = lame.mu + lame.lambda;
+            let id = Mat::<f64, D>::identity();
+            let t = m.dpdf(&lame, &id);
+            let t_lin = LinearElastic.dpdf(&lame, &id);
+            let mut diff = 0.0f64;
+            for k in 0..D {
+                for l in 0..D {
+                    diff = diff.max((t.d[k][l] - t_lin.d[k][l]).norm());
+                }
+            }
+            assert!(diff <= 1e-12 * scale, "{name} D={D}: dP/dF(I) differs from linear by {diff:e}");
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            for _ in 0..10 {
+                let h = Mat::<f64, D>::from_fn(|_, _| rng.random_range(-1.0..1.0));
+                let err = |eps: f64| {
+                    let f = id + h * eps;
+                    (m.pk1(&lame, &f) - LinearElastic.pk1(&lame, &f)).norm() / scale
+                };
+                let (e1, e2) = (err(1e-3), err(1e-4));
+                // Second order: 10x smaller strain, ~100x smaller difference (allow 60x for
+                // the third-order term).
+                assert!(e1 <= 1e-3 * 10.0, "{name} D={D}: difference {e1:e} at eps 1e-3");
+                assert!(e2 <= e1 / 60.0, "{name} D={D}: difference not O(eps^2): {e1:e} -> {e2:e}");
+            }
+        }
+        one::<M, 2>(&m, name, 7);
+        one::<M, 3>(&m, name, 8);
+    }
+    per_model!(run);
+}
+
+/// f32 evaluation matches f64 on the same (f32-representable) input to f32 precision.
+#[test]
+fn f32_matches_f64() {
+    fn run<M: AllImpls>(m: M, name: &str) {
+        fn one<M: Hyperelastic<f64, D> + Hyperelastic<f32, D>, const D: usize>(m: &M, name: &str, seed: u64) {
+            let lame = lame64();
+            let lame32 = Lame::<f32> { mu: lame.mu as f32, lambda: lame.lambda as f32 };
+            let lame_back = Lame::<f64> { mu: f64::from(lame32.mu), lambda: f64::from(lame32.lambda) };
+            let scale = lame.mu + lame.lambda;
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let mut worst = [0.0f64; 3];
+            for kind in [Kind::General, Kind::Rotation, Kind::Stretch] {
+                for _ in 0..30 {
+                    let f32m = sample::<D>(kind, &mut rng).map(|x| x as f32);
+                    let f = f32m.map(f64::from);
+                    let e = Hyperelastic::<f64, D>::energy(m, &lame_back, &f);
+                    let e32 = f64::from(Hyperelastic::<f32, D>::energy(m, &lame32, &f32m));
+                    let p = Hyperelastic::<f64, D>::pk1(m, &lame_back, &f);
+                    let p32 = Hyperelastic::<f32, D>::pk1(m, &lame32, &f32m).map(f64::from);
+                    let t = Hyperelastic::<f64, D>::dpdf(m, &lame_back, &f).to_flat();
+                    let t32 = Hyperelastic::<f32, D>::dpdf(m, &lame32, &f32m).to_flat();
+                    let errs = [
+                        (e - e32).abs() / e.abs().max(scale),
+                        (p - p32).norm() / p.norm().max(scale),
+                        t.iter().zip(&t32).map(|(a, b)| (a - f64::from(*b)).abs()).fold(0.0, f64::max)
+                            / scale,
+                    ];
+                    for (w, x) in worst.iter_mut().zip(errs) {
+                        *w = w.max(x);
+                    }
+                }
+            }
+            // A few hundred f32 roundings (SVD sweeps) of eps_f32 = 1.2e-7.
+            for (what, w) in ["psi", "P", "dP/dF"].iter().zip(worst) {
+                assert!(w <= 2e-5, "{name} D={D}: f32 {what} differs from f64 by {w:e}");
+            }
+            println!("{name} D={D}: f32 vs f64 {:.1e} {:.1e} {:.1e}", worst[0], worst[1], worst[2]);
+        }
+        one::<M, 2>(&m, name, 9);
+        one::<M, 3>(&m, name, 10);
+    }
+    per_model!(run);
+}
+
+/// Helper for the f32 comparison: the tangent entries in a fixed order.
+trait ToFlat<T> {
+    fn to_flat(&self) -> Vec<T>;
+}
+impl<T: Scalar, const D: usize> ToFlat<T> for Tangent<T, D> {
+    fn to_flat(&self) -> Vec<T> {
+        self.d.iter().flatten().flat_map(|m| m.iter().copied()).collect()
+    }
+}
+
+#[test]
+fn tangent_is_symmetric() {
+    // dP_ij/dF_kl = d^2 psi / dF_ij dF_kl = dP_kl/dF_ij.
+    fn run<M: AllImpls>(m: M, name: &str) {
+        fn one<M: Hyperelastic<f64, D>, const D: usize>(m: &M, name: &str, seed: u64) {
+            let lame = lame64();
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            for kind in [Kind::General, Kind::Rotation, Kind::Stretch, Kind::NearSingular] {
+                let f = sample::<D>(kind, &mut rng);
+                let t = m.dpdf(&lame, &f);
+                let mut asym = 0.0f64;
+                for i in 0..D {
+                    for j in 0..D {
+                        for k in 0..D {
+                            for l in 0..D {
+                                asym = asym.max((t.entry(i, j, k, l) - t.entry(k, l, i, j)).abs());
+                            }
+                        }
+                    }
+                }
+                assert!(asym <= 1e-10 * t.norm(), "{name} D={D} {kind:?}: asymmetry {asym:e}");
+            }
+        }
+        one::<M, 2>(&m, name, 11);
+        one::<M, 3>(&m, name, 12);
+    }
+    per_model!(run);
+}
+
+/// The PSD projection: PSD, the identity on PSD input, and for the corotated models the analytic
+/// eigensystem route equals the numerical one.
+#[test]
+fn psd_projection() {
+    let lame = lame64();
+    let mut rng = ChaCha8Rng::seed_from_u64(13);
+    for kind in [Kind::General, Kind::Stretch, Kind::Inverted, Kind::NearSingular] {
+        for _ in 0..10 {
+            let f = sample::<3>(kind, &mut rng);
+            for (name, t, analytic) in [
+                ("FixedCorotated", FixedCorotated.dpdf(&lame, &f), Some(FixedCorotated.dpdf_psd(&lame, &f))),
+                (
+                    "CorotatedLinear",
+                    CorotatedLinear.dpdf(&lame, &f),
+                    Some(CorotatedLinear.dpdf_psd(&lame, &f)),
+                ),
+                ("StableNeoHookean", StableNeoHookean.dpdf(&lame, &f), None),
+                ("StVenantKirchhoff", StVenantKirchhoff.dpdf(&lame, &f), None),
+            ] {
+                let p = t.project_psd();
+                let m = p.to_matrix();
+                let ev = m.symmetric_eigenvalues();
+                let min = ev.iter().copied().fold(f64::INFINITY, f64::min);
+                assert!(min >= -1e-12 * m.norm(), "{name} {kind:?}: projected eigenvalue {min:e}");
+                // Projection of a PSD matrix is itself.
+                let again = p.project_psd().to_matrix();
+                assert!((again - m).norm() <= 1e-12 * m.norm(), "{name}: not idempotent");
+                // Unchanged where the original was already PSD.
+                let orig = t.to_matrix();
+                if orig.symmetric_eigenvalues().iter().all(|&x| x >= 0.0) {
+                    assert!((orig - m).norm() <= 1e-12 * m.norm(), "{name}: PSD input changed");
+                }
+                if let Some(a) = analytic {
+                    let diff = (a.to_matrix() - m).norm();
+                    assert!(diff <= 1e-9 * m.norm(), "{name} {kind:?}: analytic projection off by {diff:e}");
+                }
+            }
+        }
+    }
+    // 2D too.
+    let f = Mat::<f64, 2>::new(0.3, 0.1, -0.2, -0.4);
+    let a = FixedCorotated.dpdf_psd(&lame, &f).to_matrix();
+    let n = FixedCorotated.dpdf(&lame, &f).project_psd().to_matrix();
+    assert!((a - n).norm() <= 1e-9 * n.norm());
+    // Round trip of the flattening.
+    let t = StableNeoHookean.dpdf(&lame, &f);
+    assert_eq!(Tangent::<f64, 2>::from_matrix(&t.to_matrix()), t);
+}
+
+#[test]
+fn svd2_properties() {
+    let mut rng = ChaCha8Rng::seed_from_u64(14);
+    let mut cases: Vec<Mat<f64, 2>> = vec![
+        Mat::zeros(),
+        Mat::identity(),
+        -Mat::<f64, 2>::identity(),
+        Mat::<f64, 2>::new(1.0, 0.0, 0.0, -1.0),
+        Mat::<f64, 2>::new(-1.0, 0.0, 0.0, 1.0),
+        Mat::<f64, 2>::new(0.0, 1.0, 0.0, 0.0),
+        Mat::<f64, 2>::new(2.0, 0.0, 0.0, 2.0),
+        Mat::<f64, 2>::new(1e-300, 0.0, 0.0, 1e-300),
+        Mat::<f64, 2>::new(0.0, -3.0, 3.0, 0.0),
+        Mat::<f64, 2>::new(1.0, 2.0, 2.0, 4.0),
+    ];
+    for _ in 0..2000 {
+        cases.push(Mat::from_fn(|_, _| rng.random_range(-1.0..1.0)));
+        let r = rotation::<2>(&mut rng);
+        let c: f64 = rng.random_range(0.1..3.0);
+        cases.push(r * c);
+    }
+    for f in cases {
+        let s = svd2(&f);
+        let norm = f.norm().max(f64::MIN_POSITIVE);
+        let rec = (s.u * Mat::from_diagonal(&s.sigma) * s.v.transpose() - f).norm() / norm;
+        assert!(rec <= 1e-14, "reconstruction {rec:e} for {f}");
+        for q in [s.u, s.v] {
+            assert!((q.transpose() * q - Mat::identity()).norm() <= 1e-14);
+            assert!((determinant(&q) - 1.0).abs() <= 1e-14);
+        }
+        assert!(s.sigma[0] >= s.sigma[1].abs(), "ordering {:?}", s.sigma);
+        let det = determinant(&f);
+        if det.abs() > 1e-12 * norm * norm {
+            assert_eq!(s.sigma[1] < 0.0, det < 0.0, "sign of sigma_1 for {f}");
+        }
+        // Independent magnitudes: eigenvalues of F^T F in closed form.
+        if f == Mat::<f64, 2>::zeros() {
+            assert_eq!(s.sigma, SVector::<f64, 2>::zeros());
+            continue;
+        }
+        let fu = f / norm;
+        let c = fu.transpose() * fu;
+        let (tr, dt) = (c.trace(), c.determinant());
+        let disc = (0.25 * tr * tr - dt).max(0.0).sqrt();
+        let (l0, l1) = (0.5 * tr + disc, (0.5 * tr - disc).max(0.0));
+        assert!((s.sigma[0] / norm - l0.sqrt()).abs() <= 1e-14, "{f}");
+        if l1 > 1e-6 {
+            assert!((s.sigma[1].abs() / norm - l1.sqrt()).abs() <= 1e-12, "{f}");
+        }
+    }
+    // Polar: F = R S, R a rotation, S symmetric, in 2D and 3D.
+    let mut rng = ChaCha8Rng::seed_from_u64(15);
+    for kind in KINDS {
+        let f = sample::<3>(kind, &mut rng);
+        let (r, s) = polar(&f);
+        assert!((r * s - f).norm() <= 1e-13 * f.norm());
+        assert!((determinant(&r) - 1.0).abs() <= 1e-13);
+        assert_eq!(s, s.transpose());
+        let f2 = sample::<2>(kind, &mut rng);
+        let (r2, s2) = polar(&f2);
+        assert!((r2 * s2 - f2).norm() <= 1e-13 * f2.norm());
+    }
+}
+
+#[test]
+fn neo_hookean_is_undefined_when_inverted() {
+    let lame = lame64();
+    for f in [Mat::<f64, 3>::from_diagonal(&Vector3::new(1.0, 1.0, -0.5)), Mat::<f64, 3>::zeros()] {
+        assert!(!NeoHookean::is_defined(&f));
+        assert_eq!(NeoHookean.energy(&lame, &f), f64::INFINITY);
+        assert!(NeoHookean.pk1(&lame, &f).iter().all(|x| x.is_nan()));
+        assert!(!NeoHookean.dpdf(&lame, &f).is_finite());
+    }
+    // Barrier: the energy grows without bound as J -> 0+.
+    let e = |j: f64| NeoHookean.energy(&lame, &Mat::<f64, 3>::from_diagonal(&Vector3::new(1.0, 1.0, j)));
+    assert!(e(1e-6) > e(1e-3) && e(1e-3) > e(1e-1));
+    // NaN input stays NaN, no panic.
+    let nan = Mat::<f64, 2>::from_element(f64::NAN);
+    assert!(NeoHookean.energy(&lame, &nan).is_nan());
+}
+
+#[test]
+fn inversion_robust_models_are_finite_everywhere() {
+    let lame = lame64();
+    let fs = [
+        Mat::<f64, 3>::zeros(),
+        Mat::<f64, 3>::from_diagonal(&Vector3::new(1.0, 1.0, 0.0)),
+        Mat::<f64, 3>::from_diagonal(&Vector3::new(1.0, 1.0, -1.0)),
+        -Mat::<f64, 3>::identity(),
+        Mat::<f64, 3>::from_diagonal(&Vector3::new(1.0, 0.0, 0.0)),
+    ];
+    for f in fs {
+        for (name, e, p, t) in [
+            (
+                "FixedCorotated",
+                FixedCorotated.energy(&lame, &f),
+                FixedCorotated.pk1(&lame, &f),
+                FixedCorotated.dpdf(&lame, &f),
+            ),
+            (
+                "StableNeoHookean",
+                StableNeoHookean.energy(&lame, &f),
+                StableNeoHookean.pk1(&lame, &f),
+                StableNeoHookean.dpdf(&lame, &f),
+            ),
+        ] {
+            assert!(e.is_finite() && p.iter().all(|x| x.is_finite()) && t.is_finite(), "{name} at {f}");
+        }
+    }
+    // An inverted element is pushed back: along the inverted axis, the stress opposes further
+    // compression (P_22 < 0 at sigma_2 = -0.5 means the energy decreases as F_22 grows).
+    let f = Mat::<f64, 3>::from_diagonal(&Vector3::new(1.0, 1.0, -0.5));
+    assert!(FixedCorotated.pk1(&lame, &f)[(2, 2)] < 0.0);
+    assert!(StableNeoHookean.pk1(&lame, &f)[(2, 2)] < 0.0);
+}
+
+#[test]
+fn lame_validation() {
+    let ok = Lame::<f64>::from_young_poisson(1e4, 0.3);
+    assert!(ok.is_ok());
+    let l = ok.unwrap_or(Lame { mu: 0.0, lambda: 0.0 });
+    assert!((l.mu - 1e4 / 2.6).abs() <= 1e-9 && (l.lambda - 1e4 * 0.3 / (1.3 * 0.4)).abs() <= 1e-9);
+    assert!((l.young() - 1e4).abs() <= 1e-8 && (l.poisson() - 0.3).abs() <= 1e-12);
+    assert_eq!(Lame::<f64>::from_young_poisson(0.0, 0.3), Err(MaterialError::YoungModulus(0.0)));
+    assert_eq!(Lame::<f64>::from_young_poisson(-1.0, 0.3), Err(MaterialError::YoungModulus(-1.0)));
+    assert!(matches!(Lame::<f64>::from_young_poisson(f64::NAN, 0.3), Err(MaterialError::YoungModulus(_))));
+    assert!(matches!(
+        Lame::<f64>::from_young_poisson(f64::INFINITY, 0.3),
+        Err(MaterialError::YoungModulus(_))
+    ));
+    assert_eq!(Lame::<f32>::from_young_poisson(1.0, 0.5), Err(MaterialError::PoissonRatio(0.5)));
+    assert_eq!(Lame::<f32>::from_young_poisson(1.0, -1.0), Err(MaterialError::PoissonRatio(-1.0)));
+    assert!(matches!(Lame::<f32>::from_young_poisson(1.0, f64::NAN), Err(MaterialError::PoissonRatio(_))));
+    assert_eq!(Lame::<f64>::new(0.0, 1.0), Err(MaterialError::ShearModulus(0.0)));
+    assert_eq!(Lame::<f64>::new(3.0, -2.5), Err(MaterialError::FirstLame { lambda: -2.5, mu: 3.0 }));
+    assert!(matches!(Lame::<f64>::new(3.0, f64::INFINITY), Err(MaterialError::FirstLame { .. })));
+    assert!(Lame::<f64>::new(3.0, -1.9).is_ok());
+    let msg = MaterialError::PoissonRatio(0.7).to_string();
+    assert!(msg.contains("nu = 0.7"), "{msg}");
+    let s = Lame { mu: 2.0, lambda: 3.0 }.scaled(0.5);
+    assert_eq!(s, Lame { mu: 1.0, lambda: 1.5 });
+}
+
+#[test]
+fn svd_3d_wrapper_reconstructs() {
+    let mut rng = ChaCha8Rng::seed_from_u64(16);
+    for kind in KINDS {
+        let f = sample::<3>(kind, &mut rng);
+        let s = svd(&f);
+        assert!((s.u * Mat::from_diagonal(&s.sigma) * s.v.transpose() - f).norm() <= 1e-13 * f.norm());
+        assert!(s.sigma[0] >= s.sigma[1] && s.sigma[1] >= s.sigma[2].abs());
+    }
+}
+
+#[test]
+fn combined_evaluation_matches_separate_calls() {
+    fn run<M: AllImpls>(m: M, name: &str) {
+        let lame = lame64();
+        let mut rng = ChaCha8Rng::seed_from_u64(17);
+        for kind in [Kind::General, Kind::Stretch, Kind::Rotation] {
+            let f = sample::<3>(kind, &mut rng);
+            let (e, p, t) = m.energy_pk1_dpdf(&lame, &f);
+            assert_eq!(e, m.energy(&lame, &f), "{name}");
+            assert_eq!(p, m.pk1(&lame, &f), "{name}");
+            assert_eq!(t, m.dpdf(&lame, &f), "{name}");
+        }
+    }
+    per_model!(run);
+}
