@@ -67,13 +67,26 @@ const GEOMETRY_EXTENSIONS: [&str; 5] = [
 /// non-increasing key times, accessors out of their buffers).
 pub fn load(path: impl AsRef<Path>) -> Result<Loaded, LoadError> {
     let path = path.as_ref();
+    let bytes = std::fs::read(path).map_err(|e| LoadError {
+        file: path.to_path_buf(),
+        element: "file".into(),
+        cause: e.to_string(),
+    })?;
+    load_slice(&bytes, path)
+}
+
+/// Loads the bytes of a `.gltf` or `.glb` file. `path` names the file in errors, and external
+/// buffers (relative URIs) are read from its folder.
+///
+/// # Errors
+/// As [`load`].
+pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
     let err = |element: &str, cause: String| LoadError {
         file: path.to_path_buf(),
         element: element.to_string(),
         cause,
     };
-    let bytes = std::fs::read(path).map_err(|e| err("file", e.to_string()))?;
-    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| err("document", e.to_string()))?;
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| err("document", e.to_string()))?;
     let doc = &gltf.document;
     let mut warnings = Vec::new();
 

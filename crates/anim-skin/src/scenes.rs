@@ -167,7 +167,19 @@ pub fn twisted_cylinder(resolution: Option<usize>) -> Result<SkinScene, SkinErro
 /// What [`gltf_io::load`] returns.
 pub fn from_gltf(path: impl AsRef<Path>) -> Result<SkinScene, LoadError> {
     let path = path.as_ref();
-    let loaded = gltf_io::load(path)?;
+    scene_of(gltf_io::load(path)?, path)
+}
+
+/// The scene of a skinned glTF given as bytes (`.gltf` JSON or `.glb`); `path` names it in
+/// errors and is the folder external buffers are read from.
+///
+/// # Errors
+/// As [`from_gltf`].
+pub fn from_gltf_slice(bytes: &[u8], path: &Path) -> Result<SkinScene, LoadError> {
+    scene_of(gltf_io::load_slice(bytes, path)?, path)
+}
+
+fn scene_of(loaded: gltf_io::Loaded, path: &Path) -> Result<SkinScene, LoadError> {
     let character = loaded.character;
     let clip = (!character.clips.is_empty()).then_some(0);
     let duration = clip.map_or(0.0, |c| character.clips[c].end());

@@ -207,3 +207,136 @@ fn pose_blend_endpoints_and_midpoint() {
     Pose::blend(&a, &b, 1.0, &mut out);
     assert!(out.local[0].rotation.angle_between(b.local[0].rotation) < 1e-7);
 }
+
+/// Joint matrices with non-uniform scale (LBS only) or rigid (both methods).
+fn scaled_joint_matrices(joints: usize, scaled: bool) -> Vec<DMat4> {
+    (0..joints)
+        .map(|j| {
+            let a = j as f64;
+            let s = if scaled { DVec3::new(1.0 + 0.1 * a, 0.7, 1.3 - 0.05 * a) } else { DVec3::ONE };
+            DMat4::from_scale_rotation_translation(
+                s,
+                DQuat::from_axis_angle(DVec3::new(0.3, 1.0, -a).normalize(), 0.9 * a - 1.0),
+                DVec3::new(0.2 * a, 1.0, -0.3 * a),
+            )
+        })
+        .collect()
+}
+
+type Raw = (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<u16>, Vec<f64>);
+
+/// Random vertices (positions, unit normals, 4 joints and weights each, some weights zero).
+fn raw_vertices(n: usize, joints: usize) -> Raw {
+    let k = 4;
+    let mut s = 777u64;
+    let mut rnd = || {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let pos: Vec<[f64; 3]> = (0..n).map(|_| [rnd() - 0.5, rnd() - 0.5, rnd() - 0.5]).collect();
+    let nrm: Vec<[f64; 3]> =
+        (0..n).map(|_| DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() + 0.1).normalize().to_array()).collect();
+    let js: Vec<u16> = (0..n * k).map(|_| (rnd() * joints as f64) as u16).collect();
+    let ws: Vec<f64> = (0..n * k).map(|i| if i % 7 == 3 { 0.0 } else { rnd() + 0.01 }).collect();
+    (pos, nrm, js, ws)
+}
+
+/// An odd vertex count spanning several parallel chunks.
+const ODD: usize = 2 * anim_skin::skinning::CHUNK + 3;
+
+/// A random mesh of `ODD` vertices, 4 influences.
+fn odd_mesh(joints: usize) -> SkinnedMesh {
+    let (pos, nrm, js, ws) = raw_vertices(ODD, joints);
+    SkinnedMesh::new(&pos, Some(&nrm), 4, &js, &ws, vec![], joints).unwrap()
+}
+
+#[test]
+fn lbs_matches_glam_matrix_blend_with_inverse_transpose_normals() {
+    let joints = 9;
+    let mesh = odd_mesh(joints);
+    let m = scaled_joint_matrices(joints, true);
+    let mut out = Skinned::new(&mesh);
+    skin(&mesh, &m, SkinningMethod::Lbs, &mut out).unwrap();
+    let k = mesh.influences();
+    let (mut ep, mut en) = (0.0f64, 0.0f64);
+    for v in 0..mesh.len() {
+        let mut a = DMat4::ZERO;
+        for i in 0..k {
+            a += m[mesh.joints()[v * k + i] as usize] * mesh.weights()[v * k + i];
+        }
+        let p = a.transform_point3(DVec3::from_array(mesh.rest_position(v)));
+        let n0 = DVec3::new(mesh.nx[v], mesh.ny[v], mesh.nz[v]);
+        let n = (anim_core::glam::DMat3::from_mat4(a).inverse().transpose() * n0).normalize();
+        ep = ep.max((DVec3::from_array(out.position(v)) - p).length());
+        en = en.max((DVec3::from_array(out.normal(v)) - n).length());
+    }
+    assert!(ep < 1e-13 && en < 1e-12, "position error {ep:e}, normal error {en:e}");
+}
+
+#[test]
+fn dqs_matches_glam_dual_quaternion_blend() {
+    let joints = 9;
+    let mesh = odd_mesh(joints);
+    let m = scaled_joint_matrices(joints, false);
+    let mut out = Skinned::new(&mesh);
+    skin(&mesh, &m, SkinningMethod::Dqs, &mut out).unwrap();
+    // Unit dual quaternion (q, d) with d = 1/2 (t, 0) q, built with glam quaternion algebra.
+    let dq: Vec<(DQuat, DQuat)> = m
+        .iter()
+        .map(|m| {
+            let (_, q, t) = m.to_scale_rotation_translation();
+            (q, DQuat::from_xyzw(t.x, t.y, t.z, 0.0) * q * 0.5)
+        })
+        .collect();
+    let k = mesh.influences();
+    let (mut ep, mut en) = (0.0f64, 0.0f64);
+    for v in 0..mesh.len() {
+        let js = &mesh.joints()[v * k..(v + 1) * k];
+        let ws = &mesh.weights()[v * k..(v + 1) * k];
+        let dom = (0..k).fold(0, |d, i| if ws[i] > ws[d] { i } else { d });
+        let q0 = dq[js[dom] as usize].0;
+        let (mut bq, mut bd) = (DVec4::ZERO, DVec4::ZERO);
+        for i in 0..k {
+            let (q, d) = dq[js[i] as usize];
+            let s = if q.dot(q0) < 0.0 { -ws[i] } else { ws[i] };
+            bq += DVec4::from(q) * s;
+            bd += DVec4::from(d) * s;
+        }
+        let len = bq.length();
+        let (r, d) = (DQuat::from_vec4(bq / len), DQuat::from_vec4(bd / len));
+        let t = d * r.conjugate() * 2.0;
+        let p = r * DVec3::from_array(mesh.rest_position(v)) + DVec3::new(t.x, t.y, t.z);
+        let n = (r * DVec3::new(mesh.nx[v], mesh.ny[v], mesh.nz[v])).normalize();
+        ep = ep.max((DVec3::from_array(out.position(v)) - p).length());
+        en = en.max((DVec3::from_array(out.normal(v)) - n).length());
+    }
+    assert!(ep < 1e-13 && en < 1e-13, "position error {ep:e}, normal error {en:e}");
+}
+
+#[test]
+fn a_vertex_result_does_not_depend_on_its_batch_neighbour() {
+    // Dropping the first vertex shifts every other vertex to the other SIMD lane and pairs it
+    // with a different neighbour; its result must not change by a single bit.
+    let joints = 9;
+    let (pos, nrm, js, ws) = raw_vertices(ODD, joints);
+    let (k, n) = (4, ODD);
+    let mesh = SkinnedMesh::new(&pos, Some(&nrm), k, &js, &ws, vec![], joints).unwrap();
+    let shifted =
+        SkinnedMesh::new(&pos[1..], Some(&nrm[1..]), k, &js[k..], &ws[k..], vec![], joints).unwrap();
+    for (method, m) in [
+        (SkinningMethod::Lbs, scaled_joint_matrices(joints, true)),
+        (SkinningMethod::Dqs, scaled_joint_matrices(joints, false)),
+    ] {
+        let (mut a, mut b) = (Skinned::new(&mesh), Skinned::new(&shifted));
+        skin(&mesh, &m, method, &mut a).unwrap();
+        skin(&shifted, &m, method, &mut b).unwrap();
+        for v in 1..n {
+            let (pa, pb) = (a.position(v), b.position(v - 1));
+            let (na, nb) = (a.normal(v), b.normal(v - 1));
+            for d in 0..3 {
+                assert_eq!(pa[d].to_bits(), pb[d].to_bits(), "{method:?} vertex {v}");
+                assert_eq!(na[d].to_bits(), nb[d].to_bits(), "{method:?} vertex {v}");
+            }
+        }
+    }
+}
