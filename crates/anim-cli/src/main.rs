@@ -14,22 +14,18 @@
 //! with a `.pvd` series for meshes, `frames.csv` for systems of a few unknowns) or the one asked
 //! for, `preview.gif` (and `preview.png`, the last frame), and `metrics.json`.
 
-mod runner;
-mod scene;
-mod view;
-
+use anim_cli::runner::{self, OutputFormat, Runner};
+use anim_cli::scene::{self, SceneFile};
+use anim_cli::view::{Snapshot, View};
 use anim_io::FrameWriter;
 use anim_io::preview::{Canvas, GifWriter};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use runner::{OutputFormat, Runner};
-use scene::SceneFile;
 use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
-use view::{Snapshot, View};
 
 #[derive(Parser)]
 #[command(

@@ -160,6 +160,17 @@ pub fn write_checkpoint<T: Serialize + ?Sized>(path: &Path, kind: &str, payload:
 /// [`CheckpointProblem`] otherwise.
 pub fn read_checkpoint<T: DeserializeOwned>(path: &Path) -> Result<(CheckpointHeader, T), IoError> {
     let bytes = std::fs::read(path).map_err(|e| IoError::io(path, e))?;
+    parse_checkpoint(&bytes, path)
+}
+
+/// Parses the bytes of a checkpoint file; errors name `path`. See [`read_checkpoint`].
+///
+/// # Errors
+/// [`IoError::Checkpoint`] naming `path` and the [`CheckpointProblem`].
+pub fn parse_checkpoint<T: DeserializeOwned>(
+    bytes: &[u8],
+    path: &Path,
+) -> Result<(CheckpointHeader, T), IoError> {
     let header_end = bytes
         .iter()
         .take(MAX_HEADER_BYTES)

@@ -73,7 +73,9 @@ pub mod tetgen;
 mod text;
 pub mod vtk;
 
-pub use checkpoint::{CheckpointHeader, CheckpointProblem, read_checkpoint, write_atomic, write_checkpoint};
+pub use checkpoint::{
+    CheckpointHeader, CheckpointProblem, parse_checkpoint, read_checkpoint, write_atomic, write_checkpoint,
+};
 pub use data::{DataArray, Element, Real, Values};
 pub use error::IoError;
 pub use frames::{FrameFormat, FrameSequence, FrameWriter};

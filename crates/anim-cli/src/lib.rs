@@ -1,0 +1,21 @@
+//! # anim-cli
+//!
+//! The library behind the `anim` command: scene files ([`scene`]: TOML with every field checked,
+//! the built-in scenes), their runnable form ([`runner`]: one [`runner::Runner`] per crate, with
+//! checkpoint save and restore), and how a run is drawn and written ([`view`]). The binary adds
+//! the command line, the writer thread and the checkpoint files.
+//!
+//! ```
+//! use anim_cli::scene;
+//! let text = scene::builtin("kepler").expect("a built-in scene");
+//! let file = scene::parse(text, std::path::Path::new("kepler"))?;
+//! assert!(file.run.dt > 0.0);
+//! let mut runner = anim_cli::runner::build(&file.scene, std::path::Path::new("kepler"), None)?;
+//! runner.step(file.run.dt)?;
+//! assert!(runner.state().t > 0.0);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub mod runner;
+pub mod scene;
+pub mod view;
