@@ -1,5 +1,134 @@
-//! `cargo xtask bench --peers`, anim-mpm part.
+//! `cargo xtask bench --peers`, anim-mpm part: Taichi's MLS-MPM fluid (`mpm88` in 2D at 8k, 32k
+//! and 131k particles on 128^2, 256^2 and 512^2 grids; `mpm3d` at 65k particles on 64^3) on the
+//! CPU backend beside `anim_mpm::scenes::benchmark_2d` / `benchmark_3d` (same particle count,
+//! grid, dt, material, boundary), at 1 and 2 threads, time per substep and throughput in
+//! particle-steps per second. Taichi is installed with pip when missing; if that fails the peer
+//! is skipped with a visible note.
+
+use crate::cases::mpm::peer_benchmark;
+use std::io::Write;
+use std::process::Command;
+
+const SCRIPT: &str = "peers/mpm/taichi_mpm.py";
+
+fn python() -> String {
+    std::env::var("PYTHON").unwrap_or_else(|_| "python3".into())
+}
+
+fn ensure_taichi() -> Result<(), String> {
+    let works = || {
+        Command::new(python())
+            .args(["-c", "import taichi"])
+            .output()
+            .map(|o| o.status.success())
+            .unwrap_or(false)
+    };
+    if works() {
+        return Ok(());
+    }
+    eprintln!("== taichi not found: {} -m pip install taichi", python());
+    let out = Command::new(python())
+        .args(["-m", "pip", "install", "--quiet", "taichi"])
+        .output()
+        .map_err(|e| format!("could not run pip: {e}"))?;
+    if !out.status.success() || !works() {
+        return Err(format!(
+            "pip install taichi failed: {}",
+            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
+        ));
+    }
+    Ok(())
+}
+
+fn field(line: &str, key: &str) -> Option<String> {
+    let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
+    let rest = rest.trim_start();
+    let end = rest.find([',', '}']).unwrap_or(rest.len());
+    Some(rest[..end].trim().trim_matches('"').to_string())
+}
+
+fn taichi(dim: usize, n: usize, steps: usize, repeats: usize, threads: usize) -> Result<(f64, f64), String> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(SCRIPT);
+    let out = Command::new(python())
+        .arg(&path)
+        .args(["--dim", &dim.to_string(), "--n", &n.to_string(), "--steps", &steps.to_string()])
+        .args(["--repeats", &repeats.to_string(), "--threads", &threads.to_string()])
+        .output()
+        .map_err(|e| format!("could not run {}: {e}", python()))?;
+    if !out.status.success() {
+        return Err(format!(
+            "taichi script failed: {}",
+            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
+        ));
+    }
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout.lines().find(|l| l.starts_with('{')).ok_or("no result line")?;
+    let get = |k: &str| field(line, k).and_then(|v| v.parse::<f64>().ok()).ok_or(format!("no {k}"));
+    Ok((get("per_step_s")?, get("mean_y")?))
+}
 
 pub fn run() -> bool {
-    true
+    let cases: [(usize, usize, usize); 4] = [(2, 128, 200), (2, 256, 100), (2, 512, 40), (3, 64, 20)];
+    let repeats = 5;
+    let peer = ensure_taichi();
+    if let Err(e) = &peer {
+        println!("\nNOTE: Taichi peer SKIPPED: {e}\n");
+    }
+    println!(
+        "peer benchmark: MLS-MPM fluid (mpm88 / mpm3d), anim-mpm vs Taichi CPU, median of {repeats} x steps after 50 warm-up steps\n"
+    );
+    println!(
+        "| scene | particles | threads | anim-mpm / step | taichi / step | anim Mp-steps/s | taichi Mp-steps/s | ratio (ours / theirs throughput) | mean y ours / taichi |"
+    );
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    let mut rows = vec![];
+    let mut ok = true;
+    for (dim, n, steps) in cases {
+        for threads in [1, 2] {
+            let ours = match peer_benchmark(dim, n, steps, repeats, threads) {
+                Ok(r) => r,
+                Err(e) => {
+                    eprintln!("our run failed: {e}");
+                    ok = false;
+                    continue;
+                }
+            };
+            let theirs =
+                if peer.is_ok() { taichi(dim, n, steps, repeats, threads) } else { Err("skipped".into()) };
+            let (t_step, t_y) = match &theirs {
+                Ok(v) => *v,
+                Err(e) => {
+                    println!("NOTE: taichi {dim}D n={n} threads={threads}: {e}");
+                    (f64::NAN, f64::NAN)
+                }
+            };
+            let np = ours.particles as f64;
+            let ratio = t_step / ours.per_step_s;
+            println!(
+                "| {dim}D {n}^{dim} | {} | {threads} | {} | {} | {:.2} | {:.2} | {:.2} | {:.4} / {:.4} |",
+                ours.particles,
+                super::human(ours.per_step_s * 1e9),
+                super::human(t_step * 1e9),
+                np / ours.per_step_s / 1e6,
+                np / t_step / 1e6,
+                ratio,
+                ours.mean_y,
+                t_y
+            );
+            rows.push((dim, n, ours.particles, threads, ours.per_step_s, t_step, ratio));
+        }
+    }
+    let dir = std::path::Path::new("target/xtask");
+    let written = std::fs::create_dir_all(dir).and_then(|_| {
+        let mut f = std::fs::File::create(dir.join("peers_mpm.csv"))?;
+        writeln!(f, "dim,n,particles,threads,ours_per_step_s,taichi_per_step_s,throughput_ratio")?;
+        for (dim, n, np, th, a, b, r) in &rows {
+            writeln!(f, "{dim},{n},{np},{th},{a},{b},{r}")?;
+        }
+        Ok(())
+    });
+    if let Err(e) = written {
+        eprintln!("could not write target/xtask/peers_mpm.csv: {e}");
+    }
+    ok
 }

@@ -177,6 +177,16 @@ pub fn build(
                 s.into_simulation().map_err(|e| SceneError::invalid(file, "scene.preset", e.to_string()))?;
             Box::new(PbdRunner { name, method, sim, state })
         }
+        Scene::Mpm { ref preset, resolution } => {
+            let scene = preset_scene(
+                file,
+                "scene.resolution",
+                preset,
+                &anim_mpm::scenes::NAMES,
+                anim_mpm::scenes::by_name(preset, resolution),
+            )?;
+            Box::new(MpmRunner::new(scene))
+        }
         Scene::Springs { ref preset, resolution, integrator, linear_solver } => {
             let mut s = preset_scene(
                 file,
@@ -498,6 +508,127 @@ impl Runner for PbdRunner {
             ground,
             spheres,
             frame_box: frame_box(&self.state.x, ground, true),
+        }
+    }
+}
+
+/// A material-point-method scene (anim-mpm): particles drawn as discs, 2D scenes in the z = 0
+/// plane. The particle order changes every step (the simulation sorts them by grid block) and
+/// particles may leave, so the display state is refreshed from the particles after each step.
+struct MpmRunner {
+    name: String,
+    scene: anim_mpm::scenes::MpmScene,
+    display: State,
+}
+
+impl MpmRunner {
+    fn new(scene: anim_mpm::scenes::MpmScene) -> Self {
+        let mut runner = Self {
+            name: format!("mpm/{}", scene.name()),
+            scene,
+            display: State::new(Vec::new(), Vec::new()),
+        };
+        runner.refresh();
+        runner
+    }
+
+    /// Positions and velocities as 3-vectors in `f64` for the writers.
+    fn refresh(&mut self) {
+        fn copy<const D: usize>(from: &anim_mpm::Particles<D>, x: &mut Vec<f64>, v: &mut Vec<f64>) {
+            x.clear();
+            v.clear();
+            for (p, u) in from.x.chunks_exact(D).zip(from.v.chunks_exact(D)) {
+                for k in 0..3 {
+                    x.push(p.get(k).map_or(0.0, |c| f64::from(*c)));
+                    v.push(u.get(k).map_or(0.0, |c| f64::from(*c)));
+                }
+            }
+        }
+        let d = &mut self.display;
+        match &self.scene {
+            anim_mpm::scenes::MpmScene::Two(s) => copy(&s.state, &mut d.x, &mut d.v),
+            anim_mpm::scenes::MpmScene::Three(s) => copy(&s.state, &mut d.x, &mut d.v),
+        }
+        d.t = self.scene.time();
+    }
+}
+
+impl Runner for MpmRunner {
+    fn system(&self) -> String {
+        self.name.clone()
+    }
+
+    fn method(&self) -> String {
+        format!("{}D MLS-MPM, quadratic B-splines, CFL substeps", self.scene.dim())
+    }
+
+    fn state(&self) -> &State {
+        &self.display
+    }
+
+    fn step(&mut self, dt: f64) -> Result<StepReport, String> {
+        let report = match &mut self.scene {
+            anim_mpm::scenes::MpmScene::Two(s) => s.sim.step(&mut s.state, dt),
+            anim_mpm::scenes::MpmScene::Three(s) => s.sim.step(&mut s.state, dt),
+        }
+        .map_err(|e| e.to_string())?;
+        self.refresh();
+        Ok(report)
+    }
+
+    fn save(&self) -> serde_json::Value {
+        match &self.scene {
+            anim_mpm::scenes::MpmScene::Two(s) => {
+                serde_json::json!({ "dim": 2, "particles": s.state, "simulation": s.sim.memory() })
+            }
+            anim_mpm::scenes::MpmScene::Three(s) => {
+                serde_json::json!({ "dim": 3, "particles": s.state, "simulation": s.sim.memory() })
+            }
+        }
+    }
+
+    fn restore(&mut self, saved: &serde_json::Value) -> Result<(), String> {
+        let dim: usize = field(saved, "dim")?;
+        if dim != self.scene.dim() {
+            return Err(format!("a {dim}D checkpoint for a {}D scene", self.scene.dim()));
+        }
+        let memory = saved.get("simulation").ok_or("the checkpoint has no `simulation`")?;
+        fn restore<const D: usize>(
+            s: &mut anim_mpm::scenes::Scene<D>,
+            saved: &serde_json::Value,
+            memory: &serde_json::Value,
+        ) -> Result<(), String> {
+            let particles: anim_mpm::Particles<D> = field(saved, "particles")?;
+            particles.check_lengths().map_err(|e| format!("`particles`: {e}"))?;
+            s.sim.restore_memory(memory).map_err(|e| e.to_string())?;
+            s.state = particles;
+            Ok(())
+        }
+        match &mut self.scene {
+            anim_mpm::scenes::MpmScene::Two(s) => restore(s, saved, memory)?,
+            anim_mpm::scenes::MpmScene::Three(s) => restore(s, saved, memory)?,
+        }
+        self.refresh();
+        Ok(())
+    }
+
+    fn natural_format(&self) -> OutputFormat {
+        OutputFormat::Vtu
+    }
+
+    fn geometry(&self) -> Geometry {
+        let params = match &self.scene {
+            anim_mpm::scenes::MpmScene::Two(s) => s.sim.params(),
+            anim_mpm::scenes::MpmScene::Three(s) => s.sim.params(),
+        };
+        let cell = params.size / params.resolution as f64;
+        Geometry::Particles {
+            triangles: Vec::new(),
+            edges: Vec::new(),
+            radius: 0.5 * cell,
+            ground: None,
+            spheres: Vec::new(),
+            frame_box: frame_box(&self.display.x, None, true),
         }
     }
 }

@@ -106,6 +106,15 @@ pub enum Scene {
         #[serde(default)]
         resolution: Option<usize>,
     },
+    /// A material-point-method scene of anim-mpm (`three-materials` in 2D, `dam-break-3d`,
+    /// `snowball`, `benchmark-2d`, `benchmark-3d`); each step may take CFL substeps.
+    Mpm {
+        /// The preset's name.
+        preset: String,
+        /// Grid cells per axis (the preset's default when absent).
+        #[serde(default)]
+        resolution: Option<usize>,
+    },
     /// A mass-spring scene of anim-springs (`hanging-cloth`, `swinging-rope`, `jelly-drop`,
     /// `benchmark-cloth`), with its own integrator and solver unless overridden.
     Springs {
@@ -171,7 +180,7 @@ pub enum SceneError {
 }
 
 /// The scenes built into the binary: `(name, description, TOML text)`.
-pub const BUILTIN: [(&str, &str, &str); 13] = [
+pub const BUILTIN: [(&str, &str, &str); 16] = [
     (
         "cloth",
         "a 32x32 cloth pinned at two corners falls and swings, backward Euler + sparse Cholesky",
@@ -187,6 +196,9 @@ pub const BUILTIN: [(&str, &str, &str); 13] = [
     ("chain", "a 32-link pendulum chain (RK4)", CHAIN),
     ("t-handle", "a spinning T-handle flipping about its intermediate axis (free-body midpoint)", T_HANDLE),
     ("twist", "a cylinder twisted 180 degrees: LBS's candy-wrapper collapse beside DQS", TWIST),
+    ("mpm", "MLS-MPM in 2D: a jelly block, a snow block and water falling together", MPM),
+    ("dam-break", "MLS-MPM in 3D: a water column collapsing in a tank", DAM_BREAK),
+    ("snowball", "MLS-MPM in 3D: a snowball hitting a wall and breaking up", SNOWBALL),
     ("kepler", "a planet on an e = 0.5 ellipse, velocity Verlet, about 3 orbits", KEPLER),
     ("oscillator", "a lightly damped harmonic oscillator, implicit midpoint", OSCILLATOR),
 ];
@@ -253,6 +265,42 @@ steps_per_frame = 1
 [scene]
 kind = "pbd"
 preset = "flag"
+"#;
+
+const MPM: &str = r#"name = "mpm"
+
+[run]
+dt = 0.0005
+frames = 120
+steps_per_frame = 40
+
+[scene]
+kind = "mpm"
+preset = "three-materials"
+"#;
+
+const DAM_BREAK: &str = r#"name = "dam-break"
+
+[run]
+dt = 0.001
+frames = 100
+steps_per_frame = 16
+
+[scene]
+kind = "mpm"
+preset = "dam-break-3d"
+"#;
+
+const SNOWBALL: &str = r#"name = "snowball"
+
+[run]
+dt = 0.0005
+frames = 100
+steps_per_frame = 16
+
+[scene]
+kind = "mpm"
+preset = "snowball"
 "#;
 
 const BLOB: &str = r#"name = "blob"
@@ -474,7 +522,7 @@ fn validate(s: &SceneFile) -> Result<(), (&'static str, String)> {
             }
             integrator
         }
-        Scene::Pbd { .. } | Scene::Rigid { .. } => return Ok(()),
+        Scene::Pbd { .. } | Scene::Rigid { .. } | Scene::Mpm { .. } => return Ok(()),
         Scene::Skinning { preset, file, .. } => {
             if preset.is_some() == file.is_some() {
                 return Err(("scene.preset", "give exactly one of `preset` and `file`".into()));

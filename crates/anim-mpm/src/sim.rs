@@ -1,0 +1,558 @@
+//! The simulation: parameters, the step with CFL-adaptive substeps, divergence detection and
+//! the diagnostics every step reports.
+
+use crate::boundary::{Boundary, Collider};
+use crate::grid::SparseGrid;
+use crate::kernel::{Cubic, Kernel, Quadratic, Spline};
+use crate::material::{Compiled, Material, energy};
+use crate::particles::Particles;
+use crate::transfer::{self, Ctx};
+use crate::{MpmError, Vector};
+use anim_core::solver::{Solver, StepReport};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// The transfer scheme.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Transfer {
+    /// APIC (seed 5.3.1): grid forces from `grad w_ip`, `F` updated with `sum v_i grad w_ip^T`.
+    Apic,
+    /// MLS-MPM (seed 5.3.2): stress fused into the affine momentum, `F` updated with `C_p`.
+    #[default]
+    Mls,
+}
+
+/// What to do with a particle that leaves the domain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum OutOfDomain {
+    /// Clamp its position back to the domain edge (counted).
+    #[default]
+    Clamp,
+    /// Remove it from the state (counted).
+    Remove,
+}
+
+/// Simulation parameters. The domain is `[0, size]^D` with `resolution` cells per axis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub struct MpmParams {
+    /// Cells per axis `n` (grid spacing `h = size / n`); default 64. At least 8.
+    pub resolution: usize,
+    /// Side of the cubic domain; default 1.
+    pub size: f64,
+    /// Transfer scheme; default MLS-MPM.
+    pub transfer: Transfer,
+    /// Interpolation kernel; default quadratic.
+    pub kernel: Kernel,
+    /// Gravity (the first `D` components are used); default `(0, -9.81, 0)`.
+    pub gravity: [f64; 3],
+    /// Boundary condition on the domain walls; default separating, frictionless.
+    pub wall: Boundary,
+    /// Grid nodes within this many nodes of a wall get the wall condition; default 3 (at least
+    /// 2, so that no particle stencil reaches outside the grid).
+    pub wall_nodes: usize,
+    /// Analytic colliders; default none.
+    pub colliders: Vec<Collider>,
+    /// Largest allowed advective CFL number `max |v_p| dt / h` per substep; default 1.
+    pub cfl: f64,
+    /// Largest allowed elastic-wave CFL number `max c_p dt / h` (`c_p^2 = (lambda + 2 mu) / rho`,
+    /// hardened for snow); default 1. `f64::INFINITY` disables the check.
+    pub wave_cfl: f64,
+    /// Largest number of substeps a step may take to meet the CFL limits; default 256.
+    pub max_substeps: usize,
+    /// Policy for particles leaving the domain; default clamp.
+    pub out_of_domain: OutOfDomain,
+}
+
+impl Default for MpmParams {
+    fn default() -> Self {
+        Self {
+            resolution: 64,
+            size: 1.0,
+            transfer: Transfer::Mls,
+            kernel: Kernel::Quadratic,
+            gravity: [0.0, -9.81, 0.0],
+            wall: Boundary::SeparateFrictionless,
+            wall_nodes: 3,
+            colliders: Vec::new(),
+            cfl: 1.0,
+            wave_cfl: 1.0,
+            max_substeps: 256,
+            out_of_domain: OutOfDomain::Clamp,
+        }
+    }
+}
+
+impl MpmParams {
+    /// Default parameters with `resolution` cells per axis.
+    #[must_use]
+    pub fn with_resolution(resolution: usize) -> Self {
+        Self { resolution, ..Self::default() }
+    }
+
+    /// Grid spacing `h`.
+    #[must_use]
+    pub fn h(&self) -> f64 {
+        self.size / self.resolution as f64
+    }
+
+    /// The allowed particle coordinate range `[2h, size - 2h]`.
+    #[must_use]
+    pub fn particle_range(&self) -> (f64, f64) {
+        let h = self.h();
+        (2.0 * h, self.size - 2.0 * h)
+    }
+}
+
+/// Counters of the last step.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct StepStats {
+    /// Substeps taken.
+    pub substeps: usize,
+    /// Advective CFL number `max |v| dt / h` of the whole step (before splitting).
+    pub cfl: f64,
+    /// Elastic-wave CFL number `max c dt / h` of the whole step.
+    pub wave_cfl: f64,
+    /// Particles that left the domain during the step (clamped or removed).
+    pub out_of_domain: u64,
+    /// Particles removed during the step.
+    pub removed: u64,
+    /// Occupied particle blocks at the last substep.
+    pub particle_blocks: usize,
+    /// Allocated grid nodes at the last substep.
+    pub grid_nodes: usize,
+}
+
+/// Totals over the particles (in `f64`, summed in a fixed order).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Totals {
+    /// Total mass.
+    pub mass: f64,
+    /// Linear momentum `sum m v` (trailing components zero in 2D).
+    pub momentum: [f64; 3],
+    /// Angular momentum about the origin including APIC's affine part,
+    /// `sum m (x x v) + m eps : (C D_p)^T`; in 2D only the third component is nonzero.
+    pub angular_momentum: [f64; 3],
+    /// Kinetic energy `sum m |v|^2 / 2`.
+    pub kinetic: f64,
+    /// Elastic energy `sum V psi(F)`.
+    pub elastic: f64,
+    /// Gravitational potential energy `-sum m g . x`.
+    pub potential: f64,
+}
+
+/// An MPM simulation in `D = 2` or `3` dimensions: the model (parameters and materials) and the
+/// scratch of a step (the sparse grid, the sort, the double buffer). The particles are the
+/// separate [`Particles`] state.
+#[derive(Debug, Clone)]
+pub struct MpmSimulation<const D: usize> {
+    params: MpmParams,
+    materials: Vec<Material>,
+    compiled: Vec<Compiled>,
+    pub(crate) grid: SparseGrid<D>,
+    out: Particles<D>,
+    backup: Particles<D>,
+    remove: Vec<bool>,
+    partials: Vec<[f64; 12]>,
+    steps: u64,
+    time: f64,
+    stats: StepStats,
+}
+
+/// Particles per chunk of the ordered reductions.
+const CHUNK: usize = 2048;
+
+impl<const D: usize> MpmSimulation<D> {
+    /// A simulation with the given parameters and material table.
+    ///
+    /// # Errors
+    /// [`MpmError::Dimension`] unless `D` is 2 or 3; [`MpmError::BadParameter`] /
+    /// [`MpmError::BadMaterial`] / [`MpmError::BadCollider`] naming the offending field.
+    pub fn new(params: MpmParams, materials: Vec<Material>) -> Result<Self, MpmError> {
+        if D != 2 && D != 3 {
+            return Err(MpmError::Dimension(D));
+        }
+        let bad = |name: &'static str, reason: String| Err(MpmError::BadParameter { name, reason });
+        if params.resolution < 8 || params.resolution > 1 << 14 {
+            return bad("resolution", format!("{} must lie in [8, 16384]", params.resolution));
+        }
+        if !(params.size > 0.0) || !params.size.is_finite() {
+            return bad("size", format!("{} must be finite and > 0", params.size));
+        }
+        if params.gravity.iter().any(|g| !g.is_finite()) {
+            return bad("gravity", format!("{:?} must be finite", params.gravity));
+        }
+        if params.wall_nodes < 2 || params.wall_nodes > params.resolution / 2 {
+            return bad("wall_nodes", format!("{} must lie in [2, resolution / 2]", params.wall_nodes));
+        }
+        if !(params.cfl > 0.0) {
+            return bad("cfl", format!("{} must be > 0", params.cfl));
+        }
+        if !(params.wave_cfl > 0.0) {
+            return bad("wave_cfl", format!("{} must be > 0", params.wave_cfl));
+        }
+        if params.max_substeps == 0 {
+            return bad("max_substeps", "must be >= 1".into());
+        }
+        if materials.is_empty() || materials.len() > usize::from(u16::MAX) {
+            return bad("materials", format!("{} materials; need 1 to 65535", materials.len()));
+        }
+        params.wall.validate("wall friction")?;
+        for (i, c) in params.colliders.iter().enumerate() {
+            c.validate(i, D)?;
+        }
+        let compiled =
+            materials.iter().enumerate().map(|(i, m)| m.compile(i)).collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            grid: SparseGrid::new(params.resolution),
+            params,
+            materials,
+            compiled,
+            out: Particles::new(),
+            backup: Particles::new(),
+            remove: Vec::new(),
+            partials: Vec::new(),
+            steps: 0,
+            time: 0.0,
+            stats: StepStats::default(),
+        })
+    }
+
+    /// The parameters.
+    #[must_use]
+    pub fn params(&self) -> &MpmParams {
+        &self.params
+    }
+
+    /// The material table.
+    #[must_use]
+    pub fn materials(&self) -> &[Material] {
+        &self.materials
+    }
+
+    /// Simulated time.
+    #[must_use]
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Completed steps.
+    #[must_use]
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// What the simulation carries from one step to the next (step count and time; the grid is
+    /// rebuilt from the particles every step), for checkpoints: with the [`Particles`], it
+    /// continues a run bit for bit.
+    #[must_use]
+    pub fn memory(&self) -> serde_json::Value {
+        serde_json::json!({ "steps": self.steps, "time": self.time })
+    }
+
+    /// Restores what [`MpmSimulation::memory`] returned.
+    ///
+    /// # Errors
+    /// [`MpmError::Checkpoint`] when a field is missing or the time is not finite.
+    pub fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), MpmError> {
+        let steps = memory
+            .get("steps")
+            .and_then(serde_json::Value::as_u64)
+            .ok_or_else(|| MpmError::Checkpoint("no step count".into()))?;
+        let time = memory
+            .get("time")
+            .and_then(serde_json::Value::as_f64)
+            .filter(|t| t.is_finite())
+            .ok_or_else(|| MpmError::Checkpoint("no finite time".into()))?;
+        self.steps = steps;
+        self.time = time;
+        Ok(())
+    }
+
+    /// Counters of the last step.
+    #[must_use]
+    pub fn stats(&self) -> StepStats {
+        self.stats
+    }
+
+    /// Grid nodes of the last substep with mass: `(position, mass, velocity)` (velocities after
+    /// the grid update). For diagnostics and tests.
+    pub fn grid_nodes(&self) -> impl Iterator<Item = (Vector<D>, f32, Vector<D>)> + '_ {
+        let stride = D + 1;
+        let bn = SparseGrid::<D>::BN;
+        let h = self.params.h() as f32;
+        self.grid.gblocks.iter().enumerate().flat_map(move |(g, &key)| {
+            let block = self.grid.coords(key);
+            (0..bn).filter_map(move |l| {
+                let node = &self.grid.nodes[(g * bn + l) * stride..(g * bn + l + 1) * stride];
+                if node[0] <= 0.0 {
+                    return None;
+                }
+                let mut r = l;
+                let mut x = Vector::<D>::zeros();
+                for a in 0..D {
+                    x[a] = (block[a] as usize * 4 + r % 4) as f32 * h;
+                    r /= 4;
+                }
+                Some((x, node[0], Vector::<D>::from_column_slice(&node[1..])))
+            })
+        })
+    }
+
+    /// Mass, momenta and energies of a particle state, summed in `f64` in a fixed order
+    /// (identical for any thread count).
+    pub fn totals(&mut self, st: &Particles<D>) -> Totals {
+        let n = st.len();
+        let chunks = n.div_ceil(CHUNK);
+        self.partials.resize(chunks, [0.0; 12]);
+        let d_inv = f64::from(self.params.kernel.d_inv());
+        let h = self.params.h();
+        let dp = h * h / d_inv;
+        let g = self.params.gravity;
+        let compiled = &self.compiled;
+        self.partials.par_iter_mut().enumerate().for_each(|(c, acc)| {
+            *acc = [0.0; 12];
+            for p in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                let m = f64::from(st.mass[p]);
+                let x = st.position(p);
+                let v = st.velocity(p);
+                let cm = st.affine(p);
+                let x3 = [f64::from(x[0]), f64::from(x[1]), if D == 3 { f64::from(x[2]) } else { 0.0 }];
+                let v3 = [f64::from(v[0]), f64::from(v[1]), if D == 3 { f64::from(v[2]) } else { 0.0 }];
+                acc[0] += m;
+                for a in 0..3 {
+                    acc[1 + a] += m * v3[a];
+                }
+                // x x v.
+                let l = [
+                    x3[1] * v3[2] - x3[2] * v3[1],
+                    x3[2] * v3[0] - x3[0] * v3[2],
+                    x3[0] * v3[1] - x3[1] * v3[0],
+                ];
+                // Affine part: B = C D_p; angular momentum eps_abc B_cb (the skew part of B^T).
+                let b = |i: usize, j: usize| -> f64 {
+                    if i < D && j < D { f64::from(cm[(i, j)]) * dp } else { 0.0 }
+                };
+                let la = [b(2, 1) - b(1, 2), b(0, 2) - b(2, 0), b(1, 0) - b(0, 1)];
+                for a in 0..3 {
+                    acc[4 + a] += m * (l[a] + la[a]);
+                }
+                acc[7] += 0.5 * m * (v3[0] * v3[0] + v3[1] * v3[1] + v3[2] * v3[2]);
+                let mat = &compiled[usize::from(st.material[p]).min(compiled.len() - 1)];
+                acc[8] += f64::from(st.volume[p]) * f64::from(energy(mat, &st.deformation(p), st.plastic[p]));
+                acc[9] -= m * (g[0] * x3[0] + g[1] * x3[1] + if D == 3 { g[2] * x3[2] } else { 0.0 });
+            }
+        });
+        let mut t = [0.0; 12];
+        for acc in &self.partials {
+            for i in 0..12 {
+                t[i] += acc[i];
+            }
+        }
+        Totals {
+            mass: t[0],
+            momentum: [t[1], t[2], t[3]],
+            angular_momentum: [t[4], t[5], t[6]],
+            kinetic: t[7],
+            elastic: t[8],
+            potential: t[9],
+        }
+    }
+
+    /// Checks the state and measures the CFL numbers of a step of `dt`.
+    fn survey(&self, st: &Particles<D>, dt: f64) -> Result<(f64, f64), MpmError> {
+        st.check_lengths()?;
+        let (lo, hi) = self.params.particle_range();
+        let (lo, hi) = (lo as f32, hi as f32);
+        let nmat = self.compiled.len();
+        let compiled = &self.compiled;
+        // (max |v|^2, max c^2, first bad particle)
+        let (v2, c2, bad) = (0..st.len())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|p| {
+                let x = &st.x[p * D..p * D + D];
+                let v = st.velocity(p);
+                let mi = usize::from(st.material[p]);
+                let ok = mi < nmat
+                    && x.iter().all(|c| *c >= lo && *c <= hi)
+                    && v.iter().all(|c| c.is_finite())
+                    && st.f[p * D * D..(p + 1) * D * D].iter().all(|c| c.is_finite())
+                    && st.c[p * D * D..(p + 1) * D * D].iter().all(|c| c.is_finite())
+                    && st.mass[p] > 0.0
+                    && st.volume[p] > 0.0;
+                if !ok {
+                    return (0.0f32, 0.0f32, p);
+                }
+                let m = &compiled[mi];
+                let j = anim_material::decomposition::determinant(&st.deformation(p));
+                (v.norm_squared(), m.wave_speed2(st.plastic[p], j), usize::MAX)
+            })
+            .reduce(|| (0.0, 0.0, usize::MAX), |a, b| (a.0.max(b.0), a.1.max(b.1), a.2.min(b.2)));
+        if bad != usize::MAX {
+            let p = bad;
+            let x = &st.x[p * D..p * D + D];
+            let reason = if usize::from(st.material[p]) >= nmat {
+                format!("material index {} but only {nmat} materials", st.material[p])
+            } else if !x.iter().all(|c| *c >= lo && *c <= hi) {
+                format!("position {x:?} outside the particle range [{lo}, {hi}]")
+            } else {
+                "non-finite velocity, affine matrix or deformation gradient, or non-positive mass or volume"
+                    .to_string()
+            };
+            return Err(MpmError::BadParticle { index: st.id[p] as usize, reason });
+        }
+        let h = self.params.h();
+        Ok((f64::from(v2).sqrt() * dt / h, f64::from(c2).sqrt() * dt / h))
+    }
+
+    fn substep<K: Spline>(&mut self, st: &mut Particles<D>, dt: f64) -> Result<(u64, u64), MpmError> {
+        let h = self.params.h();
+        let (lo, hi) = self.params.particle_range();
+        let g = self.params.gravity;
+        let ctx = Ctx {
+            h: h as f32,
+            inv_h: (1.0 / h) as f32,
+            dt: dt as f32,
+            apic: self.params.transfer == Transfer::Apic,
+            gravity: Vector::<D>::from_fn(|a, _| g[a] as f32),
+            wall_nodes: self.params.wall_nodes,
+            wall: self.params.wall,
+            colliders: &self.params.colliders,
+            time: self.time as f32,
+            lo: lo as f32,
+            hi: hi as f32,
+            materials: &self.compiled,
+        };
+        let n = st.len();
+        self.grid.bin(&st.x, ctx.inv_h, self.params.kernel);
+        transfer::p2g::<D, K>(&mut self.grid, st, &ctx);
+        transfer::grid_update(&mut self.grid, &ctx);
+        transfer::gather(&mut self.grid);
+        self.out.resize(n);
+        let removing = self.params.out_of_domain == OutOfDomain::Remove;
+        self.remove.resize(n, false);
+        let outcome = transfer::g2p::<D, K>(
+            &self.grid,
+            st,
+            &mut self.out,
+            if removing { Some(&mut self.remove) } else { None },
+            &ctx,
+        );
+        if outcome.first_bad != u32::MAX {
+            let s = outcome.first_bad as usize;
+            let p = self.grid.order[s] as usize;
+            let bad = |a: &[f32]| a.iter().copied().find(|c| !c.is_finite());
+            let (field, value) = if let Some(v) = bad(&self.out.x[s * D..s * D + D]) {
+                ("position", v)
+            } else if let Some(v) = bad(&self.out.v[s * D..s * D + D]) {
+                ("velocity", v)
+            } else if let Some(v) = bad(&self.out.f[s * D * D..(s + 1) * D * D]) {
+                ("deformation gradient", v)
+            } else if let Some(v) = bad(&self.out.c[s * D * D..(s + 1) * D * D]) {
+                ("affine matrix", v)
+            } else {
+                ("plastic state", self.out.plastic[s])
+            };
+            return Err(MpmError::NonFinite {
+                step: self.steps,
+                particle: st.id[p] as usize,
+                field,
+                value: f64::from(value),
+            });
+        }
+        st.swap(&mut self.out);
+        let mut removed = 0;
+        if removing && outcome.outside > 0 {
+            st.retain(&self.remove);
+            removed = outcome.outside;
+        }
+        self.time += dt;
+        Ok((outcome.outside, removed))
+    }
+
+    /// Advances the particles by `dt`, splitting the step into substeps so that both CFL
+    /// numbers stay within their limits.
+    ///
+    /// # Errors
+    /// [`MpmError::BadParameter`] for `dt <= 0`; [`MpmError::BadParticle`] / [`MpmError::BadState`]
+    /// for an inconsistent state or a particle outside the domain;
+    /// [`MpmError::TooManySubsteps`] when the CFL limits need more than `max_substeps`;
+    /// [`MpmError::NonFinite`] when the step diverges, naming the step and particle. On error
+    /// the state is left as it was.
+    pub fn advance(&mut self, st: &mut Particles<D>, dt: f64) -> Result<StepStats, MpmError> {
+        if !(dt > 0.0) || !dt.is_finite() {
+            return Err(MpmError::BadParameter {
+                name: "dt",
+                reason: format!("{dt} must be finite and > 0"),
+            });
+        }
+        let (cfl, wave) = self.survey(st, dt)?;
+        let need = (cfl / self.params.cfl).max(wave / self.params.wave_cfl).ceil().max(1.0);
+        if need > self.params.max_substeps as f64 {
+            return Err(MpmError::TooManySubsteps {
+                step: self.steps,
+                cfl,
+                wave_cfl: wave,
+                needed: need,
+                limit: self.params.max_substeps,
+            });
+        }
+        let substeps = need as usize;
+        if substeps > 1 {
+            self.backup.copy_from(st);
+        }
+        let time0 = self.time;
+        let sub_dt = dt / substeps as f64;
+        let (mut outside, mut removed) = (0, 0);
+        for _ in 0..substeps {
+            let r = match self.params.kernel {
+                Kernel::Quadratic => self.substep::<Quadratic>(st, sub_dt),
+                Kernel::Cubic => self.substep::<Cubic>(st, sub_dt),
+            };
+            match r {
+                Ok((o, rm)) => {
+                    outside += o;
+                    removed += rm;
+                }
+                Err(e) => {
+                    if substeps > 1 {
+                        st.copy_from(&self.backup);
+                    }
+                    self.time = time0;
+                    return Err(e);
+                }
+            }
+        }
+        self.time = time0 + dt;
+        self.steps += 1;
+        self.stats = StepStats {
+            substeps,
+            cfl,
+            wave_cfl: wave,
+            out_of_domain: outside,
+            removed,
+            particle_blocks: self.grid.pblocks.len(),
+            grid_nodes: self.grid.allocated_nodes(),
+        };
+        Ok(self.stats)
+    }
+}
+
+impl<const D: usize> Solver for MpmSimulation<D> {
+    type State = Particles<D>;
+    type Error = MpmError;
+
+    /// [`advance`](MpmSimulation::advance), then the totals: `iterations` is the number of
+    /// substeps, `energy` kinetic + elastic + gravitational, momenta as in [`Totals`].
+    fn step(&mut self, state: &mut Particles<D>, dt: f64) -> Result<StepReport, MpmError> {
+        let stats = self.advance(state, dt)?;
+        let t = self.totals(state);
+        let mut r = StepReport::at_time(self.time);
+        r.iterations = stats.substeps;
+        r.energy = Some(t.kinetic + t.elastic + t.potential);
+        r.linear_momentum = Some(t.momentum);
+        r.angular_momentum = Some(t.angular_momentum);
+        Ok(r)
+    }
+}
