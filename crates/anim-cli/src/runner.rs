@@ -177,6 +177,20 @@ pub fn build(
                 s.into_simulation().map_err(|e| SceneError::invalid(file, "scene.preset", e.to_string()))?;
             Box::new(PbdRunner { name, method, sim, state })
         }
+        Scene::Fem { ref preset, resolution } => {
+            let scene = preset_scene(
+                file,
+                "scene.resolution",
+                preset,
+                &anim_fem::scenes::NAMES,
+                anim_fem::scenes::by_name(preset, resolution),
+            )?;
+            let name = format!("fem/{}", scene.name);
+            let (sim, state) = scene
+                .into_simulation()
+                .map_err(|e| SceneError::invalid(file, "scene.preset", e.to_string()))?;
+            Box::new(FemRunner { name, sim, state })
+        }
         Scene::Mpm { ref preset, resolution } => {
             let scene = preset_scene(
                 file,
@@ -505,6 +519,70 @@ impl Runner for PbdRunner {
             triangles,
             edges,
             radius: 0.2 * mean,
+            ground,
+            spheres,
+            frame_box: frame_box(&self.state.x, ground, true),
+        }
+    }
+}
+
+/// A tetrahedral finite element body (anim-fem), drawn as its boundary surface.
+struct FemRunner {
+    name: String,
+    sim: anim_fem::sim::FemSimulation,
+    state: State,
+}
+
+impl Runner for FemRunner {
+    fn system(&self) -> String {
+        self.name.clone()
+    }
+
+    fn method(&self) -> String {
+        let p = self.sim.params();
+        format!("{} / {}", p.integrator.name(), p.linear_solver.name())
+    }
+
+    fn state(&self) -> &State {
+        &self.state
+    }
+
+    fn step(&mut self, dt: f64) -> Result<StepReport, String> {
+        self.sim.step(&mut self.state, dt).map_err(|e| e.to_string())
+    }
+
+    fn save(&self) -> serde_json::Value {
+        serde_json::json!({ "state": self.state, "simulation": self.sim.memory() })
+    }
+
+    fn restore(&mut self, saved: &serde_json::Value) -> Result<(), String> {
+        let state = saved_state(saved, "state", &self.state)?;
+        let memory = saved.get("simulation").ok_or("the checkpoint has no `simulation`")?;
+        self.sim.restore_memory(memory).map_err(|e| e.to_string())?;
+        self.state = state;
+        Ok(())
+    }
+
+    fn natural_format(&self) -> OutputFormat {
+        OutputFormat::Vtu
+    }
+
+    fn geometry(&self) -> Geometry {
+        let model = self.sim.model();
+        let (mut ground, mut spheres) = (None, Vec::new());
+        for o in model.obstacles() {
+            match *o {
+                anim_fem::boundary::Obstacle::Plane { normal: [0.0, 0.0, 1.0], offset } => {
+                    ground = Some(offset)
+                }
+                anim_fem::boundary::Obstacle::Sphere { center, radius } => spheres.push((center, radius)),
+                _ => {}
+            }
+        }
+        Geometry::Particles {
+            triangles: model.surface().to_vec(),
+            edges: Vec::new(),
+            radius: 0.0,
             ground,
             spheres,
             frame_box: frame_box(&self.state.x, ground, true),

@@ -106,6 +106,15 @@ pub enum Scene {
         #[serde(default)]
         resolution: Option<usize>,
     },
+    /// A finite element scene of anim-fem (`cantilever-beam`, `soft-cube-drop`, `twisted-bar`).
+    Fem {
+        /// The preset's name.
+        preset: String,
+        /// Cells across the beam or bar, or along the cube's side (the preset's default when
+        /// absent).
+        #[serde(default)]
+        resolution: Option<usize>,
+    },
     /// A material-point-method scene of anim-mpm (`three-materials` in 2D, `dam-break-3d`,
     /// `snowball`, `benchmark-2d`, `benchmark-3d`); each step may take CFL substeps.
     Mpm {
@@ -180,7 +189,7 @@ pub enum SceneError {
 }
 
 /// The scenes built into the binary: `(name, description, TOML text)`.
-pub const BUILTIN: [(&str, &str, &str); 16] = [
+pub const BUILTIN: [(&str, &str, &str); 19] = [
     (
         "cloth",
         "a 32x32 cloth pinned at two corners falls and swings, backward Euler + sparse Cholesky",
@@ -196,6 +205,9 @@ pub const BUILTIN: [(&str, &str, &str); 16] = [
     ("chain", "a 32-link pendulum chain (RK4)", CHAIN),
     ("t-handle", "a spinning T-handle flipping about its intermediate axis (free-body midpoint)", T_HANDLE),
     ("twist", "a cylinder twisted 180 degrees: LBS's candy-wrapper collapse beside DQS", TWIST),
+    ("beam", "a stable Neo-Hookean FEM beam clamped at one end sags and swings, backward Euler", BEAM),
+    ("cube", "a soft FEM cube dropped on the ground, backward Euler with penalty contact", CUBE),
+    ("twisted-bar", "an FEM bar twisted by a half turn at one end (large rotation)", TWISTED_BAR),
     ("mpm", "MLS-MPM in 2D: a jelly block, a snow block and water falling together", MPM),
     ("dam-break", "MLS-MPM in 3D: a water column collapsing in a tank", DAM_BREAK),
     ("snowball", "MLS-MPM in 3D: a snowball hitting a wall and breaking up", SNOWBALL),
@@ -265,6 +277,42 @@ steps_per_frame = 1
 [scene]
 kind = "pbd"
 preset = "flag"
+"#;
+
+const BEAM: &str = r#"name = "beam"
+
+[run]
+dt = 0.016666666666666666
+frames = 120
+steps_per_frame = 1
+
+[scene]
+kind = "fem"
+preset = "cantilever-beam"
+"#;
+
+const CUBE: &str = r#"name = "cube"
+
+[run]
+dt = 0.005
+frames = 100
+steps_per_frame = 2
+
+[scene]
+kind = "fem"
+preset = "soft-cube-drop"
+"#;
+
+const TWISTED_BAR: &str = r#"name = "twisted-bar"
+
+[run]
+dt = 0.01
+frames = 100
+steps_per_frame = 1
+
+[scene]
+kind = "fem"
+preset = "twisted-bar"
 "#;
 
 const MPM: &str = r#"name = "mpm"
@@ -522,7 +570,7 @@ fn validate(s: &SceneFile) -> Result<(), (&'static str, String)> {
             }
             integrator
         }
-        Scene::Pbd { .. } | Scene::Rigid { .. } | Scene::Mpm { .. } => return Ok(()),
+        Scene::Pbd { .. } | Scene::Rigid { .. } | Scene::Mpm { .. } | Scene::Fem { .. } => return Ok(()),
         Scene::Skinning { preset, file, .. } => {
             if preset.is_some() == file.is_some() {
                 return Err(("scene.preset", "give exactly one of `preset` and `file`".into()));

@@ -1,0 +1,183 @@
+//! The crate's error type: bad input (meshes, parameters, boundary conditions) and numerical
+//! failure (divergence, a failed Newton or linear solve), each naming the element, vertex or
+//! step concerned.
+
+use anim_core::linalg::SolveError;
+use anim_material::MaterialError;
+
+/// Which state array held a non-finite value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StateField {
+    /// Vertex positions.
+    Position,
+    /// Vertex velocities.
+    Velocity,
+}
+
+impl std::fmt::Display for StateField {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            StateField::Position => "position",
+            StateField::Velocity => "velocity",
+        })
+    }
+}
+
+/// Everything that can go wrong building or stepping a finite element body.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FemError {
+    /// A checkpointed memory that does not belong to this simulation.
+    #[error("checkpoint does not fit this simulation: {0}")]
+    Checkpoint(String),
+    /// The mesh has no elements.
+    #[error("the mesh has no elements")]
+    EmptyMesh,
+    /// An element names a vertex that does not exist.
+    #[error("element {element} references vertex {vertex}, but the mesh has {vertices} vertices")]
+    VertexOutOfRange {
+        /// Element index.
+        element: usize,
+        /// The bad vertex index.
+        vertex: usize,
+        /// Number of vertices.
+        vertices: usize,
+    },
+    /// An element uses the same vertex twice.
+    #[error("element {element} uses vertex {vertex} twice")]
+    RepeatedVertex {
+        /// Element index.
+        element: usize,
+        /// The repeated vertex.
+        vertex: usize,
+    },
+    /// A rest vertex has a NaN or infinite coordinate.
+    #[error("rest vertex {vertex} has a non-finite coordinate")]
+    NonFiniteVertex {
+        /// Vertex index.
+        vertex: usize,
+    },
+    /// A rest element has (almost) zero volume: `|det Dm| <= 1e-12 * (longest edge)^3`.
+    #[error(
+        "element {element} is degenerate in the rest configuration (6 x volume {volume6:e}, longest edge {edge:e})"
+    )]
+    DegenerateElement {
+        /// Element index.
+        element: usize,
+        /// Six times its signed rest volume.
+        volume6: f64,
+        /// Its longest rest edge.
+        edge: f64,
+    },
+    /// A rest element is inverted: `(X1 - X0) x (X2 - X0) . (X3 - X0) < 0`.
+    #[error(
+        "element {element} is inverted in the rest configuration (6 x signed volume {volume6:e}); swap two of its vertices"
+    )]
+    InvertedElement {
+        /// Element index.
+        element: usize,
+        /// Six times its signed rest volume.
+        volume6: f64,
+    },
+    /// Bad material parameters (Young's modulus, Poisson's ratio).
+    #[error("material: {0}")]
+    Material(#[from] MaterialError),
+    /// A scalar parameter out of its range.
+    #[error("parameter `{name}` = {value}: {reason}")]
+    BadParameter {
+        /// Field name.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// What is required.
+        reason: &'static str,
+    },
+    /// A boundary condition or load names a vertex that does not exist.
+    #[error("{what} names vertex {vertex}, but the mesh has {vertices} vertices")]
+    BoundaryVertexOutOfRange {
+        /// Which input ("pinned vertex", "kinematic group 2", "nodal force").
+        what: String,
+        /// The bad vertex index.
+        vertex: usize,
+        /// Number of vertices.
+        vertices: usize,
+    },
+    /// The state does not match the mesh.
+    #[error("state has {found} {what} coordinates, the mesh needs {expected}")]
+    StateSize {
+        /// "position" or "velocity".
+        what: &'static str,
+        /// Length found.
+        found: usize,
+        /// Length expected (3 x vertices).
+        expected: usize,
+    },
+    /// A mesh file could not be read or converted.
+    #[error("mesh input: {0}")]
+    MeshInput(String),
+    /// The step produced a NaN or infinity.
+    #[error("divergence at step {step}: non-finite {field} of vertex {vertex} (value {value})")]
+    NonFiniteState {
+        /// Completed steps before the failing one.
+        step: u64,
+        /// Which array.
+        field: StateField,
+        /// First offending vertex.
+        vertex: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// An element's energy or stress is not finite (an element inverted beyond what its material
+    /// model defines, e.g. `det F <= 0` for Neo-Hookean, or a NaN deformation).
+    #[error("divergence at step {step}: element {element} has non-finite energy or stress (det F = {det_f})")]
+    NonFiniteElement {
+        /// Completed steps before the failing one.
+        step: u64,
+        /// First offending element.
+        element: usize,
+        /// `det F` of that element.
+        det_f: f64,
+    },
+    /// Newton's method hit its iteration cap.
+    #[error(
+        "Newton did not converge at step {step}: {iterations} iterations, last update {update:e} (tolerance {tolerance:e})"
+    )]
+    NewtonNotConverged {
+        /// Completed steps before the failing one.
+        step: u64,
+        /// Iterations performed.
+        iterations: usize,
+        /// Infinity norm of the last Newton update.
+        update: f64,
+        /// The tolerance it had to reach.
+        tolerance: f64,
+    },
+    /// The backtracking line search found no decrease of the incremental potential.
+    #[error(
+        "line search failed at step {step}, Newton iteration {iteration}: no decrease after {halvings} halvings"
+    )]
+    LineSearch {
+        /// Completed steps before the failing one.
+        step: u64,
+        /// Newton iteration.
+        iteration: usize,
+        /// Step halvings tried.
+        halvings: usize,
+    },
+    /// The linear solve inside Newton failed.
+    #[error("linear solve failed at step {step}, Newton iteration {iteration}: {source}")]
+    LinearSolve {
+        /// Completed steps before the failing one.
+        step: u64,
+        /// Newton iteration.
+        iteration: usize,
+        /// The solver's error.
+        source: SolveError,
+    },
+}
+
+impl From<anim_io::IoError> for FemError {
+    fn from(e: anim_io::IoError) -> Self {
+        FemError::MeshInput(e.to_string())
+    }
+}

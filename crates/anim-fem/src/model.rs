@@ -1,0 +1,455 @@
+//! The finite element model: an immutable description of a body (rest mesh, precomputed
+//! `Dm^-1` and `W` per element, material, masses, loads, boundary conditions, obstacles) that
+//! algorithms read and never modify.
+
+use crate::assembly::Assembly;
+use crate::boundary::{KinematicGroup, Motion, Obstacle};
+use crate::element::{add_stiffness, deformation_gradient, gather, gradients, nodal_forces, rest_shape};
+use crate::error::FemError;
+use crate::material::Material;
+use crate::mesh::{TetMesh, validate};
+use crate::newton::ElasticBody;
+use anim_core::linalg::CsrMatrix;
+use anim_material::nalgebra::Matrix3;
+use serde::{Deserialize, Serialize};
+
+/// Standard gravity, z-up (m/s^2).
+pub const EARTH_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
+
+/// How mass is distributed to the vertices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MassKind {
+    /// Diagonal: each element gives a quarter of its mass `rho W` to each vertex.
+    Lumped,
+    /// The consistent mass matrix of linear shape functions,
+    /// `M_ab = rho W (1 + delta_ab) / 20 I_3` per element.
+    Consistent,
+}
+
+/// A tetrahedral body (see the [module docs](self)).
+#[derive(Debug, Clone)]
+pub struct FemModel {
+    mesh: TetMesh,
+    surface: Vec<[usize; 3]>,
+    material: Material,
+    dm_inv: Vec<Matrix3<f64>>,
+    volume: Vec<f64>,
+    shape_grad: Vec<[[f64; 3]; 4]>,
+    lumped_mass: Vec<f64>,
+    mass_kind: MassKind,
+    consistent_mass: CsrMatrix,
+    assembly: Assembly,
+    gravity: [f64; 3],
+    loads: Vec<f64>,
+    fixed: Vec<bool>,
+    kinematic: Vec<KinematicGroup>,
+    obstacles: Vec<Obstacle>,
+    contact_stiffness: f64,
+}
+
+impl FemModel {
+    /// A body from a mesh and a material, with lumped mass, no gravity, no boundary conditions.
+    ///
+    /// Precomputes `Dm^-1` and `W` of every element (seed 5.2, Algorithm 1, PRECOMPUTATION).
+    ///
+    /// # Errors
+    /// The mesh errors of [`validate`] (degenerate or inverted rest
+    /// elements named by index).
+    pub fn new(mesh: TetMesh, material: Material) -> Result<Self, FemError> {
+        validate(&mesh.positions, &mesh.tets)?;
+        let n = mesh.positions.len();
+        let m = mesh.tets.len();
+        let mut dm_inv = Vec::with_capacity(m);
+        let mut volume = Vec::with_capacity(m);
+        let mut shape_grad = Vec::with_capacity(m);
+        let mut lumped_mass = vec![0.0; n];
+        for (e, t) in mesh.tets.iter().enumerate() {
+            let rest = t.map(|v| mesh.positions[v]);
+            let (inv, w) = rest_shape(rest).ok_or(FemError::DegenerateElement {
+                element: e,
+                volume6: 0.0,
+                edge: 0.0,
+            })?;
+            dm_inv.push(inv);
+            volume.push(w);
+            shape_grad.push(gradients(&inv));
+            for &v in t {
+                lumped_mass[v] += 0.25 * material.density * w;
+            }
+        }
+        let flat: Vec<usize> = mesh.tets.iter().flatten().copied().collect();
+        let assembly = Assembly::new(n, 4, &flat);
+        // Consistent mass: per-element 12 x 12 blocks rho W / 20 (1 + delta_ab) I_3.
+        let mut blocks = vec![0.0; m * 144];
+        for e in 0..m {
+            let c = material.density * volume[e] / 20.0;
+            for a in 0..4 {
+                for b in 0..4 {
+                    let v = if a == b { 2.0 * c } else { c };
+                    for i in 0..3 {
+                        blocks[e * 144 + (3 * a + i) * 12 + 3 * b + i] = v;
+                    }
+                }
+            }
+        }
+        let mut consistent_mass = assembly.matrix();
+        assembly.gather_matrix(&blocks, &mut consistent_mass);
+        let surface = mesh.boundary_triangles();
+        Ok(Self {
+            mesh,
+            surface,
+            material,
+            dm_inv,
+            volume,
+            shape_grad,
+            lumped_mass,
+            mass_kind: MassKind::Lumped,
+            consistent_mass,
+            assembly,
+            gravity: [0.0; 3],
+            loads: vec![0.0; 3 * n],
+            fixed: vec![false; 3 * n],
+            kinematic: Vec::new(),
+            obstacles: Vec::new(),
+            contact_stiffness: 0.0,
+        })
+    }
+
+    /// Chooses lumped or consistent mass (default lumped).
+    #[must_use]
+    pub fn with_mass(mut self, kind: MassKind) -> Self {
+        self.mass_kind = kind;
+        self
+    }
+
+    /// Sets the gravitational acceleration (default zero).
+    #[must_use]
+    pub fn with_gravity(mut self, g: [f64; 3]) -> Self {
+        self.gravity = g;
+        self
+    }
+
+    fn check_vertex(&self, what: &str, vertex: usize) -> Result<(), FemError> {
+        if vertex >= self.vertices() {
+            return Err(FemError::BoundaryVertexOutOfRange {
+                what: what.to_string(),
+                vertex,
+                vertices: self.vertices(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Pins the given coordinates (`mask[c]` for x, y, z) of a vertex: they keep their value.
+    ///
+    /// # Errors
+    /// [`FemError::BoundaryVertexOutOfRange`].
+    pub fn pin(&mut self, vertex: usize, mask: [bool; 3]) -> Result<(), FemError> {
+        self.check_vertex("pinned vertex", vertex)?;
+        for c in 0..3 {
+            self.fixed[3 * vertex + c] |= mask[c];
+        }
+        Ok(())
+    }
+
+    /// Pins every coordinate of the given vertices.
+    ///
+    /// # Errors
+    /// [`FemError::BoundaryVertexOutOfRange`].
+    pub fn pin_vertices(&mut self, vertices: &[usize]) -> Result<(), FemError> {
+        for &v in vertices {
+            self.pin(v, [true; 3])?;
+        }
+        Ok(())
+    }
+
+    /// Makes the given vertices follow `motion`, starting from their rest positions at `t = 0`.
+    ///
+    /// # Errors
+    /// [`FemError::BoundaryVertexOutOfRange`].
+    pub fn add_kinematic(&mut self, vertices: &[usize], motion: Motion) -> Result<(), FemError> {
+        let what = format!("kinematic group {}", self.kinematic.len());
+        for &v in vertices {
+            self.check_vertex(&what, v)?;
+        }
+        for &v in vertices {
+            self.fixed[3 * v..3 * v + 3].fill(true);
+        }
+        let initial = vertices.iter().map(|&v| self.mesh.positions[v]).collect();
+        self.kinematic.push(KinematicGroup { vertices: vertices.to_vec(), motion, initial });
+        Ok(())
+    }
+
+    /// Adds a constant force on a vertex.
+    ///
+    /// # Errors
+    /// [`FemError::BoundaryVertexOutOfRange`], or [`FemError::BadParameter`] for a non-finite
+    /// force.
+    pub fn add_nodal_force(&mut self, vertex: usize, force: [f64; 3]) -> Result<(), FemError> {
+        self.check_vertex("nodal force", vertex)?;
+        for c in 0..3 {
+            if !force[c].is_finite() {
+                return Err(FemError::BadParameter {
+                    name: "nodal force",
+                    value: force[c],
+                    reason: "must be finite",
+                });
+            }
+            self.loads[3 * vertex + c] += force[c];
+        }
+        Ok(())
+    }
+
+    /// Adds a frictionless obstacle with penalty stiffness `stiffness` for implicit steps (the
+    /// largest stiffness given is used for all obstacles).
+    ///
+    /// # Errors
+    /// [`FemError::BadParameter`] for a non-positive stiffness, sphere radius or plane normal.
+    pub fn add_obstacle(&mut self, obstacle: Obstacle, stiffness: f64) -> Result<(), FemError> {
+        if !(stiffness > 0.0) || !stiffness.is_finite() {
+            return Err(FemError::BadParameter {
+                name: "contact stiffness",
+                value: stiffness,
+                reason: "must be finite and > 0",
+            });
+        }
+        match obstacle {
+            Obstacle::Sphere { radius, .. } if !(radius > 0.0) => {
+                return Err(FemError::BadParameter {
+                    name: "sphere radius",
+                    value: radius,
+                    reason: "must be > 0",
+                });
+            }
+            Obstacle::Plane { normal, .. } if !(normal.iter().map(|c| c * c).sum::<f64>() > 0.0) => {
+                return Err(FemError::BadParameter {
+                    name: "plane normal",
+                    value: 0.0,
+                    reason: "must be non-zero",
+                });
+            }
+            _ => {}
+        }
+        self.obstacles.push(obstacle);
+        self.contact_stiffness = self.contact_stiffness.max(stiffness);
+        Ok(())
+    }
+
+    /// The vertices whose rest position satisfies `select`.
+    #[must_use]
+    pub fn vertices_where(&self, select: impl Fn([f64; 3]) -> bool) -> Vec<usize> {
+        (0..self.vertices()).filter(|&i| select(self.mesh.positions[i])).collect()
+    }
+
+    /// Adds the consistent nodal loads of a uniform traction `t` (force per rest area) on the
+    /// boundary triangles whose centroid satisfies `select`: each vertex of a triangle of area
+    /// `A` gets `A t / 3`. Returns the loaded area.
+    pub fn add_traction(&mut self, select: impl Fn([f64; 3]) -> bool, t: [f64; 3]) -> f64 {
+        let mut total = 0.0;
+        for tri in &self.surface {
+            let p = tri.map(|v| self.mesh.positions[v]);
+            let centroid = [0, 1, 2].map(|c| (p[0][c] + p[1][c] + p[2][c]) / 3.0);
+            if !select(centroid) {
+                continue;
+            }
+            let u = [0, 1, 2].map(|c| p[1][c] - p[0][c]);
+            let v = [0, 1, 2].map(|c| p[2][c] - p[0][c]);
+            let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+            let area = 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            total += area;
+            for &vtx in tri {
+                for c in 0..3 {
+                    self.loads[3 * vtx + c] += area * t[c] / 3.0;
+                }
+            }
+        }
+        total
+    }
+
+    /// The rest mesh.
+    #[must_use]
+    pub fn mesh(&self) -> &TetMesh {
+        &self.mesh
+    }
+
+    /// Number of vertices.
+    #[must_use]
+    pub fn vertices(&self) -> usize {
+        self.mesh.positions.len()
+    }
+
+    /// Number of tetrahedra.
+    #[must_use]
+    pub fn elements(&self) -> usize {
+        self.mesh.tets.len()
+    }
+
+    /// The boundary surface triangles (outward), for output.
+    #[must_use]
+    pub fn surface(&self) -> &[[usize; 3]] {
+        &self.surface
+    }
+
+    /// The material.
+    #[must_use]
+    pub fn material(&self) -> &Material {
+        &self.material
+    }
+
+    /// `Dm^-1` per element.
+    #[must_use]
+    pub fn dm_inv(&self) -> &[Matrix3<f64>] {
+        &self.dm_inv
+    }
+
+    /// Rest volume `W` per element.
+    #[must_use]
+    pub fn rest_volume(&self) -> &[f64] {
+        &self.volume
+    }
+
+    /// Lumped vertex masses.
+    #[must_use]
+    pub fn lumped_mass(&self) -> &[f64] {
+        &self.lumped_mass
+    }
+
+    /// The mass distribution.
+    #[must_use]
+    pub fn mass_kind(&self) -> MassKind {
+        self.mass_kind
+    }
+
+    /// The consistent mass matrix (on the stiffness pattern).
+    #[must_use]
+    pub fn consistent_mass(&self) -> &CsrMatrix {
+        &self.consistent_mass
+    }
+
+    /// The assembly pattern.
+    #[must_use]
+    pub fn assembly(&self) -> &Assembly {
+        &self.assembly
+    }
+
+    /// Gravity.
+    #[must_use]
+    pub fn gravity(&self) -> [f64; 3] {
+        self.gravity
+    }
+
+    /// Which coordinates are fixed (pinned or kinematic), 3 per vertex.
+    #[must_use]
+    pub fn fixed(&self) -> &[bool] {
+        &self.fixed
+    }
+
+    /// Kinematic groups.
+    #[must_use]
+    pub fn kinematic(&self) -> &[KinematicGroup] {
+        &self.kinematic
+    }
+
+    /// Obstacles.
+    #[must_use]
+    pub fn obstacles(&self) -> &[Obstacle] {
+        &self.obstacles
+    }
+
+    /// Penalty stiffness of the obstacles.
+    #[must_use]
+    pub fn contact_stiffness(&self) -> f64 {
+        self.contact_stiffness
+    }
+
+    /// The rest positions, flat (`[x0, y0, z0, x1, ...]`).
+    #[must_use]
+    pub fn rest_positions(&self) -> Vec<f64> {
+        self.mesh.positions.iter().flatten().copied().collect()
+    }
+
+    /// Writes the external force: `m_i g` plus the nodal loads, times `scale`.
+    pub fn external_force(&self, scale: f64, out: &mut [f64]) {
+        for (i, o) in out.chunks_mut(3).enumerate() {
+            for c in 0..3 {
+                o[c] = scale * (self.lumped_mass[i] * self.gravity[c] + self.loads[3 * i + c]);
+            }
+        }
+    }
+
+    /// Writes the kinematic targets at time `t` into `x` (other entries untouched).
+    pub fn apply_kinematic(&self, t: f64, x: &mut [f64]) {
+        for g in &self.kinematic {
+            for (&v, &x0) in g.vertices.iter().zip(&g.initial) {
+                let p = g.motion.position(x0, t);
+                x[3 * v..3 * v + 3].copy_from_slice(&p);
+            }
+        }
+    }
+
+    /// Total elastic energy `sum_e W_e psi(F_e)` at positions `x`.
+    #[must_use]
+    pub fn elastic_energy(&self, x: &[f64]) -> f64 {
+        (0..self.elements()).map(|e| self.element(e, x, None, None, false)).sum()
+    }
+
+    /// The deformation gradient of element `e` at positions `x`.
+    #[must_use]
+    pub fn deformation_gradient(&self, e: usize, x: &[f64]) -> Matrix3<f64> {
+        deformation_gradient(&gather(x, &self.mesh.tets[e]), &self.dm_inv[e])
+    }
+
+    /// The elastic nodal forces of element `e` (seed 5.2: `H = -W P(F) Dm^-T`, `f_4 = -(f_1 +
+    /// f_2 + f_3)`).
+    #[inline]
+    #[must_use]
+    pub fn element_forces(&self, e: usize, x: &[f64]) -> [[f64; 3]; 4] {
+        let f = self.deformation_gradient(e, x);
+        let p = self.material.model.pk1(&self.material.lame, &f);
+        nodal_forces(self.volume[e], &p, &self.dm_inv[e])
+    }
+}
+
+impl ElasticBody for FemModel {
+    fn elements(&self) -> usize {
+        self.mesh.tets.len()
+    }
+
+    fn per_element(&self) -> usize {
+        4
+    }
+
+    #[inline]
+    fn element(
+        &self,
+        e: usize,
+        x: &[f64],
+        grad: Option<&mut [f64]>,
+        hess: Option<&mut [f64]>,
+        project: bool,
+    ) -> f64 {
+        let f = self.deformation_gradient(e, x);
+        let w = self.volume[e];
+        let mat = &self.material;
+        let energy = w * mat.model.energy(&mat.lame, &f);
+        if let Some(g) = grad {
+            let p = mat.model.pk1(&mat.lame, &f);
+            let h = nodal_forces(w, &p, &self.dm_inv[e]);
+            for a in 0..4 {
+                for i in 0..3 {
+                    g[3 * a + i] = -h[a][i];
+                }
+            }
+        }
+        if let Some(h) = hess {
+            let c = mat.model.tangent_matrix(&mat.lame, &f, project);
+            add_stiffness::<4>(w, &self.shape_grad[e], &c, h);
+        }
+        energy
+    }
+
+    fn det_f(&self, e: usize, x: &[f64]) -> f64 {
+        self.deformation_gradient(e, x).determinant()
+    }
+}
