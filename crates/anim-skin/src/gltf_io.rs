@@ -243,11 +243,25 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
             if prim.mode() != gltf::mesh::Mode::Triangles {
                 return Err(err(&el, format!("mode {:?} is not supported (triangles only)", prim.mode())));
             }
-            for (_, a) in prim.attributes() {
+            for (semantic, a) in prim.attributes() {
                 check(&a)?;
+                attribute_types(&semantic, &a).map_err(|c| err(&format!("{el} {semantic:?}"), c))?;
             }
             if let Some(a) = prim.indices() {
                 check(&a)?;
+                use gltf::accessor::{DataType, Dimensions};
+                if !matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
+                    || a.dimensions() != Dimensions::Scalar
+                {
+                    return Err(err(
+                        &format!("{el} indices"),
+                        format!(
+                            "{:?} {:?}: indices must be unsigned integer scalars",
+                            a.data_type(),
+                            a.dimensions()
+                        ),
+                    ));
+                }
             }
             let r = prim.reader(get);
             let pos: Vec<[f64; 3]> = r
@@ -443,4 +457,34 @@ fn base64_decode(s: &str) -> Result<Vec<u8>, String> {
         }
     }
     Ok(out)
+}
+
+/// The component types and shapes glTF 2.0 allows for the attributes this loader reads
+/// (specification 3.7.2.1); anything else is refused here rather than misread.
+fn attribute_types(semantic: &gltf::Semantic, a: &gltf::Accessor<'_>) -> Result<(), String> {
+    use gltf::Semantic;
+    use gltf::accessor::{DataType, Dimensions};
+    let (types, dims): (&[DataType], Dimensions) = match semantic {
+        Semantic::Positions | Semantic::Normals => (&[DataType::F32], Dimensions::Vec3),
+        Semantic::Joints(_) => (&[DataType::U8, DataType::U16], Dimensions::Vec4),
+        Semantic::Weights(_) => (&[DataType::F32, DataType::U8, DataType::U16], Dimensions::Vec4),
+        // Attributes the loader does not read (texture coordinates, colours, tangents).
+        _ => return Ok(()),
+    };
+    let normalized_ok =
+        a.data_type() == DataType::F32 || !matches!(semantic, Semantic::Weights(_)) || a.normalized();
+    if types.contains(&a.data_type()) && a.dimensions() == dims && normalized_ok {
+        Ok(())
+    } else {
+        Err(format!(
+            "accessor {} is {:?} {:?}{}, the specification allows {:?} {:?}{}",
+            a.index(),
+            a.data_type(),
+            a.dimensions(),
+            if a.normalized() { " normalized" } else { "" },
+            types,
+            dims,
+            if matches!(semantic, Semantic::Weights(_)) { " (integers normalized)" } else { "" }
+        ))
+    }
 }

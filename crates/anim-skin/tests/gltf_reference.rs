@@ -144,3 +144,13 @@ fn loader_errors_name_file_element_and_cause() {
     let e = anim_skin::gltf_io::load(&p).unwrap_err();
     assert!(e.to_string().contains("mesh 0 primitive 0"), "{e}");
 }
+
+/// Found by the `gltf_skin` fuzz target: a .glb whose WEIGHTS_1 accessor holds signed bytes
+/// (componentType 5120), which the specification does not allow, made the glTF reader panic.
+#[test]
+fn disallowed_attribute_component_types_are_errors_not_panics() {
+    let path = testdata("fuzz/signed_byte_weights.glb");
+    let e = anim_skin::gltf_io::load(&path).unwrap_err();
+    assert!(e.element.contains("Weights(1)") && e.cause.contains("I8"), "{e}");
+    assert!(e.to_string().contains("signed_byte_weights.glb"), "{e}");
+}
