@@ -1,4 +1,5 @@
-//! Criterion benches of anim-material: throughput of `pk1` and `dpdf` per model, in f32 and f64,
+//! Criterion benches of anim-material: throughput of `pk1` and `dpdf` per model and of the PSD
+//! projection `dpdf_psd` (analytic against eigenvalue clamping), in f32 and f64,
 //! 2D and 3D, over 1024 pre-generated deformation gradients (`R1 diag(s) R2^T`, `s` in
 //! [0.6, 1.6], ChaCha-seeded, all with `det F > 0` so that every model is defined).
 
@@ -84,6 +85,35 @@ fn run<T: Scalar, const D: usize>(c: &mut Criterion, precision: &str) {
         bench_model(&mut g, "stable-neo-hookean", &StableNeoHookean, &lame, &fs, tangent);
         g.finish();
     }
+    let mut g = c.benchmark_group(format!("material dpdf_psd {precision} {D}D"));
+    g.sample_size(10).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(1));
+    g.throughput(Throughput::Elements(N as u64));
+    bench_psd(&mut g, "fixed-corotated (analytic)", &FixedCorotated, &lame, &fs, false);
+    bench_psd(&mut g, "stable-neo-hookean (analytic)", &StableNeoHookean, &lame, &fs, false);
+    bench_psd(&mut g, "stable-neo-hookean (eigenvalue clamping)", &StableNeoHookean, &lame, &fs, true);
+    g.finish();
+}
+
+/// `dpdf_psd` of a model, or with `clamp` the generic projection `dpdf(F).project_psd()`.
+fn bench_psd<T: Scalar, const D: usize, M: Hyperelastic<T, D>>(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    name: &str,
+    m: &M,
+    lame: &Lame<T>,
+    fs: &[Mat<T, D>],
+    clamp: bool,
+) {
+    g.bench_function(name, |b| {
+        b.iter(|| {
+            for f in fs {
+                if clamp {
+                    black_box(m.dpdf(lame, black_box(f)).project_psd());
+                } else {
+                    black_box(m.dpdf_psd(lame, black_box(f)));
+                }
+            }
+        })
+    });
 }
 
 fn materials(c: &mut Criterion) {

@@ -38,8 +38,8 @@
 //!   `(J - alpha)^2` (fixed corotated, stable Neo-Hookean).
 //!
 //! For Newton solvers, [`Hyperelastic::dpdf_psd`] gives the positive semi-definite projection of
-//! `dP/dF` (analytic eigensystem for the corotated models, clamped eigendecomposition of the
-//! `D^2 x D^2` matrix otherwise; see [`Tangent::project_psd`]).
+//! `dP/dF` (analytic eigensystem for the corotated models and stable Neo-Hookean, clamped
+//! eigendecomposition of the `D^2 x D^2` matrix otherwise; see [`Tangent::project_psd`]).
 //!
 //! ## Contract
 //!

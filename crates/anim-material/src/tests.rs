@@ -598,3 +598,133 @@ fn combined_evaluation_matches_separate_calls() {
     }
     per_model!(run);
 }
+
+/// `|a - b| / |b|` over the flattened tensors (`|a - b|` itself when `b = 0`).
+fn tangent_rel_diff<const D: usize>(a: &Tangent<f64, D>, b: &Tangent<f64, D>) -> f64 {
+    let mut diff = Tangent::<f64, D>::zeros();
+    for k in 0..D {
+        for l in 0..D {
+            diff.d[k][l] = a.d[k][l] - b.d[k][l];
+        }
+    }
+    // `dP/dF(0) = 0` in 3D: there the difference itself must vanish.
+    diff.norm() / b.norm().max(f64::MIN_POSITIVE)
+}
+
+/// Stable Neo-Hookean deformation gradients beyond [`KINDS`]: repeated and sign-paired singular
+/// values (`sigma_i = -sigma_j`, where the corotated tangents are singular but this model is
+/// smooth), two tiny singular values and `F = 0`.
+fn snh_special<const D: usize>(rng: &mut ChaCha8Rng) -> Vec<Mat<f64, D>> {
+    let mut out = Vec::new();
+    let diag = |v: [f64; 3]| Mat::<f64, D>::from_fn(|i, j| if i == j { v[i] } else { 0.0 });
+    for v in [
+        [1.3, 1.3, 1.3],
+        [0.7, 0.7, 0.7],
+        [1.0, 1.0, 1.0],
+        [1.5, 0.8, -0.8],
+        [0.9, 0.9, -0.9],
+        [1.2, -1.2, 0.5],
+        [1e-3, 1e-3, 1e-3],
+        [1.1, 1e-3, 1e-3],
+        [1.1, 1e-3, -1e-3],
+        [0.0, 0.0, 0.0],
+        [2.0, 2.0, 0.3],
+        [-0.5, 1.0, 1.0],
+    ] {
+        let (r1, r2) = (rotation::<D>(rng), rotation::<D>(rng));
+        out.push(r1 * diag(v) * r2.transpose());
+        out.push(diag(v));
+    }
+    out
+}
+
+/// Stable Neo-Hookean: the analytic eigensystem (Smith, de Goes & Kim 2019) without clamping
+/// rebuilds the invariant-based `dP/dF`, its eigenvalues are those of the flattened tensor, and
+/// its clamped version ([`Hyperelastic::dpdf_psd`]) equals the numerical eigenvalue clamping.
+#[test]
+fn stable_neo_hookean_analytic_projection() {
+    use crate::models::principal::{self, PrincipalEnergy};
+    fn one<const D: usize>(f: &Mat<f64, D>, label: &str, worst: &mut [f64; 2]) {
+        let lame = lame64();
+        let p = StableNeoHookean::params::<f64, D>(&lame);
+        let direct = StableNeoHookean.dpdf(&lame, f);
+        // The energy and stress in the singular values agree with the invariant-based ones.
+        let psi = PrincipalEnergy::<f64, D>::psi_hat(&StableNeoHookean, p.mu, p.lambda, &svd(f).sigma);
+        let psi_ref = StableNeoHookean.energy(&lame, f);
+        assert!(
+            (psi - psi_ref).abs() <= 1e-10 * (1.0 + psi_ref.abs()),
+            "{D}D {label}: psi {psi} vs {psi_ref}"
+        );
+        let pk = principal::pk1(&StableNeoHookean, p.mu, p.lambda, f);
+        let pk_ref = StableNeoHookean.pk1(&lame, f);
+        assert!(
+            (pk - pk_ref).norm() <= 1e-10 * (lame.mu + pk_ref.norm()),
+            "{D}D {label}: P {pk} vs {pk_ref}"
+        );
+        let rebuilt = principal::dpdf(&StableNeoHookean, p.mu, p.lambda, f);
+        let e = tangent_rel_diff(&rebuilt, &direct);
+        assert!(e <= 1e-10, "{D}D {label}: eigensystem reconstruction off by {e:e}, F = {f}");
+        let analytic = StableNeoHookean.dpdf_psd(&lame, f);
+        let numerical = direct.project_psd();
+        let e2 = tangent_rel_diff(&analytic, &numerical);
+        assert!(e2 <= 1e-9, "{D}D {label}: analytic projection off by {e2:e}, F = {f}");
+        worst[0] = worst[0].max(e);
+        worst[1] = worst[1].max(e2);
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(29);
+    let mut worst = [0.0f64; 2];
+    for kind in KINDS {
+        for _ in 0..20 {
+            one::<3>(&sample::<3>(kind, &mut rng), &format!("{kind:?}"), &mut worst);
+            one::<2>(&sample::<2>(kind, &mut rng), &format!("{kind:?}"), &mut worst);
+        }
+    }
+    for f in snh_special::<3>(&mut rng) {
+        one::<3>(&f, "special", &mut worst);
+    }
+    for f in snh_special::<2>(&mut rng) {
+        one::<2>(&f, "special", &mut worst);
+    }
+    // The clamping must have mattered: some samples are indefinite.
+    let lame = lame64();
+    let inverted = Mat::<f64, 3>::from_diagonal(&Vector3::new(1.5, 1.2, -0.4));
+    let h = StableNeoHookean.dpdf(&lame, &inverted).to_matrix();
+    assert!(h.symmetric_eigenvalues().min() < -1e-3 * h.norm());
+    // The eigenvalues: twist and flip per pair and the eigenvalues of the 3x3 Hessian of
+    // psi_hat are exactly the spectrum of the flattened 9x9 tangent.
+    for kind in KINDS {
+        for _ in 0..10 {
+            let f = sample::<3>(kind, &mut rng);
+            let p = StableNeoHookean::params::<f64, 3>(&lame);
+            let s = svd(&f).sigma;
+            let m = &StableNeoHookean;
+            let mut analytic: Vec<f64> = Vec::new();
+            for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+                analytic.push(PrincipalEnergy::<f64, 3>::twist(m, p.mu, p.lambda, &s, i, j));
+                analytic.push(PrincipalEnergy::<f64, 3>::flip(m, p.mu, p.lambda, &s, i, j));
+            }
+            let hess = PrincipalEnergy::<f64, 3>::hessian(m, p.mu, p.lambda, &s);
+            analytic.extend(hess.symmetric_eigenvalues().iter());
+            analytic.sort_by(f64::total_cmp);
+            let h = StableNeoHookean.dpdf(&lame, &f).to_matrix();
+            let mut numerical: Vec<f64> = h.symmetric_eigenvalues().iter().copied().collect();
+            numerical.sort_by(f64::total_cmp);
+            for (a, n) in analytic.iter().zip(&numerical) {
+                assert!((a - n).abs() <= 1e-10 * h.norm(), "{kind:?}: eigenvalue {a} vs {n}");
+            }
+        }
+    }
+    // f32 follows f64 to single-precision rounding of the tangent's scale.
+    let mut rng = ChaCha8Rng::seed_from_u64(31);
+    let lame32 = Lame::<f32> { mu: lame.mu as f32, lambda: lame.lambda as f32 };
+    for kind in KINDS {
+        for _ in 0..10 {
+            let f = sample::<3>(kind, &mut rng).map(|x| x as f32);
+            let a32 = StableNeoHookean.dpdf_psd(&lame32, &f).to_matrix().map(f64::from);
+            let a64 = StableNeoHookean.dpdf_psd(&lame, &f.map(f64::from)).to_matrix();
+            let e = (a32 - a64).norm() / a64.norm();
+            assert!(e <= 1e-4, "f32 {kind:?}: {e:e}");
+        }
+    }
+    eprintln!("stable Neo-Hookean: reconstruction {:.2e}, projection {:.2e}", worst[0], worst[1]);
+}

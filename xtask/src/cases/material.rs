@@ -438,7 +438,7 @@ fn psd_projection(ctx: &Ctx) -> Vec<Check> {
     let lame = lame();
     let mut out = Vec::new();
     let mut rng = ChaCha8Rng::seed_from_u64(940);
-    let mut worst = [0.0f64; 4];
+    let mut worst = [0.0f64; 6];
     let mut min_eig = 0.0f64;
     for kind in KINDS {
         for _ in 0..samples {
@@ -452,6 +452,10 @@ fn psd_projection(ctx: &Ctx) -> Vec<Check> {
                 (
                     CorotatedLinear.dpdf_psd(&lame, &f3).to_flat_vec(),
                     CorotatedLinear.dpdf(&lame, &f3).project_psd(),
+                ),
+                (
+                    StableNeoHookean.dpdf_psd(&lame, &f3).to_flat_vec(),
+                    StableNeoHookean.dpdf(&lame, &f3).project_psd(),
                 ),
             ]
             .into_iter()
@@ -467,18 +471,26 @@ fn psd_projection(ctx: &Ctx) -> Vec<Check> {
             for (k, (a, n)) in [
                 (FixedCorotated.dpdf_psd(&lame, &f2), FixedCorotated.dpdf(&lame, &f2).project_psd()),
                 (CorotatedLinear.dpdf_psd(&lame, &f2), CorotatedLinear.dpdf(&lame, &f2).project_psd()),
+                (StableNeoHookean.dpdf_psd(&lame, &f2), StableNeoHookean.dpdf(&lame, &f2).project_psd()),
             ]
             .into_iter()
             .enumerate()
             {
                 let d = (a.to_matrix() - n.to_matrix()).norm() / n.to_matrix().norm();
-                worst[2 + k] = worst[2 + k].max(d);
+                worst[3 + k] = worst[3 + k].max(d);
             }
         }
     }
-    for (k, label) in ["FixedCorotated 3D", "CorotatedLinear 3D", "FixedCorotated 2D", "CorotatedLinear 2D"]
-        .iter()
-        .enumerate()
+    for (k, label) in [
+        "FixedCorotated 3D",
+        "CorotatedLinear 3D",
+        "StableNeoHookean 3D",
+        "FixedCorotated 2D",
+        "CorotatedLinear 2D",
+        "StableNeoHookean 2D",
+    ]
+    .iter()
+    .enumerate()
     {
         out.push(check(
             format!("{label}, {} F of all kinds", 6 * samples),
