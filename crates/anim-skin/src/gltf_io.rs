@@ -86,7 +86,30 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
         element: element.to_string(),
         cause,
     };
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| err("document", e.to_string()))?;
+    // Parse, check the accessor indices of mesh primitives, then validate: the glTF crate's own
+    // validation indexes the POSITION accessor before checking that it exists.
+    let unchecked =
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| err("document", e.to_string()))?;
+    {
+        let json = unchecked.document.as_json();
+        let accessors = json.accessors.len();
+        for (m, mesh) in json.meshes.iter().enumerate() {
+            for (p, prim) in mesh.primitives.iter().enumerate() {
+                if let Some(bad) =
+                    prim.attributes.values().chain(&prim.indices).find(|i| i.value() >= accessors)
+                {
+                    return Err(err(
+                        &format!("mesh {m} primitive {p}"),
+                        format!("accessor {} does not exist (the file has {accessors})", bad.value()),
+                    ));
+                }
+            }
+        }
+    }
+    let blob = unchecked.blob;
+    let document = gltf::Document::from_json(unchecked.document.into_json())
+        .map_err(|e| err("document", e.to_string()))?;
+    let gltf = gltf::Gltf { document, blob };
     let doc = &gltf.document;
     let mut warnings = Vec::new();
 

@@ -154,3 +154,12 @@ fn disallowed_attribute_component_types_are_errors_not_panics() {
     assert!(e.element.contains("Weights(1)") && e.cause.contains("I8"), "{e}");
     assert!(e.to_string().contains("signed_byte_weights.glb"), "{e}");
 }
+
+/// Found by the `gltf_skin` fuzz target: a primitive whose POSITION names an accessor that does
+/// not exist made the glTF crate's own validation panic; it is now an error naming the primitive.
+#[test]
+fn a_primitive_naming_a_missing_accessor_is_an_error_not_a_panic() {
+    let path = testdata("fuzz/missing_position_accessor.glb");
+    let e = anim_skin::gltf_io::load(&path).unwrap_err();
+    assert!(e.element.starts_with("mesh 0 primitive") && e.cause.contains("does not exist"), "{e}");
+}
