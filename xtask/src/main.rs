@@ -4,6 +4,7 @@
 //! | --- | --- |
 //! | `conformance [--quick] [--filter S]` | every reference case with metric, error, tolerance and verdict; exit 1 on any failure |
 //! | `stability [--quick] [--filter S]` | the named hard cases of every crate with their outcomes; exit 1 on an unexpected outcome |
+//! | `stability --long [--quick] [--filter S] [--out DIR]` | soak: each crate's hard case for `10^5` steps or ten minutes with its energy bound; written to `docs/report/soak.md` |
 //! | `bench [--filter S]` | the criterion benches under `benches/`, printed as a table and written to `target/xtask/bench.csv` |
 //! | `report [--quick] [--out DIR]` | conformance, stability and work-precision studies written to `docs/report/` (Markdown + SVG) |
 //! | `ci` | what CI runs: format, clippy, tests (with doc tests), docs, quick conformance and stability |
@@ -14,16 +15,17 @@ mod cases;
 mod ci;
 mod registry;
 mod report;
+mod soak;
 mod suites;
 
 use std::process::ExitCode;
 
-const USAGE: &str =
-    "usage: cargo xtask <conformance|stability|bench|report|ci> [--quick] [--filter TEXT] [--out DIR]";
+const USAGE: &str = "usage: cargo xtask <conformance|stability|bench|report|ci> [--quick] [--long] [--filter TEXT] [--out DIR]";
 
 #[derive(Debug, Default)]
 struct Args {
     quick: bool,
+    long: bool,
     filter: Option<String>,
     out: Option<String>,
 }
@@ -34,6 +36,7 @@ fn parse(args: &[String]) -> Result<Args, String> {
     while let Some(a) = it.next() {
         match a.as_str() {
             "--quick" => parsed.quick = true,
+            "--long" => parsed.long = true,
             "--filter" => parsed.filter = Some(it.next().ok_or("--filter needs a value")?.clone()),
             "--out" => parsed.out = Some(it.next().ok_or("--out needs a value")?.clone()),
             // `bench --peers`: read by bench.rs from the process arguments.
@@ -60,6 +63,9 @@ fn main() -> ExitCode {
     let ctx = registry::Ctx { quick: args.quick };
     let ok = match cmd.as_str() {
         "conformance" => suites::conformance(&ctx, args.filter.as_deref()).passed(),
+        "stability" if args.long => {
+            soak::run(args.quick, args.filter.as_deref(), args.out.as_deref().unwrap_or("docs/report"))
+        }
         "stability" => suites::stability(&ctx, args.filter.as_deref()).passed(),
         "bench" => bench::run(args.filter.as_deref()),
         "report" => report::run(&ctx, args.out.as_deref().unwrap_or("docs/report")),

@@ -45,6 +45,12 @@ pub fn run(ctx: &Ctx, out: &str) -> bool {
     let _ = writeln!(md, "## Conformance\n\n{}", suites::conformance_table(&conf.checks));
     let _ = writeln!(md, "{} passed, {} failed.\n", conf.checks.len() - conf.failures(), conf.failures());
     let _ = writeln!(md, "## Stability (hard cases)\n\n{}", suites::stability_table(&stab));
+    if dir.join("soak.md").exists() {
+        let _ = writeln!(
+            md,
+            "Long runs of each crate's hard case (`cargo xtask stability --long`): [soak.md](soak.md).\n"
+        );
+    }
     let index = dir.join("index.md");
     if let Err(e) = std::fs::write(&index, md) {
         eprintln!("cannot write {}: {e}", index.display());

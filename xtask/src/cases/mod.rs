@@ -10,4 +10,5 @@ pub mod mpm;
 pub mod pbd;
 pub mod rigid;
 pub mod skin;
+pub mod soak;
 pub mod springs;
