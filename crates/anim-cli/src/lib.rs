@@ -5,6 +5,11 @@
 //! checkpoint save and restore), and how a run is drawn and written ([`view`]). The binary adds
 //! the command line, the writer thread and the checkpoint files.
 //!
+//! Particle and mesh scenes are written as VTK unstructured grids, PLY, OBJ or CSV and drawn in
+//! 3-D; the grid fluids of anim-fluid (`smoke-box-2d`, `smoke-plume-3d`, `lid-driven-cavity`)
+//! are a [`view::Geometry::Grid`]: their density and velocity fields go to VTK image data
+//! (`.vti` with a `.pvd` series) and the preview shows the density as a picture.
+//!
 //! ```
 //! use anim_cli::scene;
 //! let text = scene::builtin("kepler").expect("a built-in scene");

@@ -5,14 +5,17 @@
 //! anim run scene.toml           # a scene file
 //! anim run kepler               # a built-in scene by name
 //! anim run cloth --out out --frames 60 --format obj --stride 2
-//! anim list                     # the built-in scenes
+//! anim list                     # the built-in scenes (also `anim scenes`)
+//! anim run smoke-plume-3d --resolution 48   # a fluid on a finer grid
 //! anim run cloth --checkpoint-every 50   # also keep out/checkpoint.anim current
 //! anim resume anim-out/cloth/checkpoint.anim   # continue from it, bit for bit
 //! ```
 //!
 //! Every run writes into its output folder: the frames in the scene's natural format (VTK `.vtu`
-//! with a `.pvd` series for meshes, `frames.csv` for systems of a few unknowns) or the one asked
-//! for, `preview.gif` (and `preview.png`, the last frame), and `metrics.json`.
+//! with a `.pvd` series for meshes, VTK `.vti` image data with a `.pvd` for fluid grids (cell
+//! fields `density` and `velocity`), `frames.csv` for systems of a few unknowns) or the one asked
+//! for, `preview.gif` (and `preview.png`, the last frame; fluids show their density), and
+//! `metrics.json`.
 
 use anim_cli::runner::{self, OutputFormat, Runner};
 use anim_cli::scene::{self, SceneFile};
@@ -46,6 +49,7 @@ enum Command {
     /// bit for bit those of an uninterrupted run.
     Resume(ResumeArgs),
     /// List the built-in scenes.
+    #[command(visible_alias = "scenes")]
     List,
 }
 
@@ -77,9 +81,13 @@ struct RunArgs {
     /// Override the time step in seconds.
     #[arg(long, allow_hyphen_values = true)]
     dt: Option<f64>,
-    /// Frame file format (default: the scene's natural one).
+    /// Frame file format (default: the scene's natural one; fluid grids: vti or none).
     #[arg(long, value_enum)]
     format: Option<OutputFormat>,
+    /// Override the resolution of a preset scene that has one (cloth, MPM, FEM and fluid
+    /// grids: cells or particles across).
+    #[arg(long)]
+    resolution: Option<usize>,
     /// Write every N-th frame to files.
     #[arg(long, default_value_t = 1)]
     stride: usize,
@@ -101,14 +109,28 @@ struct RunArgs {
     checkpoint_every: Option<usize>,
 }
 
+/// The built-in scenes, one a line: name, description, and which one is the default.
+fn builtin_listing() -> String {
+    let mut out = String::new();
+    for (name, description, _) in scene::BUILTIN {
+        let default = if name == scene::DEFAULT_SCENE { " [default]" } else { "" };
+        out.push_str(&format!("{name:<18} {description}{default}\n"));
+    }
+    out
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    use clap::{CommandFactory, FromArgMatches};
+    // `anim run --help` ends with the list of built-in scenes.
+    let listing = format!("Built-in scenes:\n{}", builtin_listing());
+    let command = Cli::command().mut_subcommand("run", |run| run.after_help(listing));
+    let cli = match Cli::from_arg_matches(&command.get_matches()) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
     match cli.command {
         Command::List => {
-            for (name, description, _) in scene::BUILTIN {
-                let default = if name == scene::DEFAULT_SCENE { " [default]" } else { "" };
-                println!("{name:<12} {description}{default}");
-            }
+            print!("{}", builtin_listing());
             ExitCode::SUCCESS
         }
         Command::Run(args) => finish(fresh(&args).and_then(execute)),
@@ -131,7 +153,8 @@ fn finish(result: Result<(), String>) -> ExitCode {
 fn resolve(arg: Option<&str>) -> Result<(SceneFile, PathBuf), String> {
     let arg = arg.unwrap_or(scene::DEFAULT_SCENE);
     let path = Path::new(arg);
-    if path.exists() {
+    // A folder of that name (such as a run's output) is not a scene file.
+    if path.is_file() {
         return scene::load(path).map(|s| (s, path.to_path_buf())).map_err(|e| e.to_string());
     }
     match scene::builtin(arg) {
@@ -332,7 +355,11 @@ impl Output {
             writer.csv = Some(csv);
         }
         if let Some((width, every)) = preview {
-            let height = (width * 3 / 4).max(1);
+            // A grid is shown at its own proportions; everything else at 4:3.
+            let height = match writer.view.aspect() {
+                Some(a) => (f64::from(width) / a).round().clamp(16.0, 4096.0) as u32,
+                None => (width * 3 / 4).max(1),
+            };
             let path = dir.join("preview.gif");
             let gif = GifWriter::create(&path, width, height, 4, true).map_err(|e| e.to_string())?;
             let camera = writer.view.camera(f64::from(width) / f64::from(height));
@@ -411,8 +438,26 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
     if args.checkpoint_every == Some(0) {
         return Err("--checkpoint-every must be at least 1".into());
     }
+    if let Some(r) = args.resolution {
+        file.scene.set_resolution(r).map_err(|e| format!("--resolution {r}: {e}"))?;
+    }
     let runner = runner::build(&file.scene, &origin, args.skinning).map_err(|e| e.to_string())?;
     let format = args.format.unwrap_or_else(|| runner.natural_format());
+    if !runner.geometry().accepts(format) {
+        return Err(if format == OutputFormat::Vti {
+            format!(
+                "--format vti: {} is not a grid scene (vti frames hold grid fields); it writes {} frames",
+                file.name,
+                format_name(runner.natural_format())
+            )
+        } else {
+            format!(
+                "--format {}: {} is a grid scene: its frames are vti (or none)",
+                format_name(format),
+                file.name
+            )
+        });
+    }
     let out = args.out.clone().unwrap_or_else(|| Path::new("anim-out").join(&file.name));
     Ok(Session {
         file,
@@ -433,6 +478,12 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
         newton_iterations: 0,
         resumed: false,
     })
+}
+
+/// The command-line spelling of a frame format.
+fn format_name(format: OutputFormat) -> String {
+    use clap::ValueEnum;
+    format.to_possible_value().map_or_else(|| format!("{format:?}"), |v| v.get_name().to_string())
 }
 
 /// A run continued from a checkpoint: the scene is rebuilt from the checkpoint's copy and the

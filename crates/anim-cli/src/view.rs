@@ -2,17 +2,18 @@
 //! and per-frame [`Snapshot`]s. A [`View`] turns the two into frame files and preview images; it
 //! is `Send`, so the run loop hands snapshots to a writer thread and keeps stepping.
 
+use crate::runner::OutputFormat;
 use anim_io::preview::{Camera, Canvas, Colors, MeshStyle};
-use anim_io::{DataArray, FrameFormat, FrameWriter, UnstructuredGrid};
+use anim_io::{DataArray, FrameFormat, FrameWriter, ImageData, UnstructuredGrid};
 
 /// The state at one frame, copied out of the simulation.
 #[derive(Debug, Clone, Default)]
 pub struct Snapshot {
     /// Simulated time.
     pub t: f64,
-    /// Positions (flat).
+    /// Positions (flat); for a [`Geometry::Grid`], the density per cell.
     pub x: Vec<f64>,
-    /// Velocities (flat).
+    /// Velocities (flat); for a [`Geometry::Grid`], the velocity per cell (3 components).
     pub v: Vec<f64>,
     /// Total energy, where defined.
     pub energy: Option<f64>,
@@ -47,11 +48,48 @@ pub enum Geometry {
         /// Region kept in view.
         frame_box: ([f64; 3], [f64; 3]),
     },
+    /// Fields on a regular grid of cells (a fluid): the snapshot's `x` holds the density per
+    /// cell and `v` the velocity per cell, x fastest, then y, then z. Frames are `.vti` image
+    /// data (cell fields `density` and `velocity`); the preview shows the density through
+    /// viridis, a 3D grid as its maximum along z (the view axis, y up).
+    Grid {
+        /// Cells along x, y, z (1 along z in 2D).
+        dims: [usize; 3],
+        /// 2 or 3.
+        dim: usize,
+        /// Cell size (the grid's corner is at the origin).
+        spacing: f64,
+        /// Density shown as the ends of the colour scale (fixed for the run).
+        range: (f64, f64),
+    },
+}
+
+impl Geometry {
+    /// Whether frames of this geometry can be written in `format`: grids as `vti` (or none),
+    /// everything else in any format but `vti`.
+    #[must_use]
+    pub fn accepts(&self, format: OutputFormat) -> bool {
+        match self {
+            Geometry::Grid { .. } => matches!(format, OutputFormat::Vti | OutputFormat::None),
+            _ => format != OutputFormat::Vti,
+        }
+    }
+
+    /// Width over height of the picture the geometry wants (a grid's cross-section), if any.
+    #[must_use]
+    pub fn aspect(&self) -> Option<f64> {
+        match self {
+            Geometry::Grid { dims, .. } => Some(dims[0] as f64 / dims[1].max(1) as f64),
+            _ => None,
+        }
+    }
 }
 
 /// Frame files and preview images from snapshots.
 pub struct View {
     geometry: Geometry,
+    /// The 2-D picture of a 3-D grid.
+    projection: Vec<f64>,
     trail: Vec<[f64; 3]>,
     positions: Vec<[f64; 3]>,
     velocities: Vec<[f64; 3]>,
@@ -76,6 +114,7 @@ impl View {
     pub fn new(geometry: Geometry) -> Self {
         Self {
             geometry,
+            projection: Vec::new(),
             trail: Vec::new(),
             positions: Vec::new(),
             velocities: Vec::new(),
@@ -83,7 +122,14 @@ impl View {
         }
     }
 
-    /// Writes the snapshot as the next frame of a mesh/particle sequence.
+    /// Width over height of the picture the geometry wants, if any ([`Geometry::aspect`]).
+    #[must_use]
+    pub fn aspect(&self) -> Option<f64> {
+        self.geometry.aspect()
+    }
+
+    /// Writes the snapshot as the next frame of a mesh/particle sequence (or, for a grid, of a
+    /// `vti` sequence).
     pub fn write_frame(&mut self, frames: &mut FrameWriter, s: &Snapshot) -> Result<(), String> {
         match &self.geometry {
             Geometry::Planar { .. } => {
@@ -110,6 +156,18 @@ impl View {
                 };
                 io(frames.write(s.t, &grid)).map(|_| ())
             }
+            Geometry::Grid { dims, dim, spacing, .. } => {
+                let h = *spacing;
+                let image = if *dim == 2 {
+                    ImageData::from_cells_2d([dims[0], dims[1]], [0.0; 2], [h; 2])
+                } else {
+                    ImageData::from_cells_3d(*dims, [0.0; 3], [h; 3])
+                };
+                let image = image
+                    .cell_field(DataArray::scalars("density", &s.x))
+                    .cell_field(DataArray::vectors("velocity", s.v.as_chunks::<3>().0));
+                io(frames.write_image(s.t, &image)).map(|_| ())
+            }
         }
     }
 
@@ -119,6 +177,9 @@ impl View {
             Geometry::Planar { extent, .. } => Camera::top_down_2d(extent.0, extent.1, aspect),
             Geometry::Particles { frame_box, .. } => {
                 Camera::framing(frame_box.0, frame_box.1, [0.55, 1.0, -0.45], [0.0, 0.0, 1.0])
+            }
+            Geometry::Grid { dims, spacing, .. } => {
+                Camera::top_down_2d([0.0, 0.0], [dims[0] as f64 * spacing, dims[1] as f64 * spacing], aspect)
             }
         }
     }
@@ -191,6 +252,24 @@ impl View {
                     }
                     Ok(())
                 }
+            }
+            Geometry::Grid { dims, dim, range, .. } => {
+                let [nx, ny, nz] = *dims;
+                if s.x.len() != nx * ny * nz {
+                    return Err(format!("{} density values for a {nx} x {ny} x {nz} grid", s.x.len()));
+                }
+                if *dim == 2 {
+                    return io(canvas.draw_scalar_field(&s.x, nx, ny, Some(*range)));
+                }
+                // Maximum along z: what looking through the smoke along the view axis shows.
+                self.projection.clear();
+                self.projection.extend_from_slice(&s.x[..nx * ny]);
+                for layer in s.x.chunks_exact(nx * ny).skip(1) {
+                    for (p, &d) in self.projection.iter_mut().zip(layer) {
+                        *p = p.max(d);
+                    }
+                }
+                io(canvas.draw_scalar_field(&self.projection, nx, ny, Some(*range)))
             }
         }
     }

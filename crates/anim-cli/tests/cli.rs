@@ -14,7 +14,7 @@ fn anim(args: &[&str]) -> (bool, String) {
 fn bad_flags_and_names_are_refused_with_the_value_named() {
     let dir = std::env::temp_dir().join(format!("anim-cli-flags-{}", std::process::id()));
     let out = dir.to_str().unwrap();
-    let cases: [(&[&str], &str); 9] = [
+    let cases: [(&[&str], &str); 14] = [
         (&["run", "kepler", "--frames", "0"], "--frames must be at least 1"),
         (&["run", "kepler", "--dt", "0"], "--dt must be a positive finite number, got 0"),
         (&["run", "kepler", "--dt", "-1e-3"], "got -0.001"),
@@ -24,6 +24,14 @@ fn bad_flags_and_names_are_refused_with_the_value_named() {
         (&["run", "kepler", "--checkpoint-every", "0"], "--checkpoint-every must be at least 1"),
         (&["run", "warp-drive"], "warp-drive: no such scene file, and no built-in scene of that name"),
         (&["resume", "no-such-checkpoint.anim"], "no-such-checkpoint.anim"),
+        (&["run", "lid-driven-cavity", "--resolution", "1"], "field `scene.resolution`: anim-fluid: grid"),
+        (&["run", "smoke-plume-3d", "--resolution", "100000"], "takes at most 128 cells across"),
+        (&["run", "kepler", "--resolution", "8"], "--resolution 8: a kepler-orbit scene has no resolution"),
+        (
+            &["run", "smoke-box-2d", "--format", "csv"],
+            "--format csv: smoke-box-2d is a grid scene: its frames are vti",
+        ),
+        (&["run", "kepler", "--format", "vti"], "--format vti: kepler is not a grid scene"),
     ];
     for (args, expect) in cases {
         let mut args = args.to_vec();
@@ -52,4 +60,96 @@ fn a_scene_file_with_an_error_names_file_line_and_field() {
     assert!(!ok);
     assert!(err.contains("bad.toml:5:") && err.contains("frmes"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+fn temp(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("anim-cli-fluid-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+#[test]
+fn fluid_scenes_are_listed_by_anim_scenes_and_run_help() {
+    let out = Command::new(env!("CARGO_BIN_EXE_anim")).arg("scenes").output().unwrap();
+    assert!(out.status.success());
+    let list = String::from_utf8_lossy(&out.stdout);
+    let help = Command::new(env!("CARGO_BIN_EXE_anim")).args(["run", "--help"]).output().unwrap();
+    assert!(help.status.success());
+    let help = String::from_utf8_lossy(&help.stdout);
+    for name in ["smoke-box-2d", "smoke-plume-3d", "lid-driven-cavity"] {
+        assert!(list.lines().any(|l| l.starts_with(name)), "{name} not in {list}");
+        assert!(help.lines().any(|l| l.starts_with(name)), "{name} not in {help}");
+    }
+}
+
+/// A fluid run writes `.vti` frames of the density and velocity, their `.pvd`, the density
+/// preview and the metrics.
+#[test]
+fn a_fluid_run_writes_vti_frames_a_series_and_a_density_preview() {
+    for (scene, resolution, extent) in
+        [("lid-driven-cavity", "12", "0 12 0 12 0 0"), ("smoke-plume-3d", "6", "0 6 0 9 0 6")]
+    {
+        let dir = temp(scene);
+        let d = dir.to_str().unwrap();
+        let args = [
+            "run",
+            scene,
+            "--resolution",
+            resolution,
+            "--frames",
+            "3",
+            "--out",
+            d,
+            "--quiet",
+            "--preview-width",
+            "48",
+        ];
+        let (ok, err) = anim(&args);
+        assert!(ok, "{scene}: {err}");
+        for k in 0..3 {
+            let frame = dir.join("frames").join(format!("frame_0000{k}.vti"));
+            let text = std::fs::read_to_string(&frame).unwrap();
+            assert!(text.contains(&format!("WholeExtent=\"{extent}\"")), "{scene}: {text:.300}");
+            assert!(text.contains("Name=\"density\"") && text.contains("Name=\"velocity\""));
+        }
+        let pvd = std::fs::read_to_string(dir.join("frames").join("frames.pvd")).unwrap();
+        assert!(pvd.contains("file=\"frame_00002.vti\""), "{pvd}");
+        for file in ["preview.gif", "preview.png", "metrics.json"] {
+            assert!(dir.join(file).exists(), "{scene}: no {file}");
+        }
+        let metrics = std::fs::read_to_string(dir.join("metrics.json")).unwrap();
+        assert!(metrics.contains("\"status\": \"completed\"") && metrics.contains("fluid/"), "{metrics}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
+
+/// `anim resume` of a fluid run: the frames after the checkpoint are byte for byte those of an
+/// uninterrupted run (base64 of the values: equal text is equal bits).
+#[test]
+fn a_resumed_fluid_run_writes_the_frames_of_an_uninterrupted_one() {
+    for (scene, resolution) in [("smoke-box-2d", "16"), ("smoke-plume-3d", "6")] {
+        let whole = temp(&format!("{scene}-whole"));
+        let parts = temp(&format!("{scene}-parts"));
+        let common = ["--resolution", resolution, "--no-preview", "--quiet"];
+        let run = |out: &std::path::Path, frames: &str, extra: &[&str]| {
+            let mut args = vec!["run", scene, "--frames", frames, "--out", out.to_str().unwrap()];
+            args.extend(common);
+            args.extend(extra);
+            let (ok, err) = anim(&args);
+            assert!(ok, "{scene}: {err}");
+        };
+        run(&whole, "6", &[]);
+        run(&parts, "4", &["--checkpoint-every", "3"]);
+        let ckpt = parts.join("checkpoint.anim");
+        let (ok, err) = anim(&["resume", ckpt.to_str().unwrap(), "--frames", "6", "--quiet"]);
+        assert!(ok, "{scene}: {err}");
+        for k in 0..6 {
+            let name = format!("frame_0000{k}.vti");
+            let a = std::fs::read(whole.join("frames").join(&name)).unwrap();
+            let b = std::fs::read(parts.join("frames").join(&name)).unwrap();
+            assert!(a == b, "{scene}: {name} differs");
+        }
+        std::fs::remove_dir_all(&whole).ok();
+        std::fs::remove_dir_all(&parts).ok();
+    }
 }

@@ -1,12 +1,14 @@
 //! The crate's error type: bad parameters and grids are rejected up front, a step that produces
-//! a non-finite value or a failed pressure solve is reported with the step and the cell.
+//! a non-finite value or a failed pressure solve is reported with the step and the cell, and a
+//! checkpoint that does not fit the simulation is refused naming what is wrong. Every message
+//! begins with `anim-fluid: `, so a run driving several crates tells where it came from.
 
 /// Everything that can go wrong building or stepping a fluid.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum FluidError {
     /// A grid with no interior cells, or one too small for the method.
-    #[error("grid {what} must be at least {min} cells, got {got}")]
+    #[error("anim-fluid: grid {what} must be at least {min} cells, got {got}")]
     BadGrid {
         /// Which extent (`"N"`, `"nx"`, `"ny"`, `"nz"`).
         what: &'static str,
@@ -16,7 +18,7 @@ pub enum FluidError {
         got: usize,
     },
     /// A parameter outside its valid range.
-    #[error("parameter {name} {requirement}, got {value}")]
+    #[error("anim-fluid: parameter {name} {requirement}, got {value}")]
     BadParameter {
         /// The parameter's name.
         name: &'static str,
@@ -26,7 +28,7 @@ pub enum FluidError {
         value: String,
     },
     /// An input array of the wrong length.
-    #[error("{name} has {got} values, expected {expected}")]
+    #[error("anim-fluid: {name} has {got} values, expected {expected}")]
     BadLength {
         /// The array.
         name: &'static str,
@@ -35,8 +37,11 @@ pub enum FluidError {
         /// The length the grid needs.
         expected: usize,
     },
-    /// A step produced NaN or infinity.
-    #[error("non-finite {field} at step {step}, cell ({i}, {j}, {k}) (value {value})")]
+    /// A step produced NaN or infinity. The simulation is left as it was before the step.
+    #[error(
+        "anim-fluid: step {step}: non-finite {field} {value} at cell ({i}, {j}, {k}); {}",
+        last_finite_text(*last_finite)
+    )]
     NonFinite {
         /// Steps completed before the failing one.
         step: u64,
@@ -50,10 +55,12 @@ pub enum FluidError {
         k: usize,
         /// The offending value.
         value: f64,
+        /// The value the same cell (or face) held before the failing step, if that was finite.
+        last_finite: Option<f64>,
     },
     /// The pressure (or viscosity) solve did not reach its tolerance.
     #[error(
-        "{solve} solve at step {step} did not converge: residual {residual:.3e} after {iterations} iterations (tolerance {tolerance:.3e})"
+        "anim-fluid: {solve} solve at step {step} did not converge: residual {residual:.3e} after {iterations} iterations (tolerance {tolerance:.3e})"
     )]
     NotConverged {
         /// Steps completed before the failing one.
@@ -67,6 +74,16 @@ pub enum FluidError {
         /// The requested tolerance.
         tolerance: f64,
     },
+    /// A checkpointed memory that does not belong to this simulation, or a malformed one.
+    #[error("anim-fluid: checkpoint does not fit this simulation: {0}")]
+    Checkpoint(String),
+}
+
+fn last_finite_text(last: Option<f64>) -> String {
+    match last {
+        Some(v) => format!("last finite value there {v}"),
+        None => "no finite value there before the step".into(),
+    }
 }
 
 /// Checks `value > 0` and finite.

@@ -149,6 +149,8 @@ pub struct MacFluid {
     advect_tmp: [Vec<f64>; 3],
     scalar_old: Vec<f64>,
     backup: MacState,
+    /// The warm-start pressure before the current step, restored when the step fails.
+    s_backup: Vec<f64>,
     partials: Vec<f64>,
     rhs: Vec<f64>,
     s: Vec<f64>,
@@ -224,6 +226,7 @@ impl MacFluid {
             advect_tmp: [vec![0.0; max_len], vec![0.0; max_len], vec![0.0; max_len]],
             scalar_old: vec![0.0; cells],
             backup: state.clone(),
+            s_backup: vec![0.0; cells],
             partials: vec![0.0; max_len.div_ceil(crate::pressure::CHUNK) + 1],
             rhs: vec![0.0; cells],
             s: vec![0.0; cells],
@@ -1030,17 +1033,22 @@ impl MacFluid {
         info
     }
 
-    fn check_finite(&self, state: &MacState, step: u64) -> Result<(), FluidError> {
-        let fields: [(&'static str, &[f64], [usize; 3]); 5] = [
-            ("u", &state.vel[0], self.face_dims(0)),
-            ("v", &state.vel[1], self.face_dims(1)),
-            ("w", &state.vel[2], self.face_dims(2)),
-            ("density", &state.density, self.dims),
-            ("temperature", &state.temperature, self.dims),
+    /// The first non-finite value of `state` (fields in the order u, v, w, density,
+    /// temperature), reported with the value `before` held there.
+    fn check_finite(&self, state: &MacState, before: &MacState, step: u64) -> Result<(), FluidError> {
+        // (name, values after the step, values before it, lattice extents)
+        type Field<'a> = (&'static str, &'a [f64], &'a [f64], [usize; 3]);
+        let fields: [Field<'_>; 5] = [
+            ("u", &state.vel[0], &before.vel[0], self.face_dims(0)),
+            ("v", &state.vel[1], &before.vel[1], self.face_dims(1)),
+            ("w", &state.vel[2], &before.vel[2], self.face_dims(2)),
+            ("density", &state.density, &before.density, self.dims),
+            ("temperature", &state.temperature, &before.temperature, self.dims),
         ];
-        for (field, values, d) in fields {
+        for (field, values, old, d) in fields {
             if values.par_iter().any(|x| !x.is_finite()) {
                 let at = values.iter().position(|x| !x.is_finite()).unwrap_or(0);
+                let last = old.get(at).copied().filter(|x| x.is_finite());
                 return Err(FluidError::NonFinite {
                     step,
                     field,
@@ -1048,26 +1056,36 @@ impl MacFluid {
                     j: (at / d[0].max(1)) % d[1].max(1),
                     k: at / (d[0] * d[1]).max(1),
                     value: values[at],
+                    last_finite: last,
                 });
             }
         }
         Ok(())
     }
 
-    /// Advances `state` by `dt`; on error `state` is unchanged.
+    /// Advances `state` by `dt`; on error `state` and the warm-start pressure are exactly as
+    /// before the step (both are copied aside first, into buffers sized by [`MacFluid::new`]).
     ///
     /// # Errors
     /// [`FluidError::BadParameter`] for a non-positive or non-finite `dt`,
-    /// [`FluidError::NonFinite`] naming the field and cell, [`FluidError::NotConverged`] when a
-    /// solve misses its tolerance and `require_convergence` is set.
+    /// [`FluidError::NonFinite`] naming the field, the cell (or face), the value and the value
+    /// there before the step, [`FluidError::NotConverged`] when a solve misses its tolerance
+    /// and `require_convergence` is set.
+    ///
+    /// # Panics
+    /// If `state` does not have this fluid's array lengths (a state of another fluid; see
+    /// [`MacFluid::check_state`]).
+    #[track_caller]
     pub fn advance(&mut self, state: &mut MacState, dt: f64) -> Result<MacStepInfo, FluidError> {
         error::positive("dt", dt)?;
         let step = state.steps;
         let mut backup = std::mem::take(&mut self.backup);
         copy_state(state, &mut backup);
-        let result = self.advance_in_place(state, dt, step);
+        self.s_backup.copy_from_slice(&self.s);
+        let result = self.advance_in_place(state, &backup, dt, step);
         if result.is_err() {
             copy_state(&backup, state);
+            self.s.copy_from_slice(&self.s_backup);
         }
         self.backup = backup;
         let info = result?;
@@ -1075,9 +1093,84 @@ impl MacFluid {
         Ok(info)
     }
 
+    /// Checks that `state` fits this fluid: array lengths, finite values, finite time.
+    ///
+    /// # Errors
+    /// [`FluidError::BadLength`] naming the array, [`FluidError::Checkpoint`] naming the array
+    /// and index of a non-finite value or a non-finite time.
+    pub fn check_state(&self, state: &MacState) -> Result<(), FluidError> {
+        let cells = self.solid.len();
+        let fields: [(&'static str, &[f64], usize); 5] = [
+            ("u", &state.vel[0], self.face_dims(0).iter().product()),
+            ("v", &state.vel[1], self.face_dims(1).iter().product()),
+            ("w", &state.vel[2], self.face_dims(2).iter().product()),
+            ("density", &state.density, cells),
+            ("temperature", &state.temperature, cells),
+        ];
+        for (name, values, expected) in fields {
+            if values.len() != expected {
+                return Err(FluidError::BadLength { name, got: values.len(), expected });
+            }
+            if let Some(at) = values.iter().position(|x| !x.is_finite()) {
+                return Err(FluidError::Checkpoint(format!("`{name}`[{at}] is {}", values[at])));
+            }
+        }
+        if !(state.time.is_finite() && state.time >= 0.0) {
+            return Err(FluidError::Checkpoint(format!(
+                "time {} is not finite and non-negative",
+                state.time
+            )));
+        }
+        Ok(())
+    }
+
+    /// What the solver itself carries from one step to the next: the pressure of the last
+    /// projection, the next solve's starting guess. With the [`MacState`], it continues a run bit
+    /// for bit ([`MacFluid::restore_memory`]).
+    #[must_use]
+    pub fn memory(&self) -> serde_json::Value {
+        serde_json::json!({ "dims": self.dims, "pressure": self.s })
+    }
+
+    /// Restores what [`MacFluid::memory`] of a fluid of the same grid returned. Nothing changes
+    /// on error.
+    ///
+    /// # Errors
+    /// [`FluidError::Checkpoint`] when a field is missing or mistyped, the grid differs, the
+    /// pressure has the wrong length or a non-finite value.
+    pub fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), FluidError> {
+        let dims: [usize; 3] = memory
+            .get("dims")
+            .and_then(|d| serde_json::from_value(d.clone()).ok())
+            .ok_or_else(|| FluidError::Checkpoint("no grid `dims` (three cell counts)".into()))?;
+        if dims != self.dims {
+            return Err(FluidError::Checkpoint(format!(
+                "the checkpoint is of a {dims:?} grid, this fluid is {:?}",
+                self.dims
+            )));
+        }
+        let pressure: Vec<f64> = memory
+            .get("pressure")
+            .and_then(|d| serde_json::from_value(d.clone()).ok())
+            .ok_or_else(|| FluidError::Checkpoint("no `pressure` (an array of numbers)".into()))?;
+        if pressure.len() != self.s.len() {
+            return Err(FluidError::Checkpoint(format!(
+                "`pressure` has {} values, the grid has {} cells",
+                pressure.len(),
+                self.s.len()
+            )));
+        }
+        if let Some(at) = pressure.iter().position(|x| !x.is_finite()) {
+            return Err(FluidError::Checkpoint(format!("`pressure`[{at}] is {}", pressure[at])));
+        }
+        self.s.copy_from_slice(&pressure);
+        Ok(())
+    }
+
     fn advance_in_place(
         &mut self,
         next: &mut MacState,
+        before: &MacState,
         dt: f64,
         step: u64,
     ) -> Result<MacStepInfo, FluidError> {
@@ -1106,7 +1199,7 @@ impl MacFluid {
             if self.params.viscosity > 0.0 { self.viscosity(next, dt, step)? } else { 0 };
         let pressure = self.project(next);
         self.enforce_walls(&mut next.vel);
-        self.check_finite(next, step)?;
+        self.check_finite(next, before, step)?;
         if !pressure.converged && self.params.require_convergence {
             return Err(FluidError::NotConverged {
                 step,
@@ -1196,6 +1289,109 @@ mod tests {
     fn taylor_green_decay_matches_analytic_at_low_resolution() {
         let (a, exact) = taylor_green(32, Advection::MacCormack, 0.05, 0.5);
         assert!((a / exact - 1.0).abs() < 0.02, "{a} vs {exact}");
+    }
+
+    /// Finite but huge densities overflow the buoyancy force (`-alpha (rho_a + rho_b) / 2` is
+    /// infinite): the step fails naming the step, field, face, value and the face's value
+    /// before the step, and leaves the state and the warm-start pressure bitwise as they were.
+    #[test]
+    fn overflow_is_reported_and_the_step_undone() {
+        for (dims, dim) in [([8, 8, 1], 2), ([6, 6, 6], 3)] {
+            let params = MacParams { buoyancy_density: 10.0, ..MacParams::default() };
+            let (mut fluid, mut state) = MacFluid::new(dims, dim, 0.125, params).unwrap();
+            fluid.set_velocity(&mut state, |p| [(3.0 * p[1]).sin() + 1.0, (2.0 * p[0]).cos(), p[0]]);
+            for _ in 0..2 {
+                fluid.advance(&mut state, 0.05).unwrap();
+            }
+            let c = idx(dims, 3, 2, dims[2] / 2);
+            state.density[c] = 1e308;
+            state.density[c + dims[0]] = 1e308;
+            let before = state.clone();
+            let memory = serde_json::to_string(&fluid.memory()).unwrap();
+            assert!(fluid.memory()["pressure"].as_array().unwrap().iter().any(|p| p.as_f64() != Some(0.0)));
+            let err = fluid.advance(&mut state, 0.05).unwrap_err();
+            let FluidError::NonFinite { step, field, i, j, k, value, last_finite } = err.clone() else {
+                panic!("{err}")
+            };
+            assert_eq!(step, 2);
+            assert!(!value.is_finite());
+            let (old, d) = match field {
+                "u" => (&before.vel[0], fluid.face_dims(0)),
+                "v" => (&before.vel[1], fluid.face_dims(1)),
+                "w" => (&before.vel[2], fluid.face_dims(2)),
+                "density" => (&before.density, dims),
+                "temperature" => (&before.temperature, dims),
+                other => panic!("field {other}"),
+            };
+            assert!(i < d[0] && j < d[1] && k < d[2], "{err}");
+            let last = old[idx(d, i, j, k)];
+            assert_eq!(last_finite, Some(last));
+            let msg = err.to_string();
+            assert!(msg.starts_with("anim-fluid: step 2: non-finite "), "{msg}");
+            assert!(msg.contains(&format!("{field} {value} at cell ({i}, {j}, {k})")), "{msg}");
+            assert!(msg.contains(&format!("last finite value there {last}")), "{msg}");
+            let bits = |s: &MacState| {
+                s.vel
+                    .iter()
+                    .chain([&s.density, &s.temperature])
+                    .flatten()
+                    .map(|x| x.to_bits())
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(bits(&state), bits(&before));
+            assert_eq!((state.steps, state.time.to_bits()), (before.steps, before.time.to_bits()));
+            assert_eq!(serde_json::to_string(&fluid.memory()).unwrap(), memory, "warm start changed");
+        }
+    }
+
+    /// Every pressure method and advection scheme, 2D and 3D: the state and the solver's memory
+    /// continue a run bit for bit.
+    #[test]
+    fn state_and_memory_continue_bit_for_bit() {
+        for (k, method) in PressureMethod::ALL.into_iter().enumerate() {
+            for (dims, dim) in [([10, 8, 1], 2), ([6, 5, 4], 3)] {
+                let params = MacParams {
+                    pressure: method,
+                    pressure_tolerance: 1e-6,
+                    pressure_max_iterations: 100_000,
+                    viscosity: 0.01,
+                    advection: Advection::ALL[k % 4],
+                    buoyancy_temperature: 1.0,
+                    vorticity_confinement: 1.0,
+                    sources: vec![Source {
+                        min: [0.3, 0.0, 0.3],
+                        max: [0.6, 0.2, 0.6],
+                        density: 1.0,
+                        temperature: 1.0,
+                        velocity: None,
+                    }],
+                    ..MacParams::default()
+                };
+                let build = || {
+                    let (mut f, mut s) = MacFluid::new(dims, dim, 0.1, params.clone()).unwrap();
+                    f.set_solid(|p| (p[0] - 0.7).powi(2) + (p[1] - 0.5).powi(2) < 0.01).unwrap();
+                    f.set_velocity(&mut s, |p| [(3.0 * p[1]).sin(), (2.0 * p[0]).cos(), 0.5 * p[1]]);
+                    (f, s)
+                };
+                let (mut f, mut s) = build();
+                for _ in 0..2 {
+                    f.advance(&mut s, 0.05).unwrap();
+                }
+                let saved = serde_json::to_string(&(&s, f.memory())).unwrap();
+                for _ in 0..3 {
+                    f.advance(&mut s, 0.05).unwrap();
+                }
+                let (mut g, _) = build();
+                let (mut r, memory): (MacState, serde_json::Value) = serde_json::from_str(&saved).unwrap();
+                g.check_state(&r).unwrap();
+                g.restore_memory(&memory).unwrap();
+                for _ in 0..3 {
+                    g.advance(&mut r, 0.05).unwrap();
+                }
+                let text = |s: &MacState, f: &MacFluid| serde_json::to_string(&(s, f.memory())).unwrap();
+                assert_eq!(text(&s, &f), text(&r, &g), "{method:?} {dim}D");
+            }
+        }
     }
 
     #[test]

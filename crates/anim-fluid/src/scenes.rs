@@ -4,7 +4,7 @@
 //! | --- | --- | --- | --- |
 //! | [`smoke_box_2d`] | the seed's interactive-style demo: a smoke source at the bottom of a closed box pushes density up, its sideways force flipping every 25 steps | [`seed`](crate::seed) mode, `f32`, 20 Gauss-Seidel sweeps | the seed's routines exactly, as Stam's demo runs them |
 //! | [`smoke_plume_3d`] | hot smoke rises from a vent around a sphere into an open-topped box | MAC 3D, MacCormack, MGPCG, buoyancy + vorticity confinement | the 3D solver with an obstacle, inflow and an open boundary |
-//! | [`lid_driven_cavity`] | the unit square, top wall sliding at 1, Re = 100 | MAC 2D, MacCormack, MGPCG, implicit viscosity | the classic steady benchmark (Ghia, Ghia and Shin 1982) |
+//! | [`lid_driven_cavity`] | the unit square, top wall sliding at 1, Re = 100, bands of passive dye | MAC 2D, MacCormack, MGPCG, implicit viscosity | the classic steady benchmark (Ghia, Ghia and Shin 1982) |
 //!
 //! ```
 //! use anim_fluid::scenes;
@@ -23,6 +23,7 @@ use crate::mac::{MacFluid, MacParams, MacState, Source, Wall};
 use crate::pressure::PressureMethod;
 use crate::seed::{SeedFluid, SeedParams, ix};
 use anim_core::solver::{Solver, StepReport};
+use serde::Deserialize as _;
 
 /// The built-in scene names.
 pub const NAMES: [&str; 3] = ["smoke-box-2d", "smoke-plume-3d", "lid-driven-cavity"];
@@ -59,18 +60,71 @@ impl FluidScene {
         (self.duration / self.dt).round().max(1.0) as usize
     }
 
-    /// Advances one step of `dt` (the seed scene first applies its source pattern).
+    /// Advances one step of the scene's `dt` (the seed scene first applies its source pattern).
     ///
     /// # Errors
-    /// The solver's [`FluidError`].
+    /// The solver's [`FluidError`]; the simulation is then as before the step.
     pub fn step(&mut self) -> Result<StepReport, FluidError> {
+        self.step_by(self.dt)
+    }
+
+    /// Advances one step of `dt` (the seed scene first applies its source pattern; its solver
+    /// takes the step in `f32`, so `dt` is rounded to `f32` there).
+    ///
+    /// # Errors
+    /// [`FluidError::BadParameter`] for a non-positive or non-finite `dt`; the solver's
+    /// [`FluidError`]. The fields, step count and time are then as before the step (the seed
+    /// scene's source arrays hold the failed step's source pattern, which the next step writes
+    /// again in full).
+    pub fn step_by(&mut self, dt: f64) -> Result<StepReport, FluidError> {
+        crate::error::positive("dt", dt)?;
         match &mut self.sim {
             FluidSim::Seed(f) => {
+                let dt32 = dt as f32;
+                if dt32 != f.params().dt {
+                    f.set_dt(dt32)?;
+                }
                 f.apply_source_pattern();
                 f.step()?;
-                Ok(StepReport::at_time(f.steps() as f64 * f64::from(f.params().dt)))
+                Ok(StepReport::at_time(f.time()))
             }
-            FluidSim::Mac(f, s) => f.step(s, self.dt),
+            FluidSim::Mac(f, s) => f.step(s, dt),
+        }
+    }
+
+    /// Steps taken.
+    #[must_use]
+    pub fn steps_taken(&self) -> u64 {
+        match &self.sim {
+            FluidSim::Seed(f) => f.steps(),
+            FluidSim::Mac(_, s) => s.steps,
+        }
+    }
+
+    /// Simulated time.
+    #[must_use]
+    pub fn time(&self) -> f64 {
+        match &self.sim {
+            FluidSim::Seed(f) => f.time(),
+            FluidSim::Mac(_, s) => s.time,
+        }
+    }
+
+    /// 2 or 3.
+    #[must_use]
+    pub fn dim(&self) -> usize {
+        match &self.sim {
+            FluidSim::Seed(_) => 2,
+            FluidSim::Mac(f, _) => f.dim(),
+        }
+    }
+
+    /// Cell size (world units; the domain's corner is at the origin).
+    #[must_use]
+    pub fn cell_size(&self) -> f64 {
+        match &self.sim {
+            FluidSim::Seed(f) => 1.0 / f.n() as f64,
+            FluidSim::Mac(f, _) => f.h(),
         }
     }
 
@@ -86,44 +140,107 @@ impl FluidScene {
     /// Density per interior cell (x fastest, then y, then z) and the dimensions.
     #[must_use]
     pub fn density(&self) -> (Vec<f64>, [usize; 3]) {
-        let dims = self.dims();
+        let mut out = Vec::new();
+        self.density_into(&mut out);
+        (out, self.dims())
+    }
+
+    /// [`FluidScene::density`] into `out` (resized; no allocation once it has the capacity).
+    pub fn density_into(&self, out: &mut Vec<f64>) {
+        out.clear();
         match &self.sim {
             FluidSim::Seed(f) => {
                 let n = f.n();
                 let d = f.density();
-                let v = (1..=n).flat_map(|j| (1..=n).map(move |i| f64::from(d[ix(n, i, j)]))).collect();
-                (v, dims)
+                out.extend((1..=n).flat_map(|j| (1..=n).map(move |i| f64::from(d[ix(n, i, j)]))));
             }
-            FluidSim::Mac(_, s) => (s.density.clone(), dims),
+            FluidSim::Mac(_, s) => out.extend_from_slice(&s.density),
         }
     }
 
     /// Velocity at the cell centres (x fastest), 3 components (z = 0 in 2D), and the dimensions.
     #[must_use]
     pub fn velocity(&self) -> (Vec<[f64; 3]>, [usize; 3]) {
+        let mut flat = Vec::new();
+        self.velocity_into(&mut flat);
+        (flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(), self.dims())
+    }
+
+    /// [`FluidScene::velocity`] flattened (`[u0, v0, w0, u1, ...]`) into `out` (resized; no
+    /// allocation once it has the capacity).
+    pub fn velocity_into(&self, out: &mut Vec<f64>) {
+        out.clear();
         let dims = self.dims();
         match &self.sim {
             FluidSim::Seed(f) => {
                 let n = f.n();
                 let (u, v) = f.velocity();
-                let out = (1..=n)
-                    .flat_map(|j| {
-                        (1..=n).map(move |i| [f64::from(u[ix(n, i, j)]), f64::from(v[ix(n, i, j)]), 0.0])
-                    })
-                    .collect();
-                (out, dims)
+                for j in 1..=n {
+                    for i in 1..=n {
+                        out.extend([f64::from(u[ix(n, i, j)]), f64::from(v[ix(n, i, j)]), 0.0]);
+                    }
+                }
             }
             FluidSim::Mac(f, s) => {
-                let mut out = Vec::with_capacity(dims[0] * dims[1] * dims[2]);
                 for k in 0..dims[2] {
                     for j in 0..dims[1] {
                         for i in 0..dims[0] {
-                            out.push(f.velocity_at_point(s, f.cell_centre(i, j, k)));
+                            out.extend(f.velocity_at_point(s, f.cell_centre(i, j, k)));
                         }
                     }
                 }
-                (out, dims)
             }
+        }
+    }
+
+    /// Everything the scene's simulation carries from one step to the next, for checkpoints:
+    /// the seed solver's six arrays, step count and time ([`SeedFluid::memory`]), or the MAC
+    /// solver's [`MacState`] (velocities, density, temperature, step count, time) and its
+    /// warm-start pressure ([`MacFluid::memory`]). A scene built by the same call and given this
+    /// by [`FluidScene::restore_memory`] continues bit for bit.
+    #[must_use]
+    pub fn memory(&self) -> serde_json::Value {
+        match &self.sim {
+            FluidSim::Seed(f) => serde_json::json!({ "solver": "seed", "seed": f.memory() }),
+            FluidSim::Mac(f, s) => {
+                serde_json::json!({ "solver": "mac", "state": s, "simulation": f.memory() })
+            }
+        }
+    }
+
+    /// Restores what [`FluidScene::memory`] of the same scene returned. Nothing changes on
+    /// error.
+    ///
+    /// # Errors
+    /// [`FluidError::Checkpoint`] (or [`FluidError::BadLength`] for a state array of the wrong
+    /// length) naming what does not fit: the solver kind, a missing or mistyped field, the
+    /// grid, an array's length or a non-finite value.
+    pub fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), FluidError> {
+        let solver = memory
+            .get("solver")
+            .and_then(serde_json::Value::as_str)
+            .ok_or_else(|| FluidError::Checkpoint("no `solver` (\"seed\" or \"mac\")".into()))?;
+        let field = |key: &str| {
+            memory.get(key).ok_or_else(|| FluidError::Checkpoint(format!("no `{key}` in a {solver} memory")))
+        };
+        match &mut self.sim {
+            FluidSim::Seed(f) if solver == "seed" => f.restore_memory(field("seed")?),
+            FluidSim::Mac(f, s) if solver == "mac" => {
+                let state = MacState::deserialize(field("state")?)
+                    .map_err(|e| FluidError::Checkpoint(format!("`state`: {e}")))?;
+                f.check_state(&state)?;
+                // Both checked before anything changes: `restore_memory` validates first.
+                f.restore_memory(field("simulation")?)?;
+                *s = state;
+                Ok(())
+            }
+            _ => Err(FluidError::Checkpoint(format!(
+                "a {solver} memory for a scene run by the {} solver",
+                match self.sim {
+                    FluidSim::Seed(_) => "seed",
+                    FluidSim::Mac(..) => "mac",
+                }
+            ))),
         }
     }
 }
@@ -198,7 +315,9 @@ pub fn smoke_plume_3d(n: usize) -> Result<FluidScene, FluidError> {
 
 /// The lid-driven cavity: unit square, `n x n` cells, the top wall moving at `u = 1`, viscosity
 /// `1 / re`, implicit viscosity, MGPCG (tolerance 1e-8), dt = h (CFL 1 at the lid), run to
-/// t = 20 (steady at Re = 100).
+/// t = 20 (steady at Re = 100). The density is a passive dye (no buoyancy) in eight
+/// horizontal bands, 1 and 0 alternating, that shows the flow in pictures and leaves the
+/// velocity untouched.
 ///
 /// # Errors
 /// [`FluidError::BadGrid`] for `n < 2`, [`FluidError::BadParameter`] for `re <= 0`.
@@ -215,7 +334,11 @@ pub fn lid_driven_cavity(n: usize, re: f64, advection: Advection) -> Result<Flui
         walls,
         ..MacParams::default()
     };
-    let (fluid, state) = MacFluid::new([n, n, 1], 2, h, params)?;
+    let (fluid, mut state) = MacFluid::new([n, n, 1], 2, h, params)?;
+    for (c, d) in state.density.iter_mut().enumerate() {
+        let j = c / n;
+        *d = if (8 * j / n).is_multiple_of(2) { 1.0 } else { 0.0 };
+    }
     Ok(FluidScene {
         name: "lid-driven-cavity",
         description: "lid-driven cavity, Re = 100",
@@ -240,6 +363,115 @@ mod tests {
         }
         assert!(by_name("nope", None).is_none());
         assert!(matches!(smoke_box_2d(1), Err(FluidError::BadGrid { .. })));
+    }
+
+    fn memory_text(scene: &FluidScene) -> String {
+        serde_json::to_string(&scene.memory()).unwrap()
+    }
+
+    /// Run n steps, save through JSON text, run m more; a fresh scene given the saved memory
+    /// and run m steps ends with the same bits (JSON prints every value in its shortest
+    /// round-trip form, so equal text is equal bits; `-0.0` prints differently from `0.0`).
+    #[test]
+    fn every_scene_resumes_from_its_memory_bit_for_bit() {
+        for (name, res) in [("smoke-box-2d", 16), ("lid-driven-cavity", 12), ("smoke-plume-3d", 8)] {
+            let mut whole = by_name(name, Some(res)).unwrap().unwrap();
+            for _ in 0..3 {
+                whole.step().unwrap();
+            }
+            let saved = memory_text(&whole);
+            for _ in 0..4 {
+                whole.step().unwrap();
+            }
+            let mut resumed = by_name(name, Some(res)).unwrap().unwrap();
+            resumed.restore_memory(&serde_json::from_str(&saved).unwrap()).unwrap();
+            assert_eq!(resumed.steps_taken(), 3, "{name}");
+            for _ in 0..4 {
+                resumed.step().unwrap();
+            }
+            assert_eq!(memory_text(&whole), memory_text(&resumed), "{name}");
+            let bits = |v: Vec<f64>| v.into_iter().map(f64::to_bits).collect::<Vec<_>>();
+            assert_eq!(bits(whole.density().0), bits(resumed.density().0), "{name}");
+            assert_eq!(whole.time().to_bits(), resumed.time().to_bits(), "{name}");
+            // The run moved: the comparison is not between two resting fields.
+            assert!(whole.velocity().0.iter().any(|c| c[0] != 0.0 || c[1] != 0.0), "{name}");
+        }
+    }
+
+    /// The MAC solver's warm-start pressure is part of what a step reads: restoring the state
+    /// alone does not continue the run bit for bit.
+    #[test]
+    fn mac_memory_needs_the_warm_start_pressure() {
+        let mut whole = smoke_plume_3d(8).unwrap();
+        for _ in 0..3 {
+            whole.step().unwrap();
+        }
+        let mut saved = whole.memory();
+        whole.step().unwrap();
+        let mut cold = smoke_plume_3d(8).unwrap();
+        let FluidSim::Mac(f, _) = &cold.sim else { panic!("a MAC scene") };
+        saved["simulation"] = f.memory();
+        cold.restore_memory(&saved).unwrap();
+        cold.step().unwrap();
+        assert_ne!(memory_text(&whole), memory_text(&cold));
+    }
+
+    #[test]
+    fn malformed_or_foreign_memories_are_refused_and_change_nothing() {
+        let mut seed = by_name("smoke-box-2d", Some(8)).unwrap().unwrap();
+        let mut mac = by_name("lid-driven-cavity", Some(8)).unwrap().unwrap();
+        let mut mac3 = by_name("smoke-plume-3d", Some(6)).unwrap().unwrap();
+        for scene in [&mut seed, &mut mac, &mut mac3] {
+            scene.step().unwrap();
+        }
+        let other_seed = by_name("smoke-box-2d", Some(10)).unwrap().unwrap().memory();
+        let other_mac = by_name("lid-driven-cavity", Some(10)).unwrap().unwrap().memory();
+        let edit = |m: &serde_json::Value, f: &dyn Fn(&mut serde_json::Value)| {
+            let mut m = m.clone();
+            f(&mut m);
+            m
+        };
+        let (sm, mm, m3) = (seed.memory(), mac.memory(), mac3.memory());
+        // 0: the seed's 2D box, 1: a MAC 2D cavity, 2: the MAC 3D plume.
+        let cases: Vec<(usize, serde_json::Value, &str)> = vec![
+            (0, serde_json::json!(42), "no `solver`"),
+            (0, mm.clone(), "a mac memory for a scene run by the seed solver"),
+            (0, other_seed, "N = 10 grid, this fluid has N = 8"),
+            (0, edit(&sm, &|m| m["seed"]["u"].as_array_mut().unwrap().truncate(5)), "`u` has 5 values"),
+            (0, edit(&sm, &|m| m["seed"]["v"][3] = "x".into()), "not a seed-fluid memory"),
+            (0, edit(&sm, &|m| m["seed"]["steps"] = (-1).into()), "not a seed-fluid memory"),
+            (0, edit(&sm, &|m| m["seed"]["params"]["dt"] = 0.5.into()), "settings"),
+            (0, edit(&sm, &|m| m["seed"]["extra"] = 1.into()), "unknown field `extra`"),
+            (1, sm.clone(), "a seed memory for a scene run by the mac solver"),
+            (1, other_mac, "u has 110 values, expected 72"),
+            (1, edit(&mm, &|m| m["simulation"]["dims"] = serde_json::json!([8, 9, 1])), "[8, 9, 1] grid"),
+            (
+                1,
+                edit(&mm, &|m| {
+                    m["simulation"]["pressure"].as_array_mut().unwrap().pop().map(|_| ()).unwrap()
+                }),
+                "`pressure` has 63 values",
+            ),
+            (1, edit(&mm, &|m| m["state"]["density"][0] = serde_json::Value::Null), "`state`"),
+            (1, edit(&mm, &|m| m["state"]["time"] = (-1.0).into()), "time -1"),
+            (
+                1,
+                edit(&mm, &|m| {
+                    m.as_object_mut().unwrap().remove("simulation");
+                }),
+                "no `simulation`",
+            ),
+            (2, edit(&m3, &|m| m["state"]["vel"][2] = serde_json::json!([])), "w has 0 values, expected 378"),
+        ];
+        let mut scenes = [seed, mac, mac3];
+        for (which, memory, expect) in cases {
+            let scene = &mut scenes[which];
+            let before = memory_text(scene);
+            let err = scene.restore_memory(&memory).unwrap_err();
+            let msg = err.to_string();
+            assert!(msg.starts_with("anim-fluid: ") && msg.contains(expect), "{expect}: {msg}");
+            assert_eq!(memory_text(scene), before, "{expect}: the scene changed");
+        }
     }
 
     #[test]

@@ -32,6 +32,7 @@
 //! band's rows are independent chains the processor overlaps.
 
 use crate::error::{self, FluidError};
+use serde::Deserialize as _;
 
 /// Gauss-Seidel sweeps per `lin_solve`, as in the seed.
 pub const SWEEPS: usize = 20;
@@ -232,17 +233,37 @@ impl Default for SeedParams {
 ///
 /// Fill the sources ([`SeedFluid::sources_mut`], or [`SeedFluid::apply_source_pattern`]) before
 /// each [`SeedFluid::step`], as the seed's `get_force_source` does; the step consumes them.
-#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+/// [`SeedFluid::memory`] and [`SeedFluid::restore_memory`] checkpoint it.
+#[derive(Debug, Clone)]
 pub struct SeedFluid {
     n: usize,
     params: SeedParams,
     steps: u64,
+    time: f64,
     dens: Vec<f32>,
     dens_prev: Vec<f32>,
     u: Vec<f32>,
     v: Vec<f32>,
     u_prev: Vec<f32>,
     v_prev: Vec<f32>,
+    /// The six arrays before the current step, restored when the step fails.
+    backup: [Vec<f32>; 6],
+}
+
+/// What [`SeedFluid::memory`] writes: everything a step reads.
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SeedMemory {
+    n: usize,
+    params: SeedParams,
+    steps: u64,
+    time: f64,
+    density: Vec<f32>,
+    density_source: Vec<f32>,
+    u: Vec<f32>,
+    v: Vec<f32>,
+    u_source: Vec<f32>,
+    v_source: Vec<f32>,
 }
 
 impl SeedFluid {
@@ -263,6 +284,8 @@ impl SeedFluid {
             n,
             params,
             steps: 0,
+            time: 0.0,
+            backup: std::array::from_fn(|_| vec![0.0; size]),
             dens: vec![0.0; size],
             dens_prev: vec![0.0; size],
             u: vec![0.0; size],
@@ -290,6 +313,22 @@ impl SeedFluid {
         self.steps
     }
 
+    /// Simulated time: the sum of the steps' `dt` (in `f64`).
+    #[must_use]
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Changes the time step of the following steps.
+    ///
+    /// # Errors
+    /// [`FluidError::BadParameter`] for `dt <= 0` or a non-finite `dt`.
+    pub fn set_dt(&mut self, dt: f32) -> Result<(), FluidError> {
+        error::positive("dt", f64::from(dt))?;
+        self.params.dt = dt;
+        Ok(())
+    }
+
     /// Density, `(N+2)^2` values indexed by [`ix`].
     #[must_use]
     pub fn density(&self) -> &[f32] {
@@ -315,28 +354,134 @@ impl SeedFluid {
     /// The seed's `sim_main` after `get_force_source`: `vel_step`, then `dens_step`.
     ///
     /// # Errors
-    /// [`FluidError::NonFinite`] naming the field and cell if the step produced NaN or infinity
-    /// (only possible from non-finite sources or parameters that overflow `f32`); the fields then
-    /// hold the failed step's values, as the C code would.
+    /// [`FluidError::NonFinite`] naming the field, the cell (`i`, `j` index the `(N+2)^2` array,
+    /// border included; `k = 0`), the value and the value the cell held before the step, if the
+    /// step produced NaN or infinity (from non-finite sources, or finite ones large enough to
+    /// overflow `f32`). The six arrays, sources included, and the step count are then exactly as
+    /// before the step (they are copied aside before each step; nothing is allocated).
     pub fn step(&mut self) -> Result<(), FluidError> {
         let (n, p) = (self.n, self.params);
+        for (b, a) in self.backup.iter_mut().zip([
+            &self.dens,
+            &self.dens_prev,
+            &self.u,
+            &self.v,
+            &self.u_prev,
+            &self.v_prev,
+        ]) {
+            b.copy_from_slice(a);
+        }
         vel_step(n, &mut self.u, &mut self.v, &mut self.u_prev, &mut self.v_prev, p.visc, p.dt);
         dens_step(n, &mut self.dens, &mut self.dens_prev, &self.u, &self.v, p.diff, p.dt);
         let step = self.steps;
-        self.steps += 1;
-        for (field, values) in [("density", &self.dens), ("u", &self.u), ("v", &self.v)] {
+        // Backup order: dens, dens_prev, u, v, u_prev, v_prev.
+        let mut failure = None;
+        for (field, values, before) in [("density", &self.dens, 0), ("u", &self.u, 2), ("v", &self.v, 3)] {
+            // One multiply-add per value: NaN as soon as any value is NaN or infinite.
             if values.iter().fold(0.0f32, |acc, &x| acc + x * 0.0) != 0.0 {
                 let at = values.iter().position(|x| !x.is_finite()).unwrap_or(0);
-                return Err(FluidError::NonFinite {
+                let last = self.backup[before][at];
+                failure = Some(FluidError::NonFinite {
                     step,
                     field,
                     i: at % (n + 2),
                     j: at / (n + 2),
                     k: 0,
                     value: f64::from(values[at]),
+                    last_finite: last.is_finite().then_some(f64::from(last)),
                 });
+                break;
             }
         }
+        if let Some(err) = failure {
+            let [d, dp, u, v, up, vp] = &self.backup;
+            self.dens.copy_from_slice(d);
+            self.dens_prev.copy_from_slice(dp);
+            self.u.copy_from_slice(u);
+            self.v.copy_from_slice(v);
+            self.u_prev.copy_from_slice(up);
+            self.v_prev.copy_from_slice(vp);
+            return Err(err);
+        }
+        self.steps += 1;
+        self.time += f64::from(p.dt);
+        Ok(())
+    }
+
+    /// Everything a step reads (the six arrays, step count, time, `N` and the settings), for
+    /// checkpoints: a fluid built with the same `N` and settings and given this by
+    /// [`SeedFluid::restore_memory`] continues bit for bit (`f32` values round-trip exactly
+    /// through JSON).
+    #[must_use]
+    pub fn memory(&self) -> serde_json::Value {
+        let m = SeedMemory {
+            n: self.n,
+            params: self.params,
+            steps: self.steps,
+            time: self.time,
+            density: self.dens.clone(),
+            density_source: self.dens_prev.clone(),
+            u: self.u.clone(),
+            v: self.v.clone(),
+            u_source: self.u_prev.clone(),
+            v_source: self.v_prev.clone(),
+        };
+        serde_json::to_value(m).unwrap_or(serde_json::Value::Null)
+    }
+
+    /// Restores what [`SeedFluid::memory`] returned. Nothing changes on error.
+    ///
+    /// # Errors
+    /// [`FluidError::Checkpoint`] naming the problem: not a seed-fluid memory (missing, unknown
+    /// or mistyped fields), another `N` or other settings, an array of the wrong length, a
+    /// non-finite value (naming the array and index) or a non-finite time.
+    pub fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), FluidError> {
+        let m = SeedMemory::deserialize(memory)
+            .map_err(|e| FluidError::Checkpoint(format!("not a seed-fluid memory: {e}")))?;
+        if m.n != self.n {
+            return Err(FluidError::Checkpoint(format!(
+                "the checkpoint is of an N = {} grid, this fluid has N = {}",
+                m.n, self.n
+            )));
+        }
+        if m.params != self.params {
+            return Err(FluidError::Checkpoint(format!(
+                "the checkpoint's settings {:?} differ from this fluid's {:?}",
+                m.params, self.params
+            )));
+        }
+        if !m.time.is_finite() || m.time < 0.0 {
+            return Err(FluidError::Checkpoint(format!("time {} is not finite and non-negative", m.time)));
+        }
+        let size = (self.n + 2) * (self.n + 2);
+        let arrays = [
+            ("density", &m.density),
+            ("density_source", &m.density_source),
+            ("u", &m.u),
+            ("v", &m.v),
+            ("u_source", &m.u_source),
+            ("v_source", &m.v_source),
+        ];
+        for (name, a) in arrays {
+            if a.len() != size {
+                return Err(FluidError::Checkpoint(format!(
+                    "`{name}` has {} values, an N = {} grid has (N+2)^2 = {size}",
+                    a.len(),
+                    self.n
+                )));
+            }
+            if let Some(at) = a.iter().position(|x| !x.is_finite()) {
+                return Err(FluidError::Checkpoint(format!("`{name}`[{at}] is {}", a[at])));
+            }
+        }
+        self.steps = m.steps;
+        self.time = m.time;
+        self.dens = m.density;
+        self.dens_prev = m.density_source;
+        self.u = m.u;
+        self.v = m.v;
+        self.u_prev = m.u_source;
+        self.v_prev = m.v_source;
         Ok(())
     }
 
@@ -455,5 +600,52 @@ mod tests {
         let mut f = SeedFluid::new(8, SeedParams::default()).unwrap();
         f.sources_mut().0[ix(8, 4, 4)] = f32::NAN;
         assert!(matches!(f.step(), Err(FluidError::NonFinite { field: "density", step: 0, .. })));
+    }
+
+    /// A finite but huge force overflows `f32` inside the step (`u += dt * f` is infinite, and
+    /// the solves turn it into NaN): the error names the step, field, cell, value and the cell's
+    /// value before the step, and the fluid (sources included) is bitwise as before.
+    #[test]
+    fn overflow_is_reported_and_the_step_undone() {
+        let n = 8;
+        let mut f = SeedFluid::new(n, SeedParams { dt: 4.0, ..SeedParams::default() }).unwrap();
+        for _ in 0..3 {
+            f.apply_source_pattern();
+            f.step().unwrap();
+        }
+        f.apply_source_pattern();
+        f.sources_mut().1[ix(n, 3, 5)] = f32::MAX;
+        let before = f.clone();
+        let err = f.step().unwrap_err();
+        let FluidError::NonFinite { step, field, i, j, k, value, last_finite } = err.clone() else {
+            panic!("{err}")
+        };
+        assert_eq!((step, k), (3, 0));
+        assert!(!value.is_finite());
+        let old = match field {
+            "density" => before.density(),
+            "u" => before.velocity().0,
+            "v" => before.velocity().1,
+            other => panic!("field {other}"),
+        };
+        assert_eq!(last_finite, Some(f64::from(old[ix(n, i, j)])));
+        let msg = err.to_string();
+        for part in [
+            "anim-fluid: ".to_string(),
+            format!("step 3: non-finite {field} {value}"),
+            format!("cell ({i}, {j}, 0)"),
+            format!("last finite value there {}", f64::from(old[ix(n, i, j)])),
+        ] {
+            assert!(msg.contains(&part), "{part:?} not in {msg}");
+        }
+        assert!(msg.starts_with("anim-fluid: "), "{msg}");
+        assert_eq!(f.steps(), 3);
+        assert_eq!(f.time().to_bits(), before.time().to_bits());
+        assert_eq!(f.to_le_bytes(), before.to_le_bytes());
+        let text = |f: &SeedFluid| serde_json::to_string(&f.memory()).unwrap();
+        assert_eq!(text(&f), text(&before), "sources differ");
+        // The same step with the force removed goes through.
+        f.sources_mut().1[ix(n, 3, 5)] = 0.0;
+        f.step().unwrap();
     }
 }

@@ -1,12 +1,13 @@
 //! Numbered frame sequences (`frame_00000.vtu`, `frame_00001.vtu`, ...) and the writer that
-//! turns one [`UnstructuredGrid`] per frame into files of a chosen format, plus the `.pvd` that
-//! lets ParaView play a `.vtu` sequence against simulation time. Blender's and Houdini's
+//! turns one [`UnstructuredGrid`] (or, for grids, one [`ImageData`]) per frame into files of a
+//! chosen format, plus the `.pvd` that lets ParaView play a `.vtu` or `.vti` sequence against
+//! simulation time. Blender's and Houdini's
 //! importers recognise the numbered names of `.ply`/`.obj` sequences.
 
 use crate::IoError;
 use crate::data::{DataArray, Values};
 use crate::ply::Ply;
-use crate::vtk::{CellKind, UnstructuredGrid, VtkEncoding, write_pvd};
+use crate::vtk::{CellKind, ImageData, UnstructuredGrid, VtkEncoding, write_pvd};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
@@ -73,6 +74,7 @@ impl FrameSequence {
 /// | `Vtu` | points; vertex, line, triangle, tetrahedron cells | all point and cell fields |
 /// | `Ply` | points, triangles (vertex cells add nothing and are not needed) | point fields (a 3-vector `v` as properties `v_x v_y v_z`); cell fields are not written |
 /// | `Obj` | points, triangles, lines | none: fields are not written |
+/// | `Vti` | a regular grid ([`ImageData`], through [`FrameWriter::write_image`]) | all point and cell fields |
 ///
 /// A cell kind the format cannot hold (tetrahedra in PLY or OBJ, lines in PLY) is an error, not a
 /// silent omission: pass [`TetMesh::boundary_triangles`](crate::TetMesh::boundary_triangles)
@@ -85,6 +87,8 @@ pub enum FrameFormat {
     Ply,
     /// Wavefront OBJ (any DCC tool).
     Obj,
+    /// VTK XML image data (ParaView): regular grids such as fluid fields, with a `.pvd`.
+    Vti,
 }
 
 impl FrameFormat {
@@ -94,6 +98,7 @@ impl FrameFormat {
             FrameFormat::Vtu => "vtu",
             FrameFormat::Ply => "ply",
             FrameFormat::Obj => "obj",
+            FrameFormat::Vti => "vti",
         }
     }
 }
@@ -101,19 +106,20 @@ impl FrameFormat {
 impl FromStr for FrameFormat {
     type Err = String;
 
-    /// Parses `vtu`, `ply` or `obj` (any case).
+    /// Parses `vtu`, `ply`, `obj` or `vti` (any case).
     fn from_str(s: &str) -> Result<Self, String> {
         match s.to_ascii_lowercase().as_str() {
             "vtu" | "vtk" => Ok(FrameFormat::Vtu),
             "ply" => Ok(FrameFormat::Ply),
             "obj" => Ok(FrameFormat::Obj),
-            _ => Err(format!("unknown frame format `{s}` (expected vtu, ply or obj)")),
+            "vti" => Ok(FrameFormat::Vti),
+            _ => Err(format!("unknown frame format `{s}` (expected vtu, ply, obj or vti)")),
         }
     }
 }
 
-/// Writes one file per frame into a folder; for `.vtu`, [`finish`](Self::finish) adds
-/// `frames.pvd`.
+/// Writes one file per frame into a folder; for `.vtu` and `.vti`, [`finish`](Self::finish)
+/// adds `frames.pvd`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameWriter {
     sequence: FrameSequence,
@@ -158,6 +164,12 @@ impl FrameWriter {
         frame.check().map_err(|e| IoError::data(what.display(), e))?;
         match self.format {
             FrameFormat::Vtu => frame.write(&what, self.encoding)?,
+            FrameFormat::Vti => {
+                return Err(IoError::data(
+                    what.display(),
+                    "vti frames hold grids: write them with FrameWriter::write_image",
+                ));
+            }
             FrameFormat::Ply => ply_of(frame).map_err(|e| IoError::data(what.display(), e))?.write(&what)?,
             FrameFormat::Obj => {
                 let (tris, lines) = surface(frame, true).map_err(|e| IoError::data(what.display(), e))?;
@@ -173,10 +185,27 @@ impl FrameWriter {
         Ok(self.sequence.next_path(time))
     }
 
-    /// Finishes the sequence: for `.vtu` writes `frames.pvd` and returns its path.
+    /// Writes the next frame of a [`FrameFormat::Vti`] sequence, a regular grid, at simulation
+    /// time `time` and returns its path. A grid in another format's sequence, or a grid that
+    /// fails [`ImageData::check`], is an [`IoError::InvalidData`] naming the file and the cause;
+    /// nothing is recorded then.
+    pub fn write_image(&mut self, time: f64, frame: &ImageData<'_>) -> Result<PathBuf, IoError> {
+        let name = self.sequence.file_name(self.sequence.frames().len());
+        let what = self.sequence.dir().join(&name);
+        if self.format != FrameFormat::Vti {
+            return Err(IoError::data(
+                what.display(),
+                format!("a grid frame in a {} sequence: grids are written as vti", self.format.extension()),
+            ));
+        }
+        frame.write(&what, self.encoding)?;
+        Ok(self.sequence.next_path(time))
+    }
+
+    /// Finishes the sequence: for `.vtu` and `.vti` writes `frames.pvd` and returns its path.
     pub fn finish(&self) -> Result<Option<PathBuf>, IoError> {
         match self.format {
-            FrameFormat::Vtu => self.sequence.write_pvd("frames.pvd").map(Some),
+            FrameFormat::Vtu | FrameFormat::Vti => self.sequence.write_pvd("frames.pvd").map(Some),
             _ => Ok(None),
         }
     }
@@ -271,7 +300,37 @@ mod tests {
             "{text}"
         );
         assert_eq!("PLY".parse::<FrameFormat>(), Ok(FrameFormat::Ply));
+        assert_eq!("vti".parse::<FrameFormat>(), Ok(FrameFormat::Vti));
         assert!("stl".parse::<FrameFormat>().is_err());
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn grid_frames_are_vti_with_a_pvd() {
+        let dir = tmp("vti");
+        let density = [0.0f64, 1.0, 2.0, 3.0, 4.0, 5.0];
+        let img = ImageData::from_cells_2d([3, 2], [0.0, 0.0], [0.5, 0.5])
+            .cell_field(DataArray::scalars("density", &density));
+        let mut w = FrameWriter::new(&dir, FrameFormat::Vti).unwrap();
+        for k in 0..2 {
+            let p = w.write_image(0.1 * k as f64, &img).unwrap();
+            assert_eq!(p, dir.join(format!("frame_0000{k}.vti")));
+            assert!(std::fs::read_to_string(&p).unwrap().contains("<ImageData WholeExtent=\"0 3 0 2 0 0\""));
+        }
+        let pts = [[0.0f64; 3]];
+        let e = w.write(0.2, &UnstructuredGrid::new(&pts)).unwrap_err();
+        assert!(e.to_string().contains("write_image"), "{e}");
+        let short = [1.0f64; 5];
+        let bad = ImageData::from_cells_2d([3, 2], [0.0, 0.0], [0.5, 0.5])
+            .cell_field(DataArray::scalars("density", &short));
+        let e = w.write_image(0.2, &bad).unwrap_err();
+        assert!(e.to_string().contains("field `density` has 5 tuples"), "{e}");
+        assert_eq!(w.sequence().frames().len(), 2, "a failed frame is not recorded");
+        let text = std::fs::read_to_string(w.finish().unwrap().unwrap()).unwrap();
+        assert!(text.contains("file=\"frame_00001.vti\""), "{text}");
+        let mut u = FrameWriter::new(&dir, FrameFormat::Vtu).unwrap();
+        let e = u.write_image(0.0, &img).unwrap_err();
+        assert!(e.to_string().contains("grids are written as vti"), "{e}");
         std::fs::remove_dir_all(dir).unwrap();
     }
 }

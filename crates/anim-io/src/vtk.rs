@@ -582,6 +582,103 @@ mod tests {
         assert_eq!(e, "field `p` has 11 tuples but there are 12 grid cells");
     }
 
+    /// Standard base64 decoding, for reading files back.
+    fn unbase64(text: &str) -> Vec<u8> {
+        const TABLE: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        let digits: Vec<u32> = text
+            .bytes()
+            .filter(|b| !b.is_ascii_whitespace() && *b != b'=')
+            .map(|b| TABLE.iter().position(|&t| t == b).unwrap() as u32)
+            .collect();
+        let mut out = Vec::new();
+        for c in digits.chunks(4) {
+            let n = c.iter().enumerate().fold(0u32, |n, (k, &d)| n | (d << (18 - 6 * k)));
+            out.extend(n.to_be_bytes()[1..c.len()].iter().copied());
+        }
+        out
+    }
+
+    /// The values of a `Float64` `DataArray` element, in either encoding.
+    fn read_f64(array: roxmltree::Node<'_, '_>) -> Vec<f64> {
+        assert_eq!(array.attribute("type"), Some("Float64"));
+        let text = array.text().unwrap_or("");
+        match array.attribute("format") {
+            Some("ascii") => text.split_whitespace().map(|t| t.parse().unwrap()).collect(),
+            Some("binary") => {
+                let bytes = unbase64(text);
+                let (count, data) = bytes.split_at(8);
+                assert_eq!(u64::from_le_bytes(count.try_into().unwrap()) as usize, data.len());
+                data.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect()
+            }
+            other => panic!("format {other:?}"),
+        }
+    }
+
+    /// Writes 2-D and 3-D grids in both encodings, parses the files back with an XML parser
+    /// and checks the extents, origin, spacing, field names, component counts and every value.
+    #[test]
+    fn vti_reads_back_with_its_extents_spacing_and_values() {
+        let dir = std::env::temp_dir().join(format!("anim-io-vti-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let cases = [
+            ([4usize, 3, 1], [0.25, -1.0, 0.0], [0.1, 1.0 / 3.0, 1.0]),
+            ([3, 2, 5], [1.0, 2.0, 3.0], [0.5, 0.25, 0.125]),
+        ];
+        for (cells, origin, spacing) in cases {
+            let img = if cells[2] == 1 {
+                ImageData::from_cells_2d(
+                    [cells[0], cells[1]],
+                    [origin[0], origin[1]],
+                    [spacing[0], spacing[1]],
+                )
+            } else {
+                ImageData::from_cells_3d(cells, origin, spacing)
+            };
+            let n_cells = cells.iter().product::<usize>();
+            let n_points = img.num_points();
+            // Point extents: a 2-D grid is one point thick along z.
+            let extent: Vec<f64> = img.dims.iter().flat_map(|&d| [0.0, (d - 1) as f64]).collect();
+            assert_eq!(img.num_cells(), n_cells);
+            let density: Vec<f64> = (0..n_cells).map(|c| (c as f64).sqrt() - 1.5).collect();
+            let velocity: Vec<[f64; 3]> =
+                (0..n_cells).map(|c| [c as f64, -(c as f64) / 7.0, 1e-300]).collect();
+            let height: Vec<f64> = (0..n_points).map(|p| 0.1 * p as f64 + f64::EPSILON).collect();
+            let img = img
+                .cell_field(DataArray::scalars("density", &density))
+                .cell_field(DataArray::vectors("velocity", &velocity))
+                .point_field(DataArray::scalars("height", &height));
+            for encoding in [VtkEncoding::Ascii, VtkEncoding::Base64] {
+                let path = dir.join(format!("g{}-{encoding:?}.vti", cells[2]));
+                img.write(&path, encoding).unwrap();
+                let text = std::fs::read_to_string(&path).unwrap();
+                let doc = roxmltree::Document::parse(&text).unwrap();
+                let root = doc.root_element();
+                assert_eq!(root.attribute("type"), Some("ImageData"));
+                let grid = root.children().find(|n| n.has_tag_name("ImageData")).unwrap();
+                let numbers = |s: Option<&str>| -> Vec<f64> {
+                    s.unwrap().split_whitespace().map(|t| t.parse().unwrap()).collect()
+                };
+                assert_eq!(numbers(grid.attribute("WholeExtent")), extent);
+                assert_eq!(numbers(grid.attribute("Origin")), origin.to_vec());
+                assert_eq!(numbers(grid.attribute("Spacing")), spacing.to_vec());
+                let piece = grid.children().find(|n| n.has_tag_name("Piece")).unwrap();
+                assert_eq!(numbers(piece.attribute("Extent")), extent);
+                let array = |section: &str, name: &str| {
+                    let data = piece.children().find(|n| n.has_tag_name(section)).unwrap();
+                    data.children().find(|n| n.attribute("Name") == Some(name)).unwrap()
+                };
+                let d = array("CellData", "density");
+                assert_eq!(d.attribute("NumberOfComponents"), Some("1"));
+                assert_eq!(read_f64(d), density, "{encoding:?}");
+                let v = array("CellData", "velocity");
+                assert_eq!(v.attribute("NumberOfComponents"), Some("3"));
+                assert_eq!(read_f64(v), velocity.as_flattened(), "{encoding:?}");
+                assert_eq!(read_f64(array("PointData", "height")), height, "{encoding:?}");
+            }
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     #[test]
     fn escape_covers_xml_specials() {
         assert_eq!(escape("a<b>&\"c'"), "a&lt;b&gt;&amp;&quot;c&apos;");
