@@ -45,7 +45,8 @@ impl Clock {
 
     /// Whether another step fits the budget (the clock is read every 16 steps).
     pub fn more(&self) -> bool {
-        self.steps < self.budget.steps && (!self.steps.is_multiple_of(16) || self.start.elapsed() < self.budget.wall)
+        self.steps < self.budget.steps
+            && (!self.steps.is_multiple_of(16) || self.start.elapsed() < self.budget.wall)
     }
 
     pub fn tick(&mut self) {
