@@ -105,6 +105,29 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
                 }
             }
         }
+        // The glTF crate validates an animation's samplers but not its channels' targets: an
+        // unknown path or a missing node would panic when read.
+        for (a, anim) in json.animations.iter().enumerate() {
+            for (c, ch) in anim.channels.iter().enumerate() {
+                let el = format!("animation {a} channel {c}");
+                if !matches!(ch.target.path, gltf::json::validation::Checked::Valid(_)) {
+                    return Err(err(
+                        &el,
+                        "target path is not one of translation, rotation, scale, weights".into(),
+                    ));
+                }
+                if ch.target.node.value() >= json.nodes.len() {
+                    return Err(err(
+                        &el,
+                        format!(
+                            "target node {} does not exist (the file has {})",
+                            ch.target.node.value(),
+                            json.nodes.len()
+                        ),
+                    ));
+                }
+            }
+        }
     }
     let blob = unchecked.blob;
     let document = gltf::Document::from_json(unchecked.document.into_json())

@@ -163,3 +163,27 @@ fn a_primitive_naming_a_missing_accessor_is_an_error_not_a_panic() {
     let e = anim_skin::gltf_io::load(&path).unwrap_err();
     assert!(e.element.starts_with("mesh 0 primitive") && e.cause.contains("does not exist"), "{e}");
 }
+
+/// Found by the `gltf_skin` fuzz target: an animation channel whose target path is not a glTF
+/// property passed the glTF crate's validation (it checks samplers, not channel targets) and
+/// panicked when read; it is now an error naming the channel.
+#[test]
+fn an_animation_channel_with_an_unknown_path_is_an_error_not_a_panic() {
+    let path = testdata("fuzz/invalid_channel_path.glb");
+    let e = anim_skin::gltf_io::load(&path).unwrap_err();
+    assert!(e.element.starts_with("animation 0 channel") && e.cause.contains("target path"), "{e}");
+}
+
+/// A channel targeting a node that does not exist is an error naming the channel.
+#[test]
+fn an_animation_channel_targeting_a_missing_node_is_an_error() {
+    let p = write_temp(
+        "missing_node.gltf",
+        &edited(|v| {
+            v["animations"][0]["channels"][0]["target"]["node"] = serde_json::json!(999);
+        }),
+    );
+    let e = anim_skin::gltf_io::load(&p).unwrap_err();
+    assert_eq!(e.element, "animation 0 channel 0");
+    assert!(e.cause.contains("node 999 does not exist"), "{e}");
+}
