@@ -80,6 +80,37 @@ impl Soak {
     }
 }
 
+/// Steps until the budget ends: `step(k)` takes step `k` (1-based) and checks what it must; an
+/// error ends the run as a detected divergence with that text.
+pub fn drive(
+    budget: Budget,
+    dt: f64,
+    mut step: impl FnMut(u64) -> Result<(), String>,
+) -> Result<Clock, Soak> {
+    let mut clock = Clock::start(budget);
+    while clock.more() {
+        if let Err(e) = step(clock.steps + 1) {
+            return Err(Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(e)));
+        }
+        clock.tick();
+    }
+    Ok(clock)
+}
+
+/// A setup that failed: rejected before the first step.
+pub fn rejected(budget: Budget, e: impl std::fmt::Display) -> Soak {
+    Soak::new(&Clock::start(budget), 0.0, Outcome::Rejected(e.to_string()))
+}
+
+/// The verdict of a finished run: stable when `ok`, else diverged, with `detail`.
+pub fn finish(clock: &Clock, dt: f64, ok: bool, detail: String) -> Soak {
+    Soak::new(
+        clock,
+        clock.steps as f64 * dt,
+        if ok { Outcome::Stable(detail) } else { Outcome::Diverged(detail) },
+    )
+}
+
 /// A named soak case.
 pub struct SoakCase {
     pub crate_name: &'static str,

@@ -2,8 +2,8 @@
 //! for `10^5` steps or ten minutes, with its bound checked on a fixed stride. anim-material has no
 //! time stepping of its own (its models run inside the FEM and MPM soaks); anim-io has none.
 
-use crate::registry::{Outcome, fmt_num};
-use crate::soak::{Budget, Clock, Soak, SoakCase};
+use crate::registry::fmt_num;
+use crate::soak::{Budget, Soak, SoakCase, drive, finish, rejected};
 
 /// Every soak case, in crate order.
 pub fn cases() -> Vec<SoakCase> {
@@ -62,8 +62,14 @@ pub fn cases() -> Vec<SoakCase> {
 /// Energy-stride shared by the cases.
 const STRIDE: u64 = 10;
 
+/// Whether `e` is above `e0` beyond rounding.
 fn exceeds(e: f64, e0: f64) -> bool {
     !(e <= e0 + 1e-9 * e0.abs().max(1e-12))
+}
+
+/// The error text of a bound broken at step `k`.
+fn above(k: u64, e: f64, e0: f64) -> String {
+    format!("step {k}: energy {e} J above its initial value {e0} J")
 }
 
 fn core_kepler(budget: Budget) -> Soak {
@@ -83,99 +89,63 @@ fn core_kepler(budget: Budget) -> Soak {
     let l0 = KeplerOrbit::angular_momentum(&state.x, &state.v);
     let tenth = budget.steps / 10;
     let (mut early, mut worst, mut worst_l) = (0.0f64, 0.0f64, 0.0f64);
-    let mut clock = Clock::start(budget);
-    while clock.more() {
-        if let Err(e) = integ.step(&mut sys, &mut state, dt) {
-            return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(e.to_string()));
-        }
-        clock.tick();
+    let clock = match drive(budget, dt, |k| {
+        integ.step(&mut sys, &mut state, dt).map_err(|e| e.to_string())?;
         let de = (sys.energy_of(&state.x, &state.v) - e0).abs();
         worst = worst.max(de);
-        if clock.steps <= tenth {
+        if k <= tenth {
             early = early.max(de);
         }
         worst_l = worst_l.max((KeplerOrbit::angular_momentum(&state.x, &state.v) - l0).abs());
-    }
-    let t = clock.steps as f64 * dt;
+        Ok(())
+    }) {
+        Ok(c) => c,
+        Err(s) => return s,
+    };
     let detail = format!(
         "{} orbits; |E - E0| at most {} in the first tenth, {} overall (E0 = {}); |L - L0| at most {}",
-        fmt_num(t / sys.period()),
+        fmt_num(clock.steps as f64 * dt / sys.period()),
         fmt_num(early),
         fmt_num(worst),
         fmt_num(e0),
         fmt_num(worst_l)
     );
-    let ok = worst.is_finite() && worst <= 2.0 * early && worst_l <= 1e-9 * l0.abs();
-    Soak::new(&clock, t, if ok { Outcome::Stable(detail) } else { Outcome::Diverged(detail) })
+    finish(&clock, dt, worst.is_finite() && worst <= 2.0 * early && worst_l <= 1e-9 * l0.abs(), detail)
 }
 
 fn springs_stiff_cloth(budget: Budget) -> Soak {
-    use anim_core::integrate::{IntegratorKind, NewtonParams};
-    use anim_core::linalg::{IterativeParams, LinearSolverKind};
-    use anim_springs::{Cloth, EARTH_GRAVITY, NetworkBuilder, SpringParams, SpringSimulation};
-    let dt = 1.0 / 30.0;
-    let clock0 = Clock::start(budget);
-    let setup = || -> Result<_, String> {
-        let mut b = NetworkBuilder::new();
-        b.gravity(EARTH_GRAVITY);
-        let p = SpringParams::new(1e6, 0.0);
-        let n = 10;
-        let r = b
-            .cloth(&Cloth {
-                nx: n,
-                ny: n,
-                origin: [0.0, 0.0, 1.0],
-                u: [0.5, 0.0, 0.0],
-                v: [0.0, 0.5, 0.0],
-                mass: 1e-3 * (n * n) as f64,
-                structural: p,
-                shear: Some(p),
-                bending: None,
-            })
-            .map_err(|e| e.to_string())?;
-        b.pin(r.start).pin(r.start + n - 1);
-        let net = b.build().map_err(|e| e.to_string())?;
-        let state = net.rest_state();
-        // The seed's linearised backward Euler (one Newton iteration). It is not a minimiser of
-        // the incremental potential, so it may raise the energy while the cloth swings through
-        // large rotations; the bound is that it never does so after the first tenth of the run.
-        // (Newton to convergence stalls here: with the residual-norm line search it stops near
-        // a relative residual of 1e-5 at omega dt = 1000.)
-        let mut newton = NewtonParams::linearized();
-        newton.linear = IterativeParams::new(1e-8, 20_000);
-        let sim =
-            SpringSimulation::new(net, IntegratorKind::BackwardEuler, newton, LinearSolverKind::JacobiPcg)
-                .map_err(|e| e.to_string())?;
-        Ok((sim, state))
-    };
-    let (mut sim, mut state) = match setup() {
+    // The seed's linearised backward Euler is not a minimiser of the incremental potential, so it
+    // may raise the energy while the cloth swings through large rotations; the bound is that it
+    // never does so after the first tenth of the run. (Newton to convergence stalls here: with the
+    // residual-norm line search it stops near a relative residual of 1e-5 at omega dt = 1000.)
+    let (mut sim, mut state) = match super::springs::stiff_cloth() {
         Ok(s) => s,
-        Err(e) => return Soak::new(&clock0, 0.0, Outcome::Rejected(e)),
+        Err(e) => return rejected(budget, e),
     };
+    let dt = 1.0 / 30.0;
     let e0 = sim.network_mut().energy_parts(&state.x, &state.v).total();
     let tenth = budget.steps / 10;
-    let mut clock = Clock::start(budget);
     let (mut last, mut stretch, mut early, mut late) = (e0, 0.0f64, 0.0f64, 0.0f64);
-    while clock.more() {
-        if let Err(e) = sim.advance(&mut state, dt) {
-            return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(e.to_string()));
-        }
-        clock.tick();
-        if clock.steps.is_multiple_of(STRIDE) {
+    let clock = match drive(budget, dt, |k| {
+        sim.advance(&mut state, dt).map_err(|e| e.to_string())?;
+        if k.is_multiple_of(STRIDE) {
             last = sim.network_mut().energy_parts(&state.x, &state.v).total();
             stretch = stretch.max(sim.network().max_stretch(&state.x).map_or(f64::NAN, |s| s.ratio));
             let excess = (last - e0).max(0.0);
-            if clock.steps <= tenth {
+            if k <= tenth {
                 early = early.max(excess);
             } else {
                 late = late.max(excess);
             }
             if !last.is_finite() || !(stretch < 1.01) {
-                let d = format!("step {}: energy {last} J, max stretch ratio {stretch}", clock.steps);
-                return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(d));
+                return Err(format!("step {k}: energy {last} J, max stretch ratio {stretch}"));
             }
         }
-    }
+        Ok(())
+    }) {
+        Ok(c) => c,
+        Err(s) => return s,
+    };
     let d = format!(
         "energy {} -> {} J, checked every {STRIDE} steps; largest excess over the initial energy {} J in the first tenth, {} J after it; max stretch ratio {}",
         fmt_num(e0),
@@ -184,36 +154,31 @@ fn springs_stiff_cloth(budget: Budget) -> Soak {
         fmt_num(late),
         fmt_num(stretch)
     );
-    let ok = late <= early && last <= e0;
-    Soak::new(&clock, clock.steps as f64 * dt, if ok { Outcome::Stable(d) } else { Outcome::Diverged(d) })
+    finish(&clock, dt, late <= early && last <= e0, d)
 }
 
 fn pbd_drape(budget: Budget) -> Soak {
-    let clock0 = Clock::start(budget);
-    let (mut sim, mut state) = match anim_pbd::scenes::cloth_drape(Some(24))
-        .map_err(|e| e.to_string())
-        .and_then(|s| s.into_simulation().map_err(|e| e.to_string()))
-    {
+    let scene = anim_pbd::scenes::cloth_drape(Some(24)).map_err(|e| e.to_string());
+    let (mut sim, mut state) = match scene.and_then(|s| s.into_simulation().map_err(|e| e.to_string())) {
         Ok(s) => s,
-        Err(e) => return Soak::new(&clock0, 0.0, Outcome::Rejected(e)),
+        Err(e) => return rejected(budget, e),
     };
     let dt = 1.0 / 30.0;
     let e0 = sim.model().kinetic_and_gravity_energy(&state.x, &state.v);
-    let mut clock = Clock::start(budget);
     let mut last = e0;
-    while clock.more() {
-        if let Err(e) = sim.advance(&mut state, dt) {
-            return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(e.to_string()));
-        }
-        clock.tick();
-        if clock.steps.is_multiple_of(STRIDE) {
+    let clock = match drive(budget, dt, |k| {
+        sim.advance(&mut state, dt).map_err(|e| e.to_string())?;
+        if k.is_multiple_of(STRIDE) {
             last = sim.model().kinetic_and_gravity_energy(&state.x, &state.v);
             if exceeds(last, e0) {
-                let d = format!("step {}: energy {last} J above initial {e0} J", clock.steps);
-                return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(d));
+                return Err(above(k, last, e0));
             }
         }
-    }
+        Ok(())
+    }) {
+        Ok(c) => c,
+        Err(s) => return s,
+    };
     let x = &state.x;
     let mut strain = 0.0f64;
     for c in sim.model().constraints() {
@@ -233,41 +198,39 @@ fn pbd_drape(budget: Budget) -> Soak {
         fmt_num(last),
         fmt_num(strain)
     );
-    Soak::new(&clock, clock.steps as f64 * dt, Outcome::Stable(d))
+    finish(&clock, dt, true, d)
 }
 
 fn rigid_chain(budget: Budget) -> Soak {
     use anim_core::solver::Solver;
-    let clock0 = Clock::start(budget);
     let scene = match anim_rigid::scenes::pendulum_chain(None) {
         Ok(s) => s,
-        Err(e) => return Soak::new(&clock0, 0.0, Outcome::Rejected(e.to_string())),
+        Err(e) => return rejected(budget, e),
     };
     let dt = scene.dt;
     let (mut sim, mut state) = match scene.into_simulation() {
         Ok(s) => s,
-        Err(e) => return Soak::new(&clock0, 0.0, Outcome::Rejected(e.to_string())),
+        Err(e) => return rejected(budget, e),
     };
     // 32 links of 0.1 kg and 0.1 m: total mass 3.2 kg, the centre of mass can fall 1.6 m at most.
     let scale = 3.2 * 9.81 * 1.6;
     let e0 = sim.energy(&state);
-    let mut clock = Clock::start(budget);
     let (mut gain, mut loss) = (0.0f64, 0.0f64);
-    while clock.more() {
-        if let Err(e) = sim.step(&mut state, dt) {
-            return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(e.to_string()));
-        }
-        clock.tick();
-        if clock.steps.is_multiple_of(STRIDE) {
+    let clock = match drive(budget, dt, |k| {
+        sim.step(&mut state, dt).map_err(|e| e.to_string())?;
+        if k.is_multiple_of(STRIDE) {
             let de = sim.energy(&state) - e0;
             gain = gain.max(de);
             loss = loss.max(-de);
             if !(de < 0.01 * scale) {
-                let d = format!("step {}: energy gain {de} J against m g L = {scale} J", clock.steps);
-                return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(d));
+                return Err(format!("step {k}: energy gain {de} J against m g L = {scale} J"));
             }
         }
-    }
+        Ok(())
+    }) {
+        Ok(c) => c,
+        Err(s) => return s,
+    };
     let d = format!(
         "largest energy gain {} J ({} of m g L = {} J), largest loss {} J ({}; RK4 is not symplectic and dissipates slowly), checked every {STRIDE} steps",
         fmt_num(gain),
@@ -276,7 +239,7 @@ fn rigid_chain(budget: Budget) -> Soak {
         fmt_num(loss),
         fmt_num(loss / scale)
     );
-    Soak::new(&clock, clock.steps as f64 * dt, Outcome::Stable(d))
+    finish(&clock, dt, true, d)
 }
 
 fn fem_stiff_beam(budget: Budget) -> Soak {
@@ -285,7 +248,6 @@ fn fem_stiff_beam(budget: Budget) -> Soak {
     use anim_fem::material::{Material, MaterialModel};
     use anim_fem::model::{EARTH_GRAVITY, FemModel};
     use anim_fem::sim::{FemParams, FemSimulation};
-    let clock0 = Clock::start(budget);
     let setup = || -> Result<FemSimulation, anim_fem::FemError> {
         let mesh = generate::box_mesh([0.0; 3], [1.0, 0.1, 0.1], [20, 2, 2])?;
         let mut m = FemModel::new(mesh, Material::new(MaterialModel::StableNeoHookean, 1e8, 0.3, 1000.0)?)?
@@ -296,26 +258,25 @@ fn fem_stiff_beam(budget: Budget) -> Soak {
     };
     let mut sim = match setup() {
         Ok(s) => s,
-        Err(e) => return Soak::new(&clock0, 0.0, Outcome::Rejected(e.to_string())),
+        Err(e) => return rejected(budget, e),
     };
     let mut state = sim.rest_state();
     let dt = 1.0 / 24.0;
     let e0 = sim.total_energy(&state);
-    let mut clock = Clock::start(budget);
     let mut last = e0;
-    while clock.more() {
-        if let Err(e) = sim.step(&mut state, dt) {
-            return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(e.to_string()));
-        }
-        clock.tick();
-        if clock.steps.is_multiple_of(STRIDE) {
+    let clock = match drive(budget, dt, |k| {
+        sim.step(&mut state, dt).map_err(|e| e.to_string())?;
+        if k.is_multiple_of(STRIDE) {
             last = sim.total_energy(&state);
             if exceeds(last, e0) {
-                let d = format!("step {}: energy {last} J above initial {e0} J", clock.steps);
-                return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(d));
+                return Err(above(k, last, e0));
             }
         }
-    }
+        Ok(())
+    }) {
+        Ok(c) => c,
+        Err(s) => return s,
+    };
     let tip = state.x.chunks(3).map(|p| p[2]).fold(f64::INFINITY, f64::min);
     let d = format!(
         "20x2x2 cells (240 tets); total energy {} -> {} J, checked every {STRIDE} steps; lowest point z = {} m",
@@ -323,9 +284,11 @@ fn fem_stiff_beam(budget: Budget) -> Soak {
         fmt_num(last),
         fmt_num(tip)
     );
-    Soak::new(&clock, clock.steps as f64 * dt, Outcome::Stable(d))
+    finish(&clock, dt, true, d)
 }
 
+/// Kinetic plus gravitational energy of the particles (their elastic energy is not negative, so
+/// this sum may not exceed the initial total of a dissipative run that starts at rest shape).
 fn mpm_energy<const D: usize>(p: &anim_mpm::Particles<D>, g: [f64; 3]) -> f64 {
     let mut e = 0.0;
     for i in 0..p.mass.len() {
@@ -339,49 +302,45 @@ fn mpm_energy<const D: usize>(p: &anim_mpm::Particles<D>, g: [f64; 3]) -> f64 {
 }
 
 fn mpm_three_materials(budget: Budget) -> Soak {
-    let clock0 = Clock::start(budget);
     let mut scene = match anim_mpm::scenes::three_materials(64) {
         Ok(s) => s,
-        Err(e) => return Soak::new(&clock0, 0.0, Outcome::Rejected(e.to_string())),
+        Err(e) => return rejected(budget, e),
     };
     let dt = scene.dt;
     let g = scene.sim.params().gravity;
     let e0 = mpm_energy(&scene.state, g);
-    let mut clock = Clock::start(budget);
     let (mut last, mut substeps) = (e0, 0usize);
-    while clock.more() {
-        match scene.sim.advance(&mut scene.state, dt) {
-            Ok(s) => substeps += s.substeps,
-            Err(e) => return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(e.to_string())),
-        }
-        clock.tick();
-        if clock.steps.is_multiple_of(STRIDE) {
+    let clock = match drive(budget, dt, |k| {
+        substeps += scene.sim.advance(&mut scene.state, dt).map_err(|e| e.to_string())?.substeps;
+        if k.is_multiple_of(STRIDE) {
             last = mpm_energy(&scene.state, g);
             if exceeds(last, e0) {
-                let d = format!("step {}: energy {last} J above initial {e0} J", clock.steps);
-                return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(d));
+                return Err(above(k, last, e0));
             }
         }
-    }
+        Ok(())
+    }) {
+        Ok(c) => c,
+        Err(s) => return s,
+    };
     let d = format!(
         "{} particles, {substeps} substeps; kinetic + gravitational energy {} -> {} J, checked every {STRIDE} frames",
         scene.state.len(),
         fmt_num(e0),
         fmt_num(last)
     );
-    Soak::new(&clock, clock.steps as f64 * dt, Outcome::Stable(d))
+    finish(&clock, dt, true, d)
 }
 
 fn fluid_cfl10(budget: Budget) -> Soak {
     use anim_fluid::advection::Advection;
     use anim_fluid::mac::{MacFluid, MacParams, MacState};
     use std::f64::consts::PI;
-    let clock0 = Clock::start(budget);
     let (n, speed) = (64, 1.0);
     let params = MacParams { advection: Advection::Linear, ..MacParams::default() };
     let (mut f, mut s) = match MacFluid::new([n, n, 1], 2, 1.0 / n as f64, params) {
         Ok(x) => x,
-        Err(e) => return Soak::new(&clock0, 0.0, Outcome::Rejected(e.to_string())),
+        Err(e) => return rejected(budget, e),
     };
     f.set_velocity(&mut s, |p| [speed * (PI * p[1]).sin(), -speed * (PI * p[0]).sin(), 0.0]);
     for c in 0..s.density.len() {
@@ -391,40 +350,37 @@ fn fluid_cfl10(budget: Budget) -> Soak {
     let kinetic = |s: &MacState| 0.5 * s.vel.iter().flatten().map(|u| u * u).sum::<f64>() / (n * n) as f64;
     let dt = 10.0 / n as f64 / speed;
     let e0 = kinetic(&s);
-    let mut clock = Clock::start(budget);
     let mut last = e0;
-    while clock.more() {
-        if let Err(e) = f.advance(&mut s, dt) {
-            return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(e.to_string()));
-        }
-        clock.tick();
-        if clock.steps.is_multiple_of(STRIDE) {
+    let clock = match drive(budget, dt, |k| {
+        f.advance(&mut s, dt).map_err(|e| e.to_string())?;
+        if k.is_multiple_of(STRIDE) {
             last = kinetic(&s);
             let (lo, hi) = s.density.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
             if exceeds(last, e0) || lo < -1e-12 || hi > 1.0 + 1e-12 {
-                let d = format!(
-                    "step {}: kinetic energy {last} (initial {e0}), density in [{lo}, {hi}]",
-                    clock.steps
-                );
-                return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(d));
+                return Err(format!(
+                    "step {k}: kinetic energy {last} (initial {e0}), density in [{lo}, {hi}]"
+                ));
             }
         }
-    }
+        Ok(())
+    }) {
+        Ok(c) => c,
+        Err(s) => return s,
+    };
     let d = format!(
         "kinetic energy per unit area {} -> {}, checked every {STRIDE} steps",
         fmt_num(e0),
         fmt_num(last)
     );
-    Soak::new(&clock, clock.steps as f64 * dt, Outcome::Stable(d))
+    finish(&clock, dt, true, d)
 }
 
 fn skin_loop(budget: Budget) -> Soak {
     use anim_skin::SkinningMethod;
     use anim_skin::scenes::{twisted_cylinder, volume};
-    let clock0 = Clock::start(budget);
     let scene = match twisted_cylinder(None) {
         Ok(s) => s,
-        Err(e) => return Soak::new(&clock0, 0.0, Outcome::Rejected(e.to_string())),
+        Err(e) => return rejected(budget, e),
     };
     // 200 frames per loop of the 2 s clip; the first loop is kept and every later frame compared.
     let frames = 200u64;
@@ -432,38 +388,31 @@ fn skin_loop(budget: Budget) -> Soak {
     let mut data = scene.data();
     let rest = scene.rest_volume();
     let mut first: Vec<Vec<f64>> = Vec::with_capacity(frames as usize);
-    let mut clock = Clock::start(budget);
     let mut worst = 0.0f64;
-    while clock.more() {
-        let k = clock.steps % frames;
-        let t = k as f64 * dt;
-        if let Err(e) = scene.pose(&mut data, t, SkinningMethod::Dqs) {
-            return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(e.to_string()));
-        }
-        clock.tick();
+    let clock = match drive(budget, dt, |k| {
+        let frame = (k - 1) % frames;
+        let t = frame as f64 * dt;
+        scene.pose(&mut data, t, SkinningMethod::Dqs).map_err(|e| e.to_string())?;
         let flat: Vec<f64> =
             data.skinned.iter().flat_map(|m| m.x.iter().chain(&m.y).chain(&m.z).copied()).collect();
         if flat.iter().any(|v| !v.is_finite()) {
-            return Soak::new(
-                &clock,
-                clock.steps as f64 * dt,
-                Outcome::Diverged(format!("frame {k}: non-finite vertex")),
-            );
+            return Err(format!("frame {frame}: non-finite vertex"));
         }
-        if clock.steps <= frames {
-            let dv = (volume(&scene.character, &data) / rest - 1.0).abs();
-            worst = worst.max(dv);
+        if k <= frames {
+            worst = worst.max((volume(&scene.character, &data) / rest - 1.0).abs());
             first.push(flat);
-        } else if first[k as usize].iter().zip(&flat).any(|(a, b)| a.to_bits() != b.to_bits()) {
-            let d = format!("step {}: the pose at t = {t} s differs from its first cycle", clock.steps);
-            return Soak::new(&clock, clock.steps as f64 * dt, Outcome::Diverged(d));
+        } else if first[frame as usize].iter().zip(&flat).any(|(a, b)| a.to_bits() != b.to_bits()) {
+            return Err(format!("step {k}: the pose at t = {t} s differs from its first cycle"));
         }
-    }
+        Ok(())
+    }) {
+        Ok(c) => c,
+        Err(s) => return s,
+    };
     let d = format!(
         "{} loops of {frames} frames; largest volume change {} of rest",
         clock.steps / frames,
         fmt_num(worst)
     );
-    let outcome = if worst < 0.02 { Outcome::Stable(d) } else { Outcome::Diverged(d) };
-    Soak::new(&clock, clock.steps as f64 * dt, outcome)
+    finish(&clock, dt, worst < 0.02, d)
 }

@@ -426,35 +426,40 @@ fn stable_dt_sweep(ctx: &Ctx, kind: IntegratorKind) -> Outcome {
     }
 }
 
+/// The stiff hard case: a 10x10 cloth of 0.1 kg with k = 1e6 springs, pinned at two corners, on
+/// the seed's linearised backward Euler (one Newton iteration:
+/// `[M - h^2 K(x0) - h D] v1 = M v0 + h f(x0)`, the definite K solved by Jacobi-PCG).
+pub fn stiff_cloth() -> Result<(SpringSimulation, State), String> {
+    let mut b = NetworkBuilder::new();
+    b.gravity(EARTH_GRAVITY);
+    let p = SpringParams::new(1e6, 0.0);
+    let n = 10;
+    let r = b
+        .cloth(&Cloth {
+            nx: n,
+            ny: n,
+            origin: [0.0, 0.0, 1.0],
+            u: [0.5, 0.0, 0.0],
+            v: [0.0, 0.5, 0.0],
+            mass: 1e-3 * (n * n) as f64,
+            structural: p,
+            shear: Some(p),
+            bending: None,
+        })
+        .map_err(|e| e.to_string())?;
+    b.pin(r.start).pin(r.start + n - 1);
+    let net = b.build().map_err(|e| e.to_string())?;
+    let state = net.rest_state();
+    let mut newton = NewtonParams::linearized();
+    newton.linear = IterativeParams::new(1e-8, 20_000);
+    let sim = SpringSimulation::new(net, IntegratorKind::BackwardEuler, newton, LinearSolverKind::JacobiPcg)
+        .map_err(|e| e.to_string())?;
+    Ok((sim, state))
+}
+
 fn stiff_backward_euler(_ctx: &Ctx) -> Outcome {
     let run = || -> Result<String, String> {
-        let mut b = NetworkBuilder::new();
-        b.gravity(EARTH_GRAVITY);
-        let p = SpringParams::new(1e6, 0.0);
-        let n = 10;
-        let r = b
-            .cloth(&Cloth {
-                nx: n,
-                ny: n,
-                origin: [0.0, 0.0, 1.0],
-                u: [0.5, 0.0, 0.0],
-                v: [0.0, 0.5, 0.0],
-                mass: 1e-3 * (n * n) as f64,
-                structural: p,
-                shear: Some(p),
-                bending: None,
-            })
-            .map_err(|e| e.to_string())?;
-        b.pin(r.start).pin(r.start + n - 1);
-        let net = b.build().map_err(|e| e.to_string())?;
-        let mut state = net.rest_state();
-        // The seed's linearised backward Euler (one Newton iteration):
-        // [M - h^2 K(x0) - h D] v1 = M v0 + h f(x0), with the definite K solved by Jacobi-PCG.
-        let mut newton = NewtonParams::linearized();
-        newton.linear = IterativeParams::new(1e-8, 20_000);
-        let mut sim =
-            SpringSimulation::new(net, IntegratorKind::BackwardEuler, newton, LinearSolverKind::JacobiPcg)
-                .map_err(|e| e.to_string())?;
+        let (mut sim, mut state) = stiff_cloth()?;
         let dt = 1.0 / 30.0;
         let e0 = sim.network_mut().energy_parts(&state.x, &state.v).total();
         let mut cg = 0;
