@@ -119,36 +119,6 @@ mod peers {
 
     const SCRIPT: &str = "xtask/peers/taichi_cloth.py";
 
-    fn python() -> String {
-        std::env::var("PYTHON").unwrap_or_else(|_| "python3".into())
-    }
-
-    /// Whether `import taichi` works, installing it with pip if it does not.
-    fn ensure_taichi() -> Result<(), String> {
-        let works = || {
-            Command::new(python())
-                .args(["-c", "import taichi"])
-                .output()
-                .map(|o| o.status.success())
-                .unwrap_or(false)
-        };
-        if works() {
-            return Ok(());
-        }
-        eprintln!("== taichi not found: {} -m pip install taichi", python());
-        let out = Command::new(python())
-            .args(["-m", "pip", "install", "--quiet", "taichi"])
-            .output()
-            .map_err(|e| format!("could not run pip: {e}"))?;
-        if !out.status.success() || !works() {
-            return Err(format!(
-                "pip install taichi failed (taichi publishes wheels for CPython 3.7 to 3.12 on x86-64 and arm64 only): {}",
-                String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
-            ));
-        }
-        Ok(())
-    }
-
     /// A value of a flat JSON object line (numbers and strings only; the script prints no nesting).
     fn field(line: &str, key: &str) -> Option<String> {
         let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
@@ -171,10 +141,14 @@ mod peers {
             }
         };
         let mut rows = vec![("anim-springs".to_string(), ours.per_step_s, ours.sum_z, ours.min_z)];
-        match ensure_taichi() {
+        match crate::python::ensure(
+            "taichi",
+            &["taichi"],
+            " (taichi publishes wheels for CPython 3.7 to 3.12 on x86-64 and arm64 only)",
+        ) {
             Err(e) => println!("\nNOTE: Taichi peer SKIPPED: {e}\n"),
             Ok(()) => {
-                let out = Command::new(python())
+                let out = Command::new(crate::python::python())
                     .args([SCRIPT, "--n", &n.to_string(), "--steps", &steps.to_string()])
                     .args(["--repeats", &repeats.to_string(), "--threads", &threads.to_string()])
                     .output();
@@ -196,7 +170,7 @@ mod peers {
                     Ok(o) => {
                         println!("\nNOTE: Taichi script failed: {}\n", String::from_utf8_lossy(&o.stderr))
                     }
-                    Err(e) => println!("\nNOTE: could not run {}: {e}\n", python()),
+                    Err(e) => println!("\nNOTE: could not run {}: {e}\n", crate::python::python()),
                 }
             }
         }

@@ -13,6 +13,7 @@ mod architecture;
 mod bench;
 mod cases;
 mod ci;
+mod python;
 mod registry;
 mod report;
 mod soak;

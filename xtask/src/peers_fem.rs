@@ -15,35 +15,6 @@ const SCRIPT: &str = "peers/fem/pbat_beam.py";
 const CELLS: usize = 50;
 const STEPS: usize = 5;
 
-fn python() -> String {
-    std::env::var("PYTHON").unwrap_or_else(|_| "python3".into())
-}
-
-fn ensure_pbat() -> Result<(), String> {
-    let works = || {
-        Command::new(python())
-            .args(["-c", "import pbatoolkit"])
-            .output()
-            .map(|o| o.status.success())
-            .unwrap_or(false)
-    };
-    if works() {
-        return Ok(());
-    }
-    eprintln!("== pbatoolkit not found: {} -m pip install pbatoolkit scipy", python());
-    let out = Command::new(python())
-        .args(["-m", "pip", "install", "--quiet", "pbatoolkit", "scipy"])
-        .output()
-        .map_err(|e| format!("could not run pip: {e}"))?;
-    if !out.status.success() || !works() {
-        return Err(format!(
-            "pip install pbatoolkit failed: {}",
-            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
-        ));
-    }
-    Ok(())
-}
-
 fn field(line: &str, key: &str) -> Option<String> {
     let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
     let rest = rest.trim_start();
@@ -89,12 +60,12 @@ pub fn run() -> bool {
     println!(
         "| anim-fem (sparse Cholesky) | {threads} | {elements} | {ours_s:.4} | {ours_iters:?} | {ours_tip:.6} |"
     );
-    if let Err(e) = ensure_pbat() {
+    if let Err(e) = crate::python::ensure("pbatoolkit", &["pbatoolkit", "scipy"], "") {
         println!("\nnote: pbatoolkit skipped: {e}");
         return true;
     }
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(SCRIPT);
-    let out = Command::new(python())
+    let out = Command::new(crate::python::python())
         .arg(&path)
         .args(["--cells", &CELLS.to_string(), "--steps", &STEPS.to_string(), "--tol", "1e-6"])
         .output();
@@ -110,7 +81,7 @@ pub fn run() -> bool {
             return true;
         }
         Err(e) => {
-            println!("\nnote: could not run {}: {e}", python());
+            println!("\nnote: could not run {}: {e}", crate::python::python());
             return true;
         }
     };

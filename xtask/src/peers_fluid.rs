@@ -18,10 +18,6 @@ use anim_fluid::seed::{SeedFluid, SeedParams};
 use std::process::Command;
 use std::time::Instant;
 
-fn python() -> String {
-    std::env::var("PYTHON").unwrap_or_else(|_| "python3".into())
-}
-
 fn field(line: &str, key: &str) -> Option<f64> {
     let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
     let rest = rest.trim_start();
@@ -107,38 +103,13 @@ fn projection(n: usize, method: PressureMethod, tol: f64, cap: usize) -> Option<
     Some((t.elapsed().as_secs_f64(), info.residual, info.iterations))
 }
 
-fn ensure_taichi() -> Result<(), String> {
-    let works = || {
-        Command::new(python())
-            .args(["-c", "import taichi"])
-            .output()
-            .map(|o| o.status.success())
-            .unwrap_or(false)
-    };
-    if works() {
-        return Ok(());
-    }
-    eprintln!("== taichi not found: {} -m pip install taichi==1.7.4", python());
-    let out = Command::new(python())
-        .args(["-m", "pip", "install", "--quiet", "taichi==1.7.4"])
-        .output()
-        .map_err(|e| format!("could not run pip: {e}"))?;
-    if !out.status.success() || !works() {
-        return Err(format!(
-            "pip install taichi failed: {}",
-            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
-        ));
-    }
-    Ok(())
-}
-
 fn taichi(threads: usize) -> Result<f64, String> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("peers/fluid/taichi_stable_fluid.py");
-    let out = Command::new(python())
+    let out = Command::new(crate::python::python())
         .arg(&path)
         .args(["--res", "512", "--steps", "10", "--threads", &threads.to_string()])
         .output()
-        .map_err(|e| format!("could not run {}: {e}", python()))?;
+        .map_err(|e| format!("could not run {}: {e}", crate::python::python()))?;
     if !out.status.success() {
         return Err(format!(
             "taichi script failed: {}",
@@ -212,7 +183,7 @@ pub fn run() -> bool {
     }
     // 3. Taichi.
     println!("\n3. Taichi stable_fluid example, 512 x 512, 500 Jacobi iterations, CPU");
-    match ensure_taichi() {
+    match crate::python::ensure("taichi", &["taichi==1.7.4"], "") {
         Err(e) => println!("\nNOTE: Taichi peer SKIPPED: {e}\n"),
         Ok(()) => {
             let seed = seed_per_step(512, 5, 1);

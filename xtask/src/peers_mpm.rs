@@ -11,35 +11,6 @@ use std::process::Command;
 
 const SCRIPT: &str = "peers/mpm/taichi_mpm.py";
 
-fn python() -> String {
-    std::env::var("PYTHON").unwrap_or_else(|_| "python3".into())
-}
-
-fn ensure_taichi() -> Result<(), String> {
-    let works = || {
-        Command::new(python())
-            .args(["-c", "import taichi"])
-            .output()
-            .map(|o| o.status.success())
-            .unwrap_or(false)
-    };
-    if works() {
-        return Ok(());
-    }
-    eprintln!("== taichi not found: {} -m pip install taichi", python());
-    let out = Command::new(python())
-        .args(["-m", "pip", "install", "--quiet", "taichi"])
-        .output()
-        .map_err(|e| format!("could not run pip: {e}"))?;
-    if !out.status.success() || !works() {
-        return Err(format!(
-            "pip install taichi failed: {}",
-            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
-        ));
-    }
-    Ok(())
-}
-
 fn field(line: &str, key: &str) -> Option<String> {
     let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
     let rest = rest.trim_start();
@@ -49,12 +20,12 @@ fn field(line: &str, key: &str) -> Option<String> {
 
 fn taichi(dim: usize, n: usize, steps: usize, repeats: usize, threads: usize) -> Result<(f64, f64), String> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(SCRIPT);
-    let out = Command::new(python())
+    let out = Command::new(crate::python::python())
         .arg(&path)
         .args(["--dim", &dim.to_string(), "--n", &n.to_string(), "--steps", &steps.to_string()])
         .args(["--repeats", &repeats.to_string(), "--threads", &threads.to_string()])
         .output()
-        .map_err(|e| format!("could not run {}: {e}", python()))?;
+        .map_err(|e| format!("could not run {}: {e}", crate::python::python()))?;
     if !out.status.success() {
         return Err(format!(
             "taichi script failed: {}",
@@ -70,7 +41,7 @@ fn taichi(dim: usize, n: usize, steps: usize, repeats: usize, threads: usize) ->
 pub fn run() -> bool {
     let cases: [(usize, usize, usize); 4] = [(2, 128, 200), (2, 256, 100), (2, 512, 40), (3, 64, 20)];
     let repeats = 5;
-    let peer = ensure_taichi();
+    let peer = crate::python::ensure("taichi", &["taichi"], "");
     if let Err(e) = &peer {
         println!("\nNOTE: Taichi peer SKIPPED: {e}\n");
     }

@@ -17,38 +17,6 @@ use std::process::Command;
 const PYPBD: &str = "peers/pbd/pypbd_cloth.py";
 const NEWTON: &str = "peers/pbd/newton_cloth.py";
 
-fn python() -> String {
-    std::env::var("PYTHON").unwrap_or_else(|_| "python3".into())
-}
-
-/// Whether `import module` works, installing `packages` with pip if it does not.
-fn ensure(module: &str, packages: &[&str]) -> Result<(), String> {
-    let works = || {
-        Command::new(python())
-            .args(["-c", &format!("import {module}")])
-            .output()
-            .map(|o| o.status.success())
-            .unwrap_or(false)
-    };
-    if works() {
-        return Ok(());
-    }
-    eprintln!("== {module} not found: {} -m pip install {}", python(), packages.join(" "));
-    let out = Command::new(python())
-        .args(["-m", "pip", "install", "--quiet"])
-        .args(packages)
-        .output()
-        .map_err(|e| format!("could not run pip: {e}"))?;
-    if !out.status.success() || !works() {
-        return Err(format!(
-            "pip install {} failed: {}",
-            packages.join(" "),
-            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
-        ));
-    }
-    Ok(())
-}
-
 /// A value of a flat JSON object line.
 fn field(line: &str, key: &str) -> Option<String> {
     let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
@@ -75,13 +43,13 @@ fn run_script(
     repeats: usize,
 ) -> Result<String, String> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(script);
-    let out = Command::new(python())
+    let out = Command::new(crate::python::python())
         .arg(&path)
         .args(["--n", &n.to_string(), "--iterations", &iterations.to_string()])
         .args(["--steps", &steps.to_string(), "--repeats", &repeats.to_string()])
         .env("OMP_NUM_THREADS", "1")
         .output()
-        .map_err(|e| format!("could not run {}: {e}", python()))?;
+        .map_err(|e| format!("could not run {}: {e}", crate::python::python()))?;
     if !out.status.success() {
         return Err(format!(
             "{script} failed: {}",
@@ -101,8 +69,8 @@ pub fn run() -> bool {
     println!(
         "\npeer benchmark (anim-pbd): N x N cloth, XPBD distance + bending, dt = 1/60, 1 substep; median of {repeats} runs"
     );
-    let pypbd = ensure("pypbd", &["pyPBD==2.2.2"]);
-    let newton = ensure("newton", &["newton==1.8.0", "warp-lang==1.19.0"]);
+    let pypbd = crate::python::ensure("pypbd", &["pyPBD==2.2.2"], "");
+    let newton = crate::python::ensure("newton", &["newton==1.8.0", "warp-lang==1.19.0"], "");
     if let Err(e) = &pypbd {
         println!("\nNOTE: pyPBD peer SKIPPED: {e}\n");
     }

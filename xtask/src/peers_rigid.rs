@@ -30,13 +30,9 @@ const BATCHES: usize = 15;
 const CONFIGS: usize = 1024;
 const ROUNDS: usize = 3;
 
-fn python() -> String {
-    std::env::var("PYTHON").unwrap_or_else(|_| "python3".into())
-}
-
 /// The `cmeel.prefix` holding Pinocchio's and Eigen's headers, if present.
 fn find_prefix() -> Option<PathBuf> {
-    let out = Command::new(python())
+    let out = Command::new(crate::python::python())
         .args(["-c", "import site; print('\\n'.join(site.getsitepackages() + [site.getusersitepackages()]))"])
         .output()
         .ok()?;
@@ -50,8 +46,11 @@ fn ensure_prefix() -> Result<PathBuf, String> {
     if let Some(p) = find_prefix() {
         return Ok(p);
     }
-    eprintln!("== Pinocchio headers not found: {} -m pip install pin==4.1.0 cmeel-eigen==3.4.1", python());
-    let out = Command::new(python())
+    eprintln!(
+        "== Pinocchio headers not found: {} -m pip install pin==4.1.0 cmeel-eigen==3.4.1",
+        crate::python::python()
+    );
+    let out = Command::new(crate::python::python())
         .args(["-m", "pip", "install", "--quiet", "pin==4.1.0", "cmeel-eigen==3.4.1"])
         .output()
         .map_err(|e| format!("could not run pip: {e}"))?;
