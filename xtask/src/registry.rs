@@ -164,6 +164,7 @@ pub fn all() -> Registry {
     crate::cases::fem::register(&mut r);
     crate::cases::mpm::register(&mut r);
     crate::cases::fluid::register(&mut r);
+    crate::cases::flip::register(&mut r);
     crate::cases::determinism::register(&mut r);
     r
 }

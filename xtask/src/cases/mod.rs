@@ -3,6 +3,7 @@
 pub mod core;
 pub mod determinism;
 pub mod fem;
+pub mod flip;
 pub mod fluid;
 pub mod io;
 pub mod material;

@@ -457,7 +457,7 @@ fn colliding_disks(ctx: &Ctx) -> Vec<Check> {
 
 /// Martin & Moyce (1952), tables 2 and 6 (REFERENCES.md), `a` = 2.25 in, `n^2 = 2`:
 /// `T = t sqrt(2 g / a)` and `Z = x / a`.
-const MARTIN_MOYCE: [(f64, f64); 15] = [
+pub(crate) const MARTIN_MOYCE: [(f64, f64); 15] = [
     (0.41, 1.11),
     (0.84, 1.22),
     (1.19, 1.44),
@@ -520,7 +520,7 @@ struct DamBreak {
     seconds: f64,
 }
 
-fn front_errors(z: &[f64]) -> (f64, f64) {
+pub(crate) fn front_errors(z: &[f64]) -> (f64, f64) {
     let mut max: f64 = 0.0;
     let mut sq = 0.0;
     for (zi, (_, zr)) in z.iter().zip(MARTIN_MOYCE.iter()) {
@@ -534,7 +534,7 @@ fn front_errors(z: &[f64]) -> (f64, f64) {
 /// The time-origin shift `dT` (the experiment's gate takes time to open, so its clock starts
 /// early) minimising the rms error of `Z_sim(T - dT)` against the table, `dT` in [0, 0.6]; returns
 /// `(dT, max error, rms error)`.
-fn shifted_errors(history: &[(f64, f64)]) -> (f64, f64, f64) {
+pub(crate) fn shifted_errors(history: &[(f64, f64)]) -> (f64, f64, f64) {
     let at = |t: f64| -> f64 {
         if t <= 0.0 {
             return history[0].1;

@@ -1,0 +1,293 @@
+//! Tests of the particle fluid against independent references: rest, incompressibility,
+//! conservation laws of the transfers, determinism.
+
+use crate::scenes;
+use crate::{FlipError, FlipParams, FlipSimulation, Particles, Transfer};
+use anim_fluid::pressure::CellLabel;
+
+/// Still water stays still: after 1 s the largest particle speed is a small fraction of the
+/// gravity-wave speed `sqrt(g H)` (~1.1 m/s here), and the grid divergence stays below the
+/// solver's tolerance times the pre-projection divergence.
+#[test]
+fn still_water_stays_still_2d() {
+    for transfer in [Transfer::Apic, Transfer::Flip(0.95), Transfer::Pic] {
+        let params = FlipParams::<2> { transfer, ..FlipParams::default() };
+        let (mut sim, mut p) = scenes::still_water::<2>(24, params).unwrap();
+        let y0: f64 = p.x.iter().map(|x| x[1]).sum::<f64>() / p.len() as f64;
+        for _ in 0..50 {
+            sim.advance(&mut p, 0.02).unwrap();
+        }
+        let vmax = p.max_speed();
+        assert!(vmax < 0.02, "{transfer:?}: max speed after 1 s {vmax}");
+        // Centre of mass does not sink (volume kept).
+        let y1: f64 = p.x.iter().map(|x| x[1]).sum::<f64>() / p.len() as f64;
+        assert!((y1 - y0).abs() < 0.1 / 24.0, "{transfer:?}: centre of mass moved {}", y1 - y0);
+    }
+}
+
+#[test]
+fn still_water_stays_still_3d() {
+    let (mut sim, mut p) = scenes::still_water::<3>(10, FlipParams::default()).unwrap();
+    for _ in 0..25 {
+        sim.advance(&mut p, 0.04).unwrap();
+    }
+    assert!(p.max_speed() < 0.03, "max speed {}", p.max_speed());
+}
+
+/// After projection the net outflow of every fluid cell is the solver's residual: at most the
+/// tolerance times the largest pre-projection outflow (plus rounding).
+#[test]
+fn divergence_below_solver_tolerance() {
+    for tol in [1e-6, 1e-10] {
+        let params = FlipParams::<2> { tolerance: tol, ..FlipParams::default() };
+        let (mut sim, mut p, _) = scenes::dam_break(32, 0.25, params).unwrap();
+        for _ in 0..10 {
+            let info = sim.advance(&mut p, 0.01).unwrap();
+            assert!(info.max_divergence_before > 1e-3, "nothing to project: {info:?}");
+            assert!(
+                info.max_divergence <= tol * info.max_divergence_before * 1.0001 + 1e-12,
+                "tol {tol}: {info:?}"
+            );
+        }
+    }
+    let params = FlipParams::<3> { tolerance: 1e-8, ..FlipParams::default() };
+    let mut sim = FlipSimulation::<3>::new([10, 10, 10], 0.1, params).unwrap();
+    let mut p = Particles::new();
+    scenes::fill_box(&mut p, 0.1, 2, [0.1; 3], [0.5, 0.7, 0.9], |_| [0.0; 3]);
+    for _ in 0..3 {
+        let info = sim.advance(&mut p, 0.02).unwrap();
+        assert!(info.max_divergence <= 1e-8 * info.max_divergence_before * 1.0001 + 1e-12, "{info:?}");
+        // Independent check of the labels: every cell holding a particle is fluid.
+        assert!(sim.labels().iter().filter(|&&l| l == CellLabel::Fluid).count() > 0);
+    }
+}
+
+/// A rigidly rotating disk: APIC carries the linear velocity field through P2G and G2P exactly,
+/// so the angular momentum is kept to rounding over many round trips; PIC averages it away.
+#[test]
+fn rotating_disk_angular_momentum() {
+    let l = |transfer| {
+        let params = FlipParams::<2> { transfer, ..FlipParams::default() };
+        let (mut sim, mut p) = scenes::rotating_disk(32, 0.3, 2.0, params).unwrap();
+        let l0 = p.angular_momentum([0.5, 0.5])[2];
+        for _ in 0..10 {
+            sim.transfer_round_trip(&mut p);
+        }
+        (l0, p.angular_momentum([0.5, 0.5])[2])
+    };
+    let (l0, apic) = l(Transfer::Apic);
+    assert!(l0 > 0.0);
+    assert!(((apic - l0) / l0).abs() < 1e-10, "APIC: {l0} -> {apic}");
+    let (l0, pic) = l(Transfer::Pic);
+    assert!((l0 - pic) / l0 > 0.05, "PIC should lose angular momentum: {l0} -> {pic}");
+    // FLIP keeps what the grid does not change: with no forces the change is zero.
+    let (l0, flip) = l(Transfer::Flip(1.0));
+    assert!(((flip - l0) / l0).abs() < 1e-10, "FLIP: {l0} -> {flip}");
+}
+
+/// The same in 3D: a disk rotating about z.
+#[test]
+fn rotating_disk_angular_momentum_3d() {
+    let run = |transfer| {
+        let params = FlipParams::<3> { transfer, gravity: [0.0; 3], ..FlipParams::default() };
+        let mut sim = FlipSimulation::<3>::new([12; 3], 1.0 / 12.0, params).unwrap();
+        let mut all = Particles::new();
+        let w = 2.0;
+        scenes::fill_box(&mut all, 1.0 / 12.0, 2, [0.25; 3], [0.75; 3], |x| {
+            [-w * (x[1] - 0.5), w * (x[0] - 0.5), 0.0]
+        });
+        let mut p = Particles::new();
+        for (x, v) in all.x.iter().zip(&all.v) {
+            if (x[0] - 0.5).powi(2) + (x[1] - 0.5).powi(2) < 0.0625 {
+                p.push(*x, *v);
+                if transfer == Transfer::Apic {
+                    *p.c.last_mut().unwrap() = [[0.0, -w, 0.0], [w, 0.0, 0.0], [0.0; 3]];
+                }
+            }
+        }
+        let l0 = p.angular_momentum([0.5; 3])[2];
+        for _ in 0..5 {
+            sim.transfer_round_trip(&mut p);
+        }
+        (l0, p.angular_momentum([0.5; 3])[2])
+    };
+    let (l0, apic) = run(Transfer::Apic);
+    assert!(((apic - l0) / l0).abs() < 1e-10, "APIC: {l0} -> {apic}");
+    let (l0, pic) = run(Transfer::Pic);
+    assert!((l0 - pic) / l0 > 0.05, "PIC: {l0} -> {pic}");
+}
+
+fn dam_break_bits(threads: usize) -> Vec<u64> {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    pool.install(|| {
+        let params = FlipParams::<2> { transfer: Transfer::Flip(0.97), ..FlipParams::default() };
+        let (mut sim, mut p, _) = scenes::dam_break(24, 0.3, params).unwrap();
+        for _ in 0..5 {
+            sim.advance(&mut p, 0.02).unwrap();
+        }
+        p.x.iter().chain(&p.v).flatten().map(|x| x.to_bits()).collect()
+    })
+}
+
+#[test]
+fn bitwise_identical_on_1_and_2_threads() {
+    assert_eq!(dam_break_bits(1), dam_break_bits(2));
+    let run3 = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mut sim = FlipSimulation::<3>::new([8; 3], 0.125, FlipParams::default()).unwrap();
+            let mut p = Particles::new();
+            scenes::fill_box(&mut p, 0.125, 2, [0.125; 3], [0.5, 0.75, 0.5], |_| [0.0; 3]);
+            for _ in 0..3 {
+                sim.advance(&mut p, 0.02).unwrap();
+            }
+            p.x.iter().chain(&p.v).flatten().map(|x| x.to_bits()).collect::<Vec<_>>()
+        })
+    };
+    assert_eq!(run3(1), run3(2));
+}
+
+/// Resuming from a checkpoint (particles + memory) gives the same trajectory.
+#[test]
+fn checkpoint_resume_is_exact() {
+    let params = FlipParams::<2>::default();
+    let (mut sim, mut p, _) = scenes::dam_break(20, 0.3, params).unwrap();
+    for _ in 0..3 {
+        sim.advance(&mut p, 0.02).unwrap();
+    }
+    let saved = serde_json::to_string(&p).unwrap();
+    let memory = sim.memory();
+    for _ in 0..3 {
+        sim.advance(&mut p, 0.02).unwrap();
+    }
+    let (mut sim2, _, _) = scenes::dam_break(20, 0.3, params).unwrap();
+    sim2.restore_memory(&memory).unwrap();
+    let mut p2: Particles<2> = serde_json::from_str(&saved).unwrap();
+    for _ in 0..3 {
+        sim2.advance(&mut p2, 0.02).unwrap();
+    }
+    assert_eq!(p, p2);
+    assert_eq!(sim.time(), sim2.time());
+}
+
+#[test]
+fn cfl_substeps_scale_with_dt() {
+    let params = FlipParams::<2>::default();
+    let (mut sim, mut p, _) = scenes::dam_break(32, 0.3, params).unwrap();
+    let info = sim.advance(&mut p, 0.2).unwrap();
+    // With speeds up to sqrt(2 g 0.6) ~ 3.4 m/s the CFL-1 substep is at most h / sqrt(g h).
+    let bound = (0.2 / (1.0 / 32.0 / (9.81f64 / 32.0).sqrt())).floor() as usize;
+    assert!(info.substeps >= bound, "{info:?}, bound {bound}");
+    // The particles never leave the fluid box.
+    let (lo, hi) = sim.fluid_box();
+    assert!(p.x.iter().all(|x| (0..2).all(|a| x[a] >= lo[a] && x[a] <= hi[a])));
+}
+
+#[test]
+fn rejects_bad_input() {
+    let bad = |r: Result<FlipSimulation<2>, FlipError>, name: &str| match r {
+        Err(FlipError::BadParameter { name: n, .. }) => assert_eq!(n, name),
+        other => panic!("expected a bad {name}, got {other:?}"),
+    };
+    bad(FlipSimulation::new([16, 16], 0.0, FlipParams::default()), "h");
+    bad(FlipSimulation::new([3, 16], 0.1, FlipParams::default()), "cells[0]");
+    bad(FlipSimulation::new([16, 16], 0.1, FlipParams { cfl: -1.0, ..FlipParams::default() }), "cfl");
+    bad(
+        FlipSimulation::new(
+            [16, 16],
+            0.1,
+            FlipParams { transfer: Transfer::Flip(1.5), ..FlipParams::default() },
+        ),
+        "transfer (FLIP blend)",
+    );
+    bad(
+        FlipSimulation::new([16, 16], 0.1, FlipParams { gravity: [0.0, f64::NAN], ..FlipParams::default() }),
+        "gravity",
+    );
+    let (mut sim, mut p) = scenes::still_water::<2>(16, FlipParams::default()).unwrap();
+    assert!(matches!(sim.advance(&mut p, -1.0), Err(FlipError::BadParameter { name: "dt", .. })));
+    p.v[7][1] = f64::NAN;
+    let before = p.clone();
+    match sim.advance(&mut p, 0.01) {
+        Err(FlipError::BadParticle { index: 7, field: "v", .. }) => {}
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(format!("{:?}", p), format!("{:?}", before));
+    p.v[7][1] = 0.0;
+    p.c.pop();
+    assert!(matches!(sim.advance(&mut p, 0.01), Err(FlipError::BadParticle { field: "c", .. })));
+}
+
+/// Velocities whose grid average overflows reach the particles as NaN: the error names the
+/// particle and the value it had, and the particles are restored.
+#[test]
+fn non_finite_is_detected_and_state_kept() {
+    let params = FlipParams::<2> {
+        pressure: anim_fluid::pressure::PressureMethod::Jacobi,
+        tolerance: 0.0,
+        max_iterations: 5,
+        ..FlipParams::default()
+    };
+    let (mut sim, mut p) = scenes::still_water::<2>(16, params).unwrap();
+    for v in &mut p.v {
+        *v = [1e308, 0.0];
+    }
+    let before = p.clone();
+    let err = sim.advance(&mut p, 0.01).unwrap_err();
+    match &err {
+        FlipError::NonFinite { step: 0, particle, field, last_finite: Some(v), .. } => {
+            let old = match *field {
+                "x" => before.x[*particle].to_vec(),
+                "v" => before.v[*particle].to_vec(),
+                _ => before.c[*particle].iter().flatten().copied().collect(),
+            };
+            assert!(old.contains(v), "{err}");
+        }
+        other => panic!("{other}"),
+    }
+    assert!(err.to_string().contains("anim-flip"));
+    assert_eq!(p, before);
+}
+
+#[test]
+fn particles_entering_an_obstacle_are_pushed_out() {
+    let params = FlipParams::<2> { gravity: [0.0; 2], ..FlipParams::default() };
+    let mut sim = FlipSimulation::<2>::new([16, 16], 1.0 / 16.0, params).unwrap();
+    sim.set_solid(|x| (x[0] - 0.6).abs() < 0.1 && (x[1] - 0.5).abs() < 0.1);
+    let mut p = Particles::new();
+    scenes::fill_box(&mut p, 1.0 / 16.0, 2, [0.2, 0.4], [0.35, 0.6], |_| [3.0, 0.0]);
+    let mut pushed = 0;
+    for _ in 0..10 {
+        pushed += sim.advance(&mut p, 0.02).unwrap().pushed_out;
+    }
+    assert!(pushed > 0);
+    let h = 1.0 / 16.0;
+    for x in &p.x {
+        let c = (x[0] / h) as usize + 16 * (x[1] / h) as usize;
+        assert!(!sim.solid()[c], "particle in a solid cell at {x:?}");
+    }
+}
+
+/// The volume correction keeps the density-based volume of a collapsing column; without it the
+/// particles compressed at impact stay compressed.
+#[test]
+fn volume_correction_keeps_volume() {
+    let run = |beta: f64| {
+        let params = FlipParams::<2> { volume_correction: beta, ..FlipParams::default() };
+        let h = 1.0 / 24.0;
+        let mut sim = FlipSimulation::<2>::new([24, 24], h, params).unwrap();
+        let (lo, _) = sim.fluid_box();
+        let mut p = Particles::new();
+        scenes::fill_box(&mut p, h, 2, lo, [lo[0] + 0.25, lo[1] + 0.5], |_| [0.0; 2]);
+        let v0 = sim.volume_estimate(&p, 4.0);
+        assert!((v0 - 0.125).abs() < 1e-9, "seeded volume {v0}");
+        for _ in 0..40 {
+            sim.advance(&mut p, 0.05).unwrap();
+        }
+        sim.volume_estimate(&p, 4.0) / v0
+    };
+    let kept = run(0.5);
+    let lost = run(0.0);
+    assert!((kept - 1.0).abs() < 0.03, "with correction: {kept}");
+    assert!(lost < 0.9, "without correction: {lost}");
+}
