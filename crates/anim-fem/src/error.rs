@@ -23,6 +23,11 @@ impl std::fmt::Display for StateField {
     }
 }
 
+/// The name of axis `c` (`x`, `y`, `z`).
+fn axis(c: usize) -> &'static str {
+    ["x", "y", "z"].get(c).copied().unwrap_or("?")
+}
+
 /// Everything that can go wrong building or stepping a finite element body.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -115,8 +120,11 @@ pub enum FemError {
     /// A mesh file could not be read or converted.
     #[error("mesh input: {0}")]
     MeshInput(String),
-    /// The step produced a NaN or infinity.
-    #[error("divergence at step {step}: non-finite {field} of vertex {vertex} (value {value})")]
+    /// The step produced a NaN or infinity; the step was undone.
+    #[error(
+        "anim-fem: step {step}: non-finite {field} of vertex {vertex}, component {} (value {value}); last finite {field} of vertex {vertex}: {last_finite:?}",
+        axis(*component)
+    )]
     NonFiniteState {
         /// Completed steps before the failing one.
         step: u64,
@@ -124,12 +132,18 @@ pub enum FemError {
         field: StateField,
         /// First offending vertex.
         vertex: usize,
+        /// Its first offending component (0, 1, 2 for `x`, `y`, `z`).
+        component: usize,
         /// The offending value.
         value: f64,
+        /// The vertex's position or velocity (as `field` says) before the step.
+        last_finite: [f64; 3],
     },
     /// An element's energy or stress is not finite (an element inverted beyond what its material
     /// model defines, e.g. `det F <= 0` for Neo-Hookean, or a NaN deformation).
-    #[error("divergence at step {step}: element {element} has non-finite energy or stress (det F = {det_f})")]
+    #[error(
+        "anim-fem: step {step}: element {element} has non-finite energy or stress (det F = {det_f}); the state is the one before the step"
+    )]
     NonFiniteElement {
         /// Completed steps before the failing one.
         step: u64,

@@ -30,6 +30,12 @@
 //! entries are summed by gathering in a fixed element order; the direct solvers run
 //! sequentially. Results are bitwise identical for any rayon thread count.
 //!
+//! **Divergence.** A step that produces a NaN or infinity returns
+//! [`FemError::NonFiniteState`] (the vertex, its component `x`/`y`/`z`, the value and the
+//! vertex's last finite position or velocity) or [`FemError::NonFiniteElement`] (an element whose
+//! energy or stress is not finite, with its `det F`); both messages begin with
+//! `anim-fem: step N:`, and the state and the step count are left as they were before the step.
+//!
 //! ```
 //! use anim_core::solver::Solver;
 //! use anim_fem::generate::box_mesh;

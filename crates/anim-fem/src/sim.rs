@@ -15,8 +15,11 @@
 //! update, and the implicit step because anim-core's backward Euler has no line search on an
 //! energy and assumes a diagonal mass.
 //!
-//! Both steps leave the state unchanged when they fail, and report NaN or infinity as
-//! [`FemError::NonFiniteState`] / [`FemError::NonFiniteElement`] naming the vertex or element.
+//! Both steps leave the state (and the step count, the simulation's memory) unchanged when they
+//! fail, and report NaN or infinity as [`FemError::NonFiniteState`] (the vertex, its component,
+//! the value and the vertex's last finite position or velocity) or
+//! [`FemError::NonFiniteElement`] (the element and its `det F`), with messages that begin with
+//! `anim-fem: step N:`.
 
 use crate::element::{force_differential, gather};
 use crate::error::{FemError, StateField};
@@ -676,10 +679,18 @@ impl FemSimulation {
         for field in [StateField::Position, StateField::Velocity] {
             let values = if field == StateField::Position { &state.x } else { &state.v };
             if let Some(d) = anim_core::diagnostics::first_non_finite(values) {
-                let err =
-                    FemError::NonFiniteState { step: self.steps, field, vertex: d / 3, value: values[d] };
+                let value = values[d];
                 restore(self, state);
-                return Err(err);
+                let old = if field == StateField::Position { &state.x } else { &state.v };
+                let vertex = d / 3;
+                return Err(FemError::NonFiniteState {
+                    step: self.steps,
+                    field,
+                    vertex,
+                    component: d % 3,
+                    value,
+                    last_finite: [old[3 * vertex], old[3 * vertex + 1], old[3 * vertex + 2]],
+                });
             }
         }
         state.t += dt;

@@ -390,3 +390,37 @@ fn explicit_divergence_is_reported_not_silent() {
     assert!(matches!(e, FemError::NonFiniteState { .. } | FemError::NonFiniteElement { .. }), "{e}");
     assert!(state.x.iter().all(|v| v.is_finite()));
 }
+
+#[test]
+fn an_overflowing_load_is_reported_by_vertex_and_the_step_undone() {
+    // A finite load of f64::MAX on a vertex of a feather-light box (density 1e-6, vertex masses
+    // of order 1e-8 kg): its acceleration overflows, and so its velocity and position.
+    let mesh = box_mesh([0.0; 3], [1.0; 3], [2, 2, 2]).unwrap();
+    let mut m =
+        FemModel::new(mesh, Material::new(MaterialModel::NeoHookean, 1e5, 0.3, 1e-6).unwrap()).unwrap();
+    let vertex = 7;
+    m.add_nodal_force(vertex, [0.0, 0.0, f64::MAX]).unwrap();
+    let mut sim = FemSimulation::new(m, FemParams::new(TimeIntegrator::SymplecticEuler)).unwrap();
+    let mut state = sim.rest_state();
+    let before = state.clone();
+    let memory = sim.memory();
+    let err = sim.step(&mut state, 1e-3).unwrap_err();
+    let bits = |s: &anim_core::integrate::State| {
+        s.x.iter().chain(&s.v).chain([&s.t]).map(|v| v.to_bits()).collect::<Vec<_>>()
+    };
+    assert_eq!(bits(&state), bits(&before), "the failed step changed the state");
+    assert_eq!(sim.memory(), memory, "the failed step changed the memory");
+    let msg = err.to_string();
+    assert!(msg.starts_with("anim-fem: step 0: non-finite position of vertex 7, component z"), "{msg}");
+    match err {
+        FemError::NonFiniteState { step, field, vertex: v, component, value, last_finite } => {
+            assert_eq!(step, 0);
+            assert_eq!(field, crate::error::StateField::Position);
+            assert_eq!(v, vertex);
+            assert_eq!(component, 2);
+            assert_eq!(value, f64::INFINITY);
+            assert_eq!(last_finite.to_vec(), before.x[3 * vertex..3 * vertex + 3].to_vec());
+        }
+        other => panic!("expected NonFiniteState, got {other}"),
+    }
+}

@@ -67,8 +67,10 @@
 //! `max c dt / h` and splits itself into enough substeps ([`StepStats::substeps`]); a particle
 //! leaving the domain is clamped back or removed and counted ([`OutOfDomain`]); grid nodes
 //! without mass get zero velocity; a non-finite result is reported as
-//! [`MpmError::NonFinite`] naming the step, the particle and the field, with the state left as
-//! it was before the step.
+//! [`MpmError::NonFinite`], whose message begins with `anim-mpm: step N:` and names the
+//! particle (by id), the field and its component or matrix entry, the value and the particle's
+//! whole last finite vector or matrix, with the particles and the simulation's memory (step
+//! count, time) left as they were before the step.
 //!
 //! ```
 //! use anim_core::solver::Solver;
@@ -188,16 +190,39 @@ pub enum MpmError {
         /// The limit.
         limit: usize,
     },
-    /// The step produced a NaN or infinity.
-    #[error("step {step}: non-finite {field} of particle {particle} (value {value})")]
+    /// The step produced a NaN or infinity; the particles are left as they were before the step.
+    #[error(
+        "anim-mpm: step {step}: non-finite {field} of particle {particle}{} (value {value}); last finite {field} of particle {particle}: {last_finite:?}",
+        describe_component(*component, last_finite.len())
+    )]
     NonFinite {
         /// Completed steps before the failing one.
         step: u64,
         /// The particle's id.
         particle: usize,
-        /// Which quantity.
+        /// Which quantity: "position", "velocity", "deformation gradient", "affine matrix" or
+        /// "plastic state".
         field: &'static str,
+        /// The first offending entry of that quantity: the axis (0, 1, 2 for `x`, `y`, `z`) of a
+        /// vector, the column-major index of a matrix, 0 for the plastic state.
+        component: usize,
         /// The value.
         value: f64,
+        /// The particle's whole quantity before the step (the `D` entries of a vector, the `D^2`
+        /// column-major entries of a matrix, or the one plastic value).
+        last_finite: Vec<f64>,
     },
+}
+
+/// `", component y"` for an entry of a vector of `len <= 3`, `", entry (row r, column c)"` for
+/// a column-major matrix entry, nothing for a scalar.
+fn describe_component(component: usize, len: usize) -> String {
+    match len {
+        0 | 1 => String::new(),
+        2 | 3 => format!(", component {}", ["x", "y", "z"][component.min(2)]),
+        _ => {
+            let d = if len == 4 { 2 } else { 3 };
+            format!(", entry (row {}, column {})", component % d, component / d)
+        }
+    }
 }

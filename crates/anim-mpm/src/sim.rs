@@ -442,23 +442,27 @@ impl<const D: usize> MpmSimulation<D> {
         if outcome.first_bad != u32::MAX {
             let s = outcome.first_bad as usize;
             let p = self.grid.order[s] as usize;
-            let bad = |a: &[f32]| a.iter().copied().find(|c| !c.is_finite());
-            let (field, value) = if let Some(v) = bad(&self.out.x[s * D..s * D + D]) {
-                ("position", v)
-            } else if let Some(v) = bad(&self.out.v[s * D..s * D + D]) {
-                ("velocity", v)
-            } else if let Some(v) = bad(&self.out.f[s * D * D..(s + 1) * D * D]) {
-                ("deformation gradient", v)
-            } else if let Some(v) = bad(&self.out.c[s * D * D..(s + 1) * D * D]) {
-                ("affine matrix", v)
+            let bad = |a: &[f32]| a.iter().position(|c| !c.is_finite());
+            let out = &self.out;
+            let (field, component, value) = if let Some(k) = bad(&out.x[s * D..s * D + D]) {
+                ("position", k, out.x[s * D + k])
+            } else if let Some(k) = bad(&out.v[s * D..s * D + D]) {
+                ("velocity", k, out.v[s * D + k])
+            } else if let Some(k) = bad(&out.f[s * D * D..(s + 1) * D * D]) {
+                ("deformation gradient", k, out.f[s * D * D + k])
+            } else if let Some(k) = bad(&out.c[s * D * D..(s + 1) * D * D]) {
+                ("affine matrix", k, out.c[s * D * D + k])
             } else {
-                ("plastic state", self.out.plastic[s])
+                ("plastic state", 0, out.plastic[s])
             };
+            // The caller restores the particles of the step's start and fills in `last_finite`.
             return Err(MpmError::NonFinite {
                 step: self.steps,
                 particle: st.id[p] as usize,
                 field,
+                component,
                 value: f64::from(value),
+                last_finite: Vec::new(),
             });
         }
         st.swap(&mut self.out);
@@ -515,11 +519,14 @@ impl<const D: usize> MpmSimulation<D> {
                     outside += o;
                     removed += rm;
                 }
-                Err(e) => {
+                Err(mut e) => {
                     if substeps > 1 {
                         st.copy_from(&self.backup);
                     }
                     self.time = time0;
+                    if let MpmError::NonFinite { particle, field, last_finite, .. } = &mut e {
+                        *last_finite = last_finite_of(st, *particle, field);
+                    }
                     return Err(e);
                 }
             }
@@ -537,6 +544,20 @@ impl<const D: usize> MpmSimulation<D> {
         };
         Ok(self.stats)
     }
+}
+
+/// The quantity `field` of the particle with id `id` in `st` (the particles before the step),
+/// widened to `f64`; runs only on the error path.
+fn last_finite_of<const D: usize>(st: &Particles<D>, id: usize, field: &str) -> Vec<f64> {
+    let Some(p) = st.id.iter().position(|&i| i as usize == id) else { return Vec::new() };
+    let values: &[f32] = match field {
+        "position" => &st.x[p * D..p * D + D],
+        "velocity" => &st.v[p * D..p * D + D],
+        "deformation gradient" => &st.f[p * D * D..(p + 1) * D * D],
+        "affine matrix" => &st.c[p * D * D..(p + 1) * D * D],
+        _ => std::slice::from_ref(&st.plastic[p]),
+    };
+    values.iter().map(|&v| f64::from(v)).collect()
 }
 
 impl<const D: usize> Solver for MpmSimulation<D> {

@@ -281,12 +281,16 @@ fn divergence_is_reported_with_step_and_particle() {
         *c = 1e30;
     }
     let before = p.clone();
+    let memory = sim.memory();
     let err = sim.advance(&mut p, 1e-4).expect_err("diverges");
+    let msg = err.to_string();
     match err {
         MpmError::NonFinite { step, .. } => assert_eq!(step, 1),
         other => panic!("unexpected {other}"),
     }
+    assert!(msg.starts_with("anim-mpm: step 1: non-finite "), "{msg}");
     assert_eq!(p, before, "state left as it was");
+    assert_eq!(sim.memory(), memory, "memory left as it was");
     // A NaN in the input is refused up front, naming the particle.
     p.v[2 * idx] = f32::NAN;
     let err = sim.advance(&mut p, 1e-4).expect_err("bad input");
@@ -413,4 +417,69 @@ fn sand_column_stops_short_of_a_fluid_column() {
     let sand_runout = (sand - l0) / l0;
     assert!((0.8..3.0).contains(&sand_runout), "sand (L - L0) / L0 = {sand_runout}");
     assert!(water > sand + 0.2, "water front {water} vs sand {sand}");
+}
+
+/// One particle far from a cloud carries a huge (finite) deformation gradient: its stress
+/// overflows, and since it shares no grid node with the cloud it is the only particle that goes
+/// non-finite. The report names it by id with its last finite value, and a step split into
+/// substeps restores the particles and the memory bit for bit.
+#[test]
+fn an_overflowing_stress_is_reported_by_particle_and_the_step_undone() {
+    for dt in [1e-6, 4e-3] {
+        let mut params = MpmParams::with_resolution(32);
+        params.gravity = [0.0; 3];
+        let mut sim =
+            MpmSimulation::<2>::new(params, vec![Material::Fluid(Fluid::default())]).expect("valid");
+        let mut p = cloud::<2>(20, 5, 0);
+        p.push([0.85, 0.85], [0.0, 0.0], 1e-3, 1e-3, 0).expect("valid particle");
+        let lone = 20;
+        sim.advance(&mut p, 1e-4).expect("step");
+        let idx = p.id.iter().position(|&id| id as usize == lone).expect("present");
+        for c in &mut p.f[idx * 4..idx * 4 + 4] {
+            *c = 1e30;
+        }
+        let before = p.clone();
+        let memory = sim.memory();
+        // dt = 1e-6 is one substep; dt = 4e-3 is split into 13 by the wave CFL limit, so the
+        // particles are restored from the step's backup.
+        let err = sim.advance(&mut p, dt).expect_err("diverges");
+        let bits = |q: &Particles<2>| {
+            let mut b: Vec<u32> =
+                q.x.iter()
+                    .chain(&q.v)
+                    .chain(&q.c)
+                    .chain(&q.f)
+                    .chain(&q.plastic)
+                    .map(|v| v.to_bits())
+                    .collect();
+            b.extend(q.mass.iter().chain(&q.volume).map(|v| v.to_bits()));
+            b.extend(q.id.iter().copied());
+            b.extend(q.material.iter().map(|&m| u32::from(m)));
+            b
+        };
+        assert_eq!(bits(&p), bits(&before), "dt {dt}: particles changed");
+        assert_eq!(sim.memory(), memory, "dt {dt}: memory changed");
+        let msg = err.to_string();
+        assert!(msg.starts_with("anim-mpm: step 1: non-finite "), "{msg}");
+        match err {
+            MpmError::NonFinite { step, particle, field, component, value, last_finite } => {
+                assert_eq!(step, 1);
+                assert_eq!(particle, lone, "{msg}");
+                assert!(!value.is_finite(), "{msg}");
+                let old: Vec<f64> = match field {
+                    "position" => before.x[idx * 2..idx * 2 + 2].iter().map(|&v| f64::from(v)).collect(),
+                    "velocity" => before.v[idx * 2..idx * 2 + 2].iter().map(|&v| f64::from(v)).collect(),
+                    "deformation gradient" => {
+                        before.f[idx * 4..idx * 4 + 4].iter().map(|&v| f64::from(v)).collect()
+                    }
+                    "affine matrix" => before.c[idx * 4..idx * 4 + 4].iter().map(|&v| f64::from(v)).collect(),
+                    _ => vec![f64::from(before.plastic[idx])],
+                };
+                assert_eq!(last_finite, old, "{msg}");
+                assert!(component < old.len(), "{msg}");
+                assert!(msg.contains(&format!("of particle {lone}")), "{msg}");
+            }
+            other => panic!("unexpected {other}"),
+        }
+    }
 }

@@ -79,7 +79,10 @@
 //!
 //! **Failures** never pass silently: a step that makes a position or velocity non-finite, or
 //! stretches a distance constraint beyond [`PbdParams::max_stretch`], returns a [`PbdError`]
-//! naming the step, the particle and the constraint, and leaves the state as it was.
+//! naming the step, the particle and the constraint, and leaves the state and the simulation's
+//! memory as they were. A non-finite value is [`PbdError::NonFinite`], whose message begins with
+//! `anim-pbd: step N:` and gives the particle's component, the value and its last finite
+//! position or velocity.
 //!
 //! ## Speed
 //!

@@ -49,9 +49,12 @@
 //! # Failures
 //!
 //! A step is computed in the solver's own buffers and copied into the caller's state only when it
-//! succeeded: on error the state is unchanged. After each step every position and velocity is
-//! checked ([`PbdError::NonFinite`], naming the particle and the first constraint whose update was
-//! not finite, or else the first constraint at that particle), and the largest stretch
+//! succeeded: on error the state is unchanged, and so is the simulation's memory (step count,
+//! external forces, pending body targets: [`PbdSimulation::memory`]). After each step every
+//! position and velocity is checked ([`PbdError::NonFinite`], whose message begins with
+//! `anim-pbd: step N:` and names the particle, the component `x`/`y`/`z`, the value, the
+//! particle's last finite position or velocity, and the first constraint whose update was not
+//! finite, or else the first constraint at that particle), and the largest stretch
 //! `|x_i - x_j| / l` over the distance constraints is compared with
 //! [`PbdParams::max_stretch`] ([`PbdError::Diverged`]).
 
@@ -214,7 +217,8 @@ pub enum PbdError {
     },
     /// A position or velocity became NaN or infinite. The step was undone.
     #[error(
-        "non-finite {field} of particle {particle} at step {step} (last finite value {last_finite:?}); {}; the step was undone",
+        "anim-pbd: step {step}: non-finite {field} of particle {particle}{} (value {value}); last finite {field} of particle {particle}: {last_finite:?}; {}; the step was undone",
+        match component { Some(c) => format!(", component {}", ["x", "y", "z"][(*c).min(2)]), None => String::new() },
         match constraint { Some((c, kind)) => format!("constraint {c} ({kind}) produced it"), None => "no constraint involved (external force or input)".to_string() }
     )]
     NonFinite {
@@ -224,7 +228,12 @@ pub enum PbdError {
         field: &'static str,
         /// First offending particle.
         particle: usize,
-        /// Its value before the step.
+        /// Its first offending component (0, 1, 2 for `x`, `y`, `z`); `None` when a constraint's
+        /// update was not finite and was skipped, leaving the particle finite.
+        component: Option<usize>,
+        /// The offending value (NaN when the update was skipped, see `component`).
+        value: f64,
+        /// The particle's position or velocity (as `field` says) before the step.
         last_finite: [f64; 3],
         /// The first constraint whose update was not finite (or else the first constraint at that
         /// particle), with its kind.
@@ -564,7 +573,8 @@ impl PbdSimulation {
         let t0 = state.t;
         for (b, body) in self.model.bodies.iter().enumerate() {
             self.data.pose_start[b] = body.pose_at(t0);
-            self.data.pose_end[b] = self.targets[b].take().unwrap_or_else(|| body.pose_at(t0 + dt));
+            // A pending target is used up only by a step that succeeds.
+            self.data.pose_end[b] = self.targets[b].unwrap_or_else(|| body.pose_at(t0 + dt));
         }
         let s = self.params.substeps;
         let h = dt / s as f64;
@@ -579,6 +589,7 @@ impl PbdSimulation {
             state.v[3 * i..3 * i + 3].copy_from_slice(&v.to_array());
         }
         state.t = t0 + dt;
+        self.targets.iter_mut().for_each(|t| *t = None);
         self.steps += 1;
         Ok(StepInfo { substeps: s, iterations: self.params.iterations, contacts })
     }
@@ -836,11 +847,16 @@ impl PbdSimulation {
         let bad_v = d.v.iter().position(|p| !p.is_finite());
         let flagged = d.bad.load(Ordering::Relaxed);
         if bad_x.is_some() || bad_v.is_some() || flagged != usize::MAX {
-            let (field, particle) = match (bad_x, bad_v) {
-                (Some(p), _) => ("position", p),
-                (None, Some(p)) => ("velocity", p),
+            let (field, particle, after, old) = match (bad_x, bad_v) {
+                (Some(p), _) => ("position", p, Some(d.x[p]), &state.x),
+                (None, Some(p)) => ("velocity", p, Some(d.v[p]), &state.v),
                 // A skipped non-finite update left the state finite: name the constraint's first particle.
-                (None, None) => ("position", self.first_particle(flagged)),
+                (None, None) => ("position", self.first_particle(flagged), None, &state.x),
+            };
+            let component = after.and_then(|a| a.to_array().iter().position(|c| !c.is_finite()));
+            let value = match (after, component) {
+                (Some(a), Some(c)) => a[c],
+                _ => f64::NAN,
             };
             let constraint = if flagged < self.model.constraints.len() && flagged != CONTACT_ID as usize {
                 Some(flagged)
@@ -851,7 +867,9 @@ impl PbdSimulation {
                 step,
                 field,
                 particle,
-                last_finite: load(&state.x, particle).to_array(),
+                component,
+                value,
+                last_finite: load(old, particle).to_array(),
                 constraint: constraint.map(|c| (c, self.model.constraints[c].function.name())),
             });
         }

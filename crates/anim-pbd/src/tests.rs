@@ -676,11 +676,71 @@ fn a_nan_is_reported_with_step_and_constraint_and_the_state_kept() {
             assert_eq!(step, 3);
             assert_eq!(constraint.map(|c| c.0), Some(1), "{e}");
         }
-        other => panic!("unexpected {other}"),
+        ref other => panic!("unexpected {other}"),
     }
     assert_eq!(state.x, before.x);
     assert_eq!(state.v, before.v);
     assert!(e.to_string().contains("step 3") && e.to_string().contains("constraint 1"), "{e}");
+}
+
+/// An infinite external force (the API accepts any value) on a free particle: the report names
+/// the crate, the step, the particle, its component and last finite value, and the state and the
+/// simulation's memory are bit for bit what they were before the step.
+#[test]
+fn an_infinite_force_is_reported_by_particle_and_the_step_undone() {
+    let mut b = PbdBuilder::new();
+    b.gravity(EARTH_GRAVITY);
+    let r = b
+        .chain(&Chain {
+            count: 4,
+            start: [0.0; 3],
+            end: [0.3, 0.0, 0.0],
+            mass: 0.1,
+            stretch: ConstraintParams::with_compliance(1e-6),
+        })
+        .expect("chain");
+    b.pin(r.start);
+    // A kinematic body with a pending target: the target is part of the memory a failed step keeps.
+    let body = b.body(KinematicBody::new(
+        Pose::from_translation([0.0, 0.0, 1.0]),
+        BodyMotion::Oscillate { amplitude: [0.3, 0.0, 0.0], frequency: 1.0 },
+    ));
+    let model = b.build().expect("builds");
+    let mut state = model.rest_state();
+    let mut sim = PbdSimulation::new(model, PbdParams::default()).expect("ok");
+    sim.run(&mut state, 0.01, 5).expect("runs");
+    sim.set_body_target(body, Pose::from_translation([0.1, 0.0, 1.0]));
+    sim.set_external_force(3, [0.0, 0.0, f64::NEG_INFINITY]);
+    let before = state.clone();
+    let memory = sim.memory();
+    let e = sim.advance(&mut state, 0.01).unwrap_err();
+    let bits = |s: &State| s.x.iter().chain(&s.v).chain([&s.t]).map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&state), bits(&before), "the failed step changed the state");
+    assert_eq!(sim.memory(), memory, "the failed step changed the memory");
+    assert_eq!(sim.steps(), 5);
+    let msg = e.to_string();
+    assert!(msg.starts_with("anim-pbd: step 5: non-finite "), "{msg}");
+    match e {
+        PbdError::NonFinite { step, field, particle, component, value, last_finite, .. } => {
+            assert_eq!(step, 5);
+            // The force drives particle 3's predicted position to -inf along z; the distance
+            // constraint to particle 2 then has a NaN gradient, and its update is skipped, so
+            // particle 3 is the only non-finite one and positions are checked first.
+            assert_eq!(field, "position", "{msg}");
+            assert_eq!(particle, 3, "{msg}");
+            assert_eq!(component, Some(2), "{msg}");
+            assert_eq!(value, f64::NEG_INFINITY, "{msg}");
+            assert_eq!(last_finite.to_vec(), before.x[9..12].to_vec(), "{msg}");
+            let head = "anim-pbd: step 5: non-finite position of particle 3, component z (value -inf)";
+            assert!(msg.starts_with(head), "{msg}");
+        }
+        other => panic!("unexpected {other}"),
+    }
+    // With the force removed the step goes through and uses up the pending target.
+    sim.set_external_force(3, [0.0; 3]);
+    sim.advance(&mut state, 0.01).expect("recovers");
+    assert_eq!(sim.steps(), 6);
+    assert!(sim.memory()["targets"][body].is_null(), "{}", sim.memory());
 }
 
 /// Degenerate configurations at run time: coincident particles, a stencil folded flat onto its

@@ -57,6 +57,10 @@
 //! [`sim::RigidSimulation`] an anim-core [`Solver`](anim_core::solver::Solver) with Lie-group
 //! steppers for any tree (symplectic and explicit Euler, the commutator-free RK4, the implicit
 //! midpoint rule, and an energy- and momentum-conserving midpoint rule for free bodies).
+//! A step that produces a NaN or infinity returns [`sim::SimError::NonFinite`], whose message
+//! begins with `anim-rigid: step N:` and names the joint, the coordinate within it, the value and
+//! the joint's last finite `q` or `v`; the state and the simulation's memory are left as they
+//! were before the step.
 //! [`scenes`] has a swinging Panda, a 32-link pendulum chain and a spinning T-handle showing the
 //! Dzhanibekov flip, ready for the command line.
 //!

@@ -33,7 +33,10 @@
 //! built once ([`network`] explains the equations, the fix and the parallel scheme).
 //! [`SpringSimulation`] couples a network with an integrator as anim-core's
 //! [`Solver`](anim_core::solver::Solver), stops a diverging run at the step and spring that blew
-//! up, and reports energy and momenta.
+//! up, and reports energy and momenta. A NaN or infinity is [`SpringError::NonFinite`], whose
+//! message begins with `anim-springs: step N:` and names the particle, its component, the value
+//! and the particle's last finite position or velocity; a failed step leaves the state and the
+//! integrator's memory as they were.
 //!
 //! ## Which integrator, which solver
 //!

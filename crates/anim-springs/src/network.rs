@@ -773,7 +773,10 @@ impl SpringNetwork {
                     acc += model.contact_force(load(x, p), load(v, p));
                 }
                 if accel {
-                    acc *= model.inv_mass[p];
+                    // A pinned particle (zero inverse mass) does not accelerate, whatever the
+                    // force: `0 * inf` would otherwise put a NaN on a particle that cannot move.
+                    let w = model.inv_mass[p];
+                    acc = if w == 0.0 { DVec3::ZERO } else { acc * w };
                 }
                 fp[0] = acc.x;
                 fp[1] = acc.y;

@@ -90,7 +90,7 @@ pub fn by_name(name: &str, resolution: Option<usize>) -> Option<Result<SpringSce
 /// `[M - h^2 K(x0) - h D(x0)] dv = h f(x0) + h^2 K v0`, Baraff and Witkin's scheme), with the
 /// linear solve to a relative residual of `1e-6`.
 ///
-/// Why not Newton to convergence: without a line search (anim-core's Newton has none), full
+/// Why not Newton to convergence: even with anim-core's line search (on the residual norm), full
 /// Newton on a cloth that folds, with compressed springs whose definite Jacobian drops their
 /// transverse stiffness, can stall (the hanging cloth at `dt = 0.01` s does after about half a
 /// second), and each step costs several linear solves. One iteration of the linearised step is

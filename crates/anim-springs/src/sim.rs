@@ -6,12 +6,15 @@
 //! infinite. After every step [`SpringSimulation`] measures the largest stretch ratio
 //! `|x_i - x_j| / l` ([`SpringNetwork::max_stretch`]); above the bound (default
 //! [`DEFAULT_MAX_STRETCH`]) it restores the state from before the step and returns
-//! [`SpringError::Diverged`] naming the step, the spring, its particles and the ratio. A NaN that
-//! still appears (a force callback returning NaN, say) is caught by the integrator itself and
-//! reported as [`SpringError::Integrate`] with the step and degree of freedom. Either way the
-//! caller's state is the last good one.
+//! [`SpringError::Diverged`] naming the step, the spring, its particles and the ratio. A NaN or
+//! infinity that still appears (a stiffness so large that the force overflows, say) is caught by
+//! the integrator before it touches the state and reported as [`SpringError::NonFinite`]: its
+//! message begins with `anim-springs: step N:` and names the particle, the component `x`/`y`/`z`,
+//! the value and the particle's whole last finite position or velocity. Either way the caller's
+//! state is the last good one; after a non-finite step the integrator's memory is unchanged too.
 
 use crate::network::SpringNetwork;
+use anim_core::diagnostics::{Field, NonFinite};
 use anim_core::integrate::{IntegrateError, Integrator, IntegratorKind, NewtonParams, State, StepInfo};
 use anim_core::linalg::LinearSolverKind;
 use anim_core::solver::{Solver, StepReport};
@@ -29,13 +32,17 @@ pub enum SpringError {
     /// The integrator parameters are invalid (a beta outside `[0, 1]`).
     #[error("invalid integrator: {0}")]
     BadIntegrator(String),
-    /// The integrator failed (non-finite state, Newton or linear solver failure, bad `dt`).
+    /// A position, velocity or force became NaN or infinite; the step was not taken. The report
+    /// names the particle (`element.index`), its component and its last finite value.
+    #[error(transparent)]
+    NonFinite(NonFinite),
+    /// The integrator failed (Newton or linear solver failure, bad `dt`).
     #[error("step {step}: {source}")]
     Integrate {
         /// Step index (0-based count of completed steps).
         step: u64,
-        /// The integrator's error.
-        source: IntegrateError,
+        /// The integrator's error (boxed: the error type stays small).
+        source: Box<IntegrateError>,
     },
     /// A spring stretched beyond the bound: the run is diverging. The step was undone.
     #[error(
@@ -188,10 +195,23 @@ impl SpringSimulation {
     pub fn advance(&mut self, state: &mut State, dt: f64) -> Result<StepInfo, SpringError> {
         let step = self.steps;
         copy_state(&mut self.backup, state);
-        let info = self
-            .integrator
-            .step(&mut self.network, state, dt)
-            .map_err(|source| SpringError::Integrate { step, source })?;
+        let info = self.integrator.step(&mut self.network, state, dt).map_err(|source| match source {
+            // The integrator left `state` as it was: it holds the last finite values.
+            IntegrateError::NonFinite(nf) => {
+                let old: &[f64] = match nf.field {
+                    Field::Position => &state.x,
+                    Field::Velocity => &state.v,
+                    _ => &[],
+                };
+                SpringError::NonFinite(NonFinite { step, ..nf }.in_elements(
+                    "anim-springs",
+                    "particle",
+                    3,
+                    old,
+                ))
+            }
+            source => SpringError::Integrate { step, source: Box::new(source) },
+        })?;
         if let Some(s) = self.network.max_stretch(&state.x)
             && !(s.ratio <= self.max_stretch)
         {

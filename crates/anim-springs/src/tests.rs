@@ -559,6 +559,66 @@ fn a_diverging_explicit_run_is_stopped_with_the_step_and_spring() {
     assert!(state.x.iter().all(|v| v.is_finite()));
 }
 
+#[test]
+fn an_overflowing_force_is_reported_by_particle_and_the_step_undone() {
+    // k = 1e308 is finite, but the force it gives overflows as soon as a spring stretches by
+    // more than about 1.8: step 0 falls by g dt^2, step 1 flings particle 1 up by ~1e297, and
+    // the force of step 2 on particle 1 (both of its springs stretched ~1e297 along z) is
+    // infinite along z and `inf * 0 = NaN` along x and y. Positions are checked first, so the
+    // report is the position of particle 1, component x, value NaN. Velocity Verlet evaluates
+    // the force at the drifted position within the step, so it flings particle 1 in step 0
+    // (v ~ 2.5e299) and overflows in step 1, where the drifted positions (~5e296) are still
+    // finite but the closing half kick is not: velocity of particle 1, component x.
+    let chain =
+        HangingChain { count: 3, mass: 1.0, stiffness: 1e308, damping: 0.0, rest_length: 0.1, gravity: 9.81 };
+    use anim_core::diagnostics::{Component, Field};
+    for (kind, step, field) in [
+        (IntegratorKind::SymplecticEuler, 2, Field::Position),
+        (IntegratorKind::VelocityVerlet, 1, Field::Velocity),
+    ] {
+        let net = chain.network().unwrap();
+        let mut state = net.rest_state();
+        let mut sim = SpringSimulation::new(net, kind, NewtonParams::default(), LinearSolverKind::Cg)
+            .unwrap()
+            .with_max_stretch(f64::INFINITY);
+        let mut failed = None;
+        for _ in 0..10 {
+            let before = state.clone();
+            let memory = sim.memory();
+            if let Err(e) = sim.advance(&mut state, 1e-3) {
+                failed = Some((e, before, memory));
+                break;
+            }
+        }
+        let Some((err, before, memory)) = failed else { panic!("{}: never overflowed", kind.label()) };
+        let bits = |s: &State| s.x.iter().chain(&s.v).chain([&s.t]).map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&state), bits(&before), "{}: the failed step changed the state", kind.label());
+        assert_eq!(sim.memory(), memory, "{}: the failed step changed the memory", kind.label());
+        let msg = err.to_string();
+        match err {
+            SpringError::NonFinite(nf) => {
+                let old = if field == Field::Position { &before.x } else { &before.v };
+                assert_eq!(nf.step, step, "{msg}");
+                assert_eq!(sim.steps(), step);
+                assert_eq!(nf.element.kind, "particle");
+                assert_eq!(nf.element.index, 1, "{msg}");
+                assert_eq!(nf.element.component, Component::Axis(0), "{msg}");
+                assert_eq!(nf.field, field, "{msg}");
+                assert!(nf.value.is_nan(), "{msg}");
+                assert_eq!(nf.dof, 3, "{msg}");
+                assert_eq!(nf.last_finite, old[3], "{msg}");
+                assert_eq!(*nf.last_finite_element, old[3..6], "{msg}");
+                assert!(old[5].abs() > 1e296, "particle 1 was flung along z: {msg}");
+                let head = format!(
+                    "anim-springs: step {step}: non-finite {field} of particle 1, component x (value NaN)"
+                );
+                assert!(msg.starts_with(&head), "{msg}");
+            }
+            other => panic!("{}: expected NonFinite, got {other}", kind.label()),
+        }
+    }
+}
+
 // ---------------------------------------------------------------- builders
 
 #[test]

@@ -25,12 +25,14 @@
 //! the identity and their right-hand side is zero, so iterative solvers never move them and the
 //! assembled matrix stays symmetric.
 //!
-//! There is no line search here: the energy-based backtracking that FEM needs lives with the
-//! FEM solver, which knows its incremental potential.
+//! The line search here backtracks on the residual norm ([`NewtonParams::line_search`]); the
+//! energy-based backtracking that FEM needs lives with the FEM solver, which knows its
+//! incremental potential.
 
 use super::{
     IntegrateError, Integrator, MechanicalSystem, State, StepInfo, apply, check_inputs, fit, validate,
 };
+use crate::diagnostics::{Field, NonFinite, check_finite};
 use crate::linalg::{
     CsrMatrix, IterativeParams, LinearOperator, LinearSolver, SolveError, SystemMatrix, norm,
 };
@@ -320,6 +322,14 @@ impl NewtonCore {
             self.dv[i] = 0.0;
         }
         let g0 = norm(&self.rhs);
+        if !g0.is_finite() {
+            // The force at the start is not finite: name its first offending degree of freedom.
+            self.x_e.copy_from_slice(&state.x);
+            self.v_e.copy_from_slice(&state.v);
+            if let Some(e) = non_finite_iterate(step, system, state, t_e, self) {
+                return Err(e);
+            }
+        }
         let mut residual = 0.0;
         if c_x == 0.0 && c_v == 0.0 {
             // beta = 0: the Newton matrix is M, the step is explicit (symplectic Euler).
@@ -359,6 +369,9 @@ impl NewtonCore {
                 }
                 residual = g_norm / g0;
                 if !residual.is_finite() {
+                    if let Some(e) = non_finite_iterate(step, system, state, t_e, self) {
+                        return Err(e);
+                    }
                     return Err(IntegrateError::NewtonNotConverged { step, iterations: iteration, residual });
                 }
                 if residual <= params.tolerance || g_norm <= floor {
@@ -445,6 +458,30 @@ impl NewtonCore {
         self.steps += 1;
         Ok(info)
     }
+}
+
+/// Names the first non-finite entry of the Newton evaluation point `x_e`, `v_e` or of the force
+/// `f` there (compared with the state, or with the force at the start of the step). Runs only on
+/// the error path.
+fn non_finite_iterate<S: MechanicalSystem + ?Sized>(
+    step: u64,
+    system: &mut S,
+    state: &State,
+    t_e: f64,
+    core: &mut NewtonCore,
+) -> Option<IntegrateError> {
+    if let Err(e) = check_finite(step, Field::Position, &core.x_e, &state.x) {
+        return Some(e.into());
+    }
+    if let Err(e) = check_finite(step, Field::Velocity, &core.v_e, &state.v) {
+        return Some(e.into());
+    }
+    // The force at the evaluation point on a free degree of freedom (fixed rows do not enter
+    // the residual), then the force at the start of the step for the last finite value.
+    system.force(t_e, &core.x_e, &core.v_e, &mut core.f);
+    let dof = (0..core.f.len()).find(|&i| core.w[i] > 0.0 && !core.f[i].is_finite())?;
+    system.force(state.t, &state.x, &state.v, &mut core.tmp);
+    Some(NonFinite::at_dof(step, Field::Force, dof, core.f[dof], core.tmp[dof]).into())
 }
 
 /// Evaluates the Newton residual `g = h f(x_e, v_e) - M dv` (zero on fixed rows) at `dv`,

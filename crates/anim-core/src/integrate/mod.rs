@@ -37,8 +37,15 @@
 //!
 //! # Invariants
 //! - No integrator allocates in `step` after the first step of a given size.
-//! - On error the state is left as it was before the step (results are computed into scratch).
-//! - A non-finite position or velocity is reported at the step that produced it.
+//! - On error the state and the integrator's memory ([`Integrator::memory`]) are left bit for bit
+//!   as they were before the step (results are computed into scratch and committed only once
+//!   checked).
+//! - A non-finite position or velocity is reported at the step that produced it as
+//!   [`IntegrateError::NonFinite`], whose message begins with `anim-core: step N:` and names the
+//!   degree of freedom, the value and the last finite value; a non-finite Newton iterate or force
+//!   of the implicit methods is reported the same way. Crates that drive these integrators
+//!   rename the report in terms of their particles or joints
+//!   ([`NonFinite::in_elements`](crate::diagnostics::NonFinite::in_elements)).
 //! - The multistep methods (position Verlet, leapfrog, velocity Verlet) keep history between
 //!   steps; if the caller changes the state between steps (a collision response, a reset) they
 //!   notice and restart from the new state.
@@ -161,7 +168,8 @@ pub enum IntegrateError {
         /// Why it does not fit.
         cause: String,
     },
-    /// The step produced a NaN or infinity.
+    /// The step produced a NaN or infinity (a position, velocity, Newton iterate or force),
+    /// named by step, degree of freedom, value and last finite value.
     #[error(transparent)]
     NonFinite(#[from] NonFinite),
     /// The time step is not a positive finite number.

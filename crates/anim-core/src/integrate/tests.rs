@@ -263,24 +263,73 @@ fn non_finite_state_is_reported_and_the_state_kept() {
             a[2] = 0.0;
         }
     }
+    let bits = |s: &State| {
+        let mut b = vec![s.t.to_bits()];
+        b.extend(s.x.iter().chain(&s.v).map(|v| v.to_bits()));
+        b
+    };
     for kind in IntegratorKind::ALL.into_iter().filter(|k| !k.is_implicit()) {
-        let mut integ = kind.build_explicit::<Blowup>(3).unwrap();
-        let mut state = State::new(vec![0.0, 0.9, 0.0], vec![0.0, 1.0, 0.0]);
-        let mut err = None;
-        for _ in 0..100 {
-            let before = state.clone();
-            match integ.step(&mut Blowup, &mut state, 0.1) {
-                Ok(_) => {}
-                Err(e) => {
-                    assert_eq!(state, before, "{}: state changed on error", kind.label());
-                    err = Some(e);
-                    break;
+        // Twice: once stepping straight into the blow-up, once with the state changed by the
+        // caller just before it (the multistep methods then restart, rebuilding their history).
+        for nudge in [false, true] {
+            let mut integ = kind.build_explicit::<Blowup>(3).unwrap();
+            let mut state = State::new(vec![0.0, 0.9, 0.0], vec![0.0, 1.0, 0.0]);
+            let mut err = None;
+            let mut completed = 0u64;
+            for _ in 0..100 {
+                if nudge && state.x[1] + 0.1 * state.v[1] > 1.0 {
+                    state.v[0] += 0.25;
+                }
+                let before = state.clone();
+                let memory = integ.memory();
+                match integ.step(&mut Blowup, &mut state, 0.1) {
+                    Ok(_) => completed += 1,
+                    Err(e) => {
+                        let label = kind.label();
+                        assert_eq!(bits(&state), bits(&before), "{label}: state changed on error");
+                        assert_eq!(integ.memory(), memory, "{label}: memory changed on error");
+                        err = Some(e);
+                        break;
+                    }
                 }
             }
+            match err {
+                Some(IntegrateError::NonFinite(nf)) => {
+                    let label = kind.label();
+                    assert_eq!(nf.dof, 1, "{label}");
+                    assert_eq!(nf.step, completed, "{label}");
+                    assert_eq!(nf.origin, "anim-core", "{label}");
+                    let msg = nf.to_string();
+                    assert!(msg.starts_with(&format!("anim-core: step {completed}: non-finite ")), "{msg}");
+                    assert!(msg.contains("degree of freedom 1"), "{msg}");
+                }
+                other => panic!("{}: expected NonFinite, got {other:?}", kind.label()),
+            }
         }
+    }
+}
+
+#[test]
+fn implicit_methods_name_a_non_finite_force() {
+    // A chain whose spring force overflows: K = 1e308 times a unit stretch is finite, twice
+    // that is not; the implicit methods must name the degree of freedom, not just fail.
+    for kind in IntegratorKind::ALL.into_iter().filter(IntegratorKind::is_implicit) {
+        let mut sys = LinearChain::new(3, 1.0, 1.5e308, 1.0, 0.0);
+        let mut state = sys.rest_state();
+        state.x[2] += 2.0;
+        let before = state.clone();
+        let mut integ = kind.build(sys.dof());
+        let memory = integ.memory();
+        let err = integ.step(&mut sys, &mut state, 1e-3).unwrap_err();
+        assert_eq!(state, before, "{}", kind.label());
+        assert_eq!(integ.memory(), memory, "{}", kind.label());
         match err {
-            Some(IntegrateError::NonFinite(nf)) => assert_eq!(nf.dof, 1, "{}", kind.label()),
-            other => panic!("{}: expected NonFinite, got {other:?}", kind.label()),
+            IntegrateError::NonFinite(nf) => {
+                assert_eq!(nf.step, 0, "{}", kind.label());
+                assert_eq!(nf.dof, 1, "{}: {nf}", kind.label());
+                assert!(nf.to_string().starts_with("anim-core: step 0: non-finite"), "{nf}");
+            }
+            other => panic!("{}: expected NonFinite, got {other}", kind.label()),
         }
     }
 }

@@ -155,21 +155,34 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for Leapfrog {
             fit(b, n);
         }
         let mut evaluations = 0;
-        if !self.history.matches(state) {
+        // The staggered velocity of this step: the kept one, or (on a restart) a half kick from
+        // the state, built in `v_half_new` so that a failed step leaves `v_half` as it was.
+        let restart = !self.history.matches(state);
+        if restart {
             system.acceleration(state.t, &state.x, &state.v, &mut self.a);
             evaluations += 1;
             for i in 0..n {
-                self.v_half[i] = state.v[i] + 0.5 * dt * self.a[i];
+                self.v_half_new[i] = state.v[i] + 0.5 * dt * self.a[i];
             }
         }
+        let v_half: &[f64] = if restart { &self.v_half_new } else { &self.v_half };
         for i in 0..n {
-            self.x_new[i] = state.x[i] + dt * self.v_half[i];
+            self.x_new[i] = state.x[i] + dt * v_half[i];
         }
-        system.acceleration(state.t + dt, &self.x_new, &self.v_half, &mut self.a);
+        system.acceleration(state.t + dt, &self.x_new, v_half, &mut self.a);
         evaluations += 1;
+        // v_new first: on a restart v_half_new is also the start velocity, updated in place.
         for i in 0..n {
-            self.v_new[i] = self.v_half[i] + 0.5 * dt * self.a[i];
-            self.v_half_new[i] = self.v_half[i] + dt * self.a[i];
+            self.v_new[i] = v_half[i] + 0.5 * dt * self.a[i];
+        }
+        if restart {
+            for i in 0..n {
+                self.v_half_new[i] += dt * self.a[i];
+            }
+        } else {
+            for i in 0..n {
+                self.v_half_new[i] = self.v_half[i] + dt * self.a[i];
+            }
         }
         commit(self.steps, state, &mut self.x_new, &mut self.v_new, dt)?;
         std::mem::swap(&mut self.v_half, &mut self.v_half_new);
@@ -232,18 +245,16 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for VelocityVerlet {
             fit(b, n);
         }
         let mut evaluations = 0;
-        if !self.history.matches(state) {
-            system.acceleration(state.t, &state.x, &state.v, &mut self.a);
+        // The acceleration at the start: the kept one, or (on a restart) evaluated into `a_new`
+        // so that a failed step leaves `a` as it was.
+        let restart = !self.history.matches(state);
+        if restart {
+            system.acceleration(state.t, &state.x, &state.v, &mut self.a_new);
             evaluations += 1;
         }
         // v_new holds the half-step velocity until the second kick.
-        let (x, v, a) = (&state.x, &state.v, &self.a);
-        for_chunks2(&mut self.v_new, &mut self.x_new, |o, vn, xn| {
-            for k in 0..vn.len() {
-                vn[k] = v[o + k] + 0.5 * dt * a[o + k];
-                xn[k] = x[o + k] + dt * vn[k];
-            }
-        });
+        let a: &[f64] = if restart { &self.a_new } else { &self.a };
+        first_kick(&mut self.v_new, &mut self.x_new, &state.x, &state.v, a, dt);
         system.acceleration(state.t + dt, &self.x_new, &self.v_new, &mut self.a_new);
         evaluations += 1;
         let a_new = &self.a_new;
@@ -270,4 +281,18 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for VelocityVerlet {
     fn symplectic(&self) -> bool {
         true
     }
+}
+
+/// Velocity Verlet's first kick and drift, `v_half = v + dt/2 a`, `x_new = x + dt v_half`, over
+/// plain slices (the start acceleration is one of two buffers; as a slice argument the loop
+/// vectorises as it would on a fixed field).
+#[inline]
+fn first_kick(v_half: &mut [f64], x_new: &mut [f64], x: &[f64], v: &[f64], a: &[f64], dt: f64) {
+    for_chunks2(v_half, x_new, |o, vn, xn| {
+        let (x, v, a) = (&x[o..o + vn.len()], &v[o..o + vn.len()], &a[o..o + vn.len()]);
+        for k in 0..vn.len() {
+            vn[k] = v[k] + 0.5 * dt * a[k];
+            xn[k] = x[k] + dt * vn[k];
+        }
+    });
 }

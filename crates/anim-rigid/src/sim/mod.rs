@@ -177,8 +177,8 @@ impl SimParams {
     }
 }
 
-/// Why a simulation could not be built or a step failed. After a failed step the state is the
-/// one before it.
+/// Why a simulation could not be built or a step failed. After a failed step the state and the
+/// simulation's memory (step count, kept Newton matrix) are the ones before it.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum SimError {
@@ -213,7 +213,11 @@ pub enum SimError {
         /// The model's `nv`.
         nv: usize,
     },
-    /// The step produced a NaN or infinity.
+    /// The step produced a NaN or infinity. The report's message begins with
+    /// `anim-rigid: step N:` and names the joint (`element.index`, in [`Model::joints`] order),
+    /// the coordinate within it, the value and the joint's whole last finite `q` or `v` block.
+    ///
+    /// [`Model::joints`]: crate::Model::joints
     #[error(transparent)]
     NonFinite(#[from] NonFinite),
     /// The implicit midpoint's Newton iteration did not converge.

@@ -1,7 +1,7 @@
 //! The Lie-group steppers of [`RigidIntegrator`] and the [`RigidSimulation`] that runs them.
 //! See [`crate::sim`] for the methods and their equations.
 
-use anim_core::diagnostics::{Field, check_finite};
+use anim_core::diagnostics::{Component, Element, Field, NonFinite, check_finite};
 use anim_core::solver::{Solver, StepReport};
 use serde::{Deserialize, Serialize};
 
@@ -88,6 +88,12 @@ struct Scratch {
     jac_valid: bool,
     /// The step size `jac` was formed with.
     jac_h: f64,
+    /// The Newton matrix and pivots as they were before the current step refactorised them,
+    /// restored when the step fails (the matrix is part of the memory).
+    jac_saved: SquareMatrix,
+    pivots_saved: Vec<usize>,
+    /// Whether `jac_saved` holds this step's starting matrix.
+    saved: bool,
 }
 
 impl Scratch {
@@ -108,6 +114,9 @@ impl Scratch {
             pivots: vec![0; nv],
             jac_valid: false,
             jac_h: 0.0,
+            jac_saved: SquareMatrix::zeros(nv),
+            pivots_saved: vec![0; nv],
+            saved: false,
         }
     }
 }
@@ -451,7 +460,7 @@ fn midpoint(
     }
     let [qm, ..] = &mut s.q;
     let [vbar, v_pert, trial, _] = &mut s.v;
-    let [_, acc, ..] = &mut s.a;
+    let [a0, acc, ..] = &mut s.a;
     midpoint_residual(sys, q0, v0, &s.w, h, qm, vbar, acc, &mut s.r);
     let mut residual = max_abs(&s.r);
     let mut iterations = 0;
@@ -461,7 +470,17 @@ fn midpoint(
         if iterations >= max_newton_iterations {
             return Err(SimError::NewtonNotConverged { step, iterations, residual });
         }
+        if !residual.is_finite() {
+            return Err(non_finite_iterate(step, iterations, q0, v0, qm, &s.w, a0));
+        }
         if !s.jac_valid {
+            // Keep the matrix before this step first overwrites it (a copy of nv^2 entries,
+            // next to the nv residual evaluations and the factorisation that follow).
+            if !s.saved {
+                s.jac_saved.copy_from(&s.jac);
+                s.pivots_saved.copy_from_slice(&s.pivots);
+                s.saved = true;
+            }
             // Forward differences of the residual, column by column.
             for k in 0..nv {
                 let delta = 1e-7 * (1.0 + s.w[k].abs());
@@ -519,6 +538,52 @@ fn midpoint(
     Ok((iterations, residual))
 }
 
+/// The first non-finite value behind a non-finite midpoint residual: the velocity iterate
+/// (against `v0`), the midpoint configuration (against `q0`), or the acceleration at the start.
+fn non_finite_iterate(
+    step: u64,
+    iterations: usize,
+    q0: &[f64],
+    v0: &[f64],
+    qm: &[f64],
+    w: &[f64],
+    a0: &[f64],
+) -> SimError {
+    let nf = check_finite(step, Field::Velocity, w, v0)
+        .and_then(|()| check_finite(step, Field::Position, qm, q0))
+        .and_then(|()| check_finite(step, Field::Other("acceleration"), a0, &[]));
+    match nf {
+        Err(nf) => SimError::NonFinite(nf),
+        // Finite iterate with a non-finite residual: the forces at the midpoint overflowed.
+        Ok(()) => SimError::NewtonNotConverged { step, iterations, residual: f64::NAN },
+    }
+}
+
+/// Renames a report on the flat `q` or `v` in terms of the joint that owns the entry: its index,
+/// the coordinate within it and its whole last finite `q` or `v` block (from `state`, which the
+/// failed step left as it was).
+fn name_joint(model: &Model, nf: NonFinite, state: &RigidState) -> NonFinite {
+    let by_q = nf.field == Field::Position;
+    let old: &[f64] = match nf.field {
+        Field::Position => &state.q,
+        Field::Velocity => &state.v,
+        _ => &[],
+    };
+    for (j, joint) in model.joints().iter().enumerate() {
+        let (start, len) = if by_q { (joint.idx_q, joint.nq()) } else { (joint.idx_v, joint.nv()) };
+        if (start..start + len).contains(&nf.dof) {
+            let element = Element {
+                kind: "joint",
+                index: j,
+                component: Component::Dof(u32::try_from(nf.dof - start).unwrap_or(u32::MAX)),
+            };
+            let block = old.get(start..start + len).unwrap_or(&[]);
+            return nf.at_element("anim-rigid", element, block);
+        }
+    }
+    NonFinite { origin: "anim-rigid", ..nf }
+}
+
 /// How far above the Newton tolerance a stagnating implicit-midpoint iteration may stop: the
 /// residual cannot go below the rounding error of ABA, which grows with the conditioning of the
 /// tree (a whipping chain reaches a few 1e-10 where the tolerance asks for 1e-11).
@@ -532,9 +597,31 @@ impl Solver for RigidSimulation {
     /// energy and the world linear and angular momentum after the step.
     fn step(&mut self, state: &mut RigidState, dt: f64) -> Result<StepReport, SimError> {
         self.check(state, dt)?;
-        let (iterations, residual) = self.advance(state, dt)?;
-        check_finite(self.steps, Field::Position, &self.scratch.q_new, &state.q)?;
-        check_finite(self.steps, Field::Velocity, &self.scratch.v_new, &state.v)?;
+        // The memory this step may change: the Newton matrix (saved lazily before it is
+        // refactorised), its validity and step size.
+        let (jac_valid, jac_h) = (self.scratch.jac_valid, self.scratch.jac_h);
+        self.scratch.saved = false;
+        let result = self.advance(state, dt).and_then(|r| {
+            check_finite(self.steps, Field::Position, &self.scratch.q_new, &state.q)?;
+            check_finite(self.steps, Field::Velocity, &self.scratch.v_new, &state.v)?;
+            Ok(r)
+        });
+        let (iterations, residual) = match result {
+            Ok(r) => r,
+            Err(e) => {
+                let s = &mut self.scratch;
+                (s.jac_valid, s.jac_h) = (jac_valid, jac_h);
+                if s.saved {
+                    std::mem::swap(&mut s.jac, &mut s.jac_saved);
+                    std::mem::swap(&mut s.pivots, &mut s.pivots_saved);
+                    s.saved = false;
+                }
+                return Err(match e {
+                    SimError::NonFinite(nf) => SimError::NonFinite(name_joint(self.model(), nf, state)),
+                    other => other,
+                });
+            }
+        };
         std::mem::swap(&mut state.q, &mut self.scratch.q_new);
         std::mem::swap(&mut state.v, &mut self.scratch.v_new);
         state.t += dt;
@@ -593,5 +680,71 @@ mod tests {
             RigidSimulation::new(other, SimParams::default(), RigidIntegrator::ImplicitMidpoint).unwrap();
         let e = small.restore_memory(&serde_json::from_str(&memory).unwrap()).unwrap_err();
         assert!(e.to_string().contains("Newton matrix"), "{e}");
+    }
+
+    /// A torque of `f64::MAX` on a light rod (moment of inertia 0.003 kg m^2 about its hinge)
+    /// gives an infinite acceleration: every stepper reports it by joint, and the state and the
+    /// memory (including the implicit stepper's kept Newton matrix) are those before the step.
+    #[test]
+    fn an_overflowing_torque_is_reported_by_joint_and_the_step_undone() {
+        let model = pendulum_chain_model(&[0.1], 0.3).unwrap();
+        for integrator in [
+            RigidIntegrator::ExplicitEuler,
+            RigidIntegrator::SymplecticEuler,
+            RigidIntegrator::Rk4,
+            RigidIntegrator::ImplicitMidpoint,
+        ] {
+            let label = integrator.label();
+            let mut sim = RigidSimulation::new(model.clone(), SimParams::default(), integrator).unwrap();
+            let mut state = sim.initial_state(vec![0.4], vec![0.0]).unwrap();
+            for _ in 0..10 {
+                sim.step(&mut state, 1e-3).unwrap();
+            }
+            sim.system_mut().set_torque(&[f64::MAX]).unwrap();
+            let before = state.clone();
+            let memory = serde_json::to_string(&sim.memory()).unwrap();
+            // A different step size makes the implicit stepper drop its kept matrix first.
+            let err = sim.step(&mut state, 2e-3).unwrap_err();
+            let bits = |s: &RigidState| {
+                s.q.iter().chain(&s.v).chain([&s.t]).map(|x| x.to_bits()).collect::<Vec<_>>()
+            };
+            assert_eq!(bits(&state), bits(&before), "{label}: state changed");
+            assert_eq!(serde_json::to_string(&sim.memory()).unwrap(), memory, "{label}: memory changed");
+            assert_eq!(sim.steps(), 10);
+            let msg = err.to_string();
+            let SimError::NonFinite(nf) = err else { panic!("{label}: expected NonFinite, got {msg}") };
+            assert_eq!(nf.step, 10, "{msg}");
+            assert_eq!(nf.origin, "anim-rigid", "{msg}");
+            assert_eq!(nf.element.kind, "joint", "{msg}");
+            assert_eq!(nf.element.index, 1, "{msg}");
+            assert_eq!(nf.element.component, Component::Dof(0), "{msg}");
+            let old = if nf.field == Field::Position { &before.q } else { &before.v };
+            assert_eq!(*nf.last_finite_element, **old, "{msg}");
+            assert!(msg.starts_with("anim-rigid: step 10: non-finite "), "{msg}");
+            assert!(msg.contains("of joint 1, coordinate 0"), "{msg}");
+        }
+    }
+
+    /// A step of the implicit midpoint rule that refactorises its kept Newton matrix and then
+    /// fails (here: one Newton iteration allowed) restores that matrix bit for bit.
+    #[test]
+    fn a_failed_implicit_step_restores_the_kept_newton_matrix() {
+        let model = pendulum_chain_model(&[1.0; 3], 0.3).unwrap();
+        let mut sim =
+            RigidSimulation::new(model, SimParams::default(), RigidIntegrator::ImplicitMidpoint).unwrap();
+        let mut state = sim.initial_state(vec![0.5, 0.3, 0.1], vec![0.0; 3]).unwrap();
+        for _ in 0..10 {
+            sim.step(&mut state, 1e-3).unwrap();
+        }
+        assert!(sim.scratch.jac_valid);
+        let params = SimParams { max_newton_iterations: 1, ..sim.system().params().clone() };
+        sim.system_mut().set_params(params).unwrap();
+        let before = state.clone();
+        let memory = serde_json::to_string(&sim.memory()).unwrap();
+        let err = sim.step(&mut state, 5e-2).unwrap_err();
+        assert!(matches!(err, SimError::NewtonNotConverged { step: 10, .. }), "{err}");
+        assert!(sim.scratch.jac_h == 1e-3 && sim.scratch.jac_valid);
+        assert_eq!(serde_json::to_string(&sim.memory()).unwrap(), memory, "the kept matrix changed");
+        assert_eq!(state, before);
     }
 }
