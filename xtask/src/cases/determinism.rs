@@ -31,6 +31,21 @@ pub fn register(r: &mut Registry) {
         name: "determinism: Panda swing on 1, 2, 4 threads",
         run: rigid_panda,
     });
+    r.conformance.push(ConformanceCase {
+        crate_name: "anim-fem",
+        name: "determinism: benchmark beam (backward Euler) on 1, 2, 4 threads",
+        run: fem_beam,
+    });
+    r.conformance.push(ConformanceCase {
+        crate_name: "anim-skin",
+        name: "determinism: twisted cylinder (LBS and DQS) on 1, 2, 4 threads",
+        run: skin_cylinder,
+    });
+    r.conformance.push(ConformanceCase {
+        crate_name: "anim-flip",
+        name: "determinism: 2D dam break (APIC) on 1, 2, 4 threads",
+        run: flip_dam_break,
+    });
 }
 
 /// Number of positions in `a` and `b` whose bits differ (a length mismatch counts every value).
@@ -156,5 +171,52 @@ fn rigid_panda(ctx: &Ctx) -> Vec<Check> {
             sim.step(&mut state, dt).map_err(|e| e.to_string())?;
         }
         Ok(state.q.iter().chain(&state.v).copied().collect())
+    })
+}
+
+fn fem_beam(ctx: &Ctx) -> Vec<Check> {
+    // CI: 14 x 2 x 2 cells (336 tetrahedra), element loops split into parallel chunks; the full
+    // suite: 50 x 8 x 8 (19,200), where the gather into nodes runs in parallel too.
+    let (cells, steps) = if ctx.quick { (14, 3) } else { (50, 5) };
+    across_threads("anim-fem", &format!("benchmark beam, {cells} cells along"), || {
+        let scene = anim_fem::scenes::benchmark_beam(cells).map_err(|e| e.to_string())?;
+        let dt = scene.dt;
+        let (mut sim, mut state) = scene.into_simulation().map_err(|e| e.to_string())?;
+        for _ in 0..steps {
+            sim.step(&mut state, dt).map_err(|e| e.to_string())?;
+        }
+        Ok(flat(&state))
+    })
+}
+
+fn skin_cylinder(ctx: &Ctx) -> Vec<Check> {
+    // 96 segments around: about 11,000 vertices, several parallel chunks.
+    let segments = if ctx.quick { 96 } else { 192 };
+    across_threads("anim-skin", &format!("twisted cylinder, {segments} segments"), || {
+        let scene = anim_skin::scenes::twisted_cylinder(Some(segments)).map_err(|e| e.to_string())?;
+        let mut data = scene.data();
+        let mut out = Vec::new();
+        for method in [anim_skin::SkinningMethod::Lbs, anim_skin::SkinningMethod::Dqs] {
+            for t in [0.5, 1.3, 2.0] {
+                scene.pose(&mut data, t, method).map_err(|e| e.to_string())?;
+                for m in &data.skinned {
+                    out.extend(m.x.iter().chain(&m.y).chain(&m.z));
+                }
+            }
+        }
+        Ok(out)
+    })
+}
+
+fn flip_dam_break(ctx: &Ctx) -> Vec<Check> {
+    let (n, steps) = if ctx.quick { (48, 10) } else { (96, 40) };
+    across_threads("anim-flip", &format!("dam break, {n} cells/m"), || {
+        let mut params = anim_flip::FlipParams::<2>::default();
+        params.transfer = anim_flip::Transfer::Apic;
+        let (mut sim, mut p, _) = anim_flip::scenes::dam_break(n, 0.2, params).map_err(|e| e.to_string())?;
+        for _ in 0..steps {
+            sim.advance(&mut p, 0.01).map_err(|e| e.to_string())?;
+        }
+        Ok(p.x.iter().flatten().chain(p.v.iter().flatten()).copied().collect())
     })
 }
