@@ -29,12 +29,23 @@ fn parse_bencher(out: &str) -> Vec<Row> {
 
 pub fn run(filter: Option<&str>) -> bool {
     if std::env::args().skip(2).any(|a| a == "--peers") {
-        return peers::run()
-            & peers_rigid::run()
-            & peers_pbd::run()
-            & peers_fem::run()
-            & peers_mpm::run()
-            & peers_fluid::run();
+        // `--filter` picks peers by name (springs, rigid, pbd, fem, mpm, fluid).
+        type Peer = (&'static str, fn() -> bool);
+        let peers: [Peer; 6] = [
+            ("springs", peers::run),
+            ("rigid", peers_rigid::run),
+            ("pbd", peers_pbd::run),
+            ("fem", peers_fem::run),
+            ("mpm", peers_mpm::run),
+            ("fluid", peers_fluid::run),
+        ];
+        let mut ok = true;
+        for (name, run) in peers {
+            if filter.is_none_or(|f| name.contains(f) || f.contains(name)) {
+                ok &= run();
+            }
+        }
+        return ok;
     }
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut args = vec!["bench", "-p", "anim-benches", "--benches", "--", "--output-format", "bencher"];

@@ -5,7 +5,7 @@
 //! | `conformance [--quick] [--filter S]` | every reference case with metric, error, tolerance and verdict; exit 1 on any failure |
 //! | `stability [--quick] [--filter S]` | the named hard cases of every crate with their outcomes; exit 1 on an unexpected outcome |
 //! | `stability --long [--quick] [--filter S] [--out DIR]` | soak: each crate's hard case for `10^5` steps or ten minutes with its energy bound; written to `docs/report/soak.md` |
-//! | `bench [--filter S]` | the criterion benches under `benches/`, printed as a table and written to `target/xtask/bench.csv` |
+//! | `bench [--filter S]` | the criterion benches under `benches/`, printed as a table and written to `target/xtask/bench.csv`; `--peers [--filter S]`: the peer comparisons (springs, rigid, pbd, fem, mpm, fluid) |
 //! | `report [--quick] [--out DIR]` | conformance, stability and work-precision studies written to `docs/report/` (Markdown + SVG) |
 //! | `ci` | what CI runs: format, clippy, tests (with doc tests), docs, quick conformance and stability |
 
