@@ -56,3 +56,59 @@ pub trait Solver {
     /// A solver-specific error; the state is unchanged when one is returned.
     fn step(&mut self, state: &mut Self::State, dt: f64) -> Result<StepReport, Self::Error>;
 }
+
+/// The clock a simulation keeps for checkpoints: steps taken and simulated time. Simulations
+/// whose other state is rebuilt every step (the grid of a particle method) need nothing else.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepClock {
+    /// Steps taken.
+    pub steps: u64,
+    /// Simulated time (s).
+    pub time: f64,
+}
+
+impl StepClock {
+    /// `{"steps": ..., "time": ...}`.
+    #[must_use]
+    pub fn to_memory(self) -> serde_json::Value {
+        serde_json::json!({ "steps": self.steps, "time": self.time })
+    }
+
+    /// Reads what [`StepClock::to_memory`] wrote.
+    ///
+    /// # Errors
+    /// `"no step count"` or `"no finite time"` when a field is missing, of the wrong type or,
+    /// for the time, not finite.
+    pub fn from_memory(memory: &serde_json::Value) -> Result<Self, &'static str> {
+        let steps = memory.get("steps").and_then(serde_json::Value::as_u64).ok_or("no step count")?;
+        let time = memory
+            .get("time")
+            .and_then(serde_json::Value::as_f64)
+            .filter(|t| t.is_finite())
+            .ok_or("no finite time")?;
+        Ok(Self { steps, time })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::StepClock;
+
+    #[test]
+    fn step_clock_round_trips_and_refuses_bad_memories() {
+        let c = StepClock { steps: 42, time: 0.1 + 0.2 };
+        let text = c.to_memory().to_string();
+        let back = StepClock::from_memory(&serde_json::from_str(&text).expect("json")).expect("clock");
+        assert_eq!(back.steps, 42);
+        assert_eq!(back.time.to_bits(), c.time.to_bits());
+        for (bad, why) in [
+            (serde_json::json!({ "time": 1.0 }), "no step count"),
+            (serde_json::json!({ "steps": -1, "time": 1.0 }), "no step count"),
+            (serde_json::json!({ "steps": 1 }), "no finite time"),
+            (serde_json::json!({ "steps": 1, "time": "1" }), "no finite time"),
+            (serde_json::json!(null), "no step count"),
+        ] {
+            assert_eq!(StepClock::from_memory(&bad), Err(why), "{bad}");
+        }
+    }
+}

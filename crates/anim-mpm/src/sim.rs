@@ -247,7 +247,7 @@ impl<const D: usize> MpmSimulation<D> {
     /// continues a run bit for bit.
     #[must_use]
     pub fn memory(&self) -> serde_json::Value {
-        serde_json::json!({ "steps": self.steps, "time": self.time })
+        anim_core::solver::StepClock { steps: self.steps, time: self.time }.to_memory()
     }
 
     /// Restores what [`MpmSimulation::memory`] returned.
@@ -255,17 +255,10 @@ impl<const D: usize> MpmSimulation<D> {
     /// # Errors
     /// [`MpmError::Checkpoint`] when a field is missing or the time is not finite.
     pub fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), MpmError> {
-        let steps = memory
-            .get("steps")
-            .and_then(serde_json::Value::as_u64)
-            .ok_or_else(|| MpmError::Checkpoint("no step count".into()))?;
-        let time = memory
-            .get("time")
-            .and_then(serde_json::Value::as_f64)
-            .filter(|t| t.is_finite())
-            .ok_or_else(|| MpmError::Checkpoint("no finite time".into()))?;
-        self.steps = steps;
-        self.time = time;
+        let clock =
+            anim_core::solver::StepClock::from_memory(memory).map_err(|e| MpmError::Checkpoint(e.into()))?;
+        self.steps = clock.steps;
+        self.time = clock.time;
         Ok(())
     }
 
