@@ -9,11 +9,17 @@
 //! same pool. Skinning time divided by the stream time is how far a kernel is from being memory
 //! bound. (The whole working set fits in this machine's last-level cache, so the bound measured
 //! here is cache bandwidth, higher than DRAM bandwidth: a conservative bound.)
-//! The per-joint data (64 joints) is a few kilobytes and is not counted.
+//! The per-joint data (64 joints) is a few kilobytes and is not counted; neither is the one byte
+//! per vertex DQS reads besides (the dominant slot), 0.7% of the bytes.
+//!
+//! After criterion's rows, `cargo bench` prints the ratios measured interleaved (each round times
+//! the stream pass, then each kernel, back to back: a load change on a shared machine hits all
+//! alike), for the dispatched kernels (AVX2 where the CPU has it) and the portable ones.
 
 use anim_core::glam::{DMat4, DQuat, DVec3};
+use anim_skin::skinning::skin_portable;
 use anim_skin::{Skinned, SkinnedMesh, SkinningMethod, skin};
-use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use criterion::{Criterion, Throughput, criterion_group};
 use rayon::prelude::*;
 use std::hint::black_box;
 
@@ -94,4 +100,78 @@ fn skinning(c: &mut Criterion) {
 }
 
 criterion_group!(benches, skinning);
-criterion_main!(benches);
+
+/// Runs of each kernel in the interleaved comparison.
+const ROUNDS: usize = 200;
+
+/// The ratio of each kernel's time to the stream bound's, measured interleaved: every round
+/// times one stream pass, one LBS pass and one DQS pass back to back, so that a load change on
+/// a shared machine hits all three alike. Prints the ratio of the fastest runs (each kernel's
+/// intrinsic cost) and the median of the per-round ratios.
+fn interleaved_ratios() {
+    let (mesh, m) = mesh();
+    let mut out = Skinned::new(&mesh);
+    let all = rayon::current_num_threads();
+    println!(
+        "\nskinning time / stream-bound time, {ROUNDS} interleaved rounds (100k vertices x 4 influences):"
+    );
+    for threads in [1, all] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap_or_else(|e| panic!("pool: {e}"));
+        let mut t = [[0.0f64; ROUNDS]; 5];
+        for r in 0..ROUNDS {
+            let time = |f: &mut dyn FnMut()| {
+                let s = std::time::Instant::now();
+                f();
+                s.elapsed().as_secs_f64()
+            };
+            t[0][r] = time(&mut || pool.install(|| stream(black_box(&mesh), &mut out)));
+            for (i, method) in [(1, SkinningMethod::Lbs), (2, SkinningMethod::Dqs)] {
+                t[i][r] = time(&mut || {
+                    pool.install(|| skin(&mesh, black_box(&m), method, &mut out))
+                        .unwrap_or_else(|e| panic!("skin: {e}"))
+                });
+                t[i + 2][r] = time(&mut || {
+                    pool.install(|| skin_portable(&mesh, black_box(&m), method, &mut out))
+                        .unwrap_or_else(|e| panic!("skin: {e}"))
+                });
+            }
+        }
+        let fastest = t.map(|s| s.iter().copied().fold(f64::INFINITY, f64::min));
+        let median = |i: usize| {
+            let mut r: Vec<f64> = (0..ROUNDS).map(|k| t[i][k] / t[0][k]).collect();
+            r.sort_by(f64::total_cmp);
+            r[ROUNDS / 2]
+        };
+        println!(
+            "  {threads} thread(s): stream {:.3} ms ({:.1} GB/s); LBS {:.3} ms = {:.2}x (median ratio {:.2}x); \
+             DQS {:.3} ms = {:.2}x (median ratio {:.2}x)",
+            fastest[0] * 1e3,
+            (N * STREAM_BYTES_PER_VERTEX) as f64 / fastest[0] * 1e-9,
+            fastest[1] * 1e3,
+            fastest[1] / fastest[0],
+            median(1),
+            fastest[2] * 1e3,
+            fastest[2] / fastest[0],
+            median(2)
+        );
+        println!(
+            "  {threads} thread(s), portable kernels: LBS {:.2}x (median {:.2}x), DQS {:.2}x (median {:.2}x)",
+            fastest[3] / fastest[0],
+            median(3),
+            fastest[4] / fastest[0],
+            median(4)
+        );
+    }
+}
+
+fn main() {
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+    // `cargo bench` passes `--bench`; `cargo test --benches` does not (one quick pass only).
+    if std::env::args().any(|a| a == "--bench") {
+        interleaved_ratios();
+    }
+}

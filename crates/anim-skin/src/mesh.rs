@@ -13,6 +13,7 @@ pub const MAX_INFLUENCES: usize = 8;
 /// Weights are normalised to sum to 1 at construction; zero-weight slots are kept (their joint
 /// index is set to 0) and skipped by the skinning kernels.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(from = "MeshData")]
 pub struct SkinnedMesh {
     /// Rest positions, x.
     pub x: Vec<f64>,
@@ -31,6 +32,46 @@ pub struct SkinnedMesh {
     weights: Vec<f64>,
     triangles: Vec<[u32; 3]>,
     num_joints: usize,
+    /// Each vertex's dominant influence slot (the first of largest weight), derived from the
+    /// weights: DQS's hemisphere reference.
+    #[serde(skip)]
+    dominant: Vec<u8>,
+}
+
+/// The serialised fields of a [`SkinnedMesh`]; the derived ones are rebuilt on loading.
+#[derive(Deserialize)]
+struct MeshData {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+    nx: Vec<f64>,
+    ny: Vec<f64>,
+    nz: Vec<f64>,
+    influences: usize,
+    joints: Vec<u16>,
+    weights: Vec<f64>,
+    triangles: Vec<[u32; 3]>,
+    num_joints: usize,
+}
+
+impl From<MeshData> for SkinnedMesh {
+    fn from(m: MeshData) -> Self {
+        let dominant = dominant_slots(m.x.len(), m.influences, &m.weights);
+        let MeshData { x, y, z, nx, ny, nz, influences, joints, weights, triangles, num_joints } = m;
+        Self { x, y, z, nx, ny, nz, influences, joints, weights, triangles, num_joints, dominant }
+    }
+}
+
+/// The first slot of largest weight of each of `n` vertices with `k` slots (0 where the weights
+/// are missing).
+fn dominant_slots(n: usize, k: usize, weights: &[f64]) -> Vec<u8> {
+    (0..n)
+        .map(|v| {
+            let ws = weights.get(v * k..(v + 1) * k).unwrap_or(&[]);
+            let slot = (0..ws.len()).fold(0, |d, i| if ws[i] > ws[d] { i } else { d });
+            u8::try_from(slot).unwrap_or(0)
+        })
+        .collect()
 }
 
 impl SkinnedMesh {
@@ -114,7 +155,8 @@ impl SkinnedMesh {
             }
             None => split(&vertex_normals(positions, &triangles)),
         };
-        Ok(Self { x, y, z, nx, ny, nz, influences, joints: js, weights: ws, triangles, num_joints })
+        let dominant = dominant_slots(n, influences, &ws);
+        Ok(Self { x, y, z, nx, ny, nz, influences, joints: js, weights: ws, triangles, num_joints, dominant })
     }
 
     /// Number of vertices.
@@ -145,6 +187,12 @@ impl SkinnedMesh {
     #[must_use]
     pub fn weights(&self) -> &[f64] {
         &self.weights
+    }
+
+    /// Each vertex's dominant influence slot: the first slot of largest weight.
+    #[must_use]
+    pub fn dominant_slots(&self) -> &[u8] {
+        &self.dominant
     }
 
     /// Triangles (counter-clockwise seen from outside).

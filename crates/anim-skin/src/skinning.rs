@@ -21,10 +21,15 @@
 //! any thread count. [`Skinned`] holds the per-joint blend data and the outputs, sized once per
 //! mesh: skinning allocates nothing.
 //!
-//! ## Kernel
+//! ## Kernels
 //!
-//! Vertices are processed in pairs, one per lane of a two-wide f64 SIMD register (`wide`'s
-//! `f64x2`: SSE2 on x86-64, no `unsafe`). Each vertex first blends its joints' data along the
+//! Two implementations, chosen once per call: AVX2 + FMA kernels (module `avx2`, x86-64 CPUs
+//! that have both, detected at run time) and portable kernels (every target, and
+//! [`skin_portable`] on any CPU). Their results differ by rounding only (fused multiply-adds
+//! round once); each is bitwise identical for any thread count.
+//!
+//! The portable kernels process vertices in pairs, one per lane of a two-wide f64 SIMD register
+//! (`wide`'s `f64x2`: SSE2 on x86-64). Each vertex first blends its joints' data along the
 //! matrix rows (LBS: 3x4 matrix as six register pairs) or quaternion components (DQS: four
 //! pairs); the pair's blends are transposed so the rest (transform, cofactor normal, rotations,
 //! normalisation) runs one vertex per lane with no branches: the DQS hemisphere test is a sign
@@ -33,10 +38,19 @@
 //! vertex normalise both the rigid motion and the normal. Lanes never mix, and an odd
 //! vertex is computed in both lanes, so a vertex's result does not depend on its neighbour.
 //!
-//! Throughput (100,000 vertices, 4 influences, the mesh of `benches/benches/skin.rs`): the
-//! kernels are compute bound. On one thread LBS takes about 2.2x and DQS about 3.2x the time of
-//! a pass that only streams the same 136 bytes per vertex (fastest of 200 interleaved runs
-//! each; `cargo bench -p anim-benches --bench skin` has the "stream bound" rows).
+//! The AVX2 kernels do the same four vertices at a time: an LBS matrix row is one register (three
+//! fused multiply-adds per influence). For DQS the hemisphere tests are made once per pose for
+//! every joint pair (a `J x J` byte table, skins of up to [`SIGN_TABLE_JOINTS`] joints; larger
+//! skins use the portable kernel), each joint's dual quaternion is kept with both signs, and each
+//! vertex's dominant slot is derived once from its weights ([`SkinnedMesh::dominant_slots`]): the
+//! blend is then two loads and two fused multiply-adds per influence, with no shuffles.
+//!
+//! Throughput (100,000 vertices, 4 influences, the mesh of `benches/benches/skin.rs`, whose
+//! `cargo bench -p anim-benches --bench skin` prints the comparison): the time of each kernel
+//! over the time of a pass that only streams the same 136 bytes per vertex, fastest of 200
+//! interleaved rounds, one thread, in two runs on this
+//! 2-core machine while other jobs ran: AVX2 LBS 1.07x and 1.20x, DQS 1.71x and 1.84x; portable
+//! LBS 2.45x and 2.62x, DQS 3.36x and 3.57x.
 
 use crate::SkinError;
 use crate::mesh::{MAX_INFLUENCES, SkinnedMesh};
@@ -44,6 +58,9 @@ use anim_core::glam::{DMat3, DMat4, DQuat};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use wide::f64x2;
+
+#[cfg(target_arch = "x86_64")]
+mod avx2;
 
 /// Vertices per parallel task.
 pub const CHUNK: usize = 2048;
@@ -91,7 +108,17 @@ pub struct Skinned {
     mats: Vec<[f64x2; 6]>,
     /// Dual quaternions `(qx, qy | qz, qw | dx, dy | dz, dw)`.
     dqs: Vec<[f64x2; 4]>,
+    /// Each joint's dual quaternion and its negation, `[+, -]`, for the AVX2 DQS kernel.
+    signed: Vec<[[[f64; 4]; 2]; 2]>,
+    /// `flips[a * J + b] = 1` where joint `b`'s rotation quaternion is in the other hemisphere
+    /// from joint `a`'s (`q_a . q_b < 0`): the AVX2 DQS kernel's hemisphere test, made once per
+    /// pose for all joint pairs. Empty for skins of more than [`SIGN_TABLE_JOINTS`] joints.
+    flips: Vec<u8>,
 }
+
+/// Largest skin (in joints) for which the AVX2 DQS kernel keeps a joint-pair sign table
+/// (`J^2` bytes, 64 KiB at most); larger skins use the portable DQS kernel.
+pub const SIGN_TABLE_JOINTS: usize = 256;
 
 impl Skinned {
     /// Buffers sized for `mesh`.
@@ -107,6 +134,12 @@ impl Skinned {
             nz: mesh.nz.clone(),
             mats: vec![[f64x2::ZERO; 6]; mesh.num_joints()],
             dqs: vec![[f64x2::ZERO; 4]; mesh.num_joints()],
+            signed: vec![[[[0.0; 4]; 2]; 2]; mesh.num_joints()],
+            flips: if mesh.num_joints() <= SIGN_TABLE_JOINTS {
+                vec![0; mesh.num_joints() * mesh.num_joints()]
+            } else {
+                Vec::new()
+            },
         }
         .resized(n)
     }
@@ -149,11 +182,46 @@ pub fn skin(
     method: SkinningMethod,
     out: &mut Skinned,
 ) -> Result<(), SkinError> {
+    skin_with(mesh, matrices, method, out, true)
+}
+
+/// [`skin`] with the portable kernels whatever the CPU: the results every x86-64 CPU (and
+/// every other target) reproduces bit for bit, at the portable kernels' speed.
+///
+/// # Errors
+/// As [`skin`].
+///
+/// # Panics
+/// As [`skin`].
+#[track_caller]
+pub fn skin_portable(
+    mesh: &SkinnedMesh,
+    matrices: &[DMat4],
+    method: SkinningMethod,
+    out: &mut Skinned,
+) -> Result<(), SkinError> {
+    skin_with(mesh, matrices, method, out, false)
+}
+
+/// [`skin`], with the AVX2 kernels allowed (`simd`, used when the CPU has them) or not (the
+/// portable kernels).
+#[track_caller]
+fn skin_with(
+    mesh: &SkinnedMesh,
+    matrices: &[DMat4],
+    method: SkinningMethod,
+    out: &mut Skinned,
+    simd: bool,
+) -> Result<(), SkinError> {
     assert_eq!(matrices.len(), mesh.num_joints(), "one skinning matrix per skin joint");
     assert_eq!(out.x.len(), mesh.len(), "Skinned buffers made for another mesh");
     assert_eq!(out.mats.len(), mesh.num_joints(), "Skinned buffers made for another mesh");
     let (n, k) = (mesh.len(), mesh.influences());
-    if !(1..=MAX_INFLUENCES).contains(&k) || mesh.joints().len() != n * k || mesh.weights().len() != n * k {
+    if !(1..=MAX_INFLUENCES).contains(&k)
+        || mesh.joints().len() != n * k
+        || mesh.weights().len() != n * k
+        || mesh.dominant_slots().len() != n
+    {
         return Err(SkinError::BadMesh(format!(
             "{n} vertices with {k} influences (1 to {MAX_INFLUENCES}) but {} joints and {} weights",
             mesh.joints().len(),
@@ -176,7 +244,25 @@ pub fn skin(
             out.dqs[j] = [[d[0], d[1]], [d[2], d[3]], [d[4], d[5]], [d[6], d[7]]].map(f64x2::new);
         }
     }
-    let Skinned { x, y, z, nx, ny, nz, mats, dqs } = out;
+    let nj = mesh.num_joints();
+    // The AVX2 kernels, where the CPU has them; DQS needs the sign table too.
+    #[cfg(target_arch = "x86_64")]
+    let cpu = if simd && (method == SkinningMethod::Lbs || out.flips.len() == nj * nj) {
+        avx2::Avx2Fma::detect()
+    } else {
+        None
+    };
+    #[cfg(target_arch = "x86_64")]
+    if cpu.is_some() && method == SkinningMethod::Dqs {
+        fill_sign_table(out);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = simd;
+    let Skinned { x, y, z, nx, ny, nz, mats, dqs, signed, flips } = out;
+    #[cfg(target_arch = "x86_64")]
+    let tables = avx2::Tables { mats: bytemuck::cast_slice(mats), signed, flips, joints: nj };
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (signed, flips);
     let (lbs, dqs) = (Lbs(mats), Dqs(dqs));
     x.par_chunks_mut(CHUNK)
         .zip(y.par_chunks_mut(CHUNK))
@@ -187,6 +273,11 @@ pub fn skin(
         .enumerate()
         .for_each(|(c, (((((x, y), z), nx), ny), nz))| {
             let o = Outputs { x, y, z, nx, ny, nz };
+            #[cfg(target_arch = "x86_64")]
+            if let Some(cpu) = cpu {
+                let lbs = method == SkinningMethod::Lbs;
+                return avx2::chunk(cpu, lbs, k, &tables, mesh, c * CHUNK, o);
+            }
             match method {
                 SkinningMethod::Lbs => chunk_k(k, &lbs, mesh, c * CHUNK, o),
                 SkinningMethod::Dqs => chunk_k(k, &dqs, mesh, c * CHUNK, o),
@@ -422,6 +513,28 @@ impl Kernel for Dqs<'_> {
     }
 }
 
+/// The AVX2 DQS kernel's per-pose tables: each joint's dual quaternion with both signs, and the
+/// hemisphere test of every joint pair, `q_a . q_b < 0`, summed in the portable kernel's order
+/// `(qx qx' + qz qz') + (qy qy' + qw qw')`.
+#[cfg(target_arch = "x86_64")]
+fn fill_sign_table(out: &mut Skinned) {
+    let nj = out.dqs.len();
+    for (s, d) in out.signed.iter_mut().zip(&out.dqs) {
+        let plus = [d[0].to_array(), d[1].to_array(), d[2].to_array(), d[3].to_array()];
+        let q = [plus[0][0], plus[0][1], plus[1][0], plus[1][1]];
+        let dual = [plus[2][0], plus[2][1], plus[3][0], plus[3][1]];
+        *s = [[q, dual], [q.map(|v| -v), dual.map(|v| -v)]];
+    }
+    for a in 0..nj {
+        let qa = out.signed[a][0][0];
+        for b in 0..nj {
+            let qb = out.signed[b][0][0];
+            let dot = (qb[0] * qa[0] + qb[2] * qa[2]) + (qb[1] * qa[1] + qb[3] * qa[3]);
+            out.flips[a * nj + b] = u8::from(dot < 0.0);
+        }
+    }
+}
+
 /// The unit dual quaternion of a rigid skinning matrix.
 fn to_dual_quat(joint: usize, m: &DMat4) -> Result<[f64; 8], SkinError> {
     let r = DMat3::from_mat4(*m);
@@ -439,4 +552,113 @@ fn to_dual_quat(joint: usize, m: &DMat4) -> Result<[f64; 8], SkinError> {
     let dv = 0.5 * (q.w * t + t.cross(qv));
     let dw = -0.5 * t.dot(qv);
     Ok([q.x, q.y, q.z, q.w, dv.x, dv.y, dv.z, dw])
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+
+    use super::*;
+    use anim_core::glam::DVec3;
+
+    /// The AVX2 kernels (where the CPU has them) and the portable ones agree to rounding, for
+    /// every influence count, scaled LBS joints, antipodal DQS quaternions, zero normals and
+    /// chunk tails of every length.
+    #[test]
+    fn simd_and_portable_kernels_agree() {
+        let mut s = 4242u64;
+        let mut rnd = move || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let joints = 11;
+        for k in 1..=MAX_INFLUENCES {
+            let n = CHUNK + 4 + k % 4;
+            let pos: Vec<[f64; 3]> = (0..n).map(|_| [rnd() - 0.5, rnd() - 0.5, rnd() - 0.5]).collect();
+            let nrm: Vec<[f64; 3]> = (0..n)
+                .map(|v| if v % 13 == 0 { [0.0; 3] } else { [rnd() - 0.5, rnd() - 0.5, rnd() + 0.1] })
+                .collect();
+            let js: Vec<u16> = (0..n * k).map(|_| (rnd() * joints as f64) as u16).collect();
+            let ws: Vec<f64> = (0..n * k)
+                .map(|i| if i % k == k - 1 && i % 3 == 0 && k > 1 { 0.0 } else { rnd() + 0.01 })
+                .collect();
+            let mesh = SkinnedMesh::new(&pos, Some(&nrm), k, &js, &ws, vec![], joints).unwrap();
+            for method in [SkinningMethod::Lbs, SkinningMethod::Dqs] {
+                let m: Vec<DMat4> = (0..joints)
+                    .map(|j| {
+                        let a = j as f64;
+                        let scale = if method == SkinningMethod::Lbs {
+                            DVec3::new(1.0 + 0.1 * a, 0.8, 1.2)
+                        } else {
+                            DVec3::ONE
+                        };
+                        // Odd joints get the antipodal quaternion of a nearby rotation.
+                        let q = DQuat::from_axis_angle(DVec3::new(0.3, 1.0, -a).normalize(), 0.4 * a - 1.0);
+                        let q = if j % 2 == 1 { -q } else { q };
+                        DMat4::from_scale_rotation_translation(scale, q, DVec3::new(a, 1.0, -0.5 * a))
+                    })
+                    .collect();
+                let (mut a, mut b) = (Skinned::new(&mesh), Skinned::new(&mesh));
+                skin_with(&mesh, &m, method, &mut a, true).unwrap();
+                skin_with(&mesh, &m, method, &mut b, false).unwrap();
+                let mut worst = 0.0f64;
+                for v in 0..n {
+                    for d in 0..3 {
+                        let scale = 1.0 + b.position(v)[d].abs();
+                        worst = worst.max((a.position(v)[d] - b.position(v)[d]).abs() / scale);
+                        worst = worst.max((a.normal(v)[d] - b.normal(v)[d]).abs());
+                    }
+                    if v % 13 == 0 {
+                        assert_eq!(a.normal(v), [0.0; 3], "{method:?} k = {k}: zero normal kept");
+                    }
+                }
+                assert!(worst < 1e-13, "{method:?} k = {k}: {worst:e}");
+            }
+        }
+    }
+
+    /// A mesh read back from its serialised form has the same derived data (dominant slots)
+    /// and skins to the same bits.
+    #[test]
+    fn a_deserialised_mesh_skins_like_the_original() {
+        let pos: Vec<[f64; 3]> = (0..50).map(|v| [v as f64, 1.0, 2.0]).collect();
+        let js: Vec<u16> = (0..150).map(|i| u16::try_from(i % 5).unwrap()).collect();
+        let ws: Vec<f64> = (0..150).map(|i| ((i * 37) % 11) as f64 + 0.5).collect();
+        let mesh = SkinnedMesh::new(&pos, None, 3, &js, &ws, vec![], 5).unwrap();
+        let back: SkinnedMesh = serde_json::from_str(&serde_json::to_string(&mesh).unwrap()).unwrap();
+        assert_eq!(back, mesh);
+        for (v, &d) in mesh.dominant_slots().iter().enumerate() {
+            let w = &mesh.weights()[3 * v..3 * v + 3];
+            let first_max = (0..3).find(|&i| w.iter().all(|&o| o <= w[i])).unwrap();
+            assert_eq!(usize::from(d), first_max, "vertex {v}");
+        }
+    }
+
+    /// A skin of more joints than the DQS sign table holds runs the portable DQS kernel: the
+    /// same bits as `skin_portable`.
+    #[test]
+    fn dqs_on_a_large_skin_falls_back_to_the_portable_kernel() {
+        let joints = SIGN_TABLE_JOINTS + 44;
+        let n = 1001;
+        let pos: Vec<[f64; 3]> = (0..n).map(|v| [v as f64 * 1e-3, 0.5, -0.25]).collect();
+        let js: Vec<u16> = (0..n * 2).map(|i| u16::try_from(i * 7 % joints).unwrap()).collect();
+        let ws: Vec<f64> = (0..n * 2).map(|i| 1.0 + (i % 3) as f64).collect();
+        let mesh = SkinnedMesh::new(&pos, None, 2, &js, &ws, vec![], joints).unwrap();
+        let m: Vec<DMat4> = (0..joints)
+            .map(|j| DMat4::from_rotation_translation(DQuat::from_rotation_z(0.01 * j as f64), DVec3::X))
+            .collect();
+        let (mut a, mut b) = (Skinned::new(&mesh), Skinned::new(&mesh));
+        assert!(a.flips.is_empty());
+        skin(&mesh, &m, SkinningMethod::Dqs, &mut a).unwrap();
+        skin_portable(&mesh, &m, SkinningMethod::Dqs, &mut b).unwrap();
+        assert!(a.x.iter().chain(&a.y).zip(b.x.iter().chain(&b.y)).all(|(p, q)| p.to_bits() == q.to_bits()));
+        // And the result is the motion it should be: vertex 0 has joints 0 and 7 with weights 1/3
+        // and 2/3, rotations about z by 0 and 0.07 then the same translation; the blend keeps
+        // the translation and rotates by 2 atan2(sum w sin(a/2), sum w cos(a/2)).
+        let half = 0.035f64;
+        let angle = 2.0 * (2.0 / 3.0 * half.sin()).atan2(1.0 / 3.0 + 2.0 / 3.0 * half.cos());
+        let expected = DMat4::from_rotation_translation(DQuat::from_rotation_z(angle), DVec3::X);
+        let p = expected.transform_point3(DVec3::from_array(pos[0]));
+        assert!((DVec3::from_array(a.position(0)) - p).length() < 1e-12, "{:?} vs {p}", a.position(0));
+    }
 }
