@@ -60,6 +60,7 @@ pub mod particles;
 pub mod project;
 pub mod scenes;
 pub mod sim;
+pub mod tank;
 pub mod transfer;
 
 #[cfg(test)]
@@ -68,4 +69,5 @@ mod tests;
 pub use error::FlipError;
 pub use particles::Particles;
 pub use sim::{FlipParams, FlipSimulation, StepInfo};
+pub use tank::TankMotion;
 pub use transfer::Transfer;
