@@ -754,9 +754,11 @@ impl Runner for MpmRunner {
     }
 }
 
-/// A particle fluid (anim-flip): particles drawn as discs, 2D scenes in the z = 0 plane. The
-/// display state holds the particles in the world frame (a moving tank's displacement and
-/// velocity added), refreshed after each step.
+/// A particle fluid (anim-flip): particles drawn as discs. anim-flip has y up; the display state
+/// (frames and preview) has z up like the CLI's other scenes: a fluid point `(x, y, z)` is shown
+/// at `(x, -z, y)`, a 2D one `(x, y)` at `(x, 0, y)`, so 2D scenes lie in the y = 0 plane and
+/// face the camera. Positions and velocities are in the world frame (a moving tank's
+/// displacement and velocity added), refreshed after each step.
 struct FlipRunner {
     name: String,
     scene: anim_flip::scenes::FlipScene,
@@ -774,7 +776,7 @@ impl FlipRunner {
         runner
     }
 
-    /// Positions and velocities as world-frame 3-vectors for the writers.
+    /// Positions and velocities as world-frame, z-up 3-vectors for the writers.
     fn refresh(&mut self) {
         fn copy<const D: usize>(s: &anim_flip::scenes::Preset<D>, d: &mut State) {
             let t = s.sim.time();
@@ -786,11 +788,12 @@ impl FlipRunner {
             d.x.clear();
             d.v.clear();
             for (p, u) in s.particles.x.iter().zip(&s.particles.v) {
-                for k in 0..3 {
-                    let (shift, speed) = if k == axis { (dx, dv) } else { (0.0, 0.0) };
-                    d.x.push(p.get(k).map_or(0.0, |c| c + shift));
-                    d.v.push(u.get(k).map_or(0.0, |c| c + speed));
-                }
+                let mut x = *p;
+                let mut v = *u;
+                x[axis] += dx;
+                v[axis] += dv;
+                d.x.extend(z_up(&x));
+                d.v.extend(z_up(&v));
             }
             d.t = t;
         }
@@ -872,17 +875,18 @@ impl Runner for FlipRunner {
 
     fn geometry(&self) -> Geometry {
         fn tank<const D: usize>(s: &anim_flip::scenes::Preset<D>) -> (f64, [f64; 3], [f64; 3]) {
-            let (lo, hi) = s.sim.fluid_box();
-            let mut b = ([0.0; 3], [0.0; 3]);
-            for k in 0..D {
-                (b.0[k], b.1[k]) = (lo[k], hi[k]);
-            }
+            let (mut lo, mut hi) = s.sim.fluid_box();
             if let Some(m) = s.sim.params().tank_motion {
                 // The oscillation's reach (the presets' tanks do not accelerate steadily).
-                b.0[m.axis] -= m.amplitude;
-                b.1[m.axis] += m.amplitude;
+                lo[m.axis] -= m.amplitude;
+                hi[m.axis] += m.amplitude;
             }
-            (s.sim.grid().h(), b.0, b.1)
+            let (a, b) = (z_up(&lo), z_up(&hi));
+            (
+                s.sim.grid().h(),
+                std::array::from_fn(|k| a[k].min(b[k])),
+                std::array::from_fn(|k| a[k].max(b[k])),
+            )
         }
         let (h, lo, hi) = match &self.scene {
             anim_flip::scenes::FlipScene::Two(s) => tank(s),
@@ -897,6 +901,13 @@ impl Runner for FlipRunner {
             frame_box: (lo, hi),
         }
     }
+}
+
+/// A y-up fluid vector as the CLI's z-up one: `(x, y, z) -> (x, -z, y)` (a rotation about x),
+/// `(x, y) -> (x, 0, y)`.
+fn z_up<const D: usize>(p: &[f64; D]) -> [f64; 3] {
+    let z = if D == 3 { -p[D - 1] } else { 0.0 };
+    [p[0], z, p[1]]
 }
 
 /// A grid fluid (anim-fluid). The display state holds the density per cell as positions and
@@ -1406,10 +1417,12 @@ mod tests {
             for (k, c) in x.chunks_exact(dim).enumerate() {
                 for a in 0..dim {
                     assert!(c[a] >= lo[a] && c[a] <= hi[a], "{name}: particle {k} at {c:?}");
-                    // The display (world frame) is the tank frame shifted along x.
-                    let world = s.x[3 * k + a];
-                    let expected = c[a] + if a == 0 { shift } else { 0.0 };
-                    assert_eq!(world.to_bits(), expected.to_bits(), "{name}: particle {k}");
+                }
+                // The display (world frame, z up) is the tank frame shifted along x, the fluid's
+                // y (up) as z and its z as -y.
+                let expected = [c[0] + shift, if dim == 3 { -c[2] } else { 0.0 }, c[1]];
+                for (a, e) in expected.iter().enumerate() {
+                    assert_eq!(s.x[3 * k + a].to_bits(), e.to_bits(), "{name}: particle {k}");
                 }
             }
             if name == "sloshing-tank" {

@@ -139,8 +139,8 @@ pub enum Scene {
     },
     /// An incompressible particle fluid of anim-flip (`dam-break-2d`, `dam-break-3d`, `drop-2d`,
     /// `drop-3d`, `sloshing-tank`): particles carry the water, a MAC grid makes it
-    /// incompressible; each step takes CFL substeps. Frames are the particles as a point cloud;
-    /// the sloshing tank's are in the world frame (the tank's motion added).
+    /// incompressible; each step takes CFL substeps. Frames are the particles as a point cloud,
+    /// z up (anim-flip's y); the sloshing tank's are in the world frame (the tank's motion added).
     Flip {
         /// The preset's name (checked when the file is read).
         #[serde(deserialize_with = "flip_preset")]
