@@ -8,7 +8,10 @@
 //! Particle and mesh scenes are written as VTK unstructured grids, PLY, OBJ or CSV and drawn in
 //! 3-D; the grid fluids of anim-fluid (`smoke-box-2d`, `smoke-plume-3d`, `lid-driven-cavity`)
 //! are a [`view::Geometry::Grid`]: their density and velocity fields go to VTK image data
-//! (`.vti` with a `.pvd` series) and the preview shows the density as a picture.
+//! (`.vti` with a `.pvd` series) and the preview shows the density as a picture. The particle
+//! fluids of anim-flip (`dam-break-2d`, `dam-break-3d`, `drop-2d`, `drop-3d`, `sloshing-tank`)
+//! are particle scenes: each frame is the point cloud of the particles, turned z up like the other
+//! scenes (the sloshing tank's in the world frame, the tank's displacement added).
 //!
 //! ```
 //! use anim_cli::scene;

@@ -7,6 +7,7 @@
 //! anim run cloth --out out --frames 60 --format obj --stride 2
 //! anim list                     # the built-in scenes (also `anim scenes`)
 //! anim run smoke-plume-3d --resolution 48   # a fluid on a finer grid
+//! anim run dam-break-2d --frames 20   # an APIC particle fluid (anim-flip)
 //! anim run cloth --checkpoint-every 50   # also keep out/checkpoint.anim current
 //! anim resume anim-out/cloth/checkpoint.anim   # continue from it, bit for bit
 //! ```
@@ -84,8 +85,8 @@ struct RunArgs {
     /// Frame file format (default: the scene's natural one; fluid grids: vti or none).
     #[arg(long, value_enum)]
     format: Option<OutputFormat>,
-    /// Override the resolution of a preset scene that has one (cloth, MPM, FEM and fluid
-    /// grids: cells or particles across).
+    /// Override the resolution of a preset scene that has one (cloth, MPM, FEM, particle fluids
+    /// and fluid grids: cells or particles across).
     #[arg(long)]
     resolution: Option<usize>,
     /// Write every N-th frame to files.

@@ -224,6 +224,26 @@ pub fn build(
             )?;
             Box::new(FluidRunner::new(scene))
         }
+        Scene::Flip { ref preset, resolution, transfer } => {
+            let limit = if preset.ends_with("3d") { 128 } else { 1024 };
+            if let Some(r) = resolution
+                && r > limit
+            {
+                return Err(SceneError::invalid(
+                    file,
+                    "scene.resolution",
+                    format!("{preset} takes at most {limit} cells across, got {r}"),
+                ));
+            }
+            let scene = preset_scene(
+                file,
+                "scene.resolution",
+                preset,
+                &anim_flip::scenes::NAMES,
+                anim_flip::scenes::by_name(preset, resolution, transfer.map(|t| t.transfer())),
+            )?;
+            Box::new(FlipRunner::new(scene))
+        }
         Scene::Springs { ref preset, resolution, integrator, linear_solver } => {
             let mut s = preset_scene(
                 file,
@@ -734,6 +754,162 @@ impl Runner for MpmRunner {
     }
 }
 
+/// A particle fluid (anim-flip): particles drawn as discs. anim-flip has y up; the display state
+/// (frames and preview) has z up like the CLI's other scenes: a fluid point `(x, y, z)` is shown
+/// at `(x, -z, y)`, a 2D one `(x, y)` at `(x, 0, y)`, so 2D scenes lie in the y = 0 plane and
+/// face the camera. Positions and velocities are in the world frame (a moving tank's
+/// displacement and velocity added), refreshed after each step.
+struct FlipRunner {
+    name: String,
+    scene: anim_flip::scenes::FlipScene,
+    display: State,
+}
+
+impl FlipRunner {
+    fn new(scene: anim_flip::scenes::FlipScene) -> Self {
+        let mut runner = Self {
+            name: format!("flip/{}", scene.name()),
+            scene,
+            display: State::new(Vec::new(), Vec::new()),
+        };
+        runner.refresh();
+        runner
+    }
+
+    /// Positions and velocities as world-frame, z-up 3-vectors for the writers.
+    fn refresh(&mut self) {
+        fn copy<const D: usize>(s: &anim_flip::scenes::Preset<D>, d: &mut State) {
+            let t = s.sim.time();
+            let (axis, dx, dv) = s
+                .sim
+                .params()
+                .tank_motion
+                .map_or((0, 0.0, 0.0), |m| (m.axis, m.displacement(t), m.velocity(t)));
+            d.x.clear();
+            d.v.clear();
+            for (p, u) in s.particles.x.iter().zip(&s.particles.v) {
+                let mut x = *p;
+                let mut v = *u;
+                x[axis] += dx;
+                v[axis] += dv;
+                d.x.extend(z_up(&x));
+                d.v.extend(z_up(&v));
+            }
+            d.t = t;
+        }
+        match &self.scene {
+            anim_flip::scenes::FlipScene::Two(s) => copy(s, &mut self.display),
+            anim_flip::scenes::FlipScene::Three(s) => copy(s, &mut self.display),
+        }
+    }
+}
+
+impl Runner for FlipRunner {
+    fn system(&self) -> String {
+        self.name.clone()
+    }
+
+    fn method(&self) -> String {
+        let (dim, p) = match &self.scene {
+            anim_flip::scenes::FlipScene::Two(s) => (2, s.sim.params().transfer),
+            anim_flip::scenes::FlipScene::Three(s) => (3, s.sim.params().transfer),
+        };
+        format!("{dim}D {} on a MAC grid, MGPCG pressure, CFL substeps", p.name())
+    }
+
+    fn state(&self) -> &State {
+        &self.display
+    }
+
+    fn step(&mut self, dt: f64) -> Result<StepReport, String> {
+        let report = match &mut self.scene {
+            anim_flip::scenes::FlipScene::Two(s) => s.sim.step(&mut s.particles, dt),
+            anim_flip::scenes::FlipScene::Three(s) => s.sim.step(&mut s.particles, dt),
+        }
+        .map_err(|e| e.to_string())?;
+        self.refresh();
+        Ok(report)
+    }
+
+    fn save(&self) -> serde_json::Value {
+        match &self.scene {
+            anim_flip::scenes::FlipScene::Two(s) => {
+                serde_json::json!({ "dim": 2, "particles": s.particles, "simulation": s.sim.memory() })
+            }
+            anim_flip::scenes::FlipScene::Three(s) => {
+                serde_json::json!({ "dim": 3, "particles": s.particles, "simulation": s.sim.memory() })
+            }
+        }
+    }
+
+    fn restore(&mut self, saved: &serde_json::Value) -> Result<(), String> {
+        let dim: usize = field(saved, "dim")?;
+        if dim != self.scene.dim() {
+            return Err(format!("a {dim}D checkpoint for a {}D scene", self.scene.dim()));
+        }
+        let memory = saved.get("simulation").ok_or("the checkpoint has no `simulation`")?;
+        fn restore<const D: usize>(
+            s: &mut anim_flip::scenes::Preset<D>,
+            saved: &serde_json::Value,
+            memory: &serde_json::Value,
+        ) -> Result<(), String> {
+            let particles: anim_flip::Particles<D> = field(saved, "particles")?;
+            particles.validate().map_err(|e| format!("`particles`: {e}"))?;
+            let mut sim = s.sim.clone();
+            sim.restore_memory(memory).map_err(|e| e.to_string())?;
+            s.sim = sim;
+            s.particles = particles;
+            Ok(())
+        }
+        match &mut self.scene {
+            anim_flip::scenes::FlipScene::Two(s) => restore(s, saved, memory)?,
+            anim_flip::scenes::FlipScene::Three(s) => restore(s, saved, memory)?,
+        }
+        self.refresh();
+        Ok(())
+    }
+
+    fn natural_format(&self) -> OutputFormat {
+        OutputFormat::Vtu
+    }
+
+    fn geometry(&self) -> Geometry {
+        fn tank<const D: usize>(s: &anim_flip::scenes::Preset<D>) -> (f64, [f64; 3], [f64; 3]) {
+            let (mut lo, mut hi) = s.sim.fluid_box();
+            if let Some(m) = s.sim.params().tank_motion {
+                // The oscillation's reach (the presets' tanks do not accelerate steadily).
+                lo[m.axis] -= m.amplitude;
+                hi[m.axis] += m.amplitude;
+            }
+            let (a, b) = (z_up(&lo), z_up(&hi));
+            (
+                s.sim.grid().h(),
+                std::array::from_fn(|k| a[k].min(b[k])),
+                std::array::from_fn(|k| a[k].max(b[k])),
+            )
+        }
+        let (h, lo, hi) = match &self.scene {
+            anim_flip::scenes::FlipScene::Two(s) => tank(s),
+            anim_flip::scenes::FlipScene::Three(s) => tank(s),
+        };
+        Geometry::Particles {
+            triangles: Vec::new(),
+            edges: Vec::new(),
+            radius: 0.25 * h,
+            ground: None,
+            spheres: Vec::new(),
+            frame_box: (lo, hi),
+        }
+    }
+}
+
+/// A y-up fluid vector as the CLI's z-up one: `(x, y, z) -> (x, -z, y)` (a rotation about x),
+/// `(x, y) -> (x, 0, y)`.
+fn z_up<const D: usize>(p: &[f64; D]) -> [f64; 3] {
+    let z = if D == 3 { -p[D - 1] } else { 0.0 };
+    [p[0], z, p[1]]
+}
+
 /// A grid fluid (anim-fluid). The display state holds the density per cell as positions and
 /// the cell-centred velocity as velocities (see [`Geometry::Grid`]), refreshed after every step
 /// into the same buffers; its time is the sum of the run's steps.
@@ -1048,6 +1224,9 @@ mod tests {
         if let Scene::Fluid { resolution, .. } = &mut file.scene {
             *resolution = Some(if name == "smoke-plume-3d" { 8 } else { 16 });
         }
+        if let Scene::Flip { resolution, .. } = &mut file.scene {
+            *resolution = Some(if name.ends_with("3d") { 8 } else { 16 });
+        }
         build(&file.scene, Path::new(name), None).unwrap()
     }
 
@@ -1203,6 +1382,81 @@ mod tests {
             assert!(pixel(hi) > pixel(lo), "{name}: {hi:?} {lo:?}");
         }
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// Every particle-fluid preset at a tiny resolution: a few steps keep every value finite and
+    /// every particle inside the tank (in the world frame, the tank's displacement added), and
+    /// an error of the solver is the step's error.
+    #[test]
+    fn flip_presets_stay_finite_and_inside_their_tanks() {
+        for name in anim_flip::scenes::NAMES {
+            let mut runner = runner_of(name);
+            let dt = scene::parse(scene::builtin(name).unwrap(), Path::new(name)).unwrap().run.dt;
+            for _ in 0..4 {
+                runner.step(dt).unwrap();
+            }
+            let s = runner.state();
+            assert!(s.x.iter().chain(&s.v).all(|x| x.is_finite()), "{name}");
+            assert!(!s.x.is_empty() && s.v.iter().any(|v| *v != 0.0), "{name}: nothing moves");
+            let saved = runner.save();
+            let (dim, x) = (saved["dim"].as_u64().unwrap() as usize, &saved["particles"]["x"]);
+            let x: Vec<f64> = serde_json::from_value(x.clone()).unwrap();
+            let scene =
+                anim_flip::scenes::by_name(name, Some(if dim == 3 { 8 } else { 16 }), None).unwrap().unwrap();
+            let (lo, hi, shift) = match &scene {
+                anim_flip::scenes::FlipScene::Two(p) => {
+                    let (lo, hi) = p.sim.fluid_box();
+                    let m = p.sim.params().tank_motion;
+                    (lo.to_vec(), hi.to_vec(), m.map_or(0.0, |m| m.displacement(s.t)))
+                }
+                anim_flip::scenes::FlipScene::Three(p) => {
+                    let (lo, hi) = p.sim.fluid_box();
+                    (lo.to_vec(), hi.to_vec(), 0.0)
+                }
+            };
+            for (k, c) in x.chunks_exact(dim).enumerate() {
+                for a in 0..dim {
+                    assert!(c[a] >= lo[a] && c[a] <= hi[a], "{name}: particle {k} at {c:?}");
+                }
+                // The display (world frame, z up) is the tank frame shifted along x, the fluid's
+                // y (up) as z and its z as -y.
+                let expected = [c[0] + shift, if dim == 3 { -c[2] } else { 0.0 }, c[1]];
+                for (a, e) in expected.iter().enumerate() {
+                    assert_eq!(s.x[3 * k + a].to_bits(), e.to_bits(), "{name}: particle {k}");
+                }
+            }
+            if name == "sloshing-tank" {
+                assert!(shift != 0.0, "the tank does not move");
+            }
+            // Velocities whose grid sums overflow: the non-finite guard's error is the step's.
+            let mut bad = saved.clone();
+            let count = bad["particles"]["v"].as_array().unwrap().len();
+            bad["particles"]["v"] = serde_json::json!(vec![1e308; count]);
+            runner.restore(&bad).unwrap();
+            let msg = runner.step(dt).unwrap_err();
+            assert!(msg.contains("anim-flip: non-finite"), "{name}: {msg}");
+            // A damaged checkpoint is refused and the runner keeps its state.
+            let before = runner.save();
+            bad["particles"]["x"][0] = serde_json::json!(f64::MAX);
+            bad["particles"]["v"][0] = serde_json::Value::Null;
+            assert!(runner.restore(&bad).is_err(), "{name}");
+            bad["dim"] = serde_json::json!(5 - dim);
+            assert!(runner.restore(&bad).unwrap_err().contains("checkpoint for a"), "{name}");
+            assert_eq!(runner.save(), before, "{name}");
+        }
+        // Unknown presets and oversized grids built programmatically name the field.
+        let scene = Scene::Flip { preset: "drop-4d".into(), resolution: None, transfer: None };
+        let msg = build(&scene, Path::new("s.toml"), None).err().unwrap().to_string();
+        assert!(
+            msg.contains("`scene.preset`") && msg.contains("drop-4d") && msg.contains("sloshing-tank"),
+            "{msg}"
+        );
+        let scene = Scene::Flip { preset: "drop-3d".into(), resolution: Some(1000), transfer: None };
+        let msg = build(&scene, Path::new("s.toml"), None).err().unwrap().to_string();
+        assert!(msg.contains("`scene.resolution`") && msg.contains("128"), "{msg}");
+        let scene = Scene::Flip { preset: "drop-2d".into(), resolution: Some(2), transfer: None };
+        let msg = build(&scene, Path::new("s.toml"), None).err().unwrap().to_string();
+        assert!(msg.contains("`scene.resolution`") && msg.contains("cells[0]"), "{msg}");
     }
 
     #[test]

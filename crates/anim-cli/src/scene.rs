@@ -137,6 +137,23 @@ pub enum Scene {
         #[serde(default)]
         resolution: Option<usize>,
     },
+    /// An incompressible particle fluid of anim-flip (`dam-break-2d`, `dam-break-3d`, `drop-2d`,
+    /// `drop-3d`, `sloshing-tank`): particles carry the water, a MAC grid makes it
+    /// incompressible; each step takes CFL substeps. Frames are the particles as a point cloud,
+    /// z up (anim-flip's y); the sloshing tank's are in the world frame (the tank's motion added).
+    Flip {
+        /// The preset's name (checked when the file is read).
+        #[serde(deserialize_with = "flip_preset")]
+        preset: String,
+        /// Cells across the 1 m tank (the preset's default when absent): at most 1024 in 2D,
+        /// 128 in 3D.
+        #[serde(default)]
+        resolution: Option<usize>,
+        /// Grid-to-particle transfer: `"apic"` (the default), `"pic"`, or `{ flip = 0.97 }` (FLIP
+        /// blended with PIC, the blend in `[0, 1]`).
+        #[serde(default)]
+        transfer: Option<FlipTransfer>,
+    },
     /// A mass-spring scene of anim-springs (`hanging-cloth`, `swinging-rope`, `jelly-drop`,
     /// `benchmark-cloth`), with its own integrator and solver unless overridden.
     Springs {
@@ -153,6 +170,46 @@ pub enum Scene {
         linear_solver: Option<LinearSolverKind>,
     },
 }
+
+/// The grid-to-particle transfer of a [`Scene::Flip`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FlipTransfer {
+    /// Particle-in-cell (dissipative).
+    Pic,
+    /// Affine particle-in-cell.
+    Apic,
+    /// FLIP blended with PIC: 1 is pure FLIP, 0 pure PIC.
+    Flip(f64),
+}
+
+impl FlipTransfer {
+    /// The anim-flip transfer.
+    #[must_use]
+    pub fn transfer(self) -> anim_flip::Transfer {
+        match self {
+            FlipTransfer::Pic => anim_flip::Transfer::Pic,
+            FlipTransfer::Apic => anim_flip::Transfer::Apic,
+            FlipTransfer::Flip(blend) => anim_flip::Transfer::Flip(blend),
+        }
+    }
+}
+
+/// Reads a flip preset's name, refusing unknown ones (so the error carries the file's line).
+fn flip_preset<'de, De: serde::Deserializer<'de>>(d: De) -> Result<String, De::Error> {
+    let name = String::deserialize(d)?;
+    if anim_flip::scenes::NAMES.contains(&name.as_str()) {
+        Ok(name)
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "{UNKNOWN_PRESET}{name}` for field `preset` (one of {})",
+            anim_flip::scenes::NAMES.join(", ")
+        )))
+    }
+}
+
+/// How [`flip_preset`]'s error starts, for [`parse`] to find the line.
+const UNKNOWN_PRESET: &str = "unknown preset `";
 
 /// Which skinning to show.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
@@ -202,7 +259,7 @@ pub enum SceneError {
 }
 
 /// The scenes built into the binary: `(name, description, TOML text)`.
-pub const BUILTIN: [(&str, &str, &str); 22] = [
+pub const BUILTIN: [(&str, &str, &str); 27] = [
     (
         "cloth",
         "a 32x32 cloth pinned at two corners falls and swings, backward Euler + sparse Cholesky",
@@ -235,6 +292,23 @@ pub const BUILTIN: [(&str, &str, &str); 22] = [
         SMOKE_PLUME,
     ),
     ("lid-driven-cavity", "the Re = 100 lid-driven cavity (64x64 MAC grid) stirring bands of dye", CAVITY),
+    (
+        "dam-break-2d",
+        "APIC particle fluid in 2D: a 0.25 x 0.5 m water column collapsing in a tank (64 cells/m)",
+        FLIP_DAM_BREAK_2D,
+    ),
+    (
+        "dam-break-3d",
+        "APIC particle fluid in 3D: a water column collapsing in the corner of a tank",
+        FLIP_DAM_BREAK_3D,
+    ),
+    ("drop-2d", "APIC particle fluid in 2D: a disk of water falling into a pool", FLIP_DROP_2D),
+    ("drop-3d", "APIC particle fluid in 3D: a ball of water falling into a pool", FLIP_DROP_3D),
+    (
+        "sloshing-tank",
+        "APIC particle fluid in 2D: water in a tank shaken at its first sloshing frequency",
+        FLIP_SLOSHING,
+    ),
     ("kepler", "a planet on an e = 0.5 ellipse, velocity Verlet, about 3 orbits", KEPLER),
     ("oscillator", "a lightly damped harmonic oscillator, implicit midpoint", OSCILLATOR),
 ];
@@ -487,6 +561,72 @@ preset = "lid-driven-cavity"
 resolution = 64
 "#;
 
+const FLIP_DAM_BREAK_2D: &str = r#"name = "dam-break-2d"
+
+[run]
+dt = 0.02
+frames = 100
+steps_per_frame = 1
+
+[scene]
+kind = "flip"
+preset = "dam-break-2d"
+resolution = 64
+"#;
+
+const FLIP_DAM_BREAK_3D: &str = r#"name = "dam-break-3d"
+
+[run]
+dt = 0.02
+frames = 75
+steps_per_frame = 1
+
+[scene]
+kind = "flip"
+preset = "dam-break-3d"
+resolution = 32
+"#;
+
+const FLIP_DROP_2D: &str = r#"name = "drop-2d"
+
+[run]
+dt = 0.02
+frames = 75
+steps_per_frame = 1
+
+[scene]
+kind = "flip"
+preset = "drop-2d"
+resolution = 64
+"#;
+
+const FLIP_DROP_3D: &str = r#"name = "drop-3d"
+
+[run]
+dt = 0.02
+frames = 75
+steps_per_frame = 1
+
+[scene]
+kind = "flip"
+preset = "drop-3d"
+resolution = 32
+"#;
+
+const FLIP_SLOSHING: &str = r#"name = "sloshing-tank"
+
+[run]
+dt = 0.02
+frames = 250
+steps_per_frame = 1
+
+[scene]
+kind = "flip"
+preset = "sloshing-tank"
+resolution = 64
+transfer = "apic"
+"#;
+
 const KEPLER: &str = r#"name = "kepler"
 
 [run]
@@ -519,7 +659,7 @@ integrator = "implicit-midpoint"
 
 impl Scene {
     /// Sets the resolution of a preset scene that has one (`pbd`, `fem`, `mpm`, `springs`,
-    /// `fluid`); the preset checks the value when the scene is built.
+    /// `fluid`, `flip`); the preset checks the value when the scene is built.
     ///
     /// # Errors
     /// A message naming the scene kind when it has no resolution.
@@ -529,7 +669,8 @@ impl Scene {
             | Scene::Fem { resolution, .. }
             | Scene::Mpm { resolution, .. }
             | Scene::Springs { resolution, .. }
-            | Scene::Fluid { resolution, .. } => {
+            | Scene::Fluid { resolution, .. }
+            | Scene::Flip { resolution, .. } => {
                 *resolution = Some(value);
                 Ok(())
             }
@@ -557,8 +698,10 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
     let scene: SceneFile = toml::from_str(text).map_err(|e| {
         let start = e.span().map_or(0, |s| s.start);
         // Fields of tagged tables are reported at the table's start; point at the field itself.
-        let start =
-            unknown_field(e.message()).and_then(|name| field_offset(text, start, name)).unwrap_or(start);
+        let start = unknown_field(e.message())
+            .or_else(|| e.message().contains(UNKNOWN_PRESET).then_some("preset"))
+            .and_then(|name| field_offset(text, start, name))
+            .unwrap_or(start);
         let (line, column) = line_col(text, start);
         SceneError::Parse { path: path.to_path_buf(), line, column, message: e.message().trim().to_string() }
     })?;
@@ -662,6 +805,14 @@ fn validate(s: &SceneFile) -> Result<(), (&'static str, String)> {
         | Scene::Mpm { .. }
         | Scene::Fem { .. }
         | Scene::Fluid { .. } => return Ok(()),
+        Scene::Flip { transfer, .. } => {
+            if let Some(FlipTransfer::Flip(blend)) = transfer
+                && !(0.0..=1.0).contains(blend)
+            {
+                return Err(("scene.transfer", format!("the FLIP blend must lie in [0, 1], got {blend}")));
+            }
+            return Ok(());
+        }
         Scene::Skinning { preset, file, .. } => {
             if preset.is_some() == file.is_some() {
                 return Err(("scene.preset", "give exactly one of `preset` and `file`".into()));
@@ -732,6 +883,32 @@ mod tests {
         assert!(msg.contains("warp-drive") && msg.starts_with("s.toml:"), "{msg}");
         let msg = err(&KEPLER.replace("frames = 400", "frames = \"many\""));
         assert!(msg.starts_with("s.toml:"), "{msg}");
+    }
+
+    #[test]
+    fn flip_scenes_parse_and_refuse_unknown_presets_and_blends_by_line_and_field() {
+        let s = parse(FLIP_SLOSHING, Path::new("s.toml")).unwrap();
+        assert!(matches!(
+            s.scene,
+            Scene::Flip { transfer: Some(FlipTransfer::Apic), resolution: Some(64), .. }
+        ));
+        let text = FLIP_DROP_2D.replace("resolution = 64", "transfer = { flip = 0.97 }");
+        let s = parse(&text, Path::new("s.toml")).unwrap();
+        assert!(
+            matches!(s.scene, Scene::Flip { transfer: Some(FlipTransfer::Flip(b)), resolution: None, .. } if b == 0.97)
+        );
+        let text = FLIP_DROP_2D.replace("preset = \"drop-2d\"", "preset = \"drop-4d\"");
+        let msg = err(&text);
+        let line = text.lines().position(|l| l.starts_with("preset")).unwrap() + 1;
+        assert!(msg.starts_with(&format!("s.toml:{line}:")), "expected line {line}: {msg}");
+        assert!(msg.contains("drop-4d") && msg.contains("`preset`"), "{msg}");
+        for name in anim_flip::scenes::NAMES {
+            assert!(msg.contains(name), "{msg}");
+        }
+        let msg = err(&FLIP_DROP_2D.replace("resolution = 64", "transfer = { flip = 1.5 }"));
+        assert!(msg.contains("field `scene.transfer`") && msg.contains("1.5"), "{msg}");
+        let msg = err(&FLIP_DROP_2D.replace("resolution = 64", "transfer = \"mpm\""));
+        assert!(msg.starts_with("s.toml:") && msg.contains("mpm"), "{msg}");
     }
 
     #[test]

@@ -153,3 +153,49 @@ fn a_resumed_fluid_run_writes_the_frames_of_an_uninterrupted_one() {
         std::fs::remove_dir_all(&parts).ok();
     }
 }
+
+/// A particle-fluid run writes one point cloud per frame holding every particle, and the flip
+/// presets are listed.
+#[test]
+fn a_flip_run_writes_particle_point_clouds() {
+    let out = Command::new(env!("CARGO_BIN_EXE_anim")).arg("scenes").output().unwrap();
+    let list = String::from_utf8_lossy(&out.stdout);
+    for name in anim_flip::scenes::NAMES {
+        assert!(list.lines().any(|l| l.starts_with(name)), "{name} not in {list}");
+    }
+    let dir = temp("flip-drop-2d");
+    let (ok, err) = anim(&[
+        "run",
+        "drop-2d",
+        "--resolution",
+        "12",
+        "--frames",
+        "3",
+        "--format",
+        "ply",
+        "--no-preview",
+        "--quiet",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let Some(anim_flip::scenes::FlipScene::Two(scene)) =
+        anim_flip::scenes::by_name("drop-2d", Some(12), None).map(|r| r.unwrap())
+    else {
+        panic!("drop-2d is 2D");
+    };
+    let count = scene.particles.len();
+    let mut frames: Vec<_> = std::fs::read_dir(dir.join("frames"))
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "ply"))
+        .collect();
+    frames.sort();
+    assert_eq!(frames.len(), 3, "{frames:?}");
+    for f in frames {
+        let bytes = std::fs::read(&f).unwrap();
+        let header = String::from_utf8_lossy(&bytes[..bytes.len().min(400)]);
+        assert!(header.contains(&format!("element vertex {count}")), "{}: {header}", f.display());
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

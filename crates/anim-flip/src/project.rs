@@ -42,17 +42,14 @@ fn face_cells<const D: usize>(
     (lo, hi, lo.map(|c| labels[c]), hi.map(|c| labels[c]))
 }
 
-/// Adds `dt g` to every face not touching a solid and sets faces touching a solid to zero.
-pub(crate) fn body_forces_and_walls<const D: usize>(
-    grid: &mut MacGrid<D>,
-    solid: &[bool],
-    gravity: [f64; D],
-    dt: f64,
-) {
+/// Adds the velocity change `dv` of the body forces over the substep (`dt g`, in a moving tank
+/// less the tank's velocity change) to every face not touching a solid and sets faces touching a
+/// solid to zero.
+pub(crate) fn body_forces_and_walls<const D: usize>(grid: &mut MacGrid<D>, solid: &[bool], dv: [f64; D]) {
     let n = grid.n;
     for a in 0..D {
         let fd = grid.face_dims(a);
-        let dv = dt * gravity[a];
+        let dv = dv[a];
         grid.u[a].par_chunks_mut(fd[0]).enumerate().for_each(|(line, row)| {
             let mut idx = unflatten(fd, line * fd[0]);
             for (i, u) in row.iter_mut().enumerate() {

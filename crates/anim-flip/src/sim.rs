@@ -2,7 +2,8 @@
 //!
 //! 1. bin the particles and classify the cells ([`crate::classify`]);
 //! 2. particle-to-grid ([`crate::transfer`]), extrapolate, keep the result for FLIP;
-//! 3. gravity and solid walls, pressure projection ([`crate::project`]), extrapolate;
+//! 3. gravity (in a moving tank, less the tank's acceleration: [`crate::tank`]) and solid walls,
+//!    pressure projection ([`crate::project`]), extrapolate;
 //! 4. grid-to-particle (PIC, FLIP or APIC), advect `x += dt v_p` (seed 5.3.1), push particles
 //!    that entered solid cells back out (counted).
 //!
@@ -15,6 +16,7 @@ use crate::error::{FlipError, positive};
 use crate::mac::{MacGrid, flatten, unflatten};
 use crate::particles::Particles;
 use crate::project::{self, PressureSettings};
+use crate::tank::TankMotion;
 use crate::transfer::{self, Transfer};
 use anim_core::bspline::Kernel;
 use anim_core::solver::{Solver, StepReport};
@@ -59,6 +61,11 @@ pub struct FlipParams<const D: usize> {
     /// No-slip walls (tangential velocity zero inside solid cells) instead of free slip
     /// (tangential velocity extrapolated into them). Default false.
     pub no_slip: bool,
+    /// A moving tank ([`TankMotion`]): the fluid is simulated in the tank's frame, where the
+    /// body acceleration is `gravity - a_tank(t)` along the motion's axis, applied at each
+    /// substep's time. Default `None` (a tank at rest; absent from older scene files).
+    #[serde(default)]
+    pub tank_motion: Option<TankMotion>,
 }
 
 mod serde_array {
@@ -90,6 +97,7 @@ impl<const D: usize> Default for FlipParams<D> {
             grid_advection: true,
             volume_correction: 0.0,
             rest_per_cell: (1usize << D) as f64,
+            tank_motion: None,
         }
     }
 }
@@ -141,7 +149,7 @@ impl<const D: usize> FlipSimulation<D> {
     /// # Errors
     /// [`FlipError::BadParameter`] naming the parameter: `D` not 2 or 3, a non-positive `h`,
     /// too few cells, `cfl`, `tolerance`, `max_iterations`, `max_substeps`, a FLIP blend outside
-    /// `[0, 1]`, non-finite gravity.
+    /// `[0, 1]`, non-finite gravity, a bad [`TankMotion`] (see [`TankMotion::validate`]).
     pub fn new(cells: [usize; D], h: f64, params: FlipParams<D>) -> Result<Self, FlipError> {
         if D != 2 && D != 3 {
             return Err(FlipError::BadParameter {
@@ -193,6 +201,9 @@ impl<const D: usize> FlipSimulation<D> {
                 requirement: "must be finite",
                 value: g.to_string(),
             });
+        }
+        if let Some(tank) = &params.tank_motion {
+            tank.validate(D)?;
         }
         let count: usize = cells.iter().product();
         let solid: Vec<bool> = (0..count)
@@ -285,11 +296,14 @@ impl<const D: usize> FlipSimulation<D> {
 
     /// The largest substep the CFL condition allows at the particles' current speeds: the
     /// distance `cfl h` over the largest speed plus `sqrt(|g| h)` (what gravity adds in that
-    /// time).
+    /// time; a moving tank adds its largest acceleration to `|g|`).
     #[must_use]
     pub fn cfl_dt(&self, particles: &Particles<D>) -> f64 {
         let vmax = max_speed(particles);
-        let g = self.params.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
+        let mut g = self.params.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
+        if let Some(tank) = &self.params.tank_motion {
+            g += tank.max_acceleration();
+        }
         self.params.cfl * self.grid.h / (vmax + (g * self.grid.h).sqrt()).max(f64::MIN_POSITIVE)
     }
 
@@ -336,7 +350,7 @@ impl<const D: usize> FlipSimulation<D> {
                     speed: max_speed(particles),
                 });
             }
-            self.substep(particles, sub, &mut info)?;
+            self.substep(particles, self.time + t, sub, &mut info)?;
             self.check_finite(particles)?;
             self.steps += 1;
             t = if sub == remaining { dt } else { t + sub };
@@ -348,10 +362,11 @@ impl<const D: usize> FlipSimulation<D> {
         self.params.kernel.support()
     }
 
-    /// One substep.
+    /// One substep from time `time`.
     fn substep(
         &mut self,
         particles: &mut Particles<D>,
+        time: f64,
         dt: f64,
         info: &mut StepInfo,
     ) -> Result<(), FlipError> {
@@ -369,7 +384,11 @@ impl<const D: usize> FlipSimulation<D> {
             let (u, old) = (&self.grid.u[a], &mut self.grid.u_old[a]);
             old.copy_from_slice(u);
         }
-        project::body_forces_and_walls(&mut self.grid, &self.solid, self.params.gravity, dt);
+        let mut dv: [f64; D] = std::array::from_fn(|a| dt * self.params.gravity[a]);
+        if let Some(tank) = &self.params.tank_motion {
+            dv[tank.axis] -= tank.velocity_change(time, dt);
+        }
+        project::body_forces_and_walls(&mut self.grid, &self.solid, dv);
         let settings = PressureSettings {
             method: self.params.pressure,
             tolerance: self.params.tolerance,
