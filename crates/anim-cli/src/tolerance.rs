@@ -209,7 +209,7 @@ pub fn choose(file: &mut SceneFile, tol: f64, table: &Table) -> Result<Choice, S
     file.run.steps_per_frame = steps_per_frame;
     let why = format!(
         "cheapest measured method with error <= {:e}: {label} dt={} in the {} study, error {:.2e}, {} per run \
-         (report of {}, {} mode, {}, {} cores){}; running {steps_per_frame} steps of {dt_run:.4e} s per frame",
+         (report of {}, {} mode, {}, {} cores){}; running {steps_per_frame} step{} of {dt_run:.4e} s per frame",
         row.tolerance,
         short(dt_study),
         family.study,
@@ -224,6 +224,7 @@ pub fn choose(file: &mut SceneFile, tol: f64, table: &Table) -> Result<Choice, S
         } else {
             format!(" (= {:.4e} s at omega = {unit:.4}){scaled}", dt_study / unit)
         },
+        if steps_per_frame == 1 { "" } else { "s" },
     );
     Ok(Choice { integrator, dt: dt_run, steps_per_frame, why })
 }
