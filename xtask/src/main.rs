@@ -5,23 +5,26 @@
 //! | `conformance [--quick] [--filter S]` | every reference case with metric, error, tolerance and verdict; exit 1 on any failure |
 //! | `stability [--quick] [--filter S]` | the named hard cases of every crate with their outcomes; exit 1 on an unexpected outcome |
 //! | `stability --long [--quick] [--filter S] [--out DIR]` | soak: each crate's hard case for `10^5` steps or ten minutes with its energy bound; written to `docs/report/soak.md` |
-//! | `bench [--filter S]` | the criterion benches under `benches/`, printed as a table and written to `target/xtask/bench.csv`; `--peers [--filter S]`: the peer comparisons (springs, rigid, pbd, fem, mpm, fluid) |
-//! | `report [--quick] [--out DIR]` | conformance, stability and work-precision studies written to `docs/report/` (Markdown + SVG) |
+//! | `bench [--filter S]` | the criterion benches under `benches/`, printed as a table and written to `target/xtask/bench.csv`; `--peers [--filter S]`: the peer comparisons (springs, rigid, pbd, fem, mpm, fluid), their ratios merged into `docs/report/peers.csv` (a filtered run replaces only its crates' rows) |
+//! | `report [--quick] [--out DIR] [--threads 1,2,...]` | conformance, stability and work-precision studies, the cheapest method per tolerance (also `cheapest.json`), thread scaling (1 and all cores unless `--threads`) and the peer ratios of `docs/report/peers.csv`, written to `docs/report/` (Markdown + SVG); prints its duration |
 //! | `ci` | what CI runs: format, clippy, tests (with doc tests), docs, quick conformance and stability |
 
 mod architecture;
 mod bench;
 mod cases;
 mod ci;
+mod machine;
+mod peers_file;
 mod python;
 mod registry;
 mod report;
+mod scaling;
 mod soak;
 mod suites;
 
 use std::process::ExitCode;
 
-const USAGE: &str = "usage: cargo xtask <conformance|stability|bench|report|ci> [--quick] [--long] [--filter TEXT] [--out DIR]";
+const USAGE: &str = "usage: cargo xtask <conformance|stability|bench|report|ci> [--quick] [--long] [--filter TEXT] [--out DIR] [--threads 1,2,...]";
 
 #[derive(Debug, Default)]
 struct Args {
@@ -29,6 +32,7 @@ struct Args {
     long: bool,
     filter: Option<String>,
     out: Option<String>,
+    threads: Option<Vec<usize>>,
 }
 
 fn parse(args: &[String]) -> Result<Args, String> {
@@ -40,6 +44,9 @@ fn parse(args: &[String]) -> Result<Args, String> {
             "--long" => parsed.long = true,
             "--filter" => parsed.filter = Some(it.next().ok_or("--filter needs a value")?.clone()),
             "--out" => parsed.out = Some(it.next().ok_or("--out needs a value")?.clone()),
+            "--threads" => {
+                parsed.threads = Some(scaling::parse_threads(it.next().ok_or("--threads needs a value")?)?)
+            }
             // `bench --peers`: read by bench.rs from the process arguments.
             "--peers" => {}
             other => return Err(format!("unknown argument '{other}'")),
@@ -69,7 +76,13 @@ fn main() -> ExitCode {
         }
         "stability" => suites::stability(&ctx, args.filter.as_deref()).passed(),
         "bench" => bench::run(args.filter.as_deref()),
-        "report" => report::run(&ctx, args.out.as_deref().unwrap_or("docs/report")),
+        "report" => {
+            let threads = args.threads.unwrap_or_else(|| {
+                let n = machine::cores();
+                if n > 1 { vec![1, n] } else { vec![1] }
+            });
+            report::run(&ctx, args.out.as_deref().unwrap_or("docs/report"), &threads)
+        }
         "ci" => ci::run(),
         "help" | "--help" | "-h" => {
             println!("{USAGE}");

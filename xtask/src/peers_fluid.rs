@@ -139,7 +139,15 @@ pub fn run() -> bool {
                 let ours = seed_per_step(n, steps, 3);
                 match c {
                     Some(c) => {
-                        println!("| {n} | {:.2} ms | {:.2} ms | {:.2}x |", c * 1e3, ours * 1e3, c / ours)
+                        println!("| {n} | {:.2} ms | {:.2} ms | {:.2}x |", c * 1e3, ours * 1e3, c / ours);
+                        crate::peers_file::record(
+                            "anim-fluid",
+                            &format!("seed stable fluids N = {n}, 20 Gauss-Seidel sweeps"),
+                            "the seed's C (cc -O3 -march=native)",
+                            1,
+                            ours,
+                            c,
+                        );
                     }
                     None => println!("| {n} | (C run failed) | {:.2} ms | - |", ours * 1e3),
                 }
@@ -199,7 +207,19 @@ pub fn run() -> bool {
             println!("| code | threads | per step |\n| --- | --- | --- |");
             for t in [1, threads] {
                 match taichi(t) {
-                    Ok(s) => println!("| taichi stable_fluid (500 Jacobi) | {t} | {:.1} ms |", s * 1e3),
+                    Ok(s) => {
+                        println!("| taichi stable_fluid (500 Jacobi) | {t} | {:.1} ms |", s * 1e3);
+                        if t == 1 {
+                            crate::peers_file::record(
+                                "anim-fluid",
+                                "stable fluids 512 x 512: our seed mode (20 GS sweeps) vs Taichi (500 Jacobi)",
+                                "Taichi 1.7.4 stable_fluid",
+                                1,
+                                seed,
+                                s,
+                            );
+                        }
+                    }
                     Err(e) => println!("| taichi stable_fluid | {t} | failed: {e} |"),
                 }
             }

@@ -87,6 +87,14 @@ pub fn run() -> bool {
                 t_y
             );
             rows.push((dim, n, ours.particles, threads, ours.per_step_s, t_step, ratio));
+            crate::peers_file::record(
+                "anim-mpm",
+                &format!("MLS-MPM fluid {dim}D {n}^{dim}, {} particles", ours.particles),
+                "Taichi",
+                threads,
+                ours.per_step_s,
+                t_step,
+            );
         }
     }
     let dir = std::path::Path::new("target/xtask");

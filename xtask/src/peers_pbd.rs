@@ -159,6 +159,23 @@ pub fn run() -> bool {
             r.note
         );
     }
+    for theirs in rows.iter().filter(|r| !r.code.starts_with("anim-pbd")) {
+        for ours in rows.iter().filter(|o| {
+            o.n == theirs.n
+                && o.iterations == theirs.iterations
+                && o.threads == 1
+                && o.code.starts_with("anim-pbd")
+        }) {
+            crate::peers_file::record(
+                "anim-pbd",
+                &format!("XPBD cloth {n}x{n}, {} iterations, {}", theirs.iterations, ours.code, n = theirs.n),
+                &theirs.code,
+                1,
+                ours.per_step_s,
+                theirs.per_step_s,
+            );
+        }
+    }
     let dir = std::path::Path::new("target/xtask");
     let written = std::fs::create_dir_all(dir).and_then(|_| {
         let mut f = std::fs::File::create(dir.join("peers_pbd.csv"))?;

@@ -323,6 +323,14 @@ pub fn run() -> bool {
     );
     for (robot, kernel, ours, theirs, detail) in &rows {
         println!("| {robot} | {kernel} | {ours:.1} ns | {theirs:.1} ns | {:.3} | {detail} |", ours / theirs);
+        crate::peers_file::record(
+            "anim-rigid",
+            &format!("{robot} {kernel}"),
+            "Pinocchio",
+            1,
+            ours * 1e-9,
+            theirs * 1e-9,
+        );
     }
     let dir = Path::new("target/xtask");
     let written = std::fs::create_dir_all(dir).and_then(|_| {

@@ -1,63 +1,316 @@
-//! `cargo xtask report`: conformance, stability and work-precision studies written as Markdown
-//! tables and SVG plots.
+//! `cargo xtask report`: conformance, stability and work-precision studies, thread scaling and
+//! the committed peer ratios, written as Markdown tables and SVG plots to `docs/report/`, with the
+//! cheapest-method table also as `docs/report/cheapest.json` (read by `anim run --tolerance`).
 
+use crate::machine::Machine;
+use crate::peers_file::{self, PeerRow};
 use crate::registry::{self, Ctx, StudyResult, fmt_num};
-use crate::suites;
+use crate::scaling;
+use crate::suites::{self, ConformanceRun, StabilityRun};
 use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
 /// Tolerances of the "cheapest method" tables.
-const TOLERANCES: [f64; 5] = [1e-2, 1e-3, 1e-4, 1e-6, 1e-8];
+pub const TOLERANCES: [f64; 6] = [1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8];
 
-pub fn run(ctx: &Ctx, out: &str) -> bool {
+/// Tolerances of the headline table.
+const HEADLINE: [f64; 3] = [1e-1, 1e-2, 1e-3];
+
+/// Studies whose problem is a scene kind `anim run` knows, with the simulated time the study
+/// measured over: `(study slug, scene kind, horizon)`. `anim run --tolerance` picks from these.
+const SCENE_FAMILIES: [(&str, &str, f64); 2] = [
+    ("core-oscillator", "harmonic-oscillator", crate::cases::core::OSCILLATOR_HORIZON),
+    ("core-kepler", "kepler-orbit", crate::cases::core::KEPLER_HORIZON),
+];
+
+/// Everything the report shows.
+pub struct Report {
+    /// `(crate, study)` in registry order.
+    pub studies: Vec<(&'static str, StudyResult)>,
+    pub conformance: ConformanceRun,
+    pub stability: StabilityRun,
+    pub scaling: Vec<scaling::Row>,
+    /// The 1-minute load average before and after the scaling runs.
+    pub load: Option<(f64, f64)>,
+    /// Rows of `docs/report/peers.csv` (or an error reading it).
+    pub peers: Result<Vec<PeerRow>, String>,
+    pub quick: bool,
+    pub date: String,
+    pub machine: Machine,
+    /// Wall time of the whole report run, seconds.
+    pub seconds: f64,
+    /// Whether `soak.md` (from `stability --long`) is beside the index.
+    pub soak: bool,
+}
+
+pub fn run(ctx: &Ctx, out: &str, threads: &[usize]) -> bool {
     let start = Instant::now();
     let dir = Path::new(out);
     if let Err(e) = std::fs::create_dir_all(dir) {
         eprintln!("cannot create {out}: {e}");
         return false;
     }
-    let conf = suites::conformance(ctx, None);
-    let stab = suites::stability(ctx, None);
-    let mut md = String::new();
-    let _ = writeln!(md, "# anim: work-precision report\n");
-    let _ = writeln!(
-        md,
-        "Written by `cargo xtask report{}`. Wall times are medians of repeated runs on the machine \
-         that ran the report ({} logical cores); compare methods within one table, not across machines.\n",
-        if ctx.quick { " --quick" } else { "" },
-        std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
-    );
-    let _ = writeln!(md, "## Work-precision studies\n");
-    let mut ok = true;
+    let conformance = suites::conformance(ctx, None);
+    let stability = suites::stability(ctx, None);
+    let mut studies = Vec::new();
     for study in registry::all().studies {
         let t = Instant::now();
         let result = (study.run)(ctx);
         eprintln!("  study {:<45} {:>6.1} s", study.name, t.elapsed().as_secs_f64());
-        let svg = dir.join(format!("{}.svg", result.slug));
-        if let Err(e) = plot(&result, &svg) {
-            eprintln!("cannot write {}: {e}", svg.display());
-            ok = false;
-        }
-        md.push_str(&study_markdown(study.crate_name, &result));
+        studies.push((study.crate_name, result));
     }
+    eprintln!("thread scaling on {threads:?} threads");
+    let load_before = scaling::load_average();
+    let scaling = scaling::run(ctx.quick, threads);
+    let load = load_before.zip(scaling::load_average());
+    let report = Report {
+        studies,
+        conformance,
+        stability,
+        scaling,
+        load,
+        peers: peers_file::read(&dir.join("peers.csv")),
+        quick: ctx.quick,
+        date: crate::machine::today(),
+        machine: Machine::this(),
+        seconds: start.elapsed().as_secs_f64(),
+        soak: dir.join("soak.md").exists(),
+    };
+    let ok = match write(dir, &report) {
+        Ok(()) => true,
+        Err(e) => {
+            eprintln!("{e}");
+            false
+        }
+    };
+    eprintln!(
+        "report{} finished in {:.0} s ({:.1} min); wrote {}",
+        if ctx.quick { " --quick" } else { "" },
+        start.elapsed().as_secs_f64(),
+        start.elapsed().as_secs_f64() / 60.0,
+        dir.join("index.md").display()
+    );
+    ok && report.conformance.passed() && report.stability.passed()
+}
+
+/// Writes `index.md`, one SVG per study and `cheapest.json` into `dir`.
+pub fn write(dir: &Path, r: &Report) -> Result<(), String> {
+    let mut failed = Vec::new();
+    for (_, study) in &r.studies {
+        let svg = dir.join(format!("{}.svg", study.slug));
+        if let Err(e) = plot(study, &svg) {
+            failed.push(format!("cannot write {}: {e}", svg.display()));
+        }
+    }
+    let index = dir.join("index.md");
+    std::fs::write(&index, index_markdown(r))
+        .map_err(|e| format!("cannot write {}: {e}", index.display()))?;
+    let json = dir.join("cheapest.json");
+    let text = serde_json::to_string_pretty(&cheapest_table(r)).map_err(|e| e.to_string())?;
+    std::fs::write(&json, text + "\n").map_err(|e| format!("cannot write {}: {e}", json.display()))?;
+    if failed.is_empty() { Ok(()) } else { Err(failed.join("\n")) }
+}
+
+/// `docs/report/cheapest.json`: per study, per tolerance, the cheapest measured method.
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+pub struct CheapestTable {
+    /// Format version.
+    pub format: u32,
+    pub date: String,
+    pub machine: Machine,
+    /// `quick` or `full`.
+    pub mode: String,
+    pub tolerances: Vec<f64>,
+    pub families: Vec<Family>,
+}
+
+/// One study's picks.
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+pub struct Family {
+    /// The study's slug (its SVG's name).
+    pub study: String,
+    #[serde(rename = "crate")]
+    pub krate: String,
+    pub title: String,
+    /// What the error measures.
+    pub error: String,
+    /// What the swept parameter is (dt, iterations, resolution).
+    pub param: String,
+    /// The scene kind of `anim run` this study's problem is, if any.
+    pub scene: Option<String>,
+    /// Simulated time the study measured over (for scene families).
+    pub horizon: Option<f64>,
+    pub picks: Vec<Pick>,
+}
+
+/// The cheapest method meeting one tolerance; `method` is `None` when none in the sweep does.
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+pub struct Pick {
+    pub tolerance: f64,
+    pub method: Option<String>,
+    pub param: Option<f64>,
+    /// Median wall time of one run of the study's problem, seconds.
+    pub seconds: Option<f64>,
+    pub error: Option<f64>,
+}
+
+pub fn cheapest_table(r: &Report) -> CheapestTable {
+    let families = r
+        .studies
+        .iter()
+        .map(|(krate, s)| {
+            let scene = SCENE_FAMILIES.iter().find(|f| f.0 == s.slug);
+            Family {
+                study: s.slug.clone(),
+                krate: (*krate).into(),
+                title: s.title.clone(),
+                error: s.error_label.clone(),
+                param: s.param_label.clone(),
+                scene: scene.map(|f| f.1.to_string()),
+                horizon: scene.map(|f| f.2),
+                picks: TOLERANCES
+                    .iter()
+                    .map(|&tol| match cheapest(s, tol) {
+                        Some((method, param, seconds, error)) => Pick {
+                            tolerance: tol,
+                            method: Some(method),
+                            param: Some(param),
+                            seconds: Some(seconds),
+                            error: Some(error),
+                        },
+                        None => {
+                            Pick { tolerance: tol, method: None, param: None, seconds: None, error: None }
+                        }
+                    })
+                    .collect(),
+            }
+        })
+        .collect();
+    CheapestTable {
+        format: 1,
+        date: r.date.clone(),
+        machine: r.machine.clone(),
+        mode: if r.quick { "quick" } else { "full" }.into(),
+        tolerances: TOLERANCES.to_vec(),
+        families,
+    }
+}
+
+/// The whole `index.md`.
+pub fn index_markdown(r: &Report) -> String {
+    let mut md = String::new();
+    let _ = writeln!(md, "# anim: work-precision report\n");
+    let _ = writeln!(
+        md,
+        "Written by `cargo xtask report{}` on {} ({}); the run took {:.0} s ({:.1} min). Wall times \
+         are medians of repeated runs on that machine; compare methods within one table, not across \
+         machines.\n",
+        if r.quick { " --quick" } else { "" },
+        r.date,
+        r.machine.describe(),
+        r.seconds,
+        r.seconds / 60.0
+    );
+    let _ = writeln!(md, "## Cheapest method meeting a tolerance\n");
+    let _ = writeln!(
+        md,
+        "Measured: for each study and tolerance, the fastest point of any method whose error is at \
+         most the tolerance (method, its {{dt, iterations, resolution}}, wall time of one run, error). \
+         Each study's error measure is given below its plot; relative unless it says otherwise. The \
+         same table is in [cheapest.json](cheapest.json), which `anim run SCENE --tolerance TOL` reads.\n"
+    );
+    let _ = write!(md, "| study | crate | error measure |");
+    for tol in HEADLINE {
+        let _ = write!(md, " {tol:.0e} |");
+    }
+    let _ = writeln!(md, "\n| --- | --- | --- |{}", " --- |".repeat(HEADLINE.len()));
+    for (krate, s) in &r.studies {
+        let _ = write!(md, "| [{}](#{}) | {krate} | {} |", s.slug, s.slug, s.error_label.replace('|', "\\|"));
+        for tol in HEADLINE {
+            match cheapest(s, tol) {
+                Some((label, param, secs, err)) => {
+                    let _ = write!(
+                        md,
+                        " {label}, {} = {}: {} (error {}) |",
+                        s.param_label,
+                        fmt_num(param),
+                        seconds(secs),
+                        fmt_num(err)
+                    );
+                }
+                None => {
+                    let _ = write!(md, " none in the sweep |");
+                }
+            }
+        }
+        let _ = writeln!(md);
+    }
+    let _ = writeln!(md, "\n## Work-precision studies\n");
+    for (krate, s) in &r.studies {
+        let _ = writeln!(md, "<a id=\"{}\"></a>\n", s.slug);
+        md.push_str(&study_markdown(krate, s));
+    }
+    let _ = writeln!(md, "## Thread scaling\n");
+    let _ = writeln!(
+        md,
+        "Each parallel solver family's fixed scene stepped on rayon pools of 1 to {} threads \
+         (`cargo xtask report --threads 1,2,4,...` for more); time per step is the median of three \
+         batches after {} steps whose states are compared bit for bit with the one-thread run.\n",
+        r.scaling.iter().map(|s| s.threads).max().unwrap_or(1),
+        3
+    );
+    if let Some((before, after)) = r.load {
+        let _ = writeln!(
+            md,
+            "The machine's 1-minute load average was {before:.2} before these runs and {after:.2} after \
+             ({} cores): with other work on the cores, a second thread may find no free core and the \
+             speed-up falls below what an idle machine gives.\n",
+            r.machine.cores
+        );
+    }
+    md.push_str(&scaling::markdown(&r.scaling));
+    let _ = writeln!(md, "\n## Peer comparisons\n");
+    match &r.peers {
+        Ok(rows) if rows.is_empty() => {
+            let _ = writeln!(
+                md,
+                "No peer ratios recorded yet: `cargo xtask bench --peers [--filter CRATE]` measures them \
+                 and writes [peers.csv](peers.csv).\n"
+            );
+        }
+        Ok(rows) => {
+            let _ = writeln!(
+                md,
+                "From [peers.csv](peers.csv), written by `cargo xtask bench --peers [--filter CRATE]` (each \
+                 row with the date and machine it was measured on; a filtered run replaces only its crate's \
+                 rows). Ratio = our time per step over theirs: below 1 means faster.\n"
+            );
+            md.push_str(&peers_file::markdown(rows));
+            md.push('\n');
+        }
+        Err(e) => {
+            let _ = writeln!(md, "peers.csv could not be read: {e}\n");
+        }
+    }
+    let conf = &r.conformance;
     let _ = writeln!(md, "## Conformance\n\n{}", suites::conformance_table(&conf.checks));
     let _ = writeln!(md, "{} passed, {} failed.\n", conf.checks.len() - conf.failures(), conf.failures());
-    let _ = writeln!(md, "## Stability (hard cases)\n\n{}", suites::stability_table(&stab));
-    if dir.join("soak.md").exists() {
+    let _ = writeln!(md, "## Stability (hard cases)\n\n{}", suites::stability_table(&r.stability));
+    let _ = writeln!(
+        md,
+        "{} as expected, {} unexpected.\n",
+        r.stability.rows.len() - r.stability.unexpected(),
+        r.stability.unexpected()
+    );
+    if r.soak {
         let _ = writeln!(
             md,
             "Long runs of each crate's hard case (`cargo xtask stability --long`): [soak.md](soak.md).\n"
         );
     }
-    let index = dir.join("index.md");
-    if let Err(e) = std::fs::write(&index, md) {
-        eprintln!("cannot write {}: {e}", index.display());
-        return false;
-    }
-    eprintln!("wrote {} in {:.0} s", index.display(), start.elapsed().as_secs_f64());
-    ok && conf.passed() && stab.passed()
+    md
 }
 
 /// The cheapest point of any series whose error is at most `tol`: (label, param, seconds, error).
@@ -116,7 +369,11 @@ fn study_markdown(crate_name: &str, r: &StudyResult) -> String {
     md
 }
 
-fn seconds(s: f64) -> String {
+/// A duration for tables: us, ms or s.
+pub fn seconds(s: f64) -> String {
+    if !s.is_finite() {
+        return "-".into();
+    }
     if s < 1e-3 {
         format!("{:.2} us", s * 1e6)
     } else if s < 1.0 {
@@ -278,6 +535,165 @@ mod tests {
         let md = study_markdown("anim-core", &r);
         assert!(md.contains("| 1e-2 | fast-rough |"), "{md}");
         assert!(md.contains("| 1e-8 | none in the sweep |"), "{md}");
+        assert!(md.contains("| 1e-1 | fast-rough |"), "{md}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    fn tiny_report() -> Report {
+        use crate::registry::{Check, Judge, Outcome};
+        let oscillator = StudyResult { slug: "core-oscillator".into(), ..tiny() };
+        Report {
+            studies: vec![
+                ("anim-core", oscillator),
+                ("anim-x", StudyResult { slug: "x-study".into(), ..tiny() }),
+            ],
+            conformance: ConformanceRun {
+                checks: vec![Check {
+                    crate_name: "anim-x",
+                    case: "case".into(),
+                    metric: "error".into(),
+                    measured: 1e-3,
+                    reference: 0.0,
+                    tolerance: 1e-2,
+                    judge: Judge::AtMost,
+                    source: "a book",
+                }],
+                seconds: 0.1,
+            },
+            stability: StabilityRun {
+                rows: vec![("anim-x", "hard", Outcome::Stable("ok".into()), Outcome::Stable("ran".into()))],
+            },
+            scaling: vec![scaling::Row {
+                krate: "anim-x".into(),
+                scene: "scene".into(),
+                threads: 2,
+                seconds: 1e-3,
+                speedup: 1.8,
+                identical: Some(true),
+                note: String::new(),
+            }],
+            load: Some((0.5, 1.5)),
+            peers: Ok(vec![PeerRow {
+                date: "2026-11-25".into(),
+                cpu: "CPU".into(),
+                cores: 2,
+                krate: "anim-x".into(),
+                case: "case".into(),
+                peer: "other".into(),
+                threads: 1,
+                ours_s: 1e-3,
+                theirs_s: 2e-3,
+                ratio: 0.5,
+            }]),
+            quick: true,
+            date: "2026-11-25".into(),
+            machine: Machine { cpu: "CPU".into(), cores: 2 },
+            seconds: 12.0,
+            soak: false,
+        }
+    }
+
+    #[test]
+    fn index_has_every_section_table_and_plot() {
+        let dir = std::env::temp_dir().join(format!("anim-report-index-{}", std::process::id()));
+        std::fs::remove_dir_all(&dir).ok();
+        std::fs::create_dir_all(&dir).unwrap();
+        write(&dir, &tiny_report()).unwrap();
+        let md = std::fs::read_to_string(dir.join("index.md")).unwrap();
+        let headings: Vec<&str> = md.lines().filter(|l| l.starts_with('#')).collect();
+        assert_eq!(
+            headings,
+            [
+                "# anim: work-precision report",
+                "## Cheapest method meeting a tolerance",
+                "## Work-precision studies",
+                "### t (anim-core)",
+                "### t (anim-x)",
+                "## Thread scaling",
+                "## Peer comparisons",
+                "## Conformance",
+                "## Stability (hard cases)",
+            ]
+        );
+        assert!(
+            md.contains("`cargo xtask report --quick` on 2026-11-25 (CPU, 2 cores); the run took 12 s"),
+            "{md}"
+        );
+        // The headline table: one row per study, the cheapest point under 1e-1, 1e-2 and 1e-3.
+        assert!(md.contains("| study | crate | error measure | 1e-1 | 1e-2 | 1e-3 |\n| --- | --- | --- | --- | --- | --- |"), "{md}");
+        assert!(
+            md.contains("| [x-study](#x-study) | anim-x | e | fast-rough, dt = 0.1: 10.00 ms (error 0.001) | fast-rough, dt = 0.1: 10.00 ms (error 0.001) | fast-rough, dt = 0.1: 10.00 ms (error 0.001) |"),
+            "{md}"
+        );
+        assert!(md.contains("![t](core-oscillator.svg)") && md.contains("![t](x-study.svg)"), "{md}");
+        assert!(md.contains("| anim-x | scene | 2 | 1.00 ms | 1.80 | yes |"), "{md}");
+        assert!(md.contains("load average was 0.50 before these runs and 1.50 after (2 cores)"), "{md}");
+        assert!(
+            md.contains(
+                "| 2026-11-25 | CPU, 2 cores | anim-x | case | other | 1 | 1.00 ms | 2.00 ms | 0.500 |"
+            ),
+            "{md}"
+        );
+        assert!(md.contains("| anim-x | case | error | 0.001 | <= 0.01 | pass | a book |"), "{md}");
+        assert!(md.contains("1 passed, 0 failed.") && md.contains("1 as expected, 0 unexpected."), "{md}");
+        assert!(!md.contains("soak.md"), "no soak.md beside this index");
+        for svg in ["core-oscillator.svg", "x-study.svg"] {
+            let text = std::fs::read_to_string(dir.join(svg)).unwrap();
+            assert!(text.starts_with("<svg") && text.contains("fast-rough"), "{svg}");
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn cheapest_json_lists_every_tolerance_with_the_measured_pick() {
+        let dir = std::env::temp_dir().join(format!("anim-report-json-{}", std::process::id()));
+        std::fs::remove_dir_all(&dir).ok();
+        std::fs::create_dir_all(&dir).unwrap();
+        write(&dir, &tiny_report()).unwrap();
+        let text = std::fs::read_to_string(dir.join("cheapest.json")).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(v["format"], 1);
+        assert_eq!(v["date"], "2026-11-25");
+        assert_eq!(v["machine"]["cpu"], "CPU");
+        assert_eq!(v["machine"]["cores"], 2);
+        assert_eq!(v["mode"], "quick");
+        assert_eq!(v["tolerances"], serde_json::json!([1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8]));
+        let families = v["families"].as_array().unwrap();
+        assert_eq!(families.len(), 2);
+        let osc = &families[0];
+        assert_eq!(osc["study"], "core-oscillator");
+        assert_eq!(osc["crate"], "anim-core");
+        assert_eq!(osc["scene"], "harmonic-oscillator");
+        assert_eq!(osc["horizon"], crate::cases::core::OSCILLATOR_HORIZON);
+        assert_eq!(osc["param"], "dt");
+        assert_eq!(families[1]["scene"], serde_json::Value::Null);
+        let picks = osc["picks"].as_array().unwrap();
+        assert_eq!(picks.len(), TOLERANCES.len());
+        // tiny(): fast-rough (0.01 s, error 1e-3) meets 1e-1..1e-3; slow-accurate at dt 0.2
+        // (0.5 s, 1e-5) meets 1e-4; at dt 0.1 (1 s, 1e-7) meets 1e-6; nothing meets 1e-8.
+        let expect = [
+            (1e-1, Some(("fast-rough", 0.1, 0.01, 1e-3))),
+            (1e-2, Some(("fast-rough", 0.1, 0.01, 1e-3))),
+            (1e-3, Some(("fast-rough", 0.1, 0.01, 1e-3))),
+            (1e-4, Some(("slow-accurate", 0.2, 0.5, 1e-5))),
+            (1e-6, Some(("slow-accurate", 0.1, 1.0, 1e-7))),
+            (1e-8, None),
+        ];
+        for (p, (tol, want)) in picks.iter().zip(expect) {
+            assert_eq!(p["tolerance"], tol);
+            match want {
+                Some((m, param, secs, err)) => {
+                    assert_eq!(p["method"], m, "{tol}");
+                    assert_eq!(p["param"], param, "{tol}");
+                    assert_eq!(p["seconds"], secs, "{tol}");
+                    assert_eq!(p["error"], err, "{tol}");
+                }
+                None => assert!(p["method"].is_null() && p["param"].is_null(), "{tol}"),
+            }
+        }
+        // And it reads back into the typed form.
+        let table: CheapestTable = serde_json::from_str(&text).unwrap();
+        assert_eq!(table.families[0].picks[3].method.as_deref(), Some("slow-accurate"));
         std::fs::remove_dir_all(&dir).ok();
     }
 }

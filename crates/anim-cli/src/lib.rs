@@ -1,7 +1,8 @@
 //! # anim-cli
 //!
 //! The library behind the `anim` command: scene files ([`scene`]: TOML with every field checked,
-//! the built-in scenes), their runnable form ([`runner`]: one [`runner::Runner`] per crate, with
+//! the built-in scenes), the method picked for a stated accuracy ([`tolerance`]: the report's
+//! measured cheapest-method table, embedded), their runnable form ([`runner`]: one [`runner::Runner`] per crate, with
 //! checkpoint save and restore), and how a run is drawn and written ([`view`]). The binary adds
 //! the command line, the writer thread and the checkpoint files.
 //!
@@ -26,4 +27,5 @@
 
 pub mod runner;
 pub mod scene;
+pub mod tolerance;
 pub mod view;

@@ -8,6 +8,7 @@
 //! anim list                     # the built-in scenes (also `anim scenes`)
 //! anim run smoke-plume-3d --resolution 48   # a fluid on a finer grid
 //! anim run dam-break-2d --frames 20   # an APIC particle fluid (anim-flip)
+//! anim run kepler --tolerance 1e-3   # the cheapest measured method meeting a relative error
 //! anim run cloth --checkpoint-every 50   # also keep out/checkpoint.anim current
 //! anim resume anim-out/cloth/checkpoint.anim   # continue from it, bit for bit
 //! ```
@@ -20,6 +21,7 @@
 
 use anim_cli::runner::{self, OutputFormat, Runner};
 use anim_cli::scene::{self, SceneFile};
+use anim_cli::tolerance;
 use anim_cli::view::{Snapshot, View};
 use anim_io::FrameWriter;
 use anim_io::preview::{Canvas, GifWriter};
@@ -108,6 +110,11 @@ struct RunArgs {
     /// `anim resume` continues from it.
     #[arg(long)]
     checkpoint_every: Option<usize>,
+    /// The accuracy the run needs instead of a method: the integrator and time step come from
+    /// the report's measured cheapest-method table (oscillator and Kepler scenes), and the run's
+    /// error on the table's measure is printed at the end.
+    #[arg(long, allow_hyphen_values = true)]
+    tolerance: Option<f64>,
 }
 
 /// The built-in scenes, one a line: name, description, and which one is the default.
@@ -191,6 +198,12 @@ struct Metrics {
     energy_final: Option<f64>,
     relative_energy_change: Option<f64>,
     max_error_vs_exact: Option<f64>,
+    /// `--tolerance` asked for.
+    tolerance: Option<f64>,
+    /// The run's final error on the measure of the cheapest-method table (relative).
+    tolerance_error_final: Option<f64>,
+    /// Its largest value over the frames.
+    tolerance_error_max: Option<f64>,
     newton_iterations: usize,
     resumed_from_frame: Option<usize>,
     checkpoints_written: usize,
@@ -244,6 +257,8 @@ struct Session {
     max_error: Option<f64>,
     newton_iterations: usize,
     resumed: bool,
+    /// The `--tolerance` asked for, if any.
+    tolerance: Option<f64>,
 }
 
 /// What the writer thread produces: the files written and its own busy time.
@@ -442,6 +457,15 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
     if let Some(r) = args.resolution {
         file.scene.set_resolution(r).map_err(|e| format!("--resolution {r}: {e}"))?;
     }
+    if let Some(tol) = args.tolerance {
+        if args.dt.is_some() {
+            return Err("give --dt or --tolerance, not both (--tolerance picks the step)".into());
+        }
+        let choice = tolerance::choose(&mut file, tol, &tolerance::table()?)?;
+        if !args.quiet {
+            println!("--tolerance {tol:e}: picked {} because {}", choice.integrator.label(), choice.why);
+        }
+    }
     let runner = runner::build(&file.scene, &origin, args.skinning).map_err(|e| e.to_string())?;
     let format = args.format.unwrap_or_else(|| runner.natural_format());
     if !runner.geometry().accepts(format) {
@@ -478,6 +502,7 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
         max_error: None,
         newton_iterations: 0,
         resumed: false,
+        tolerance: args.tolerance,
     })
 }
 
@@ -526,6 +551,7 @@ fn resumed(args: &ResumeArgs) -> Result<Session, String> {
         max_error: ckpt.max_error,
         newton_iterations: ckpt.newton_iterations,
         resumed: true,
+        tolerance: None,
     })
 }
 
@@ -580,6 +606,7 @@ fn execute(mut s: Session) -> Result<(), String> {
     let mut step_seconds = 0.0;
     let mut failure = None;
     let mut checkpoints = 0usize;
+    let mut table_error: Option<(f64, f64)> = None;
     'frames: for frame in s.start_frame..run.frames {
         let t_step = Instant::now();
         for _ in 0..run.steps_per_frame {
@@ -601,6 +628,11 @@ fn execute(mut s: Session) -> Result<(), String> {
         step_seconds += t_step.elapsed().as_secs_f64();
         if let Some(e) = s.runner.exact_error() {
             s.max_error = Some(s.max_error.map_or(e, |m: f64| m.max(e)));
+        }
+        if s.tolerance.is_some()
+            && let Some(e) = tolerance::table_error(&s.file.scene, s.runner.state())
+        {
+            table_error = Some((e, table_error.map_or(e, |(_, m)| m.max(e))));
         }
         if let Err(e) = output.frame(frame, s.runner.as_ref(), energy) {
             failure = Some(format!("frame {frame}: {e}"));
@@ -650,6 +682,9 @@ fn execute(mut s: Session) -> Result<(), String> {
         energy_final: energy,
         relative_energy_change: energy0.zip(energy).map(|(e0, e)| (e - e0) / e0.abs().max(f64::MIN_POSITIVE)),
         max_error_vs_exact: s.max_error,
+        tolerance: s.tolerance,
+        tolerance_error_final: table_error.map(|e| e.0),
+        tolerance_error_max: table_error.map(|e| e.1),
         newton_iterations: s.newton_iterations,
         resumed_from_frame: s.resumed.then_some(s.start_frame),
         checkpoints_written: checkpoints,
@@ -676,6 +711,12 @@ fn execute(mut s: Session) -> Result<(), String> {
         }
         if let Some(e) = metrics.max_error_vs_exact {
             println!("  max error against the exact solution {e:.3e}");
+        }
+        if let (Some(tol), Some((last, max))) = (s.tolerance, table_error) {
+            println!(
+                "  error on the table's measure: final {last:.3e}, max over the frames {max:.3e}; tolerance {tol:e} {}",
+                if last <= tol { "met" } else { "NOT met" }
+            );
         }
         for f in &metrics.files {
             println!("  wrote {f}");

@@ -594,6 +594,13 @@ fn study(
     }
 }
 
+/// Simulated time of the oscillator study (`m = k = 1`, so 10.3 periods), the horizon its
+/// cheapest-method table holds for.
+pub const OSCILLATOR_HORIZON: f64 = 20.6 * PI;
+
+/// Simulated time of the Kepler study (`a = mu = 1`, period `2 pi`: 1.3 orbits).
+pub const KEPLER_HORIZON: f64 = 2.6 * PI;
+
 fn oscillator_study(ctx: &Ctx) -> StudyResult {
     let n = if ctx.quick { 4 } else { 8 };
     study(
@@ -602,8 +609,8 @@ fn oscillator_study(ctx: &Ctx) -> StudyResult {
         "core-oscillator",
         "|(x, v) - exact| at t = 20.6 pi",
         |_| (0..n).map(|i| 100usize << i).collect(),
-        |kind, steps| oscillator_run(kind, steps, 10.3),
-        20.6 * PI,
+        |kind, steps| oscillator_run(kind, steps, OSCILLATOR_HORIZON / (2.0 * PI)),
+        OSCILLATOR_HORIZON,
     )
 }
 
@@ -615,7 +622,7 @@ fn kepler_study(ctx: &Ctx) -> StudyResult {
         "core-kepler",
         "|x - exact| at t = 2.6 pi",
         |_| (0..n).map(|i| 250usize << i).collect(),
-        |kind, steps| kepler_run(kind, steps, 1.3),
-        2.6 * PI,
+        |kind, steps| kepler_run(kind, steps, KEPLER_HORIZON / (2.0 * PI)),
+        KEPLER_HORIZON,
     )
 }
