@@ -58,8 +58,10 @@ pub mod error;
 pub mod mac;
 pub mod particles;
 pub mod project;
+pub mod reseed;
 pub mod scenes;
 pub mod sim;
+pub mod surface;
 pub mod transfer;
 
 #[cfg(test)]
@@ -67,5 +69,7 @@ mod tests;
 
 pub use error::FlipError;
 pub use particles::Particles;
+pub use reseed::Reseed;
 pub use sim::{FlipParams, FlipSimulation, StepInfo};
+pub use surface::{Contour, Mesh, ParticleSurface, SurfaceParams};
 pub use transfer::Transfer;
