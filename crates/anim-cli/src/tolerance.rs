@@ -121,6 +121,7 @@ fn kind_of(scene: &Scene) -> &'static str {
         Scene::Mpm { .. } => "mpm",
         Scene::Fluid { .. } => "fluid",
         Scene::Springs { .. } => "springs",
+        Scene::Flip { .. } => "flip",
     }
 }
 

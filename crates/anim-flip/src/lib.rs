@@ -20,8 +20,14 @@
 //! adds a target outflow in cells whose particle density exceeds the rest density. Without it
 //! particles compressed in a violent flow are never spread apart again: in the 2D collapse of a
 //! 0.25 x 0.5 m column on a 32^2 grid the density-based volume estimate falls by about 30% over
-//! 10 s; with `volume_correction = 0.5` it ends within 0.2% (largest excursion 2.2%), as measured
-//! by `cargo xtask conformance --filter anim-flip`.
+//! 10 s; with `volume_correction = 0.5` it ends within 0.2% (largest excursion 2.2%), with
+//! `volume_correction = 1` within 0.2% (largest excursion 0.95%), as measured by
+//! `cargo xtask conformance --filter anim-flip`.
+//!
+//! Optional reseeding ([`reseed`]) keeps every interior cell's particle count between bounds. It
+//! is a sampling tool, not a volume fix: particles are the fluid's mass, and topping up cells that
+//! sampling noise left sparse adds mass the volume correction then spreads out. In the sloshing
+//! column above, bounds 2..8 per cell grew the fluid until it filled the box.
 //!
 //! Modules:
 //! - [`particles`]: the particle arrays (structure of arrays) and their momenta;
@@ -32,6 +38,11 @@
 //! - [`project`]: body forces, solid walls and the pressure projection through
 //!   `anim_fluid::pressure` (MGPCG, CG, Gauss-Seidel, Jacobi);
 //! - [`sim`]: [`FlipSimulation`] with CFL substeps, the non-finite guard and checkpoints;
+//! - [`reseed`]: optional per-cell particle count control after advection ([`Reseed`] in
+//!   [`FlipParams::reseed`]): sparse interior cells topped up, crowded cells thinned;
+//! - [`surface`]: a surface for output, [`ParticleSurface`]: Zhu & Bridson's particle level set
+//!   on a lattice, meshed by marching squares ([`Contour`]) in 2D and naive surface nets
+//!   ([`Mesh`], through the `fast-surface-nets` crate) in 3D;
 //! - [`tank`]: [`TankMotion`], a tank shaken or accelerated along one axis, simulated in its
 //!   own frame (body force `g - a_tank(t)`, `FlipParams::tank_motion`);
 //! - [`scenes`]: seeding ([`scenes::fill_box`], [`scenes::fill_region`]), still water, the dam
@@ -70,8 +81,10 @@ pub mod error;
 pub mod mac;
 pub mod particles;
 pub mod project;
+pub mod reseed;
 pub mod scenes;
 pub mod sim;
+pub mod surface;
 pub mod tank;
 pub mod transfer;
 
@@ -80,6 +93,8 @@ mod tests;
 
 pub use error::FlipError;
 pub use particles::Particles;
+pub use reseed::Reseed;
 pub use sim::{FlipParams, FlipSimulation, StepInfo};
+pub use surface::{Contour, Mesh, ParticleSurface, SurfaceParams};
 pub use tank::TankMotion;
 pub use transfer::Transfer;

@@ -5,7 +5,8 @@
 //! 3. gravity (in a moving tank, less the tank's acceleration: [`crate::tank`]) and solid walls,
 //!    pressure projection ([`crate::project`]), extrapolate;
 //! 4. grid-to-particle (PIC, FLIP or APIC), advect `x += dt v_p` (seed 5.3.1), push particles
-//!    that entered solid cells back out (counted).
+//!    that entered solid cells back out (counted);
+//! 5. optionally, reseeding ([`crate::reseed`]): top up sparse interior cells, thin crowded ones.
 //!
 //! Every buffer is sized in [`FlipSimulation::new`] (particle buffers on the first step and when
 //! the particle count grows), except the pressure operator and its multigrid hierarchy, which
@@ -16,6 +17,7 @@ use crate::error::{FlipError, positive};
 use crate::mac::{MacGrid, flatten, unflatten};
 use crate::particles::Particles;
 use crate::project::{self, PressureSettings};
+use crate::reseed::{self, Reseed, Reseeder};
 use crate::tank::TankMotion;
 use crate::transfer::{self, Transfer};
 use anim_core::bspline::Kernel;
@@ -66,6 +68,11 @@ pub struct FlipParams<const D: usize> {
     /// substep's time. Default `None` (a tank at rest; absent from older scene files).
     #[serde(default)]
     pub tank_motion: Option<TankMotion>,
+    /// Per-cell particle count control after advection ([`crate::reseed`]): interior cells
+    /// with fewer than `min` particles get new ones, cells with more than `max` lose the
+    /// excess. Default `None` (off); absent from a parameter file means off.
+    #[serde(default)]
+    pub reseed: Option<Reseed>,
 }
 
 mod serde_array {
@@ -98,6 +105,7 @@ impl<const D: usize> Default for FlipParams<D> {
             volume_correction: 0.0,
             rest_per_cell: (1usize << D) as f64,
             tank_motion: None,
+            reseed: None,
         }
     }
 }
@@ -119,6 +127,10 @@ pub struct StepInfo {
     pub pushed_out: usize,
     /// Fluid cells in the last substep.
     pub fluid_cells: usize,
+    /// Particles added by reseeding, summed over the substeps.
+    pub seeded: usize,
+    /// Particles removed by reseeding, summed over the substeps.
+    pub removed: usize,
 }
 
 /// An incompressible particle fluid on a MAC grid in `D` dimensions (2 or 3).
@@ -135,6 +147,7 @@ pub struct FlipSimulation<const D: usize> {
     target: Vec<f64>,
     solver: Option<PressureSolver>,
     backup: Particles<D>,
+    reseeder: Reseeder,
     border: usize,
     steps: u64,
     time: f64,
@@ -195,6 +208,9 @@ impl<const D: usize> FlipSimulation<D> {
                 });
             }
         }
+        if let Some(r) = params.reseed {
+            r.validate()?;
+        }
         if let Some(g) = params.gravity.iter().find(|g| !g.is_finite()) {
             return Err(FlipError::BadParameter {
                 name: "gravity",
@@ -224,6 +240,7 @@ impl<const D: usize> FlipSimulation<D> {
             target: vec![0.0; count],
             solver: None,
             backup: Particles::new(),
+            reseeder: Reseeder::default(),
             border,
             steps: 0,
             time: 0.0,
@@ -444,6 +461,18 @@ impl<const D: usize> FlipSimulation<D> {
         }
         transfer::g2p(&self.grid, particles, self.params.kernel, self.params.transfer);
         info.pushed_out += self.advect(particles, dt);
+        if let Some(bounds) = self.params.reseed {
+            let field = reseed::Field {
+                grid: &self.grid,
+                solid: &self.solid,
+                kernel: self.params.kernel,
+                transfer: self.params.transfer,
+                step: self.steps,
+            };
+            let count = self.reseeder.run(bounds, &field, &mut self.bins, particles);
+            info.seeded += count.seeded;
+            info.removed += count.removed;
+        }
         Ok(())
     }
 
@@ -510,13 +539,15 @@ impl<const D: usize> FlipSimulation<D> {
         let Some(p) = (0..particles.len()).into_par_iter().position_first(bad) else {
             return Ok(());
         };
+        // Reseeding changes the particle count, so particle `p` may not exist in the backup.
+        let before = |a: Option<&[f64]>| a.map(<[f64]>::to_vec).unwrap_or_default();
         let fields: [(&'static str, Vec<f64>, Vec<f64>); 3] = [
-            ("x", particles.x[p].to_vec(), self.backup.x[p].to_vec()),
-            ("v", particles.v[p].to_vec(), self.backup.v[p].to_vec()),
+            ("x", particles.x[p].to_vec(), before(self.backup.x.get(p).map(|x| &x[..]))),
+            ("v", particles.v[p].to_vec(), before(self.backup.v.get(p).map(|v| &v[..]))),
             (
                 "c",
                 particles.c[p].iter().flatten().copied().collect(),
-                self.backup.c[p].iter().flatten().copied().collect(),
+                self.backup.c.get(p).map(|c| c.iter().flatten().copied().collect()).unwrap_or_default(),
             ),
         ];
         for (field, now, before) in fields {

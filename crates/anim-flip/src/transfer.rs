@@ -138,56 +138,13 @@ pub(crate) fn g2p<const D: usize>(
     kernel: Kernel,
     transfer: Transfer,
 ) {
-    let h = grid.h;
-    let inv_h = 1.0 / h;
-    let r = radius(kernel);
-    let support = kernel.support();
+    let inv_h = 1.0 / grid.h;
     let d_inv = f64::from(kernel.d_inv());
     let Particles { x, v, c } = particles;
     let x: &[[f64; D]] = x;
     v.par_iter_mut().zip(c.par_iter_mut()).enumerate().for_each(|(p, (vp, cp))| {
         for a in 0..D {
-            let fd = grid.face_dims(a);
-            let st = strides(fd);
-            let xs: [f64; D] = std::array::from_fn(|b| x[p][b] * inv_h - if b == a { 0.0 } else { 0.5 });
-            let base: [isize; D] = std::array::from_fn(|b| (xs[b] + 1.0 - r).floor() as isize);
-            // 1D weights per axis, zero for nodes outside the lattice.
-            let mut w1 = [[0.0f64; 4]; D];
-            for b in 0..D {
-                for k in 0..support {
-                    let node = base[b] + k as isize;
-                    if node >= 0 && (node as usize) < fd[b] {
-                        w1[b][k] = kernel.n(xs[b] - node as f64);
-                    }
-                }
-            }
-            let mut pic = 0.0;
-            let mut old = 0.0;
-            let mut grad = [0.0; D];
-            let mut k = [0usize; D];
-            let lo = [0usize; D];
-            let hi = [support - 1; D];
-            loop {
-                let mut w = 1.0;
-                for b in 0..D {
-                    w *= w1[b][k[b]];
-                }
-                if w != 0.0 {
-                    let mut f = 0;
-                    for b in 0..D {
-                        f += (base[b] + k[b] as isize) as usize * st[b];
-                    }
-                    let uf = grid.u[a][f];
-                    pic += w * uf;
-                    old += w * grid.u_old[a][f];
-                    for b in 0..D {
-                        grad[b] += w * uf * ((base[b] + k[b] as isize) as f64 - xs[b]);
-                    }
-                }
-                if !odometer(&mut k, &lo, &hi) {
-                    break;
-                }
-            }
+            let (pic, old, grad) = gather(grid, kernel, a, &x[p]);
             match transfer {
                 Transfer::Pic => {
                     vp[a] = pic;
@@ -204,6 +161,81 @@ pub(crate) fn g2p<const D: usize>(
             }
         }
     });
+}
+
+/// Velocity component `a` at `x` (m) gathered from the face lattice of axis `a`: the
+/// interpolated velocity, the interpolated pre-force velocity (`u_old`) and the unscaled APIC
+/// moment `sum_i w_ip u_i (x_i - x_p) / h`.
+#[inline]
+fn gather<const D: usize>(grid: &MacGrid<D>, kernel: Kernel, a: usize, x: &[f64; D]) -> (f64, f64, [f64; D]) {
+    let inv_h = 1.0 / grid.h;
+    let r = radius(kernel);
+    let support = kernel.support();
+    let fd = grid.face_dims(a);
+    let st = strides(fd);
+    let xs: [f64; D] = std::array::from_fn(|b| x[b] * inv_h - if b == a { 0.0 } else { 0.5 });
+    let base: [isize; D] = std::array::from_fn(|b| (xs[b] + 1.0 - r).floor() as isize);
+    // 1D weights per axis, zero for nodes outside the lattice.
+    let mut w1 = [[0.0f64; 4]; D];
+    for b in 0..D {
+        for k in 0..support {
+            let node = base[b] + k as isize;
+            if node >= 0 && (node as usize) < fd[b] {
+                w1[b][k] = kernel.n(xs[b] - node as f64);
+            }
+        }
+    }
+    let mut pic = 0.0;
+    let mut old = 0.0;
+    let mut grad = [0.0; D];
+    let mut k = [0usize; D];
+    let lo = [0usize; D];
+    let hi = [support - 1; D];
+    loop {
+        let mut w = 1.0;
+        for b in 0..D {
+            w *= w1[b][k[b]];
+        }
+        if w != 0.0 {
+            let mut f = 0;
+            for b in 0..D {
+                f += (base[b] + k[b] as isize) as usize * st[b];
+            }
+            let uf = grid.u[a][f];
+            pic += w * uf;
+            old += w * grid.u_old[a][f];
+            for b in 0..D {
+                grad[b] += w * uf * ((base[b] + k[b] as isize) as f64 - xs[b]);
+            }
+        }
+        if !odometer(&mut k, &lo, &hi) {
+            break;
+        }
+    }
+    (pic, old, grad)
+}
+
+/// The velocity and affine matrix a particle created at `x` (m) receives from the grid: the
+/// interpolated velocity, and for APIC `C = D^-1 sum_i w_i u_i (x_i - x)^T` (zero otherwise, as
+/// G2P gives PIC and FLIP particles).
+pub(crate) fn sample_new<const D: usize>(
+    grid: &MacGrid<D>,
+    kernel: Kernel,
+    transfer: Transfer,
+    x: &[f64; D],
+) -> ([f64; D], [[f64; D]; D]) {
+    let inv_h = 1.0 / grid.h;
+    let d_inv = f64::from(kernel.d_inv());
+    let mut v = [0.0; D];
+    let mut c = [[0.0; D]; D];
+    for a in 0..D {
+        let (pic, _, grad) = gather(grid, kernel, a, x);
+        v[a] = pic;
+        if transfer == Transfer::Apic {
+            c[a] = std::array::from_fn(|b| d_inv * inv_h * grad[b]);
+        }
+    }
+    (v, c)
 }
 
 /// The grid velocity at `x` (m), interpolated with the transfer kernel from every face lattice
