@@ -40,17 +40,19 @@
 //!
 //! The AVX2 kernels do the same four vertices at a time: an LBS matrix row is one register (three
 //! fused multiply-adds per influence). For DQS the hemisphere tests are made once per pose for
-//! every joint pair (a `J x J` byte table, skins of up to [`SIGN_TABLE_JOINTS`] joints; larger
+//! every joint pair (a `J x J` table of `u16`, skins of up to [`SIGN_TABLE_JOINTS`] joints; larger
 //! skins use the portable kernel), each joint's dual quaternion is kept with both signs, and each
 //! vertex's dominant slot is derived once from its weights ([`SkinnedMesh::dominant_slots`]): the
 //! blend is then two loads and two fused multiply-adds per influence, with no shuffles.
 //!
-//! Throughput (100,000 vertices, 4 influences, the mesh of `benches/benches/skin.rs`, whose
-//! `cargo bench -p anim-benches --bench skin` prints the comparison): the time of each kernel
-//! over the time of a pass that only streams the same 136 bytes per vertex, fastest of 200
-//! interleaved rounds, one thread, in two runs on this
-//! 2-core machine while other jobs ran: AVX2 LBS 1.07x and 1.20x, DQS 1.71x and 1.84x; portable
-//! LBS 2.45x and 2.62x, DQS 3.36x and 3.57x.
+//! Throughput (100,000 vertices, 4 influences, the mesh of `benches/benches/skin.rs`; `cargo
+//! bench -p anim-benches --bench skin` prints these comparisons): the time of each kernel over
+//! the time of a pass that only streams the same 136 bytes per vertex, on this project's 2-core
+//! machine. Criterion medians, 1 thread: AVX2 LBS 771 us and DQS 1009 us against the stream's
+//! 658 us (1.17x, 1.53x); 2 threads: 385 and 524 us against 311 us (1.24x, 1.69x). Fastest of
+//! 200 interleaved rounds, four runs: AVX2 LBS 0.99-1.18x (1 thread), 1.16-1.39x (2 threads);
+//! DQS 1.24-1.42x and 1.50-1.76x; the portable kernels 2.09-2.59x (LBS) and 2.84-3.54x (DQS)
+//! on 1 thread.
 
 use crate::SkinError;
 use crate::mesh::{MAX_INFLUENCES, SkinnedMesh};
@@ -108,16 +110,19 @@ pub struct Skinned {
     mats: Vec<[f64x2; 6]>,
     /// Dual quaternions `(qx, qy | qz, qw | dx, dy | dz, dw)`.
     dqs: Vec<[f64x2; 4]>,
-    /// Each joint's dual quaternion and its negation, `[+, -]`, for the AVX2 DQS kernel.
-    signed: Vec<[[[f64; 4]; 2]; 2]>,
-    /// `flips[a * J + b] = 1` where joint `b`'s rotation quaternion is in the other hemisphere
-    /// from joint `a`'s (`q_a . q_b < 0`): the AVX2 DQS kernel's hemisphere test, made once per
-    /// pose for all joint pairs. Empty for skins of more than [`SIGN_TABLE_JOINTS`] joints.
-    flips: Vec<u8>,
+    /// Each joint's dual quaternion and its negation: entry `2 j` is `+(q_j, d_j)`, `2 j + 1`
+    /// is `-(q_j, d_j)`, for the AVX2 DQS kernel.
+    signed: Vec<[[f64; 4]; 2]>,
+    /// `pairs[a * J + b]` is `2 b + 1` where joint `b`'s rotation quaternion is in the other
+    /// hemisphere from joint `a`'s (`q_a . q_b < 0`), else `2 b`: the entry of `signed` a vertex
+    /// dominated by joint `a` blends for joint `b`. The AVX2 DQS kernel's hemisphere test, made
+    /// once per pose for all joint pairs; empty for skins of more than [`SIGN_TABLE_JOINTS`]
+    /// joints.
+    pairs: Vec<u16>,
 }
 
 /// Largest skin (in joints) for which the AVX2 DQS kernel keeps a joint-pair sign table
-/// (`J^2` bytes, 64 KiB at most); larger skins use the portable DQS kernel.
+/// (`2 J^2` bytes, 128 KiB at most); larger skins use the portable DQS kernel.
 pub const SIGN_TABLE_JOINTS: usize = 256;
 
 impl Skinned {
@@ -134,8 +139,8 @@ impl Skinned {
             nz: mesh.nz.clone(),
             mats: vec![[f64x2::ZERO; 6]; mesh.num_joints()],
             dqs: vec![[f64x2::ZERO; 4]; mesh.num_joints()],
-            signed: vec![[[[0.0; 4]; 2]; 2]; mesh.num_joints()],
-            flips: if mesh.num_joints() <= SIGN_TABLE_JOINTS {
+            signed: vec![[[0.0; 4]; 2]; 2 * mesh.num_joints()],
+            pairs: if mesh.num_joints() <= SIGN_TABLE_JOINTS {
                 vec![0; mesh.num_joints() * mesh.num_joints()]
             } else {
                 Vec::new()
@@ -247,7 +252,7 @@ fn skin_with(
     let nj = mesh.num_joints();
     // The AVX2 kernels, where the CPU has them; DQS needs the sign table too.
     #[cfg(target_arch = "x86_64")]
-    let cpu = if simd && (method == SkinningMethod::Lbs || out.flips.len() == nj * nj) {
+    let cpu = if simd && (method == SkinningMethod::Lbs || out.pairs.len() == nj * nj) {
         avx2::Avx2Fma::detect()
     } else {
         None
@@ -258,11 +263,11 @@ fn skin_with(
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = simd;
-    let Skinned { x, y, z, nx, ny, nz, mats, dqs, signed, flips } = out;
+    let Skinned { x, y, z, nx, ny, nz, mats, dqs, signed, pairs } = out;
     #[cfg(target_arch = "x86_64")]
-    let tables = avx2::Tables { mats: bytemuck::cast_slice(mats), signed, flips, joints: nj };
+    let tables = avx2::Tables { mats: bytemuck::cast_slice(mats), signed, pairs, joints: nj };
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = (signed, flips);
+    let _ = (signed, pairs);
     let (lbs, dqs) = (Lbs(mats), Dqs(dqs));
     x.par_chunks_mut(CHUNK)
         .zip(y.par_chunks_mut(CHUNK))
@@ -519,18 +524,20 @@ impl Kernel for Dqs<'_> {
 #[cfg(target_arch = "x86_64")]
 fn fill_sign_table(out: &mut Skinned) {
     let nj = out.dqs.len();
-    for (s, d) in out.signed.iter_mut().zip(&out.dqs) {
+    for (s, d) in out.signed.chunks_exact_mut(2).zip(&out.dqs) {
         let plus = [d[0].to_array(), d[1].to_array(), d[2].to_array(), d[3].to_array()];
         let q = [plus[0][0], plus[0][1], plus[1][0], plus[1][1]];
         let dual = [plus[2][0], plus[2][1], plus[3][0], plus[3][1]];
-        *s = [[q, dual], [q.map(|v| -v), dual.map(|v| -v)]];
+        s[0] = [q, dual];
+        s[1] = [q.map(|v| -v), dual.map(|v| -v)];
     }
     for a in 0..nj {
-        let qa = out.signed[a][0][0];
+        let qa = out.signed[2 * a][0];
         for b in 0..nj {
-            let qb = out.signed[b][0][0];
+            let qb = out.signed[2 * b][0];
             let dot = (qb[0] * qa[0] + qb[2] * qa[2]) + (qb[1] * qa[1] + qb[3] * qa[3]);
-            out.flips[a * nj + b] = u8::from(dot < 0.0);
+            // At most 2 * SIGN_TABLE_JOINTS - 1, which fits.
+            out.pairs[a * nj + b] = u16::try_from(2 * b).unwrap_or(u16::MAX - 1) + u16::from(dot < 0.0);
         }
     }
 }
@@ -648,7 +655,7 @@ mod tests {
             .map(|j| DMat4::from_rotation_translation(DQuat::from_rotation_z(0.01 * j as f64), DVec3::X))
             .collect();
         let (mut a, mut b) = (Skinned::new(&mesh), Skinned::new(&mesh));
-        assert!(a.flips.is_empty());
+        assert!(a.pairs.is_empty());
         skin(&mesh, &m, SkinningMethod::Dqs, &mut a).unwrap();
         skin_portable(&mesh, &m, SkinningMethod::Dqs, &mut b).unwrap();
         assert!(a.x.iter().chain(&a.y).zip(b.x.iter().chain(&b.y)).all(|(p, q)| p.to_bits() == q.to_bits()));

@@ -36,10 +36,11 @@ impl Avx2Fma {
 pub(super) struct Tables<'a> {
     /// Row-major 3x4 skinning matrices, one row per register.
     pub(super) mats: &'a [[[f64; 4]; 3]],
-    /// Each joint's dual quaternion `[(qx, qy, qz, qw), (dx, dy, dz, dw)]` and its negation.
-    pub(super) signed: &'a [[[[f64; 4]; 2]; 2]],
-    /// `flips[a * joints + b]`: whether joint `b` is in the other hemisphere from joint `a`.
-    pub(super) flips: &'a [u8],
+    /// Each joint's dual quaternion `[(qx, qy, qz, qw), (dx, dy, dz, dw)]` (entry `2 j`) and
+    /// its negation (entry `2 j + 1`).
+    pub(super) signed: &'a [[[f64; 4]; 2]],
+    /// `pairs[a * joints + b]`: the entry of `signed` for joint `b` in joint `a`'s hemisphere.
+    pub(super) pairs: &'a [u16],
     /// Joints in the skin.
     pub(super) joints: usize,
 }
@@ -297,12 +298,11 @@ fn dqs_group<const K: usize>(t: &Tables<'_>, jg: &[u16], wg: &[f64], dom: [u8; 4
         let dominant = usize::from(js[usize::from(dom[l]).min(K - 1)]);
         // Each influence's dual quaternion taken with the sign that puts it in the dominant
         // one's hemisphere (the pose's sign table), so the blend needs no shuffles.
-        let flips = &t.flips[dominant * t.joints..(dominant + 1) * t.joints];
+        let row = dominant * t.joints;
         // Two accumulators each (even and odd slots) halve the chain of dependent additions.
         let mut acc = [[zero; 2]; 2];
         for i in 0..K {
-            let j = usize::from(js[i]);
-            let e = &t.signed[j][usize::from(flips[j])];
+            let e = &t.signed[usize::from(t.pairs[row + usize::from(js[i])])];
             let w = _mm256_set1_pd(ws[i]);
             let a = &mut acc[i % 2];
             if i < 2 {
