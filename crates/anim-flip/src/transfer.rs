@@ -163,55 +163,78 @@ pub(crate) fn g2p<const D: usize>(
     });
 }
 
+/// The B-spline stencil of the face lattice of axis `a` around `x` (m): the position in that
+/// lattice's node units, its first node, the 1D weights per axis (zero for nodes outside the
+/// lattice) and the lattice's strides.
+struct Stencil<const D: usize> {
+    xs: [f64; D],
+    base: [isize; D],
+    w1: [[f64; 4]; D],
+    st: [usize; D],
+}
+
+impl<const D: usize> Stencil<D> {
+    #[inline]
+    fn new(grid: &MacGrid<D>, kernel: Kernel, a: usize, x: &[f64; D]) -> Self {
+        let inv_h = 1.0 / grid.h;
+        let r = radius(kernel);
+        let fd = grid.face_dims(a);
+        let xs: [f64; D] = std::array::from_fn(|b| x[b] * inv_h - if b == a { 0.0 } else { 0.5 });
+        let base: [isize; D] = std::array::from_fn(|b| (xs[b] + 1.0 - r).floor() as isize);
+        let mut w1 = [[0.0f64; 4]; D];
+        for b in 0..D {
+            for k in 0..kernel.support() {
+                let node = base[b] + k as isize;
+                if node >= 0 && (node as usize) < fd[b] {
+                    w1[b][k] = kernel.n(xs[b] - node as f64);
+                }
+            }
+        }
+        Self { xs, base, w1, st: strides(fd) }
+    }
+
+    /// Calls `f(w, face, k)` for every node `k` of the stencil with a non-zero weight `w`, in a
+    /// fixed order.
+    #[inline]
+    fn for_each(&self, kernel: Kernel, mut f: impl FnMut(f64, usize, &[usize; D])) {
+        let mut k = [0usize; D];
+        let hi = [kernel.support() - 1; D];
+        loop {
+            let mut w = 1.0;
+            for b in 0..D {
+                w *= self.w1[b][k[b]];
+            }
+            if w != 0.0 {
+                let mut face = 0;
+                for b in 0..D {
+                    face += (self.base[b] + k[b] as isize) as usize * self.st[b];
+                }
+                f(w, face, &k);
+            }
+            if !odometer(&mut k, &[0; D], &hi) {
+                break;
+            }
+        }
+    }
+}
+
 /// Velocity component `a` at `x` (m) gathered from the face lattice of axis `a`: the
 /// interpolated velocity, the interpolated pre-force velocity (`u_old`) and the unscaled APIC
 /// moment `sum_i w_ip u_i (x_i - x_p) / h`.
 #[inline]
 fn gather<const D: usize>(grid: &MacGrid<D>, kernel: Kernel, a: usize, x: &[f64; D]) -> (f64, f64, [f64; D]) {
-    let inv_h = 1.0 / grid.h;
-    let r = radius(kernel);
-    let support = kernel.support();
-    let fd = grid.face_dims(a);
-    let st = strides(fd);
-    let xs: [f64; D] = std::array::from_fn(|b| x[b] * inv_h - if b == a { 0.0 } else { 0.5 });
-    let base: [isize; D] = std::array::from_fn(|b| (xs[b] + 1.0 - r).floor() as isize);
-    // 1D weights per axis, zero for nodes outside the lattice.
-    let mut w1 = [[0.0f64; 4]; D];
-    for b in 0..D {
-        for k in 0..support {
-            let node = base[b] + k as isize;
-            if node >= 0 && (node as usize) < fd[b] {
-                w1[b][k] = kernel.n(xs[b] - node as f64);
-            }
-        }
-    }
+    let s = Stencil::new(grid, kernel, a, x);
     let mut pic = 0.0;
     let mut old = 0.0;
     let mut grad = [0.0; D];
-    let mut k = [0usize; D];
-    let lo = [0usize; D];
-    let hi = [support - 1; D];
-    loop {
-        let mut w = 1.0;
+    s.for_each(kernel, |w, f, k| {
+        let uf = grid.u[a][f];
+        pic += w * uf;
+        old += w * grid.u_old[a][f];
         for b in 0..D {
-            w *= w1[b][k[b]];
+            grad[b] += w * uf * ((s.base[b] + k[b] as isize) as f64 - s.xs[b]);
         }
-        if w != 0.0 {
-            let mut f = 0;
-            for b in 0..D {
-                f += (base[b] + k[b] as isize) as usize * st[b];
-            }
-            let uf = grid.u[a][f];
-            pic += w * uf;
-            old += w * grid.u_old[a][f];
-            for b in 0..D {
-                grad[b] += w * uf * ((base[b] + k[b] as isize) as f64 - xs[b]);
-            }
-        }
-        if !odometer(&mut k, &lo, &hi) {
-            break;
-        }
-    }
+    });
     (pic, old, grad)
 }
 
@@ -241,39 +264,9 @@ pub(crate) fn sample_new<const D: usize>(
 /// The grid velocity at `x` (m), interpolated with the transfer kernel from every face lattice
 /// (the PIC velocity a particle at `x` would receive).
 pub(crate) fn sample<const D: usize>(grid: &MacGrid<D>, kernel: Kernel, x: &[f64; D]) -> [f64; D] {
-    let inv_h = 1.0 / grid.h;
-    let r = radius(kernel);
-    let support = kernel.support();
     std::array::from_fn(|a| {
-        let fd = grid.face_dims(a);
-        let st = strides(fd);
-        let xs: [f64; D] = std::array::from_fn(|b| x[b] * inv_h - if b == a { 0.0 } else { 0.5 });
-        let base: [isize; D] = std::array::from_fn(|b| (xs[b] + 1.0 - r).floor() as isize);
-        let mut w1 = [[0.0f64; 4]; D];
-        for b in 0..D {
-            for k in 0..support {
-                let node = base[b] + k as isize;
-                if node >= 0 && (node as usize) < fd[b] {
-                    w1[b][k] = kernel.n(xs[b] - node as f64);
-                }
-            }
-        }
         let mut sum = 0.0;
-        let mut k = [0usize; D];
-        let hi = [support - 1; D];
-        loop {
-            let mut w = 1.0;
-            for b in 0..D {
-                w *= w1[b][k[b]];
-            }
-            if w != 0.0 {
-                let f: usize = (0..D).map(|b| (base[b] + k[b] as isize) as usize * st[b]).sum();
-                sum += w * grid.u[a][f];
-            }
-            if !odometer(&mut k, &[0; D], &hi) {
-                break;
-            }
-        }
+        Stencil::new(grid, kernel, a, x).for_each(kernel, |w, f, _| sum += w * grid.u[a][f]);
         sum
     })
 }

@@ -639,6 +639,17 @@ mod tests {
             let first_max = (0..3).find(|&i| w.iter().all(|&o| o <= w[i])).unwrap();
             assert_eq!(usize::from(d), first_max, "vertex {v}");
         }
+        let m: Vec<DMat4> = (0..5)
+            .map(|j| DMat4::from_rotation_translation(DQuat::from_rotation_x(0.9 * j as f64 - 1.5), DVec3::Y))
+            .collect();
+        for method in [SkinningMethod::Lbs, SkinningMethod::Dqs] {
+            let (mut a, mut b) = (Skinned::new(&mesh), Skinned::new(&back));
+            skin(&mesh, &m, method, &mut a).unwrap();
+            skin(&back, &m, method, &mut b).unwrap();
+            assert!(
+                a.x.iter().chain(&a.nz).zip(b.x.iter().chain(&b.nz)).all(|(p, q)| p.to_bits() == q.to_bits())
+            );
+        }
     }
 
     /// A skin of more joints than the DQS sign table holds runs the portable DQS kernel: the
