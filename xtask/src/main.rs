@@ -6,7 +6,7 @@
 //! | `stability [--quick] [--filter S]` | the named hard cases of every crate with their outcomes; exit 1 on an unexpected outcome |
 //! | `stability --long [--quick] [--filter S] [--out DIR]` | soak: each crate's hard case for `10^5` steps or ten minutes with its energy bound; written to `docs/report/soak.md` |
 //! | `bench [--filter S]` | the criterion benches under `benches/`, printed as a table and written to `target/xtask/bench.csv`; `--peers [--filter S]`: the peer comparisons (springs, rigid, pbd, fem, mpm, fluid), their ratios merged into `docs/report/peers.csv` (a filtered run replaces only its crates' rows) |
-//! | `report [--quick] [--out DIR] [--threads 1,2,...]` | conformance, stability and work-precision studies, the cheapest method per tolerance (also `cheapest.json`), thread scaling (1 and all cores unless `--threads`) and the peer ratios of `docs/report/peers.csv`, written to `docs/report/` (Markdown + SVG); prints its duration |
+//! | `report [--quick] [--filter S] [--out DIR] [--threads 1,2,...]` | conformance, stability and work-precision studies, the cheapest method per tolerance (also `cheapest.json`), thread scaling (1 and all cores unless `--threads`) and the peer ratios of `docs/report/peers.csv`, written to `docs/report/` (Markdown + SVG, and every measured part in `data.json`); `--filter` re-runs only the parts of matching crates or names and keeps the rest from `data.json`; prints its duration |
 //! | `ci` | what CI runs: format, clippy, tests (with doc tests), docs, quick conformance and stability |
 
 mod architecture;
@@ -18,6 +18,7 @@ mod peers_file;
 mod python;
 mod registry;
 mod report;
+mod report_data;
 mod scaling;
 mod soak;
 mod suites;
@@ -81,7 +82,7 @@ fn main() -> ExitCode {
                 let n = machine::cores();
                 if n > 1 { vec![1, n] } else { vec![1] }
             });
-            report::run(&ctx, args.out.as_deref().unwrap_or("docs/report"), &threads)
+            report::run(&ctx, args.out.as_deref().unwrap_or("docs/report"), &threads, args.filter.as_deref())
         }
         "ci" => ci::run(),
         "help" | "--help" | "-h" => {

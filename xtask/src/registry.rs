@@ -13,7 +13,7 @@ pub struct Ctx {
 }
 
 /// How a measured value is judged against its reference.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Judge {
     /// Pass when `|measured - reference| <= tolerance`.
     Near,
@@ -66,7 +66,7 @@ pub struct ConformanceCase {
 }
 
 /// What a hard case did.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Outcome {
     /// Ran to the end within its bounds.
     Stable(String),
@@ -107,25 +107,28 @@ pub struct StabilityCase {
 }
 
 /// One point of a work-precision curve.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 pub struct Point {
     /// The swept parameter (time step, resolution, iterations).
+    #[serde(with = "crate::report_data::float")]
     pub param: f64,
     /// Median wall time of one run, seconds.
+    #[serde(with = "crate::report_data::float")]
     pub seconds: f64,
     /// Error against the reference.
+    #[serde(with = "crate::report_data::float")]
     pub error: f64,
 }
 
 /// One method's curve.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Series {
     pub label: String,
     pub points: Vec<Point>,
 }
 
 /// A work-precision study: error against wall time for several methods on one problem.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct StudyResult {
     pub title: String,
     /// File stem for the SVG and table.

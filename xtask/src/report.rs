@@ -5,6 +5,7 @@
 use crate::machine::Machine;
 use crate::peers_file::{self, PeerRow};
 use crate::registry::{self, Ctx, StudyResult, fmt_num};
+use crate::report_data::{self, Data, Kind, Part};
 use crate::scaling;
 use crate::suites::{self, ConformanceRun, StabilityRun};
 use plotters::prelude::*;
@@ -37,62 +38,189 @@ pub struct Report {
     /// Rows of `docs/report/peers.csv` (or an error reading it).
     pub peers: Result<Vec<PeerRow>, String>,
     pub quick: bool,
+    /// When the newest part was measured.
     pub date: String,
+    /// When the oldest part was measured (the same as `date` after a whole run).
+    pub oldest: String,
     pub machine: Machine,
-    /// Wall time of the whole report run, seconds.
+    /// Wall time of all parts of the report, seconds.
     pub seconds: f64,
     /// Whether `soak.md` (from `stability --long`) is beside the index.
     pub soak: bool,
 }
 
-pub fn run(ctx: &Ctx, out: &str, threads: &[usize]) -> bool {
+/// Runs the report into `out`. With `filter`, only the conformance cases, hard cases, studies and
+/// thread-scaling families whose crate or name contains it are run; every other part is taken
+/// from `out/data.json` (written by every run), so the index stays whole.
+pub fn run(ctx: &Ctx, out: &str, threads: &[usize], filter: Option<&str>) -> bool {
     let start = Instant::now();
     let dir = Path::new(out);
     if let Err(e) = std::fs::create_dir_all(dir) {
         eprintln!("cannot create {out}: {e}");
         return false;
     }
-    let conformance = suites::conformance(ctx, None);
-    let stability = suites::stability(ctx, None);
-    let mut studies = Vec::new();
-    for study in registry::all().studies {
+    let data_path = dir.join("data.json");
+    let mut stored = match filter {
+        None => Data::new(ctx.quick, Machine::this(), Vec::new()),
+        Some(_) => match Data::load(&data_path, ctx.quick) {
+            Ok(d) => d,
+            Err(e) => {
+                eprintln!("{e}");
+                return false;
+            }
+        },
+    };
+    let today = crate::machine::today();
+    let mut parts = Vec::new();
+    let mut missing = Vec::new();
+    let mut keep = |stored: &mut Data, parts: &mut Vec<Part>, kind, krate: &str, name: &str| match stored
+        .take(kind, krate, name)
+    {
+        Some(p) => parts.push(p),
+        None => missing.push(format!("{krate}: {name}")),
+    };
+    let reg = registry::all();
+    for case in &reg.conformance {
+        if !suites::selected(filter, case.crate_name, case.name) {
+            keep(&mut stored, &mut parts, Kind::Conformance, case.crate_name, case.name);
+            continue;
+        }
+        let t = Instant::now();
+        let checks = (case.run)(ctx);
+        let secs = t.elapsed().as_secs_f64();
+        eprintln!("  {:<40} {:>4} checks  {:>7.2} s", case.name, checks.len(), secs);
+        let mut p = Part::new(Kind::Conformance, case.crate_name, case.name, &today, secs);
+        p.checks = report_data::store_checks(&checks);
+        parts.push(p);
+    }
+    for case in &reg.stability {
+        if !suites::selected(filter, case.crate_name, case.name) {
+            keep(&mut stored, &mut parts, Kind::Stability, case.crate_name, case.name);
+            continue;
+        }
+        let t = Instant::now();
+        let outcome = (case.run)(ctx);
+        let mut p = Part::new(Kind::Stability, case.crate_name, case.name, &today, t.elapsed().as_secs_f64());
+        p.outcome = Some(((case.expected)(), outcome));
+        parts.push(p);
+    }
+    for study in &reg.studies {
+        if !suites::selected(filter, study.crate_name, study.name) {
+            keep(&mut stored, &mut parts, Kind::Study, study.crate_name, study.name);
+            continue;
+        }
         let t = Instant::now();
         let result = (study.run)(ctx);
-        eprintln!("  study {:<45} {:>6.1} s", study.name, t.elapsed().as_secs_f64());
-        studies.push((study.crate_name, result));
+        let secs = t.elapsed().as_secs_f64();
+        eprintln!("  study {:<45} {:>6.1} s", study.name, secs);
+        let mut p = Part::new(Kind::Study, study.crate_name, study.name, &today, secs);
+        p.study = Some(result);
+        parts.push(p);
     }
     eprintln!("thread scaling on {threads:?} threads");
-    let load_before = scaling::load_average();
-    let scaling = scaling::run(ctx.quick, threads);
-    let load = load_before.zip(scaling::load_average());
-    let report = Report {
-        studies,
-        conformance,
-        stability,
-        scaling,
-        load,
-        peers: peers_file::read(&dir.join("peers.csv")),
-        quick: ctx.quick,
-        date: crate::machine::today(),
-        machine: Machine::this(),
-        seconds: start.elapsed().as_secs_f64(),
-        soak: dir.join("soak.md").exists(),
-    };
-    let ok = match write(dir, &report) {
+    for (i, (krate, scene)) in scaling::family_names().into_iter().enumerate() {
+        if !suites::selected(filter, krate, scene) {
+            keep(&mut stored, &mut parts, Kind::Scaling, krate, scene);
+            continue;
+        }
+        let t = Instant::now();
+        let before = scaling::load_average();
+        let rows = scaling::run_family(i, ctx.quick, threads);
+        let mut p = Part::new(Kind::Scaling, krate, scene, &today, t.elapsed().as_secs_f64());
+        p.load = before.zip(scaling::load_average());
+        p.scaling = rows;
+        parts.push(p);
+    }
+    if !missing.is_empty() {
+        eprintln!(
+            "{} registered part(s) are not in {} and were not selected by the filter; they are left \
+             out of the index until a run selects them: {}",
+            missing.len(),
+            data_path.display(),
+            missing.join("; ")
+        );
+    }
+    let data = Data::new(ctx.quick, Machine::this(), parts);
+    let report =
+        Report::from_data(&data, peers_file::read(&dir.join("peers.csv")), dir.join("soak.md").exists());
+    let mut ok = match write(dir, &report).and_then(|()| data.write(&data_path)) {
         Ok(()) => true,
         Err(e) => {
             eprintln!("{e}");
             false
         }
     };
+    ok &= missing.is_empty();
     eprintln!(
-        "report{} finished in {:.0} s ({:.1} min); wrote {}",
+        "report{}{} finished in {:.0} s ({:.1} min); its parts took {:.0} s ({:.1} min) in all; wrote {}",
         if ctx.quick { " --quick" } else { "" },
+        filter.map(|f| format!(" --filter {f}")).unwrap_or_default(),
         start.elapsed().as_secs_f64(),
         start.elapsed().as_secs_f64() / 60.0,
+        report.seconds,
+        report.seconds / 60.0,
         dir.join("index.md").display()
     );
     ok && report.conformance.passed() && report.stability.passed()
+}
+
+impl Report {
+    /// The report of the stored parts (in registry order).
+    pub fn from_data(data: &Data, peers: Result<Vec<PeerRow>, String>, soak: bool) -> Self {
+        let mut studies = Vec::new();
+        let mut checks = Vec::new();
+        let mut rows = Vec::new();
+        let mut scaling_rows = Vec::new();
+        let mut load: Option<(f64, f64)> = None;
+        let mut conformance_seconds = 0.0;
+        for p in &data.parts {
+            match p.kind {
+                Kind::Conformance => {
+                    checks.extend(p.checks());
+                    conformance_seconds += p.seconds;
+                }
+                Kind::Stability => {
+                    if let Some((expected, outcome)) = &p.outcome {
+                        rows.push((leak(&p.krate), leak(&p.name), expected.clone(), outcome.clone()));
+                    }
+                }
+                Kind::Study => {
+                    if let Some(s) = &p.study {
+                        studies.push((leak(&p.krate), s.clone()));
+                    }
+                }
+                Kind::Scaling => {
+                    scaling_rows.extend(p.scaling.iter().cloned());
+                    if let Some((a, b)) = p.load {
+                        load = Some(load.map_or((a, b), |(x, y)| (x.min(a), y.max(b))));
+                    }
+                }
+            }
+        }
+        let dates: Vec<&str> = data.parts.iter().map(|p| p.date.as_str()).collect();
+        let newest = dates.iter().max().map_or_else(crate::machine::today, |d| (*d).to_string());
+        let oldest = dates.iter().min().map_or_else(|| newest.clone(), |d| (*d).to_string());
+        Report {
+            studies,
+            conformance: ConformanceRun { checks, seconds: conformance_seconds },
+            stability: StabilityRun { rows },
+            scaling: scaling_rows,
+            load,
+            peers,
+            quick: data.mode == "quick",
+            date: newest,
+            oldest,
+            machine: data.machine.clone(),
+            seconds: data.parts.iter().map(|p| p.seconds).sum(),
+            soak,
+        }
+    }
+}
+
+/// Registry names are `&'static str`; names read back from `data.json` are leaked to match
+/// (a few kilobytes, once per run).
+fn leak(s: &str) -> &'static str {
+    Box::leak(s.to_owned().into_boxed_str())
 }
 
 /// Writes `index.md`, one SVG per study and `cheapest.json` into `dir`.
@@ -204,14 +332,23 @@ pub fn index_markdown(r: &Report) -> String {
     let _ = writeln!(md, "# anim: work-precision report\n");
     let _ = writeln!(
         md,
-        "Written by `cargo xtask report{}` on {} ({}); the run took {:.0} s ({:.1} min). Wall times \
-         are medians of repeated runs on that machine; compare methods within one table, not across \
-         machines.\n",
+        "Written by `cargo xtask report{}` on {} ({}); its parts took {:.0} s ({:.1} min) to run.{} \
+         Wall times are medians of repeated runs on that machine; compare methods within one table, \
+         not across machines.\n",
         if r.quick { " --quick" } else { "" },
         r.date,
         r.machine.describe(),
         r.seconds,
-        r.seconds / 60.0
+        r.seconds / 60.0,
+        if r.oldest == r.date {
+            String::new()
+        } else {
+            format!(
+                " The parts were measured between {} and {} (`cargo xtask report --filter TEXT` re-runs \
+                 the parts of matching crates and keeps the others from [data.json](data.json)).",
+                r.oldest, r.date
+            )
+        }
     );
     let _ = writeln!(md, "## Cheapest method meeting a tolerance\n");
     let _ = writeln!(
@@ -587,6 +724,7 @@ mod tests {
             }]),
             quick: true,
             date: "2026-11-25".into(),
+            oldest: "2026-11-25".into(),
             machine: Machine { cpu: "CPU".into(), cores: 2 },
             seconds: 12.0,
             soak: false,
@@ -616,7 +754,7 @@ mod tests {
             ]
         );
         assert!(
-            md.contains("`cargo xtask report --quick` on 2026-11-25 (CPU, 2 cores); the run took 12 s"),
+            md.contains("`cargo xtask report --quick` on 2026-11-25 (CPU, 2 cores); its parts took 12 s"),
             "{md}"
         );
         // The headline table: one row per study, the cheapest point under 1e-1, 1e-2 and 1e-3.
@@ -642,6 +780,38 @@ mod tests {
             assert!(text.starts_with("<svg") && text.contains("fast-rough"), "{svg}");
         }
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn stored_parts_give_the_report_in_order_with_their_date_range() {
+        use crate::registry::{Judge, Outcome};
+        use crate::report_data::{Data, Kind, Part, StoredCheck};
+        let mut conf = Part::new(Kind::Conformance, "anim-x", "case", "2026-11-20", 4.0);
+        conf.checks = vec![StoredCheck {
+            case: "c".into(),
+            metric: "m".into(),
+            measured: 2.0,
+            reference: 0.0,
+            tolerance: 1.0,
+            judge: Judge::AtMost,
+            source: "s".into(),
+        }];
+        let mut a = Part::new(Kind::Study, "anim-x", "first", "2026-11-25", 10.0);
+        a.study = Some(StudyResult { slug: "first".into(), ..tiny() });
+        let mut b = Part::new(Kind::Study, "anim-y", "second", "2026-11-21", 20.0);
+        b.study = Some(StudyResult { slug: "second".into(), ..tiny() });
+        let mut hard = Part::new(Kind::Stability, "anim-y", "hard", "2026-11-21", 1.0);
+        hard.outcome = Some((Outcome::Stable(String::new()), Outcome::Stable("ok".into())));
+        let data = Data::new(false, Machine { cpu: "CPU".into(), cores: 2 }, vec![conf, a, b, hard]);
+        let r = Report::from_data(&data, Ok(Vec::new()), false);
+        let slugs: Vec<&str> = r.studies.iter().map(|(_, s)| s.slug.as_str()).collect();
+        assert_eq!(slugs, ["first", "second"]);
+        assert_eq!((r.seconds, r.date.as_str(), r.oldest.as_str()), (35.0, "2026-11-25", "2026-11-20"));
+        assert_eq!(r.conformance.failures(), 1);
+        assert!(r.stability.passed() && !r.quick);
+        let md = index_markdown(&r);
+        assert!(md.contains("its parts took 35 s"), "{md}");
+        assert!(md.contains("measured between 2026-11-20 and 2026-11-25"), "{md}");
     }
 
     #[test]

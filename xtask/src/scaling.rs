@@ -172,14 +172,16 @@ fn families() -> Vec<(&'static str, &'static str, Make)> {
 }
 
 /// One measured row.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Row {
     pub krate: String,
     pub scene: String,
     pub threads: usize,
     /// Seconds per step (NaN when the run failed).
+    #[serde(with = "crate::report_data::float")]
     pub seconds: f64,
     /// Speed-up over the one-thread run of the same scene.
+    #[serde(with = "crate::report_data::float")]
     pub speedup: f64,
     /// Whether the state after the first steps equals the one-thread state bit for bit.
     pub identical: Option<bool>,
@@ -221,40 +223,44 @@ fn measure(make: Make, quick: bool, threads: usize) -> Result<(f64, u64), String
     })
 }
 
-/// Times every family at each of `threads` (the first should be 1: the speed-ups are over it).
-pub fn run(quick: bool, threads: &[usize]) -> Vec<Row> {
+/// `(crate, scene)` of every family, in report order.
+pub fn family_names() -> Vec<(&'static str, &'static str)> {
+    families().into_iter().map(|(k, s, _)| (k, s)).collect()
+}
+
+/// Times family `index` (of [`family_names`]) at each of `threads`.
+pub fn run_family(index: usize, quick: bool, threads: &[usize]) -> Vec<Row> {
+    let Some(&(krate, scene, make)) = families().get(index) else { return Vec::new() };
     let mut rows = Vec::new();
-    for (krate, scene, make) in families() {
-        let t0 = Instant::now();
-        let mut base: Option<(f64, u64)> = None;
-        for &t in threads {
-            let row = match measure(make, quick, t) {
-                Ok((seconds, fp)) => {
-                    let b = *base.get_or_insert((seconds, fp));
-                    Row {
-                        krate: krate.into(),
-                        scene: scene.into(),
-                        threads: t,
-                        seconds,
-                        speedup: b.0 / seconds,
-                        identical: Some(b.1 == fp),
-                        note: String::new(),
-                    }
-                }
-                Err(e) => Row {
+    let t0 = Instant::now();
+    let mut base: Option<(f64, u64)> = None;
+    for &t in threads {
+        let row = match measure(make, quick, t) {
+            Ok((seconds, fp)) => {
+                let b = *base.get_or_insert((seconds, fp));
+                Row {
                     krate: krate.into(),
                     scene: scene.into(),
                     threads: t,
-                    seconds: f64::NAN,
-                    speedup: f64::NAN,
-                    identical: None,
-                    note: e,
-                },
-            };
-            rows.push(row);
-        }
-        eprintln!("  scaling {krate:<13} {:>6.1} s", t0.elapsed().as_secs_f64());
+                    seconds,
+                    speedup: b.0 / seconds,
+                    identical: Some(b.1 == fp),
+                    note: String::new(),
+                }
+            }
+            Err(e) => Row {
+                krate: krate.into(),
+                scene: scene.into(),
+                threads: t,
+                seconds: f64::NAN,
+                speedup: f64::NAN,
+                identical: None,
+                note: e,
+            },
+        };
+        rows.push(row);
     }
+    eprintln!("  scaling {krate:<13} {:>6.1} s", t0.elapsed().as_secs_f64());
     rows
 }
 

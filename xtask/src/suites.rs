@@ -19,7 +19,7 @@ impl ConformanceRun {
     }
 }
 
-fn selected(filter: Option<&str>, crate_name: &str, name: &str) -> bool {
+pub fn selected(filter: Option<&str>, crate_name: &str, name: &str) -> bool {
     filter.is_none_or(|f| crate_name.contains(f) || name.contains(f))
 }
 

@@ -636,21 +636,47 @@ fn explicit_divergence(_ctx: &Ctx) -> Outcome {
 
 /// The study beam: 1 m x 0.1 m x 0.1 m, E = 1e6 Pa, nu = 0.3, rho = 1000, clamped, sagging from
 /// rest under gravity for 0.5 s; the error is the RMS over time of the tip-height difference to a
-/// converged run (backward Euler is dissipative, so a fine dt is the reference for every method),
-/// relative to the reference's RMS tip deflection.
-fn study_sim(model: MaterialModel, integrator: TimeIntegrator) -> Result<FemSimulation, FemError> {
-    let mut sim = cantilever_dynamic(1e6, 0.3, model, 2)?;
-    let mut p = FemParams::new(integrator).with_energy_report(false).with_newton_tolerance(1e-8);
+/// converged run of the same material model (symplectic Euler far below its stability limit: it
+/// is second-order accurate in positions and not dissipative, while backward Euler is), relative
+/// to the reference's RMS tip deflection. Every model is discretised by the same mesh, so the error
+/// measures time integration and solver tolerance, which is what a user trades against wall time.
+fn study_sim(method: BeamMethod) -> Result<FemSimulation, FemError> {
+    let mut sim = cantilever_dynamic(1e6, 0.3, method.model, 2)?;
+    let mut p = FemParams::new(method.integrator)
+        .with_energy_report(false)
+        .with_newton_tolerance(1e-8)
+        .with_linear_solver(method.solver);
     p.max_newton_iterations = 100;
+    p.cg_tolerance = 1e-10;
     sim.set_params(p)?;
     Ok(sim)
+}
+
+/// One method of the beam study: material model, integrator and (for backward Euler) the linear
+/// solver inside Newton.
+#[derive(Debug, Clone, Copy)]
+struct BeamMethod {
+    model: MaterialModel,
+    integrator: TimeIntegrator,
+    solver: LinearSolverChoice,
+}
+
+impl BeamMethod {
+    fn label(self) -> String {
+        match self.integrator {
+            TimeIntegrator::SymplecticEuler => format!("{} {}", self.model.name(), self.integrator.name()),
+            TimeIntegrator::BackwardEuler => {
+                format!("{} {} ({})", self.model.name(), self.integrator.name(), self.solver.name())
+            }
+        }
+    }
 }
 
 const STUDY_T: f64 = 0.5;
 const SAMPLES: usize = 50;
 
-fn tip_trajectory(model: MaterialModel, integrator: TimeIntegrator, dt: f64) -> Option<Vec<f64>> {
-    let mut sim = study_sim(model, integrator).ok()?;
+fn tip_trajectory(method: BeamMethod, dt: f64) -> Option<Vec<f64>> {
+    let mut sim = study_sim(method).ok()?;
     let tip: Vec<usize> = sim.model().vertices_where(|p| p[0] > 1.0 - 1e-9);
     let mut state = sim.rest_state();
     let steps = (STUDY_T / dt).round() as usize;
@@ -667,52 +693,50 @@ fn tip_trajectory(model: MaterialModel, integrator: TimeIntegrator, dt: f64) -> 
 
 fn beam_study(ctx: &Ctx) -> StudyResult {
     let (batches, min_batch) = if ctx.quick { (1, 0.0) } else { (3, 0.05) };
-    let models: &[MaterialModel] = if ctx.quick {
-        &[MaterialModel::StableNeoHookean]
-    } else {
-        &[
-            MaterialModel::CorotatedLinear,
-            MaterialModel::NeoHookean,
-            MaterialModel::FixedCorotated,
-            MaterialModel::StableNeoHookean,
-        ]
-    };
+    let models: &[MaterialModel] =
+        if ctx.quick { &[MaterialModel::StableNeoHookean] } else { &MaterialModel::ALL };
     let mut series = Vec::new();
     for &model in models {
+        let explicit = BeamMethod {
+            model,
+            integrator: TimeIntegrator::SymplecticEuler,
+            solver: LinearSolverChoice::Cholesky,
+        };
         // The converged reference: symplectic Euler at a step far below its stability limit.
         let ref_dt = STUDY_T / (SAMPLES as f64 * if ctx.quick { 80.0 } else { 400.0 });
-        let Some(reference) = tip_trajectory(model, TimeIntegrator::SymplecticEuler, ref_dt) else {
+        let Some(reference) = tip_trajectory(explicit, ref_dt) else {
             continue;
         };
         let rest_z = 0.05;
         let scale = (reference.iter().map(|z| (z - rest_z) * (z - rest_z)).sum::<f64>()
             / reference.len() as f64)
             .sqrt();
-        let sweeps: [(TimeIntegrator, Vec<f64>); 2] = [
-            (
-                TimeIntegrator::SymplecticEuler,
-                if ctx.quick { vec![16.0, 32.0] } else { vec![16.0, 24.0, 32.0, 64.0, 128.0] },
-            ),
-            (
-                TimeIntegrator::BackwardEuler,
-                if ctx.quick { vec![1.0, 4.0] } else { vec![1.0, 2.0, 4.0, 8.0, 16.0, 32.0] },
-            ),
-        ];
-        for (integrator, steps_per_sample) in sweeps {
+        let implicit = |solver| BeamMethod { model, integrator: TimeIntegrator::BackwardEuler, solver };
+        let explicit_steps = if ctx.quick { vec![16.0, 32.0] } else { vec![16.0, 24.0, 32.0, 64.0, 128.0] };
+        let implicit_steps = if ctx.quick { vec![1.0, 4.0] } else { vec![1.0, 2.0, 4.0, 8.0, 16.0, 32.0] };
+        let mut sweeps =
+            vec![(explicit, explicit_steps), (implicit(LinearSolverChoice::Cholesky), implicit_steps)];
+        // The linear solvers inside Newton, compared on one model (the answer is the same to the
+        // Newton tolerance; only the cost differs).
+        if !ctx.quick && model == MaterialModel::StableNeoHookean {
+            sweeps.push((implicit(LinearSolverChoice::Ldlt), vec![1.0, 4.0, 16.0]));
+            sweeps.push((implicit(LinearSolverChoice::JacobiPcg), vec![1.0, 4.0, 16.0]));
+        }
+        for (method, steps_per_sample) in sweeps {
             let mut points = Vec::new();
             for k in steps_per_sample {
                 let dt = STUDY_T / (SAMPLES as f64 * k);
-                let Some(traj) = tip_trajectory(model, integrator, dt) else { continue };
+                let Some(traj) = tip_trajectory(method, dt) else { continue };
                 let err = (traj.iter().zip(&reference).map(|(a, b)| (a - b) * (a - b)).sum::<f64>()
                     / traj.len() as f64)
                     .sqrt()
                     / scale;
                 let seconds = median_seconds(batches, min_batch, || {
-                    let _ = tip_trajectory(model, integrator, dt);
+                    let _ = tip_trajectory(method, dt);
                 });
                 points.push(Point { param: dt, seconds, error: err });
             }
-            series.push(Series { label: format!("{} {}", model.name(), integrator.name()), points });
+            series.push(Series { label: method.label(), points });
         }
     }
     StudyResult {
