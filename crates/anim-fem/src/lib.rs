@@ -77,4 +77,6 @@ pub mod sim;
 pub use error::FemError;
 
 #[cfg(test)]
+mod contact_tests;
+#[cfg(test)]
 mod tests;
