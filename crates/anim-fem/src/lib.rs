@@ -64,6 +64,7 @@ pub mod assembly;
 pub mod boundary;
 pub mod element;
 pub mod error;
+pub mod friction;
 pub mod generate;
 pub mod ldlt;
 pub mod material;

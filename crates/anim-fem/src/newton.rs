@@ -5,11 +5,13 @@
 //!
 //! ```text
 //! E(x) = 1/(2 dt^2) (x - x_hat)^T M (x - x_hat) + sum_e W_e psi(F_e(x)) - f_ext . x
-//!        + gamma/(2 dt) (x - x_n)^T K_n (x - x_n) + sum_i kappa/2 min(phi(x_i), 0)^2,
+//!        + gamma/(2 dt) (x - x_n)^T K_n (x - x_n) + sum_i kappa/2 min(phi(x_i), 0)^2
+//!        + sum_contacts mu lambda f0(|T^T (x_i - x_n,i)|),
 //! x_hat = x_n + dt v_n,
 //! ```
 //!
-//! whose gradient is minus the backward Euler residual. The Rayleigh damping force of the seed,
+//! whose gradient is minus the backward Euler residual (the last sum is the lagged friction
+//! potential of [`crate::friction`]). The Rayleigh damping force of the seed,
 //! `f_d = -gamma K v`, uses here the stiffness `K_n = K(x_n)` at the start of the step (the seed
 //! linearises it at the current iterate); with `K_n` frozen, damping is a quadratic potential and
 //! the whole step is a minimisation, so a line search on `E` is well defined and every accepted
@@ -30,6 +32,7 @@
 
 use crate::boundary::Obstacle;
 use crate::error::FemError;
+use crate::friction::FrictionContact;
 use anim_core::linalg::{CsrMatrix, LinearSolver, SystemMatrix, dot};
 use rayon::prelude::*;
 
@@ -77,6 +80,8 @@ pub struct Potential<'a> {
     pub obstacles: &'a [Obstacle],
     /// Penalty stiffness.
     pub contact_stiffness: f64,
+    /// Lagged friction contacts of the step (empty: frictionless), see [`crate::friction`].
+    pub friction: &'a [FrictionContact],
     /// Fixed degrees of freedom.
     pub fixed: &'a [bool],
     /// Project `dP/dF` to positive semi-definite.
@@ -253,6 +258,24 @@ fn contact_terms(
         }
         if let Some(h) = hess.as_deref_mut() {
             h[i] = block;
+        }
+    }
+    for contact in pot.friction {
+        let i = contact.vertex;
+        let p = [x[3 * i], x[3 * i + 1], x[3 * i + 2]];
+        let mut g = [0.0; 3];
+        let mut block = [0.0; 9];
+        energy +=
+            contact.potential(p, grad.is_some().then_some(&mut g), hess.is_some().then_some(&mut block));
+        if let Some(gr) = grad.as_deref_mut() {
+            for c in 0..3 {
+                gr[3 * i + c] += g[c];
+            }
+        }
+        if let Some(h) = hess.as_deref_mut() {
+            for (hv, b) in h[i].iter_mut().zip(&block) {
+                *hv += b;
+            }
         }
     }
     energy
