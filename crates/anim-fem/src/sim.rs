@@ -4,7 +4,8 @@
 //!   `v_{n+1} = v_n + dt M^-1 (f_e(x_n) + f_d + f_ext)`, `x_{n+1} = x_n + dt v_{n+1}`, with the
 //!   elastic forces from the batch algorithm (seed 5.2, Algorithm 1) and the Rayleigh damping
 //!   force `f_d = -gamma K(x_n) v_n` evaluated matrix-free per element. Contact projects
-//!   penetrating vertices to the obstacle surface and removes their approaching normal velocity.
+//!   penetrating vertices to the obstacle surface and removes their approaching normal velocity,
+//!   then applies velocity-level Coulomb friction ([`crate::friction`]).
 //!   With consistent mass, `M a = f` is solved by Jacobi-preconditioned conjugate gradients.
 //! - **Backward Euler** (seed 5.2) by Newton's method on the incremental potential with a
 //!   backtracking line search ([`newton`]), the stiffness assembled in parallel in
