@@ -21,7 +21,7 @@
 //! f0(y) = -y^3 / (3 (eps_v dt)^2) + y^2 / (eps_v dt) + eps_v dt / 3   for y < eps_v dt,   y otherwise,
 //! ```
 //!
-//! (`f0' = f1`, both C1), which Newton's line search sees like any other term of the incremental
+//! (`f0' = f1`; `f1` is C1, `f0` C2), which Newton's line search sees like any other term of the incremental
 //! potential. Its gradient is `mu lambda f1(|u|) T u / |u|`; the Hessian is
 //! `mu lambda T [f1'(y) u u^T / y^2 + f1(y) / y (I - u u^T / y^2)] T^T` (`y = |u|`) whose two
 //! eigenvalues in the tangent plane, `f1'(y)` and `f1(y) / y` (times `mu lambda`), are clamped at
@@ -31,10 +31,12 @@
 //! `F < mu lambda` its step displacement solves `mu lambda f1(y) = F`, so
 //! `y / dt = eps_v (1 - sqrt(1 - F / (mu lambda))) < eps_v`.
 //!
-//! In the sliding regime the Hessian has no curvature along the motion, so at impacts (many
-//! vertices changing regime at once) Newton's first steps overshoot and the line search
-//! shortens them: such steps can take tens of iterations; a larger `eps_v` smooths them
-//! (`docs/guides/anim-fem.md` has the figures).
+//! The normal force is the penalty force at `x_n`, so friction acts from the step after a vertex
+//! first penetrates. In the sliding regime the Hessian has no curvature along the motion: Newton
+//! started from the inertial predictor, which puts a contact vertex deep in that regime, overshoots
+//! at impacts and the line search shortens every step. With friction contacts Newton therefore
+//! starts from `x_n` (as IPC does), inside the smoothed static zone (`docs/guides/anim-fem.md`
+//! has the iteration counts).
 //!
 //! Quasi-static solves ([`FemSimulation::solve_static`](crate::sim::FemSimulation::solve_static))
 //! have no time step and no friction. The contacts are a list with room for every vertex and

@@ -532,7 +532,9 @@ impl FemSimulation {
             self.data.assemble_reference_stiffness(&self.model, self.model.assembly(), &self.xn);
         }
         // Initial guess: the inertial predictor, fixed coordinates at their targets; fall back
-        // to the current positions when the predictor inverts an element the material cannot.
+        // to the current positions when the predictor inverts an element the material cannot,
+        // and start from them when friction contacts are active (as IPC does: from the
+        // predictor, contact vertices start deep in the sliding regime, where Newton overshoots).
         let fixed = self.model.fixed();
         let mut x = std::mem::take(&mut state.x);
         for d in 0..n {
@@ -541,7 +543,7 @@ impl FemSimulation {
             }
         }
         self.model.apply_kinematic(state.t + dt, &mut x);
-        if !(self.model.elastic_energy(&x).is_finite()) {
+        if !self.friction_contacts.is_empty() || !(self.model.elastic_energy(&x).is_finite()) {
             for d in 0..n {
                 if !fixed[d] {
                     x[d] = self.xn[d];
