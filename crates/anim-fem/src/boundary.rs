@@ -1,10 +1,16 @@
 //! Boundary conditions and contact: pinned degrees of freedom, kinematic vertex groups that follow
-//! a prescribed motion, and frictionless obstacles (a half-space ground, a sphere).
+//! a prescribed motion, and rigid obstacles (a half-space ground, a sphere), each with a Coulomb
+//! friction coefficient `mu >= 0` given when it is added to a model
+//! ([`FemModel::add_obstacle_with_friction`](crate::model::FemModel::add_obstacle_with_friction);
+//! `mu = 0`, the default of `add_obstacle`, is frictionless).
 //!
 //! Contact is handled per integrator: the explicit step projects penetrating vertices back to the
 //! obstacle surface and removes their approaching normal velocity; the implicit step adds the
 //! penalty energy `kappa/2 min(phi(x), 0)^2` (`phi` the signed distance) to the incremental
-//! potential, so Newton's line search sees it.
+//! potential, so Newton's line search sees it. Friction is velocity-level Coulomb in the explicit
+//! step and IPC's lagged, smoothed friction potential in the implicit one
+//! ([`crate::friction`]). Contact is vertex against obstacle only: no self-collision, no
+//! body-body contact.
 
 use anim_material::nalgebra::{Rotation3, Unit, Vector3};
 use serde::{Deserialize, Serialize};
@@ -66,7 +72,8 @@ pub struct KinematicGroup {
     pub initial: Vec<[f64; 3]>,
 }
 
-/// A rigid, frictionless obstacle.
+/// A rigid obstacle (its friction coefficient is stored by the model, see
+/// [`FemModel::obstacle_friction`](crate::model::FemModel::obstacle_friction)).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Obstacle {

@@ -10,8 +10,9 @@
 //! | [`material`] | the six hyperelastic models (linear, StVK, corotated linear, Neo-Hookean, fixed corotated, stable Neo-Hookean) with Lamé parameters from `(E, nu)` | 5.1 |
 //! | [`element`] | the linear tetrahedron: `Dm^-1`, `W = abs(det Dm)/6`, `F = Ds Dm^-1`, forces `H = -W P(F) Dm^-T`, `f4 = -(f1+f2+f3)`, stiffness | 5.2 |
 //! | [`assembly`] | ordered parallel assembly of forces and the sparse stiffness (identical for any thread count) | 5.2 |
-//! | [`model`] | a body: precomputed rest data, lumped or consistent mass, gravity, loads, pinned and kinematic vertices, obstacles | 5.2 |
+//! | [`model`] | a body: precomputed rest data, lumped or consistent mass, gravity, loads, pinned and kinematic vertices, obstacles with a friction coefficient each | 5.2 |
 //! | [`boundary`] | kinematic motions, ground and sphere obstacles | - |
+//! | [`friction`] | Coulomb friction at obstacle contacts: velocity-level in explicit steps, IPC's lagged smoothed potential (Li et al. 2020, section 5) in backward Euler | - |
 //! | [`newton`] | Newton on the incremental potential with a backtracking line search, Rayleigh damping `gamma` | 5.2 |
 //! | [`sim`] | symplectic Euler and backward Euler steps, quasi-static solves, the `Solver` implementation | 2, 5.2 |
 //! | [`quadratic`] | 10-node tetrahedra for locking-free quasi-static solves | - |
@@ -64,6 +65,7 @@ pub mod assembly;
 pub mod boundary;
 pub mod element;
 pub mod error;
+pub mod friction;
 pub mod generate;
 pub mod ldlt;
 pub mod material;
@@ -76,5 +78,7 @@ pub mod sim;
 
 pub use error::FemError;
 
+#[cfg(test)]
+mod contact_tests;
 #[cfg(test)]
 mod tests;

@@ -45,6 +45,7 @@ pub struct FemModel {
     fixed: Vec<bool>,
     kinematic: Vec<KinematicGroup>,
     obstacles: Vec<Obstacle>,
+    friction: Vec<f64>,
     contact_stiffness: f64,
 }
 
@@ -112,6 +113,7 @@ impl FemModel {
             fixed: vec![false; 3 * n],
             kinematic: Vec::new(),
             obstacles: Vec::new(),
+            friction: Vec::new(),
             contact_stiffness: 0.0,
         })
     }
@@ -207,6 +209,29 @@ impl FemModel {
     /// # Errors
     /// [`FemError::BadParameter`] for a non-positive stiffness, sphere radius or plane normal.
     pub fn add_obstacle(&mut self, obstacle: Obstacle, stiffness: f64) -> Result<(), FemError> {
+        self.add_obstacle_with_friction(obstacle, stiffness, 0.0)
+    }
+
+    /// Adds an obstacle with penalty stiffness `stiffness` (as [`add_obstacle`](Self::add_obstacle))
+    /// and Coulomb friction coefficient `friction` (`mu >= 0`; 0 is frictionless), see
+    /// [`friction`](crate::friction).
+    ///
+    /// # Errors
+    /// [`FemError::BadParameter`] for a negative or non-finite friction coefficient (named
+    /// `friction`), a non-positive stiffness, sphere radius or plane normal.
+    pub fn add_obstacle_with_friction(
+        &mut self,
+        obstacle: Obstacle,
+        stiffness: f64,
+        friction: f64,
+    ) -> Result<(), FemError> {
+        if !(friction >= 0.0) || !friction.is_finite() {
+            return Err(FemError::BadParameter {
+                name: "friction",
+                value: friction,
+                reason: "must be finite and >= 0",
+            });
+        }
         if !(stiffness > 0.0) || !stiffness.is_finite() {
             return Err(FemError::BadParameter {
                 name: "contact stiffness",
@@ -232,6 +257,7 @@ impl FemModel {
             _ => {}
         }
         self.obstacles.push(obstacle);
+        self.friction.push(friction);
         self.contact_stiffness = self.contact_stiffness.max(stiffness);
         Ok(())
     }
@@ -355,6 +381,13 @@ impl FemModel {
     #[must_use]
     pub fn obstacles(&self) -> &[Obstacle] {
         &self.obstacles
+    }
+
+    /// Coulomb friction coefficient of each obstacle (same order as
+    /// [`obstacles`](Self::obstacles); 0 for frictionless).
+    #[must_use]
+    pub fn obstacle_friction(&self) -> &[f64] {
+        &self.friction
     }
 
     /// Penalty stiffness of the obstacles.

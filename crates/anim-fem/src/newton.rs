@@ -5,11 +5,13 @@
 //!
 //! ```text
 //! E(x) = 1/(2 dt^2) (x - x_hat)^T M (x - x_hat) + sum_e W_e psi(F_e(x)) - f_ext . x
-//!        + gamma/(2 dt) (x - x_n)^T K_n (x - x_n) + sum_i kappa/2 min(phi(x_i), 0)^2,
+//!        + gamma/(2 dt) (x - x_n)^T K_n (x - x_n) + sum_i kappa/2 min(phi(x_i), 0)^2
+//!        + sum_contacts mu lambda f0(|T^T (x_i - x_n,i)|),
 //! x_hat = x_n + dt v_n,
 //! ```
 //!
-//! whose gradient is minus the backward Euler residual. The Rayleigh damping force of the seed,
+//! whose gradient is minus the backward Euler residual (the last sum is the lagged friction
+//! potential of [`crate::friction`]). The Rayleigh damping force of the seed,
 //! `f_d = -gamma K v`, uses here the stiffness `K_n = K(x_n)` at the start of the step (the seed
 //! linearises it at the current iterate); with `K_n` frozen, damping is a quadratic potential and
 //! the whole step is a minimisation, so a line search on `E` is well defined and every accepted
@@ -30,6 +32,7 @@
 
 use crate::boundary::Obstacle;
 use crate::error::FemError;
+use crate::friction::FrictionContact;
 use anim_core::linalg::{CsrMatrix, LinearSolver, SystemMatrix, dot};
 use rayon::prelude::*;
 
@@ -77,6 +80,8 @@ pub struct Potential<'a> {
     pub obstacles: &'a [Obstacle],
     /// Penalty stiffness.
     pub contact_stiffness: f64,
+    /// Lagged friction contacts of the step (empty: frictionless), see [`crate::friction`].
+    pub friction: &'a [FrictionContact],
     /// Fixed degrees of freedom.
     pub fixed: &'a [bool],
     /// Project `dP/dF` to positive semi-definite.
@@ -253,6 +258,24 @@ fn contact_terms(
         }
         if let Some(h) = hess.as_deref_mut() {
             h[i] = block;
+        }
+    }
+    for contact in pot.friction {
+        let i = contact.vertex;
+        let p = [x[3 * i], x[3 * i + 1], x[3 * i + 2]];
+        let mut g = [0.0; 3];
+        let mut block = [0.0; 9];
+        energy +=
+            contact.potential(p, grad.is_some().then_some(&mut g), hess.is_some().then_some(&mut block));
+        if let Some(gr) = grad.as_deref_mut() {
+            for c in 0..3 {
+                gr[3 * i + c] += g[c];
+            }
+        }
+        if let Some(h) = hess.as_deref_mut() {
+            for (hv, b) in h[i].iter_mut().zip(&block) {
+                *hv += b;
+            }
         }
     }
     energy
@@ -449,4 +472,106 @@ pub fn minimize<B: ElasticBody>(
         update: info.last_update,
         tolerance: settings.tolerance,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::friction::lagged_contacts;
+    use crate::generate::box_mesh;
+    use crate::material::{Material, MaterialModel};
+    use crate::model::FemModel;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The assembled potential of a step with inertia, penalty contact on a tilted plane and
+    /// lagged friction (four contact vertices, tangential displacements on both sides of the
+    /// smoothing threshold): its gradient against central differences of the energy, and the
+    /// Newton matrix (no PSD projection, so the exact Hessian: the friction Hessian is PSD
+    /// without clamping) against central differences of the gradient, column by column.
+    #[test]
+    fn potential_with_friction_matches_finite_differences() {
+        let mesh = box_mesh([0.0; 3], [0.1; 3], [1, 1, 1]).unwrap();
+        let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
+        let mut model = FemModel::new(mesh, material).unwrap();
+        let theta = 0.3_f64;
+        let plane = Obstacle::Plane { normal: [theta.sin(), 0.0, theta.cos()], offset: 0.04 };
+        model.add_obstacle_with_friction(plane, 1e4, 0.4).unwrap();
+        let xn = model.rest_positions();
+        let n = xn.len();
+        let fixed = vec![false; n];
+        let threshold = 1.5e-3;
+        let mut contacts = Vec::new();
+        lagged_contacts(
+            model.obstacles(),
+            model.obstacle_friction(),
+            1e4,
+            threshold,
+            &xn,
+            &fixed,
+            &mut contacts,
+        );
+        assert_eq!(contacts.len(), 4, "the four bottom vertices penetrate at x_n");
+        let dt = 0.01;
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let xhat: Vec<f64> = xn.iter().map(|v| v + 1e-3 * rng.random_range(-1.0..1.0)).collect();
+        let external = vec![0.0; n];
+        let pot = Potential {
+            inertia: Some((1.0 / (dt * dt), &xhat)),
+            lumped_mass: model.lumped_mass(),
+            consistent_mass: None,
+            damping: None,
+            external: &external,
+            obstacles: model.obstacles(),
+            contact_stiffness: model.contact_stiffness(),
+            friction: &contacts,
+            fixed: &fixed,
+            project: false,
+        };
+        let asm = model.assembly();
+        let mut data = NewtonData::new(asm, model.elements());
+        let x: Vec<f64> = xn.iter().map(|v| v + 2.5e-3 * rng.random_range(-1.0..1.0)).collect();
+        let ys: Vec<f64> = contacts
+            .iter()
+            .map(|c| {
+                let d: Vec<f64> = (0..3).map(|k| x[3 * c.vertex + k] - c.start[k]).collect();
+                c.basis.iter().map(|t| (t[0] * d[0] + t[1] * d[1] + t[2] * d[2]).powi(2)).sum::<f64>().sqrt()
+            })
+            .collect();
+        assert!(
+            ys.iter().any(|&y| y < threshold) && ys.iter().any(|&y| y > threshold),
+            "both friction regimes: {ys:?}"
+        );
+        potential(&model, asm, &pot, &x, &mut data, true).unwrap();
+        let grad = data.grad.clone();
+        newton_matrix(&model, asm, &pot, &x, &mut data);
+        let h_scale = data.h.values().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let g_scale = grad.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let step = 1e-7;
+        let mut xp = x.clone();
+        let mut unit = vec![0.0; n];
+        let mut column = vec![0.0; n];
+        for d in 0..n {
+            xp[d] = x[d] + step;
+            let ep = potential(&model, asm, &pot, &xp, &mut data, true).unwrap();
+            let gp = data.grad.clone();
+            xp[d] = x[d] - step;
+            let em = potential(&model, asm, &pot, &xp, &mut data, true).unwrap();
+            let gm = data.grad.clone();
+            xp[d] = x[d];
+            let fd = (ep - em) / (2.0 * step);
+            assert!((fd - grad[d]).abs() <= 1e-6 * g_scale, "gradient {d}: {fd} vs {}", grad[d]);
+            unit[d] = 1.0;
+            data.h.mul_vec(&unit, &mut column);
+            unit[d] = 0.0;
+            for r in 0..n {
+                let fdh = (gp[r] - gm[r]) / (2.0 * step);
+                assert!(
+                    (fdh - column[r]).abs() <= 1e-6 * h_scale,
+                    "hessian ({r}, {d}): {fdh} vs {}",
+                    column[r]
+                );
+            }
+        }
+    }
 }

@@ -227,6 +227,7 @@ impl QuadraticModel {
                 external: &external,
                 obstacles: &[],
                 contact_stiffness: 0.0,
+                friction: &[],
                 fixed: &self.fixed,
                 project,
             };

@@ -4,7 +4,8 @@
 //!   `v_{n+1} = v_n + dt M^-1 (f_e(x_n) + f_d + f_ext)`, `x_{n+1} = x_n + dt v_{n+1}`, with the
 //!   elastic forces from the batch algorithm (seed 5.2, Algorithm 1) and the Rayleigh damping
 //!   force `f_d = -gamma K(x_n) v_n` evaluated matrix-free per element. Contact projects
-//!   penetrating vertices to the obstacle surface and removes their approaching normal velocity.
+//!   penetrating vertices to the obstacle surface and removes their approaching normal velocity,
+//!   then applies velocity-level Coulomb friction ([`crate::friction`]).
 //!   With consistent mass, `M a = f` is solved by Jacobi-preconditioned conjugate gradients.
 //! - **Backward Euler** (seed 5.2) by Newton's method on the incremental potential with a
 //!   backtracking line search ([`newton`]), the stiffness assembled in parallel in
@@ -23,6 +24,7 @@
 
 use crate::element::{force_differential, gather};
 use crate::error::{FemError, StateField};
+use crate::friction::{self, FrictionContact};
 use crate::ldlt::SparseLdlt;
 use crate::model::{FemModel, MassKind};
 use crate::newton::{self, NewtonData, NewtonInfo, NewtonSettings, Potential};
@@ -121,6 +123,11 @@ pub struct FemParams {
     pub project_psd: bool,
     /// Compute total energy in every step report (one more pass over the elements). Default true.
     pub report_energy: bool,
+    /// Smoothing velocity `eps_v` (m/s) of the implicit friction ([`crate::friction`]): relative
+    /// tangential speeds below it are treated as sticking, so a body held by static friction
+    /// creeps at most at this speed. Only used with obstacles of non-zero friction. Default
+    /// `1e-3` ([`friction::DEFAULT_EPS_V`]).
+    pub friction_eps_v: f64,
 }
 
 impl Default for FemParams {
@@ -135,6 +142,7 @@ impl Default for FemParams {
             cg_max_iterations: 20000,
             project_psd: true,
             report_energy: true,
+            friction_eps_v: friction::DEFAULT_EPS_V,
         }
     }
 }
@@ -181,6 +189,13 @@ impl FemParams {
         self
     }
 
+    /// With the friction smoothing velocity `eps_v` (m/s).
+    #[must_use]
+    pub fn with_friction_eps_v(mut self, eps_v: f64) -> Self {
+        self.friction_eps_v = eps_v;
+        self
+    }
+
     fn check(&self) -> Result<(), FemError> {
         let bad = |name, value, reason| Err(FemError::BadParameter { name, value, reason });
         if !(self.rayleigh_gamma >= 0.0) || !self.rayleigh_gamma.is_finite() {
@@ -194,6 +209,9 @@ impl FemParams {
         }
         if !(self.cg_tolerance > 0.0) {
             return bad("cg_tolerance", self.cg_tolerance, "must be > 0");
+        }
+        if !(self.friction_eps_v > 0.0) || !self.friction_eps_v.is_finite() {
+            return bad("friction_eps_v", self.friction_eps_v, "must be finite and > 0");
         }
         Ok(())
     }
@@ -216,6 +234,8 @@ pub struct FemSimulation {
     xhat: Vec<f64>,
     saved_x: Vec<f64>,
     saved_v: Vec<f64>,
+    /// Lagged friction contacts of the implicit step (capacity: vertices x frictional obstacles).
+    friction_contacts: Vec<FrictionContact>,
     tolerance: f64,
     steps: u64,
 }
@@ -277,6 +297,9 @@ impl FemSimulation {
             xhat: vec![0.0; n],
             saved_x: vec![0.0; n],
             saved_v: vec![0.0; n],
+            friction_contacts: Vec::with_capacity(
+                model.vertices() * model.obstacle_friction().iter().filter(|&&mu| mu > 0.0).count(),
+            ),
             model,
             params,
             steps: 0,
@@ -448,13 +471,13 @@ impl FemSimulation {
                 state.v[d] = (state.x[d] - self.xn[d]) / dt;
             }
         }
-        self.project_contacts(state);
+        self.project_contacts(state, dt);
         Ok(iterations)
     }
 
-    fn project_contacts(&self, state: &mut State) {
+    fn project_contacts(&self, state: &mut State, dt: f64) {
         let fixed = self.model.fixed();
-        for o in self.model.obstacles() {
+        for (o, &mu) in self.model.obstacles().iter().zip(self.model.obstacle_friction()) {
             for i in 0..self.model.vertices() {
                 if fixed[3 * i] && fixed[3 * i + 1] && fixed[3 * i + 2] {
                     continue;
@@ -471,6 +494,18 @@ impl FemSimulation {
                             }
                         }
                     }
+                    if vn < 0.0 && mu > 0.0 {
+                        let dv = friction::coulomb_velocity(
+                            &mut state.v[3 * i..3 * i + 3],
+                            n,
+                            -vn,
+                            mu,
+                            &fixed[3 * i..3 * i + 3],
+                        );
+                        for c in 0..3 {
+                            state.x[3 * i + c] += dt * dv[c];
+                        }
+                    }
                 }
             }
         }
@@ -483,12 +518,23 @@ impl FemSimulation {
             self.xhat[d] = state.x[d] + dt * state.v[d];
         }
         self.model.external_force(1.0, &mut self.external);
+        friction::lagged_contacts(
+            self.model.obstacles(),
+            self.model.obstacle_friction(),
+            self.model.contact_stiffness(),
+            self.params.friction_eps_v * dt,
+            &self.xn,
+            self.model.fixed(),
+            &mut self.friction_contacts,
+        );
         let gamma = self.params.rayleigh_gamma;
         if gamma > 0.0 {
             self.data.assemble_reference_stiffness(&self.model, self.model.assembly(), &self.xn);
         }
         // Initial guess: the inertial predictor, fixed coordinates at their targets; fall back
-        // to the current positions when the predictor inverts an element the material cannot.
+        // to the current positions when the predictor inverts an element the material cannot,
+        // and start from them when friction contacts are active (as IPC does: from the
+        // predictor, contact vertices start deep in the sliding regime, where Newton overshoots).
         let fixed = self.model.fixed();
         let mut x = std::mem::take(&mut state.x);
         for d in 0..n {
@@ -497,7 +543,7 @@ impl FemSimulation {
             }
         }
         self.model.apply_kinematic(state.t + dt, &mut x);
-        if !(self.model.elastic_energy(&x).is_finite()) {
+        if !self.friction_contacts.is_empty() || !(self.model.elastic_energy(&x).is_finite()) {
             for d in 0..n {
                 if !fixed[d] {
                     x[d] = self.xn[d];
@@ -515,6 +561,7 @@ impl FemSimulation {
             external: &self.external,
             obstacles: self.model.obstacles(),
             contact_stiffness: self.model.contact_stiffness(),
+            friction: &self.friction_contacts,
             fixed,
             project: self.params.project_psd,
         };
@@ -565,6 +612,7 @@ impl FemSimulation {
                 external: &self.external,
                 obstacles: self.model.obstacles(),
                 contact_stiffness: self.model.contact_stiffness(),
+                friction: &[],
                 fixed: self.model.fixed(),
                 project: self.params.project_psd,
             };
