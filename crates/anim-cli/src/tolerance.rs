@@ -513,12 +513,12 @@ pub fn choose(file: &mut SceneFile, tol: f64, table: &Table) -> Result<Choice, S
         return Err(match closest {
             Some((m, p)) => format!(
                 "--tolerance {tol:e}: no method of the {} study that this scene can run met it; the most \
-                 accurate measured is {m} at {} = {}, error {:.3e} (ask for {:.0e} or more){}",
+                 accurate measured is {m} at {} = {}, error {:.3e} (ask for {:.1e} or more){}",
                 family.study,
                 family.param,
                 short(p.param),
                 p.error,
-                decade_above(p.error),
+                round_up(p.error),
                 if refused.is_empty() {
                     String::new()
                 } else {
@@ -616,9 +616,18 @@ fn apply(scene: &mut Scene, settings: Settings) -> Result<String, String> {
     })
 }
 
-/// The smallest power of ten at or above `x`.
-fn decade_above(x: f64) -> f64 {
-    10f64.powf(x.log10().ceil())
+/// `x` rounded up to two significant digits (a tolerance, as typed, that admits it).
+fn round_up(x: f64) -> f64 {
+    let exponent = x.log10().floor();
+    let mantissa = x / 10f64.powf(exponent);
+    let mut tenths = (mantissa * 10.0 * (1.0 - 1e-12)).ceil();
+    loop {
+        let typed: f64 = format!("{}e{exponent}", tenths / 10.0).parse().unwrap_or(f64::INFINITY);
+        if typed >= x {
+            return typed;
+        }
+        tenths += 1.0;
+    }
 }
 
 fn short(x: f64) -> String {

@@ -164,7 +164,7 @@ fn the_cheapest_on_the_scene_accounts_for_the_step_each_method_needs_there() {
     assert_fits(&c, &short_before, &short, 0.02);
     // 1e-6 is met by nothing: the error names the most accurate point.
     let e = choose(&mut before.clone(), 1e-6, &t).unwrap_err();
-    assert!(e.contains("no method of the k study that this scene can run met it; the most accurate measured is rk4 at p = 0.05, error 1.000e-5 (ask for 1e-5 or more)"), "{e}");
+    assert!(e.contains("no method of the k study that this scene can run met it; the most accurate measured is rk4 at p = 0.05, error 1.000e-5 (ask for 1.0e-5 or more)"), "{e}");
 }
 
 #[test]
@@ -234,7 +234,7 @@ fn the_fem_beam_keeps_its_material_and_takes_the_studys_integrator_solver_and_sc
     assert_eq!(c.settings, "integrator = symplectic-euler");
     // 1e-4: the most accurate of the scene's material is named, not the other material's 1e-6.
     let e = choose(&mut before.clone(), 1e-4, &t).unwrap_err();
-    assert!(e.contains("the most accurate measured is stable-neo-hookean backward-euler (cholesky) at p = 0.0025, error 8.000e-3 (ask for 1e-2 or more)"), "{e}");
+    assert!(e.contains("the most accurate measured is stable-neo-hookean backward-euler (cholesky) at p = 0.0025, error 8.000e-3 (ask for 8.0e-3 or more)"), "{e}");
     assert!(e.contains("left out: neo-hookean symplectic-euler (neo-hookean material"), "{e}");
     // A table with only other materials: nothing this scene can run.
     let mut only_other = beam_table();
@@ -360,6 +360,17 @@ fn unmapped_scenes_and_bad_tolerances_are_refused() {
         ),
         "{e}"
     );
+}
+
+#[test]
+fn the_suggested_tolerance_admits_the_most_accurate_point() {
+    for (x, want) in
+        [(1e-5, 1e-5), (0.0107, 0.011), (3.46e-4, 3.5e-4), (8e-3, 8e-3), (0.99, 0.99), (0.991, 1.0)]
+    {
+        let got = round_up(x);
+        assert!((got - want).abs() < 1e-12 * want, "{x}: {got} != {want}");
+        assert!(got >= x, "{x}: {got} does not admit it");
+    }
 }
 
 #[test]
