@@ -464,6 +464,19 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
             return Err("give --dt or --tolerance, not both (--tolerance picks the step)".into());
         }
         let choice = tolerance::choose(&mut file, tol, &tolerance::table()?)?;
+        if let Some(r) = args.resolution {
+            // The scene had resolution r before the pick (set above); putting it back changes
+            // the scene only if the pick chose another.
+            let mut asked = file.scene.clone();
+            asked.set_resolution(r).map_err(|e| format!("--resolution {r}: {e}"))?;
+            if asked != file.scene {
+                return Err(format!(
+                    "give --resolution or --tolerance, not both: on {} the resolution is part of the method \
+                     --tolerance picks ({})",
+                    file.name, choice.settings
+                ));
+            }
+        }
         if !args.quiet {
             println!(
                 "--tolerance {tol:e}: picked {} ({}) because {}",

@@ -56,6 +56,10 @@ fn unmapped_scenes_and_conflicting_flags_are_refused() {
     let (ok, _, err) = run(&["run", "kepler", "--tolerance", "1e-2", "--dt", "0.01", "--out", out]);
     assert!(!ok);
     assert!(err.contains("give --dt or --tolerance, not both"), "{err}");
+    let (ok, _, err) =
+        run(&["run", "lid-driven-cavity", "--tolerance", "0.1", "--resolution", "48", "--out", out]);
+    assert!(!ok);
+    assert!(err.contains("give --resolution or --tolerance, not both: on lid-driven-cavity"), "{err}");
     let (ok, _, err) = run(&["run", "kepler", "--tolerance", "-1", "--out", out]);
     assert!(!ok);
     assert!(err.contains("--tolerance must be a positive finite number, got -1"), "{err}");
