@@ -19,11 +19,79 @@ pub const TOLERANCES: [f64; 6] = [1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8];
 /// Tolerances of the headline table.
 const HEADLINE: [f64; 3] = [1e-1, 1e-2, 1e-3];
 
-/// Studies whose problem is a scene kind `anim run` knows, with the simulated time the study
-/// measured over: `(study slug, scene kind, horizon)`. `anim run --tolerance` picks from these.
-const SCENE_FAMILIES: [(&str, &str, f64); 2] = [
-    ("core-oscillator", "harmonic-oscillator", crate::cases::core::OSCILLATOR_HORIZON),
-    ("core-kepler", "kepler-orbit", crate::cases::core::KEPLER_HORIZON),
+/// A study whose problem a scene of `anim run` runs (or shares its method settings with), for
+/// `anim run --tolerance`.
+pub struct SceneFamily {
+    /// The study's slug.
+    pub study: &'static str,
+    /// `KIND` (any scene of that kind) or `KIND/PRESET` (that preset only).
+    pub scene: &'static str,
+    /// Simulated time the study measured over (`None`: the error is not a trajectory's, e.g. a
+    /// steady state or one pressure projection).
+    pub horizon: Option<f64>,
+    /// The study problem's parameters the picker scales by (names and values).
+    pub problem: fn(quick: bool) -> Vec<(&'static str, f64)>,
+}
+
+fn no_problem(_quick: bool) -> Vec<(&'static str, f64)> {
+    Vec::new()
+}
+
+/// The beam of the FEM study (`cases/fem.rs`, `study_sim`): Young's modulus (Pa), density
+/// (kg/m^3) and cell size (m; 2 cells across 0.1 m).
+fn fem_beam_problem(_quick: bool) -> Vec<(&'static str, f64)> {
+    vec![("young", 1e6), ("density", 1000.0), ("cell", 0.05)]
+}
+
+/// The cloth of the spring study (`cases/springs.rs`, `study_cloth`): particles per side (6 in
+/// quick mode, 10 in full), side length (m), total mass (kg), structural stiffness (N/m).
+fn springs_cloth_problem(quick: bool) -> Vec<(&'static str, f64)> {
+    vec![("n", if quick { 6.0 } else { 10.0 }), ("size", 0.5), ("mass", 0.1), ("stiffness", 100.0)]
+}
+
+/// The cavity study's pressure tolerance (`cases/fluid.rs`, `study_ghia`).
+fn cavity_problem(_quick: bool) -> Vec<(&'static str, f64)> {
+    vec![("pressure_tolerance", 1e-5)]
+}
+
+/// The studies `anim run --tolerance` picks from.
+pub const SCENE_FAMILIES: [SceneFamily; 6] = [
+    SceneFamily {
+        study: "core-oscillator",
+        scene: "harmonic-oscillator",
+        horizon: Some(crate::cases::core::OSCILLATOR_HORIZON),
+        problem: no_problem,
+    },
+    SceneFamily {
+        study: "core-kepler",
+        scene: "kepler-orbit",
+        horizon: Some(crate::cases::core::KEPLER_HORIZON),
+        problem: no_problem,
+    },
+    SceneFamily {
+        study: "springs-cloth",
+        scene: "springs/hanging-cloth",
+        horizon: Some(0.25),
+        problem: springs_cloth_problem,
+    },
+    SceneFamily {
+        study: "fem-beam",
+        scene: "fem/cantilever-beam",
+        horizon: Some(0.5),
+        problem: fem_beam_problem,
+    },
+    SceneFamily {
+        study: "fluid_cavity_ghia",
+        scene: "fluid/lid-driven-cavity",
+        horizon: None,
+        problem: cavity_problem,
+    },
+    SceneFamily {
+        study: "fluid_pressure_divergence",
+        scene: "fluid/smoke-plume-3d",
+        horizon: None,
+        problem: no_problem,
+    },
 ];
 
 /// Everything the report shows.
@@ -241,7 +309,12 @@ pub fn write(dir: &Path, r: &Report) -> Result<(), String> {
     if failed.is_empty() { Ok(()) } else { Err(failed.join("\n")) }
 }
 
-/// `docs/report/cheapest.json`: per study, per tolerance, the cheapest measured method.
+/// Version of `cheapest.json`: 2 added every measured point per method (`series`) and the study
+/// problem's parameters (`problem`); `scene` may name a preset (`KIND/PRESET`).
+pub const FORMAT: u32 = 2;
+
+/// `docs/report/cheapest.json`: per study, per tolerance, the cheapest measured method, and every
+/// measured point per method.
 #[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub struct CheapestTable {
     /// Format version.
@@ -266,11 +339,38 @@ pub struct Family {
     pub error: String,
     /// What the swept parameter is (dt, iterations, resolution).
     pub param: String,
-    /// The scene kind of `anim run` this study's problem is, if any.
+    /// The scene of `anim run` this study's problem is (`KIND` or `KIND/PRESET`), if any.
     pub scene: Option<String>,
-    /// Simulated time the study measured over (for scene families).
+    /// Simulated time the study measured over (for scene families with a trajectory error).
     pub horizon: Option<f64>,
+    /// The study problem's parameters the picker scales by (scene families only).
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub problem: std::collections::BTreeMap<String, f64>,
+    /// The cheapest point of any method per tolerance.
     pub picks: Vec<Pick>,
+    /// Every measured point, per method: `anim run --tolerance` picks among the methods that
+    /// keep the scene's physics, which need not include the overall cheapest.
+    pub series: Vec<TableSeries>,
+}
+
+/// One method's measured points.
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+pub struct TableSeries {
+    /// The method label.
+    pub method: String,
+    /// Its points (only those with a finite error and wall time).
+    pub points: Vec<TablePoint>,
+}
+
+/// One measured point.
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+pub struct TablePoint {
+    /// The swept parameter.
+    pub param: f64,
+    /// Median wall time of one run of the study's problem, seconds.
+    pub seconds: f64,
+    /// The study's error.
+    pub error: f64,
 }
 
 /// The cheapest method meeting one tolerance; `method` is `None` when none in the sweep does.
@@ -289,15 +389,31 @@ pub fn cheapest_table(r: &Report) -> CheapestTable {
         .studies
         .iter()
         .map(|(krate, s)| {
-            let scene = SCENE_FAMILIES.iter().find(|f| f.0 == s.slug);
+            let scene = SCENE_FAMILIES.iter().find(|f| f.study == s.slug);
             Family {
                 study: s.slug.clone(),
                 krate: (*krate).into(),
                 title: s.title.clone(),
                 error: s.error_label.clone(),
                 param: s.param_label.clone(),
-                scene: scene.map(|f| f.1.to_string()),
-                horizon: scene.map(|f| f.2),
+                scene: scene.map(|f| f.scene.to_string()),
+                horizon: scene.and_then(|f| f.horizon),
+                problem: scene
+                    .map(|f| (f.problem)(r.quick).into_iter().map(|(k, v)| (k.to_string(), v)).collect())
+                    .unwrap_or_default(),
+                series: s
+                    .series
+                    .iter()
+                    .map(|series| TableSeries {
+                        method: series.label.clone(),
+                        points: series
+                            .points
+                            .iter()
+                            .filter(|p| p.error.is_finite() && p.seconds.is_finite())
+                            .map(|p| TablePoint { param: p.param, seconds: p.seconds, error: p.error })
+                            .collect(),
+                    })
+                    .collect(),
                 picks: TOLERANCES
                     .iter()
                     .map(|&tol| match cheapest(s, tol) {
@@ -317,7 +433,7 @@ pub fn cheapest_table(r: &Report) -> CheapestTable {
         })
         .collect();
     CheapestTable {
-        format: 1,
+        format: FORMAT,
         date: r.date.clone(),
         machine: r.machine.clone(),
         mode: if r.quick { "quick" } else { "full" }.into(),
@@ -821,15 +937,27 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         write(&dir, &tiny_report()).unwrap();
         let text = std::fs::read_to_string(dir.join("cheapest.json")).unwrap();
+        std::fs::remove_dir_all(&dir).ok();
+        // A report with the FEM, spring and cavity studies too, and a point that failed (NaN).
+        let mut r = tiny_report();
+        r.studies[0].1.series[1].points.push(Point { param: 0.05, seconds: f64::NAN, error: f64::NAN });
+        for (krate, slug) in
+            [("anim-fem", "fem-beam"), ("anim-springs", "springs-cloth"), ("anim-fluid", "fluid_cavity_ghia")]
+        {
+            r.studies.push((krate, StudyResult { slug: slug.into(), ..tiny() }));
+        }
+        let text_all = serde_json::to_string_pretty(&cheapest_table(&r)).unwrap();
+        assert!(text.contains("\"format\": 2"));
+        let text = text_all;
         let v: serde_json::Value = serde_json::from_str(&text).unwrap();
-        assert_eq!(v["format"], 1);
+        assert_eq!(v["format"], 2);
         assert_eq!(v["date"], "2026-11-25");
         assert_eq!(v["machine"]["cpu"], "CPU");
         assert_eq!(v["machine"]["cores"], 2);
         assert_eq!(v["mode"], "quick");
         assert_eq!(v["tolerances"], serde_json::json!([1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8]));
         let families = v["families"].as_array().unwrap();
-        assert_eq!(families.len(), 2);
+        assert_eq!(families.len(), 5);
         let osc = &families[0];
         assert_eq!(osc["study"], "core-oscillator");
         assert_eq!(osc["crate"], "anim-core");
@@ -861,6 +989,30 @@ mod tests {
                 None => assert!(p["method"].is_null() && p["param"].is_null(), "{tol}"),
             }
         }
+        // Every finite point of every method, in the study's order (the NaN point is left out).
+        let series = osc["series"].as_array().unwrap();
+        let methods: Vec<&str> = series.iter().map(|s| s["method"].as_str().unwrap()).collect();
+        assert_eq!(methods, ["slow-accurate", "fast-rough"]);
+        assert_eq!(
+            series[0]["points"],
+            serde_json::json!([
+                { "param": 0.1, "seconds": 1.0, "error": 1e-7 },
+                { "param": 0.2, "seconds": 0.5, "error": 1e-5 },
+            ])
+        );
+        assert_eq!(
+            series[1]["points"],
+            serde_json::json!([{ "param": 0.1, "seconds": 0.01, "error": 1e-3 }])
+        );
+        assert!(osc.get("problem").is_none(), "the oscillator study has no problem parameters");
+        let beam = &families[2];
+        assert_eq!(beam["study"], "fem-beam");
+        assert_eq!(beam["scene"], "fem/cantilever-beam");
+        assert_eq!(beam["horizon"], 0.5);
+        assert_eq!(beam["problem"], serde_json::json!({ "young": 1e6, "density": 1000.0, "cell": 0.05 }));
+        let cloth = &families[3];
+        assert_eq!(cloth["problem"]["n"], 6.0, "quick mode's cloth is 6 x 6");
+        assert!(families[4]["horizon"].is_null() && families[4]["scene"] == "fluid/lid-driven-cavity");
         // And it reads back into the typed form.
         let table: CheapestTable = serde_json::from_str(&text).unwrap();
         assert_eq!(table.families[0].picks[3].method.as_deref(), Some("slow-accurate"));

@@ -110,9 +110,11 @@ struct RunArgs {
     /// `anim resume` continues from it.
     #[arg(long)]
     checkpoint_every: Option<usize>,
-    /// The accuracy the run needs instead of a method: the integrator and time step come from
-    /// the report's measured cheapest-method table (oscillator and Kepler scenes), and the run's
-    /// error on the table's measure is printed at the end.
+    /// The accuracy the run needs instead of a method: the method (integrator, solver, time
+    /// step, resolution or pressure tolerance) comes from the report's measured work-precision
+    /// studies (oscillator, Kepler, FEM beam, hanging cloth, lid-driven cavity, smoke plume), and
+    /// the run's error on the study's measure is printed at the end where the scene has a
+    /// reference.
     #[arg(long, allow_hyphen_values = true)]
     tolerance: Option<f64>,
 }
@@ -462,8 +464,24 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
             return Err("give --dt or --tolerance, not both (--tolerance picks the step)".into());
         }
         let choice = tolerance::choose(&mut file, tol, &tolerance::table()?)?;
+        if let Some(r) = args.resolution {
+            // The scene had resolution r before the pick (set above); putting it back changes
+            // the scene only if the pick chose another.
+            let mut asked = file.scene.clone();
+            asked.set_resolution(r).map_err(|e| format!("--resolution {r}: {e}"))?;
+            if asked != file.scene {
+                return Err(format!(
+                    "give --resolution or --tolerance, not both: on {} the resolution is part of the method \
+                     --tolerance picks ({})",
+                    file.name, choice.settings
+                ));
+            }
+        }
         if !args.quiet {
-            println!("--tolerance {tol:e}: picked {} because {}", choice.integrator.label(), choice.why);
+            println!(
+                "--tolerance {tol:e}: picked {} ({}) because {}",
+                choice.method, choice.settings, choice.why
+            );
         }
     }
     let runner = runner::build(&file.scene, &origin, args.skinning).map_err(|e| e.to_string())?;
@@ -607,12 +625,16 @@ fn execute(mut s: Session) -> Result<(), String> {
     let mut failure = None;
     let mut checkpoints = 0usize;
     let mut table_error: Option<(f64, f64)> = None;
+    let mut max_residual: Option<f64> = None;
     'frames: for frame in s.start_frame..run.frames {
         let t_step = Instant::now();
         for _ in 0..run.steps_per_frame {
             match s.runner.step(run.dt) {
                 Ok(report) => {
                     s.newton_iterations += report.iterations;
+                    if let Some(r) = report.residual {
+                        max_residual = Some(max_residual.map_or(r, |m: f64| m.max(r)));
+                    }
                     energy = report.energy;
                     if s.energy_initial.is_none() {
                         s.energy_initial = energy;
@@ -630,7 +652,7 @@ fn execute(mut s: Session) -> Result<(), String> {
             s.max_error = Some(s.max_error.map_or(e, |m: f64| m.max(e)));
         }
         if s.tolerance.is_some()
-            && let Some(e) = tolerance::table_error(&s.file.scene, s.runner.state())
+            && let Some(e) = tolerance::table_error(&s.file.scene, s.runner.as_ref(), max_residual)
         {
             table_error = Some((e, table_error.map_or(e, |(_, m)| m.max(e))));
         }

@@ -24,6 +24,10 @@ pub trait Runner {
     fn state(&self) -> &State;
     /// Advances by `dt`.
     fn step(&mut self, dt: f64) -> Result<StepReport, String>;
+    /// The MAC fluid and its state, for grid fluid scenes run by the MAC solver.
+    fn mac(&self) -> Option<(&anim_fluid::mac::MacFluid, &anim_fluid::mac::MacState)> {
+        None
+    }
     /// Error of the current state against an exact solution, where one exists.
     fn exact_error(&self) -> Option<f64> {
         None
@@ -180,14 +184,20 @@ pub fn build(
                 s.into_simulation().map_err(|e| SceneError::invalid(file, "scene.preset", e.to_string()))?;
             Box::new(PbdRunner { name, method, sim, state })
         }
-        Scene::Fem { ref preset, resolution } => {
-            let scene = preset_scene(
+        Scene::Fem { ref preset, resolution, integrator, linear_solver } => {
+            let mut scene = preset_scene(
                 file,
                 "scene.resolution",
                 preset,
                 &anim_fem::scenes::NAMES,
                 anim_fem::scenes::by_name(preset, resolution),
             )?;
+            if let Some(i) = integrator {
+                scene.params.integrator = i;
+            }
+            if let Some(l) = linear_solver {
+                scene.params.linear_solver = l;
+            }
             let name = format!("fem/{}", scene.name);
             let (sim, state) = scene
                 .into_simulation()
@@ -204,7 +214,7 @@ pub fn build(
             )?;
             Box::new(MpmRunner::new(scene))
         }
-        Scene::Fluid { ref preset, resolution } => {
+        Scene::Fluid { ref preset, resolution, pressure_solver, pressure_tolerance } => {
             let limit = if preset == "smoke-plume-3d" { 128 } else { 2048 };
             if let Some(r) = resolution
                 && r > limit
@@ -222,7 +232,34 @@ pub fn build(
                 &anim_fluid::scenes::NAMES,
                 anim_fluid::scenes::by_name(preset, resolution),
             )?;
-            Box::new(FluidRunner::new(scene))
+            if pressure_solver.is_some() || pressure_tolerance.is_some() {
+                let field = if pressure_solver.is_some() {
+                    "scene.pressure_solver"
+                } else {
+                    "scene.pressure_tolerance"
+                };
+                let mut scene = scene;
+                let anim_fluid::scenes::FluidSim::Mac(fluid, _) = &mut scene.sim else {
+                    return Err(SceneError::invalid(
+                        file,
+                        field,
+                        format!(
+                            "{preset} runs the seed's solver (20 Gauss-Seidel sweeps), which has no pressure settings"
+                        ),
+                    ));
+                };
+                let p = fluid.params();
+                let (method, tol) = (
+                    pressure_solver.map_or(p.pressure, |s| s.0),
+                    pressure_tolerance.unwrap_or(p.pressure_tolerance),
+                );
+                fluid
+                    .set_pressure(method, tol, PRESSURE_MAX_ITERATIONS)
+                    .map_err(|e| SceneError::invalid(file, field, e.to_string()))?;
+                Box::new(FluidRunner::new(scene))
+            } else {
+                Box::new(FluidRunner::new(scene))
+            }
         }
         Scene::Flip { ref preset, resolution, transfer } => {
             let limit = if preset.ends_with("3d") { 128 } else { 1024 };
@@ -271,6 +308,10 @@ pub fn build(
         }
     })
 }
+
+/// The iteration cap of a pressure solve whose solver or tolerance a scene file sets (the report's
+/// pressure study's cap).
+pub const PRESSURE_MAX_ITERATIONS: usize = 200_000;
 
 /// The scene a crate's `by_name` found for `preset`: an unknown name is an error on
 /// `scene.preset` listing the known ones; a build error is reported on `field`.
@@ -979,6 +1020,13 @@ impl Runner for FluidRunner {
         Ok(report)
     }
 
+    fn mac(&self) -> Option<(&anim_fluid::mac::MacFluid, &anim_fluid::mac::MacState)> {
+        match &self.scene.sim {
+            anim_fluid::scenes::FluidSim::Mac(f, s) => Some((f, s)),
+            anim_fluid::scenes::FluidSim::Seed(_) => None,
+        }
+    }
+
     fn save(&self) -> serde_json::Value {
         serde_json::json!({ "time": self.display.t, "fluid": self.scene.memory() })
     }
@@ -1259,6 +1307,58 @@ mod tests {
             assert!(drawn > 20, "{name}: only {drawn} pixels drawn");
         }
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn fluid_pressure_settings_reach_the_solver_or_are_refused() {
+        let text = scene::builtin("lid-driven-cavity").unwrap().replace(
+            "resolution = 64",
+            "resolution = 8\npressure_solver = \"rb-gauss-seidel\"\npressure_tolerance = 1e-4",
+        );
+        let file = scene::parse(&text, Path::new("s.toml")).unwrap();
+        let runner = build(&file.scene, Path::new("s.toml"), None).unwrap();
+        let (fluid, _) = runner.mac().unwrap();
+        let p = fluid.params();
+        assert_eq!(
+            (p.pressure, p.pressure_tolerance, p.pressure_max_iterations),
+            (anim_fluid::pressure::PressureMethod::RedBlackGaussSeidel, 1e-4, PRESSURE_MAX_ITERATIONS)
+        );
+        assert!(runner.method().contains("rb-gauss-seidel pressure"), "{}", runner.method());
+        // Without the fields the preset's own settings stay (MGPCG to 1e-8, 1000 iterations).
+        let plain = scene::parse(
+            &scene::builtin("lid-driven-cavity").unwrap().replace("64", "8"),
+            Path::new("s.toml"),
+        );
+        let runner = build(&plain.unwrap().scene, Path::new("s.toml"), None).unwrap();
+        let p = runner.mac().unwrap().0.params();
+        assert_eq!((p.pressure, p.pressure_tolerance), (anim_fluid::pressure::PressureMethod::Mgpcg, 1e-8));
+        let text =
+            scene::builtin("smoke-box-2d").unwrap().replace("resolution = 128", "pressure_tolerance = 1e-4");
+        let file = scene::parse(&text, Path::new("s.toml")).unwrap();
+        let msg = build(&file.scene, Path::new("s.toml"), None).err().unwrap().to_string();
+        assert!(
+            msg.contains("field `scene.pressure_tolerance`: smoke-box-2d runs the seed's solver"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn fem_method_fields_reach_the_simulation() {
+        let text = scene::builtin("beam").unwrap().replace(
+            "preset = \"cantilever-beam\"",
+            "preset = \"cantilever-beam\"\nresolution = 1\nintegrator = \"symplectic-euler\"",
+        );
+        let file = scene::parse(&text, Path::new("s.toml")).unwrap();
+        let mut runner = build(&file.scene, Path::new("s.toml"), None).unwrap();
+        // An explicit step has no Newton update to report; the preset's backward Euler has.
+        assert_eq!(runner.step(1e-5).unwrap().residual, None);
+        let text = scene::builtin("beam")
+            .unwrap()
+            .replace("preset = \"cantilever-beam\"", "preset = \"cantilever-beam\"\nresolution = 1");
+        let file = scene::parse(&text, Path::new("s.toml")).unwrap();
+        let mut runner = build(&file.scene, Path::new("s.toml"), None).unwrap();
+        let report = runner.step(1e-2).unwrap();
+        assert!(report.iterations >= 1 && report.residual.is_some(), "{report:?}");
     }
 
     #[test]

@@ -114,6 +114,14 @@ pub enum Scene {
         /// absent).
         #[serde(default)]
         resolution: Option<usize>,
+        /// Time integrator (`"backward-euler"` or `"symplectic-euler"`; the preset's when
+        /// absent).
+        #[serde(default)]
+        integrator: Option<anim_fem::sim::TimeIntegrator>,
+        /// Linear solver inside Newton (`"cholesky"`, `"ldlt"`, `"jacobi-pcg"`; the preset's when
+        /// absent).
+        #[serde(default)]
+        linear_solver: Option<anim_fem::sim::LinearSolverChoice>,
     },
     /// A material-point-method scene of anim-mpm (`three-materials` in 2D, `dam-break-3d`,
     /// `snowball`, `benchmark-2d`, `benchmark-3d`); each step may take CFL substeps.
@@ -136,6 +144,15 @@ pub enum Scene {
         /// in 3D.
         #[serde(default)]
         resolution: Option<usize>,
+        /// Pressure solver of the MAC presets (`"jacobi"`, `"rb-gauss-seidel"`, `"cg"`,
+        /// `"mgpcg"`; the preset's when absent). Setting it or the tolerance lets the solver take
+        /// up to 200,000 iterations.
+        #[serde(default)]
+        pressure_solver: Option<PressureSolver>,
+        /// Relative residual `max|b - A p| / max|b|` the pressure solve stops at (MAC presets;
+        /// the preset's when absent).
+        #[serde(default)]
+        pressure_tolerance: Option<f64>,
     },
     /// An incompressible particle fluid of anim-flip (`dam-break-2d`, `dam-break-3d`, `drop-2d`,
     /// `drop-3d`, `sloshing-tank`): particles carry the water, a MAC grid makes it
@@ -169,6 +186,36 @@ pub enum Scene {
         #[serde(default)]
         linear_solver: Option<LinearSolverKind>,
     },
+}
+
+/// The pressure solver of a MAC [`Scene::Fluid`], by its name in reports
+/// ([`PressureMethod::name`](anim_fluid::pressure::PressureMethod::name)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PressureSolver(pub anim_fluid::pressure::PressureMethod);
+
+impl PressureSolver {
+    /// The solver named `name`, if any.
+    #[must_use]
+    pub fn by_name(name: &str) -> Option<Self> {
+        anim_fluid::pressure::PressureMethod::ALL.into_iter().find(|m| m.name() == name).map(Self)
+    }
+}
+
+impl Serialize for PressureSolver {
+    fn serialize<Se: serde::Serializer>(&self, s: Se) -> Result<Se::Ok, Se::Error> {
+        s.serialize_str(self.0.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for PressureSolver {
+    fn deserialize<De: serde::Deserializer<'de>>(d: De) -> Result<Self, De::Error> {
+        let name = String::deserialize(d)?;
+        Self::by_name(&name).ok_or_else(|| {
+            let names: Vec<&str> =
+                anim_fluid::pressure::PressureMethod::ALL.iter().map(|m| m.name()).collect();
+            serde::de::Error::custom(format!("{UNKNOWN_PRESSURE}{name}` (one of {})", names.join(", ")))
+        })
+    }
 }
 
 /// The grid-to-particle transfer of a [`Scene::Flip`].
@@ -207,6 +254,9 @@ fn flip_preset<'de, De: serde::Deserializer<'de>>(d: De) -> Result<String, De::E
         )))
     }
 }
+
+/// How [`PressureSolver`]'s error starts, for [`parse`] to find the line.
+const UNKNOWN_PRESSURE: &str = "unknown pressure solver `";
 
 /// How [`flip_preset`]'s error starts, for [`parse`] to find the line.
 const UNKNOWN_PRESET: &str = "unknown preset `";
@@ -700,6 +750,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
         // Fields of tagged tables are reported at the table's start; point at the field itself.
         let start = unknown_field(e.message())
             .or_else(|| e.message().contains(UNKNOWN_PRESET).then_some("preset"))
+            .or_else(|| e.message().contains(UNKNOWN_PRESSURE).then_some("pressure_solver"))
             .and_then(|name| field_offset(text, start, name))
             .unwrap_or(start);
         let (line, column) = line_col(text, start);
@@ -799,6 +850,10 @@ fn validate(s: &SceneFile) -> Result<(), (&'static str, String)> {
                 return Err(("scene.eccentricity", format!("must lie in [0, 1), got {eccentricity}")));
             }
             integrator
+        }
+        Scene::Fluid { pressure_tolerance: Some(tol), .. } => {
+            positive("scene.pressure_tolerance", *tol)?;
+            return Ok(());
         }
         Scene::Pbd { .. }
         | Scene::Rigid { .. }
@@ -909,6 +964,51 @@ mod tests {
         assert!(msg.contains("field `scene.transfer`") && msg.contains("1.5"), "{msg}");
         let msg = err(&FLIP_DROP_2D.replace("resolution = 64", "transfer = \"mpm\""));
         assert!(msg.starts_with("s.toml:") && msg.contains("mpm"), "{msg}");
+    }
+
+    #[test]
+    fn fem_and_fluid_method_fields_parse_and_bad_ones_name_their_field() {
+        let text = BEAM.replace(
+            "preset = \"cantilever-beam\"",
+            "preset = \"cantilever-beam\"\nintegrator = \"symplectic-euler\"\nlinear_solver = \"jacobi-pcg\"",
+        );
+        let s = parse(&text, Path::new("s.toml")).unwrap();
+        assert!(matches!(
+            s.scene,
+            Scene::Fem {
+                integrator: Some(anim_fem::sim::TimeIntegrator::SymplecticEuler),
+                linear_solver: Some(anim_fem::sim::LinearSolverChoice::JacobiPcg),
+                ..
+            }
+        ));
+        let msg = err(&text.replace("jacobi-pcg", "lu"));
+        assert!(msg.starts_with("s.toml:") && msg.contains("lu"), "{msg}");
+        let text = CAVITY.replace("resolution = 64", "pressure_solver = \"cg\"\npressure_tolerance = 1e-6");
+        let s = parse(&text, Path::new("s.toml")).unwrap();
+        assert!(matches!(
+            s.scene,
+            Scene::Fluid {
+                pressure_solver: Some(PressureSolver(anim_fluid::pressure::PressureMethod::ConjugateGradient)),
+                pressure_tolerance: Some(t),
+                resolution: None,
+                ..
+            } if t == 1e-6
+        ));
+        // Written back, the solver keeps its report name.
+        assert!(toml::to_string(&s).unwrap().contains("pressure_solver = \"cg\""));
+        let bad = text.replace("\"cg\"", "\"sor\"");
+        let msg = err(&bad);
+        let line = bad.lines().position(|l| l.starts_with("pressure_solver")).unwrap() + 1;
+        assert!(msg.starts_with(&format!("s.toml:{line}:")), "{msg}");
+        assert!(
+            msg.contains("unknown pressure solver `sor` (one of jacobi, rb-gauss-seidel, cg, mgpcg)"),
+            "{msg}"
+        );
+        let msg = err(&text.replace("1e-6", "0.0"));
+        assert!(
+            msg.contains("field `scene.pressure_tolerance`: must be a positive finite number, got 0"),
+            "{msg}"
+        );
     }
 
     #[test]

@@ -1,0 +1,414 @@
+use super::*;
+use crate::scene;
+use std::path::Path;
+
+fn builtin(name: &str) -> SceneFile {
+    scene::parse(scene::builtin(name).unwrap_or_default(), Path::new(name)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn pt(param: f64, seconds: f64, error: f64) -> Point {
+    Point { param, seconds, error }
+}
+
+fn family(
+    study: &str,
+    scene: &str,
+    horizon: Option<f64>,
+    problem: &[(&str, f64)],
+    series: &[(&str, Vec<Point>)],
+) -> Family {
+    Family {
+        study: study.into(),
+        scene: Some(scene.into()),
+        horizon,
+        error: "e".into(),
+        param: "p".into(),
+        problem: problem.iter().map(|(k, v)| ((*k).to_string(), *v)).collect(),
+        series: series.iter().map(|(m, p)| Series { method: (*m).into(), points: p.clone() }).collect(),
+    }
+}
+
+fn made(families: Vec<Family>) -> Table {
+    Table {
+        format: FORMAT,
+        date: "2026-11-25".into(),
+        machine: Machine { cpu: "CPU".into(), cores: 2 },
+        mode: "full".into(),
+        families,
+    }
+}
+
+fn frame(file: &SceneFile) -> f64 {
+    file.run.dt * file.run.steps_per_frame as f64
+}
+
+/// The run's step is the largest that divides the frame into whole steps and is at most `dt`.
+fn assert_fits(c: &Choice, before: &SceneFile, after: &SceneFile, dt: f64) {
+    let f = frame(before);
+    assert!((frame(after) - f).abs() < 1e-12 * f, "frame time changed");
+    assert_eq!(after.run.frames, before.run.frames);
+    assert!(c.dt <= dt * (1.0 + 1e-12), "{} > {dt}", c.dt);
+    assert_eq!(c.steps_per_frame, (f / dt * (1.0 - 1e-12)).ceil() as usize);
+    assert_eq!((after.run.dt, after.run.steps_per_frame), (c.dt, c.steps_per_frame));
+}
+
+#[test]
+fn the_embedded_table_parses_and_its_scene_families_name_known_methods() {
+    let t = table_or_panic();
+    assert!(!t.date.is_empty() && t.machine.cores >= 1);
+    let scenes: Vec<&str> = t.families.iter().filter_map(|f| f.scene.as_deref()).collect();
+    for s in [
+        "harmonic-oscillator",
+        "kepler-orbit",
+        "springs/hanging-cloth",
+        "fem/cantilever-beam",
+        "fluid/lid-driven-cavity",
+        "fluid/smoke-plume-3d",
+    ] {
+        assert!(scenes.contains(&s), "{s} missing from {scenes:?}");
+    }
+    for f in t.families.iter().filter(|f| f.scene.is_some()) {
+        assert!(!f.series.is_empty(), "{}", f.study);
+        for s in &f.series {
+            let known = match f.scene.as_deref() {
+                Some("harmonic-oscillator" | "kepler-orbit") => integrator(&s.method).is_some(),
+                Some("springs/hanging-cloth") => {
+                    integrator(s.method.split(" / ").next().unwrap_or_default()).is_some()
+                }
+                Some("fem/cantilever-beam") => fem_label(&s.method).is_some(),
+                Some("fluid/lid-driven-cavity") => PressureSolver::by_name(&s.method).is_some(),
+                Some("fluid/smoke-plume-3d") => pressure_label(&s.method).is_some(),
+                other => panic!("unexpected scene {other:?}"),
+            };
+            assert!(known, "{}: unknown method {}", f.study, s.method);
+            for p in &s.points {
+                assert!(p.error.is_finite() && p.error >= 0.0 && p.seconds > 0.0 && p.param > 0.0, "{p:?}");
+            }
+        }
+    }
+}
+
+fn table_or_panic() -> Table {
+    table().unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn labels_of_the_fem_and_pressure_studies_parse_back() {
+    // The beam study's labels, spelled as its brief gives them.
+    for model in MaterialModel::ALL {
+        assert_eq!(
+            fem_label(&format!("{} symplectic-euler", model.name())),
+            Some((model, TimeIntegrator::SymplecticEuler, None))
+        );
+        for solver in LinearSolverChoice::ALL {
+            assert_eq!(
+                fem_label(&format!("{} backward-euler ({})", model.name(), solver.name())),
+                Some((model, TimeIntegrator::BackwardEuler, Some(solver)))
+            );
+        }
+    }
+    assert_eq!(
+        fem_label("linear backward-euler"),
+        Some((MaterialModel::Linear, TimeIntegrator::BackwardEuler, None))
+    );
+    for bad in [
+        "stable-neo-hookean",
+        "rubber symplectic-euler",
+        "linear backward-euler (lu)",
+        "linear backward-eulerx",
+    ] {
+        assert_eq!(fem_label(bad), None, "{bad}");
+    }
+    assert_eq!(pressure_label("rb-gauss-seidel N=256"), Some((PressureMethod::RedBlackGaussSeidel, 256)));
+    assert_eq!(pressure_label("mgpcg N=64"), Some((PressureMethod::Mgpcg, 64)));
+    assert_eq!(pressure_label("sor N=64"), None);
+}
+
+#[test]
+fn the_cheapest_on_the_scene_accounts_for_the_step_each_method_needs_there() {
+    // The Kepler scene runs 400 frames x 10 steps x 0.005 s = 20 s; a study horizon of 5 makes
+    // the run 4 horizons long: a first-order method's step shrinks by (1/4)^2 = 1/16, RK4's by
+    // (1/4)^(1/2) = 1/2. Symplectic Euler is the cheapest in the study (1 ms against 5 ms) but on
+    // the scene costs 16 ms against RK4's 10 ms.
+    let t = made(vec![family(
+        "k",
+        "kepler-orbit",
+        Some(5.0),
+        &[],
+        &[
+            ("symplectic-euler", vec![pt(0.01, 1e-3, 1e-3)]),
+            ("rk4", vec![pt(0.1, 5e-3, 1e-3), pt(0.05, 9e-3, 1e-5)]),
+            ("velocity-verlet", vec![pt(0.02, 1e-4, 2e-2)]),
+        ],
+    )]);
+    let before = builtin("kepler");
+    let mut file = before.clone();
+    let c = choose(&mut file, 1e-2, &t).unwrap();
+    assert_eq!(c.method, "rk4");
+    assert_eq!(c.param, 0.1);
+    assert!(matches!(file.scene, Scene::KeplerOrbit { integrator: IntegratorKind::Rk4, .. }));
+    assert_fits(&c, &before, &file, 0.1 * 0.5);
+    assert!(
+        c.why.starts_with(
+            "cheapest measured method with error <= 1e-2 that this scene can run: rk4 at p = 0.1"
+        ),
+        "{}",
+        c.why
+    );
+    // Over a run no longer than the horizon the study's own ranking holds: velocity Verlet at 2e-2.
+    let mut short_before = before.clone();
+    short_before.run.frames = 5;
+    let mut short = short_before.clone();
+    let c = choose(&mut short, 3e-2, &t).unwrap();
+    assert_eq!((c.method.as_str(), c.param), ("velocity-verlet", 0.02));
+    assert_fits(&c, &short_before, &short, 0.02);
+    // 1e-6 is met by nothing: the error names the most accurate point.
+    let e = choose(&mut before.clone(), 1e-6, &t).unwrap_err();
+    assert!(e.contains("no method of the k study that this scene can run met it; the most accurate measured is rk4 at p = 0.05, error 1.000e-5 (ask for 1.0e-5 or more)"), "{e}");
+}
+
+#[test]
+fn the_oscillator_step_is_in_units_of_one_over_omega() {
+    // The built-in oscillator: k = 40, m = 1, so omega = sqrt(40); its 1000 steps of 0.01 s run
+    // 10 s = 63 time units, inside a horizon of 100.
+    let t = made(vec![family(
+        "o",
+        "harmonic-oscillator",
+        Some(100.0),
+        &[],
+        &[("rk4", vec![pt(0.5, 1e-5, 1e-3)])],
+    )]);
+    let before = builtin("oscillator");
+    let mut file = before.clone();
+    let c = choose(&mut file, 1e-2, &t).unwrap();
+    assert_fits(&c, &before, &file, 0.5 / 40f64.sqrt());
+}
+
+fn beam_table() -> Table {
+    made(vec![family(
+        "fem-beam",
+        "fem/cantilever-beam",
+        Some(0.5),
+        &[("young", 1e6), ("density", 1000.0), ("cell", 0.05)],
+        &[
+            // The cheapest and most accurate, but another material: never the scene's.
+            ("neo-hookean symplectic-euler", vec![pt(1e-3, 1e-3, 1e-6)]),
+            ("stable-neo-hookean symplectic-euler", vec![pt(6.25e-4, 2e-2, 5e-2)]),
+            (
+                "stable-neo-hookean backward-euler (cholesky)",
+                vec![pt(0.01, 8e-2, 4e-2), pt(2.5e-3, 0.3, 8e-3)],
+            ),
+            ("stable-neo-hookean backward-euler (ldlt)", vec![pt(0.01, 5e-2, 4e-2), pt(2.5e-3, 0.2, 8e-3)]),
+        ],
+    )])
+}
+
+#[test]
+fn the_fem_beam_keeps_its_material_and_takes_the_studys_integrator_solver_and_scaled_step() {
+    let t = beam_table();
+    let before = builtin("beam");
+    let mut file = before.clone();
+    let c = choose(&mut file, 1e-2, &t).unwrap();
+    assert_eq!((c.method.as_str(), c.param), ("stable-neo-hookean backward-euler (ldlt)", 2.5e-3));
+    assert!(matches!(
+        file.scene,
+        Scene::Fem {
+            integrator: Some(TimeIntegrator::BackwardEuler),
+            linear_solver: Some(LinearSolverChoice::Ldlt),
+            ..
+        }
+    ));
+    assert_eq!(c.settings, "integrator = backward-euler, linear_solver = ldlt");
+    // The preset (anim-fem scenes docs): E = 10 MPa, rho = 1000, 4 cells across 0.1 m; the study's
+    // beam E = 1 MPa, 2 cells: wave speeds sqrt(1e6 / 1e7), cells 0.025 / 0.05; the scene runs 120
+    // frames of 1/60 s = 2 s, four times the 0.5 s horizon, a first-order method: (1/4)^2.
+    let dt = 2.5e-3 * (0.1f64).sqrt() * 0.5 / 16.0;
+    assert_fits(&c, &before, &file, dt);
+    assert!(c.why.contains("left out as not this scene's: neo-hookean symplectic-euler (neo-hookean material (the scene's is stable-neo-hookean))"), "{}", c.why);
+    assert!(c.why.contains("wave speed and cell ratios 0.1581 x run length (H/T)^2 = 0.0625"), "{}", c.why);
+    // An explicit pick sets the integrator (the solver is unused).
+    let mut file = before.clone();
+    let c = choose(&mut file, 6e-2, &t).unwrap();
+    assert_eq!(c.method, "stable-neo-hookean symplectic-euler");
+    assert!(matches!(file.scene, Scene::Fem { integrator: Some(TimeIntegrator::SymplecticEuler), .. }));
+    assert_eq!(c.settings, "integrator = symplectic-euler");
+    // 1e-4: the most accurate of the scene's material is named, not the other material's 1e-6.
+    let e = choose(&mut before.clone(), 1e-4, &t).unwrap_err();
+    assert!(e.contains("the most accurate measured is stable-neo-hookean backward-euler (cholesky) at p = 0.0025, error 8.000e-3 (ask for 8.0e-3 or more)"), "{e}");
+    assert!(e.contains("left out: neo-hookean symplectic-euler (neo-hookean material"), "{e}");
+    // A table with only other materials: nothing this scene can run.
+    let mut only_other = beam_table();
+    only_other.families[0].series.truncate(1);
+    let e = choose(&mut before.clone(), 1e-2, &only_other).unwrap_err();
+    assert!(e.contains("no method of the fem-beam study can run on this scene: neo-hookean symplectic-euler (neo-hookean material"), "{e}");
+}
+
+#[test]
+fn the_hanging_cloth_takes_explicit_methods_only_at_the_stiffer_cloths_step() {
+    let t = made(vec![family(
+        "springs-cloth",
+        "springs/hanging-cloth",
+        Some(0.25),
+        &[("n", 10.0), ("size", 0.5), ("mass", 0.1), ("stiffness", 100.0)],
+        &[
+            ("backward-euler / cholesky", vec![pt(0.01, 1e-4, 1e-4)]),
+            ("rk4", vec![pt(6.25e-4, 2e-3, 1e-6)]),
+            ("symplectic-euler", vec![pt(6.25e-4, 5e-4, 3e-3)]),
+        ],
+    )]);
+    let before = builtin("cloth");
+    let mut file = before.clone();
+    let c = choose(&mut file, 1e-4, &t).unwrap();
+    assert_eq!(c.method, "rk4");
+    assert!(matches!(file.scene, Scene::Springs { integrator: Some(IntegratorKind::Rk4), .. }));
+    // The preset (anim-springs scenes docs): 32 x 32 particles, 0.2 kg, structural 1000 N/m; the
+    // study's 10 x 10, 0.1 kg, 100 N/m. The scene runs 120 x 2 x 0.01 = 2.4 s against 0.25 s.
+    let omega = |k: f64, count: f64, mass: f64| (k * count / mass).sqrt();
+    let dt = 6.25e-4 * omega(100.0, 100.0, 0.1) / omega(1000.0, 1024.0, 0.2) * (0.25f64 / 2.4).sqrt();
+    assert_fits(&c, &before, &file, dt);
+    assert!(c.why.contains("left out as not this scene's: backward-euler / cholesky (implicit"), "{}", c.why);
+    // Other spring presets have no entry.
+    let e = choose(&mut builtin("rope"), 1e-2, &t).unwrap_err();
+    assert!(e.contains("no entry for springs/swinging-rope scenes (rope)"), "{e}");
+    assert!(e.contains("springs/hanging-cloth (study springs-cloth)"), "{e}");
+}
+
+#[test]
+fn the_cavity_takes_the_studys_resolution_and_pressure_solver() {
+    let t = made(vec![family(
+        "fluid_cavity_ghia",
+        "fluid/lid-driven-cavity",
+        None,
+        &[("pressure_tolerance", 1e-5)],
+        &[
+            ("cg", vec![pt(16.0, 0.1, 0.04), pt(32.0, 0.5, 0.02)]),
+            ("mgpcg", vec![pt(32.0, 0.3, 0.02), pt(64.0, 2.0, 0.008)]),
+        ],
+    )]);
+    let before = builtin("lid-driven-cavity");
+    let mut file = before.clone();
+    let c = choose(&mut file, 0.03, &t).unwrap();
+    assert_eq!((c.method.as_str(), c.param), ("mgpcg", 32.0));
+    assert!(matches!(
+        file.scene,
+        Scene::Fluid {
+            resolution: Some(32),
+            pressure_solver: Some(PressureSolver(PressureMethod::Mgpcg)),
+            pressure_tolerance: Some(tol),
+            ..
+        } if tol == 1e-5
+    ));
+    // The study's dt = h = 1/32; the scene's frames of 10/64 s take 5 steps of exactly 1/32.
+    assert_fits(&c, &before, &file, 1.0 / 32.0);
+    assert_eq!(file.run.dt, 1.0 / 32.0);
+    let e = choose(&mut before.clone(), 1e-3, &t).unwrap_err();
+    assert!(e.contains("the most accurate measured is mgpcg at p = 64, error 8.000e-3"), "{e}");
+    // The seed solver's smoke box is not a mapped preset.
+    let e = choose(&mut builtin("smoke-box-2d"), 1e-2, &t).unwrap_err();
+    assert!(e.contains("no entry for fluid/smoke-box-2d scenes"), "{e}");
+}
+
+#[test]
+fn the_smoke_plume_takes_the_pressure_solver_measured_at_the_nearest_grid() {
+    let t = made(vec![family(
+        "fluid_pressure_divergence",
+        "fluid/smoke-plume-3d",
+        None,
+        &[],
+        &[
+            ("cg N=64", vec![pt(1e-3, 2e-3, 9e-4), pt(1e-5, 4e-3, 9e-6)]),
+            ("mgpcg N=64", vec![pt(1e-3, 3e-3, 8e-4), pt(1e-5, 3.5e-3, 8e-6)]),
+            ("cg N=256", vec![pt(1e-5, 1e-4, 9e-6)]),
+        ],
+    )]);
+    // 32 x 48 x 32 cells: the largest side, 48, is nearest N = 64 (log scale).
+    let before = builtin("smoke-plume-3d");
+    let mut file = before.clone();
+    let c = choose(&mut file, 1e-4, &t).unwrap();
+    assert_eq!((c.method.as_str(), c.param), ("mgpcg N=64", 1e-5));
+    assert!(matches!(
+        file.scene,
+        Scene::Fluid { resolution: Some(32), pressure_solver: Some(PressureSolver(PressureMethod::Mgpcg)), pressure_tolerance: Some(tol), .. }
+            if tol == 1e-5
+    ));
+    assert_eq!((file.run.dt, file.run.steps_per_frame), (before.run.dt, before.run.steps_per_frame));
+    assert!(
+        c.why.contains("cg N=256 (measured at N = 256; the scene's grid (48 cells) is nearest N = 64)"),
+        "{}",
+        c.why
+    );
+    let c = choose(&mut before.clone(), 1e-3, &t).unwrap();
+    assert_eq!((c.method.as_str(), c.param), ("cg N=64", 1e-3));
+}
+
+#[test]
+fn unmapped_scenes_and_bad_tolerances_are_refused() {
+    let t = table_or_panic();
+    for name in ["mpm", "drape", "chain", "dam-break-2d", "cube"] {
+        let e = choose(&mut builtin(name), 1e-2, &t).unwrap_err();
+        assert!(e.contains("has no entry for") && e.contains(&format!("({name})")), "{e}");
+        assert!(e.contains("kepler-orbit (study core-kepler)") && e.contains("fem/cantilever-beam"), "{e}");
+    }
+    let mut kepler = builtin("kepler");
+    for bad in [0.0, -1e-2, f64::NAN, f64::INFINITY] {
+        assert!(choose(&mut kepler, bad, &t).unwrap_err().contains("--tolerance must be a positive"));
+    }
+    let e = choose(&mut kepler, 1e-30, &t).unwrap_err();
+    assert!(
+        e.contains(
+            "no method of the core-kepler study that this scene can run met it; the most accurate measured is"
+        ),
+        "{e}"
+    );
+}
+
+#[test]
+fn the_suggested_tolerance_admits_the_most_accurate_point() {
+    for (x, want) in
+        [(1e-5, 1e-5), (0.0107, 0.011), (3.46e-4, 3.5e-4), (8e-3, 8e-3), (0.99, 0.99), (0.991, 1.0)]
+    {
+        let got = round_up(x);
+        assert!((got - want).abs() < 1e-12 * want, "{x}: {got} != {want}");
+        assert!(got >= x, "{x}: {got} does not admit it");
+    }
+}
+
+#[test]
+fn an_older_table_format_is_refused() {
+    let old = TABLE.replacen("\"format\": 2", "\"format\": 1", 1);
+    assert_ne!(old, TABLE);
+    let e = parse_table(&old).unwrap_err();
+    assert!(e.contains("has format 1, this build reads 2"), "{e}");
+    assert!(parse_table(TABLE).is_ok());
+}
+
+#[test]
+fn the_ode_error_is_zero_on_the_exact_solution() {
+    // Independent of the runner: the exact state at t gives zero, a shifted one its shift.
+    let osc = builtin("oscillator");
+    let Scene::HarmonicOscillator { mass, stiffness, damping, x0, v0, .. } = osc.scene else { panic!() };
+    let (xe, ve) = HarmonicOscillator::damped(mass, stiffness, damping).exact(x0, v0, 0.7);
+    let mut s = State::new(vec![xe], vec![ve]);
+    s.t = 0.7;
+    assert_eq!(ode_error(&osc.scene, &s), Some(0.0));
+    s.x[0] += 1e-3;
+    let e = ode_error(&osc.scene, &s).unwrap();
+    assert!((e - 1e-3 / x0.hypot(v0 / (stiffness / mass).sqrt())).abs() < 1e-15);
+    let kep = builtin("kepler");
+    let (xe, ve) = KeplerOrbit::ellipse(0.5).exact(1.3);
+    let mut s = State::new(xe.to_vec(), ve.to_vec());
+    s.t = 1.3;
+    assert_eq!(ode_error(&kep.scene, &s), Some(0.0));
+}
+
+#[test]
+fn the_ghia_error_of_a_cavity_at_rest_is_ghias_largest_interior_speed() {
+    // At rest every sampled velocity is 0 (Ghia's points lie more than half a cell from the lid
+    // at N = 128), so the error is the largest |u| or |v| of Ghia et al. (1982), Table I/II at
+    // Re = 100: u = 0.84123 at y = 0.9766.
+    let scene =
+        anim_fluid::scenes::lid_driven_cavity(128, 100.0, anim_fluid::advection::Advection::MacCormack)
+            .unwrap();
+    let anim_fluid::scenes::FluidSim::Mac(fluid, state) = &scene.sim else { panic!("a MAC scene") };
+    assert!((ghia_error(fluid, state) - 0.84123).abs() < 1e-12);
+}
