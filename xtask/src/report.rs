@@ -37,23 +37,6 @@ fn no_problem(_quick: bool) -> Vec<(&'static str, f64)> {
     Vec::new()
 }
 
-/// The beam of the FEM study (`cases/fem.rs`, `study_sim`): Young's modulus (Pa), density
-/// (kg/m^3) and cell size (m; 2 cells across 0.1 m).
-fn fem_beam_problem(_quick: bool) -> Vec<(&'static str, f64)> {
-    vec![("young", 1e6), ("density", 1000.0), ("cell", 0.05)]
-}
-
-/// The cloth of the spring study (`cases/springs.rs`, `study_cloth`): particles per side (6 in
-/// quick mode, 10 in full), side length (m), total mass (kg), structural stiffness (N/m).
-fn springs_cloth_problem(quick: bool) -> Vec<(&'static str, f64)> {
-    vec![("n", if quick { 6.0 } else { 10.0 }), ("size", 0.5), ("mass", 0.1), ("stiffness", 100.0)]
-}
-
-/// The cavity study's pressure tolerance (`cases/fluid.rs`, `study_ghia`).
-fn cavity_problem(_quick: bool) -> Vec<(&'static str, f64)> {
-    vec![("pressure_tolerance", 1e-5)]
-}
-
 /// The studies `anim run --tolerance` picks from.
 pub const SCENE_FAMILIES: [SceneFamily; 6] = [
     SceneFamily {
@@ -72,19 +55,19 @@ pub const SCENE_FAMILIES: [SceneFamily; 6] = [
         study: "springs-cloth",
         scene: "springs/hanging-cloth",
         horizon: Some(0.25),
-        problem: springs_cloth_problem,
+        problem: crate::cases::springs::study_problem,
     },
     SceneFamily {
         study: "fem-beam",
         scene: "fem/cantilever-beam",
         horizon: Some(0.5),
-        problem: fem_beam_problem,
+        problem: crate::cases::fem::study_problem,
     },
     SceneFamily {
         study: "fluid_cavity_ghia",
         scene: "fluid/lid-driven-cavity",
         horizon: None,
-        problem: cavity_problem,
+        problem: crate::cases::fluid::ghia_study_problem,
     },
     SceneFamily {
         study: "fluid_pressure_divergence",

@@ -541,6 +541,9 @@ fn inverted_recovery_snh(ctx: &Ctx) -> Outcome {
     inverted_recovery_with(ctx, MaterialModel::StableNeoHookean)
 }
 
+/// Density of the dynamic cantilevers (kg/m^3).
+const CANTILEVER_DENSITY: f64 = 1000.0;
+
 fn cantilever_dynamic(
     young: f64,
     poisson: f64,
@@ -548,8 +551,8 @@ fn cantilever_dynamic(
     cells: usize,
 ) -> Result<FemSimulation, FemError> {
     let mesh = box_mesh([0.0; 3], [1.0, 0.1, 0.1], [10 * cells, cells, cells])?;
-    let mut m =
-        FemModel::new(mesh, Material::new(model, young, poisson, 1000.0)?)?.with_gravity(EARTH_GRAVITY);
+    let mut m = FemModel::new(mesh, Material::new(model, young, poisson, CANTILEVER_DENSITY)?)?
+        .with_gravity(EARTH_GRAVITY);
     let clamp = m.vertices_where(|p| p[0] < 1e-9);
     m.pin_vertices(&clamp)?;
     FemSimulation::new(m, FemParams::default())
@@ -641,7 +644,7 @@ fn explicit_divergence(_ctx: &Ctx) -> Outcome {
 /// to the reference's RMS tip deflection. Every model is discretised by the same mesh, so the error
 /// measures time integration and solver tolerance, which is what a user trades against wall time.
 fn study_sim(method: BeamMethod) -> Result<FemSimulation, FemError> {
-    let mut sim = cantilever_dynamic(1e6, 0.3, method.model, 2)?;
+    let mut sim = cantilever_dynamic(STUDY_YOUNG, 0.3, method.model, STUDY_CELLS)?;
     let mut p = FemParams::new(method.integrator)
         .with_energy_report(false)
         .with_newton_tolerance(1e-8)
@@ -673,6 +676,16 @@ impl BeamMethod {
 }
 
 const STUDY_T: f64 = 0.5;
+/// Young's modulus of the study beam (Pa).
+const STUDY_YOUNG: f64 = 1e6;
+/// Cells across the study beam's 0.1 m section.
+const STUDY_CELLS: usize = 2;
+
+/// The study problem's parameters `anim run --tolerance` scales a picked step by: Young's modulus
+/// (Pa), density (kg/m^3, [`cantilever_dynamic`]'s) and cell size (m).
+pub fn study_problem(_quick: bool) -> Vec<(&'static str, f64)> {
+    vec![("young", STUDY_YOUNG), ("density", CANTILEVER_DENSITY), ("cell", 0.1 / STUDY_CELLS as f64)]
+}
 const SAMPLES: usize = 50;
 
 fn tip_trajectory(method: BeamMethod, dt: f64) -> Option<Vec<f64>> {

@@ -642,6 +642,14 @@ fn study_divergence(ctx: &Ctx) -> StudyResult {
     }
 }
 
+/// Pressure-solver tolerance of the cavity study.
+const GHIA_STUDY_PRESSURE_TOLERANCE: f64 = 1e-5;
+
+/// The cavity study's parameters `anim run --tolerance` uses: its pressure tolerance.
+pub fn ghia_study_problem(_quick: bool) -> Vec<(&'static str, f64)> {
+    vec![("pressure_tolerance", GHIA_STUDY_PRESSURE_TOLERANCE)]
+}
+
 fn study_ghia(ctx: &Ctx) -> StudyResult {
     let sizes: &[usize] = if ctx.quick { &[16, 32] } else { &[16, 32, 64] };
     let mut series = Vec::new();
@@ -649,7 +657,8 @@ fn study_ghia(ctx: &Ctx) -> StudyResult {
         let mut points = Vec::new();
         for &n in sizes {
             let t = Instant::now();
-            if let Ok((f, s, _)) = cavity_run(n, Advection::MacCormack, method, 1e-5) {
+            if let Ok((f, s, _)) = cavity_run(n, Advection::MacCormack, method, GHIA_STUDY_PRESSURE_TOLERANCE)
+            {
                 let (eu, ev) = ghia_errors(&f, &s);
                 points.push(Point { param: n as f64, seconds: t.elapsed().as_secs_f64(), error: eu.max(ev) });
             }

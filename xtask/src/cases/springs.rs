@@ -581,10 +581,10 @@ fn study_cloth(n: usize) -> Option<(SpringNetwork, State)> {
             nx: n,
             ny: n,
             origin: [0.0, 0.0, 1.0],
-            u: [0.5, 0.0, 0.0],
-            v: [0.0, 0.5, 0.0],
-            mass: 0.1,
-            structural: SpringParams::new(100.0, 0.01),
+            u: [STUDY_SIZE, 0.0, 0.0],
+            v: [0.0, STUDY_SIZE, 0.0],
+            mass: STUDY_MASS,
+            structural: SpringParams::new(STUDY_STIFFNESS, 0.01),
             shear: Some(SpringParams::new(20.0, 0.002)),
             bending: Some(SpringParams::new(2.0, 0.0002)),
         })
@@ -611,8 +611,29 @@ fn cloth_run(n: usize, kind: IntegratorKind, linear: LinearSolverKind, steps: us
     Some(state.x)
 }
 
+/// Side (m), total mass (kg) and structural stiffness (N/m) of the study cloth.
+const STUDY_SIZE: f64 = 0.5;
+const STUDY_MASS: f64 = 0.1;
+const STUDY_STIFFNESS: f64 = 100.0;
+
+/// Particles per side of the study cloth.
+fn study_side(quick: bool) -> usize {
+    if quick { 6 } else { 10 }
+}
+
+/// The study problem's parameters `anim run --tolerance` scales a picked step by: particles per
+/// side, side length (m), total mass (kg), structural stiffness (N/m).
+pub fn study_problem(quick: bool) -> Vec<(&'static str, f64)> {
+    vec![
+        ("n", study_side(quick) as f64),
+        ("size", STUDY_SIZE),
+        ("mass", STUDY_MASS),
+        ("stiffness", STUDY_STIFFNESS),
+    ]
+}
+
 fn cloth_study(ctx: &Ctx) -> StudyResult {
-    let n = if ctx.quick { 6 } else { 10 };
+    let n = study_side(ctx.quick);
     let (batches, min_batch) = if ctx.quick { (3, 0.002) } else { (5, 0.02) };
     let points = if ctx.quick { 3 } else { 5 };
     let x0 = study_cloth(n).map(|(_, s)| s.x).unwrap_or_default();
