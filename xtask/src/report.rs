@@ -16,6 +16,22 @@ use std::time::Instant;
 /// Tolerances of the "cheapest method" tables.
 pub const TOLERANCES: [f64; 6] = [1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8];
 
+/// Tolerances a study adds to [`TOLERANCES`] in its cheapest-method tables (its table in
+/// `index.md` and its picks in `cheapest.json`): `(study slug, extra tolerances)`.
+const EXTRA_TOLERANCES: [(&str, &[f64]); 1] =
+    [(crate::cases::flip::DAM_BREAK_SLUG, crate::cases::flip::DAM_BREAK_TOLERANCES)];
+
+/// The tolerances of `study`'s cheapest-method tables: [`TOLERANCES`] and its extra ones
+/// ([`EXTRA_TOLERANCES`]), largest first.
+pub fn tolerances(study: &StudyResult) -> Vec<f64> {
+    let mut tols = TOLERANCES.to_vec();
+    for (_, extra) in EXTRA_TOLERANCES.iter().filter(|(slug, _)| *slug == study.slug) {
+        tols.extend(extra.iter().filter(|t| !TOLERANCES.contains(t)));
+    }
+    tols.sort_by(|a, b| b.total_cmp(a));
+    tols
+}
+
 /// Tolerances of the headline table.
 const HEADLINE: [f64; 3] = [1e-1, 1e-2, 1e-3];
 
@@ -306,6 +322,8 @@ pub struct CheapestTable {
     pub machine: Machine,
     /// `quick` or `full`.
     pub mode: String,
+    /// The tolerances of every study's picks (a study may add more to its own, see
+    /// [`tolerances`]).
     pub tolerances: Vec<f64>,
     pub families: Vec<Family>,
 }
@@ -397,9 +415,9 @@ pub fn cheapest_table(r: &Report) -> CheapestTable {
                             .collect(),
                     })
                     .collect(),
-                picks: TOLERANCES
-                    .iter()
-                    .map(|&tol| match cheapest(s, tol) {
+                picks: tolerances(s)
+                    .into_iter()
+                    .map(|tol| match cheapest(s, tol) {
                         Some((method, param, seconds, error)) => Pick {
                             tolerance: tol,
                             method: Some(method),
@@ -571,7 +589,7 @@ fn study_markdown(crate_name: &str, r: &StudyResult) -> String {
         "| tolerance | method | {} | wall time | error |\n| --- | --- | --- | --- | --- |",
         r.param_label
     );
-    for tol in TOLERANCES {
+    for tol in tolerances(r) {
         match cheapest(r, tol) {
             Some((label, param, secs, err)) => {
                 let _ = writeln!(
@@ -773,6 +791,26 @@ mod tests {
         assert!(md.contains("| 1e-8 | none in the sweep |"), "{md}");
         assert!(md.contains("| 1e-1 | fast-rough |"), "{md}");
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn a_study_with_extra_tolerances_gets_their_rows_in_order() {
+        // tiny(): fast-rough has error 1e-3, so it meets 5e-2 as well.
+        let r = StudyResult { slug: crate::cases::flip::DAM_BREAK_SLUG.into(), ..tiny() };
+        assert_eq!(tolerances(&r), [1e-1, 5e-2, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8]);
+        assert_eq!(tolerances(&tiny()), TOLERANCES);
+        let md = study_markdown("anim-flip", &r);
+        let rows: Vec<&str> =
+            md.lines().filter(|l| l.starts_with("| 1e-1 |") || l.starts_with("| 5e-2 |")).collect();
+        assert_eq!(rows.len(), 2, "{md}");
+        assert!(rows[1].starts_with("| 5e-2 | fast-rough | 0.1 |"), "{md}");
+        let mut report = tiny_report();
+        report.studies.push(("anim-flip", r));
+        let table = cheapest_table(&report);
+        let picks: Vec<f64> = table.families[2].picks.iter().map(|p| p.tolerance).collect();
+        assert_eq!(picks, [1e-1, 5e-2, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8]);
+        assert_eq!(table.families[2].picks[1].method.as_deref(), Some("fast-rough"));
+        assert_eq!(table.families[0].picks.len(), TOLERANCES.len());
     }
 
     fn tiny_report() -> Report {

@@ -3,10 +3,15 @@
 //! tolerance, angular momentum of a rotating disk over the transfers (APIC keeps it, PIC does
 //! not), and the 2D dam-break surge front against Martin & Moyce (1952) (the table of
 //! [`super::mpm`]). Hard cases: CFL 10 (large steps split into adaptive substeps) and particles
-//! driven into an obstacle (pushed out, counted).
+//! driven into an obstacle (pushed out, counted). Study: the dam break's surge-front error
+//! against wall time for PIC, FLIP and APIC and for anim-mpm's weakly compressible fluid, each at
+//! several resolutions.
 
 use super::mpm::{MARTIN_MOYCE, front_errors, shifted_errors};
-use crate::registry::{Check, ConformanceCase, Ctx, Judge, Outcome, Registry, StabilityCase, fmt_num};
+use crate::registry::{
+    Check, ConformanceCase, Ctx, Judge, Outcome, Point, Registry, Series, StabilityCase, Study, StudyResult,
+    fmt_num,
+};
 use anim_flip::{
     Contour, FlipError, FlipParams, FlipSimulation, ParticleSurface, Particles, Reseed, SurfaceParams,
     Transfer, scenes,
@@ -47,6 +52,11 @@ pub fn register(r: &mut Registry) {
         name: "FLIP particles driven into a solid obstacle",
         expected: stable,
         run: into_obstacle,
+    });
+    r.studies.push(Study {
+        crate_name: CRATE,
+        name: "PIC/FLIP/APIC and MPM dam break",
+        run: dam_break_study,
     });
 }
 
@@ -382,6 +392,58 @@ fn dam_break_case(ctx: &Ctx) -> Vec<Check> {
         });
     }
     checks
+}
+
+/// Slug of [`dam_break_study`].
+pub(crate) const DAM_BREAK_SLUG: &str = "flip_dam_break";
+
+/// Tolerances the dam-break study adds to the report's cheapest-method table: 5 %, the accuracy
+/// the question "which method reaches 5 % cheapest?" asks about.
+pub(crate) const DAM_BREAK_TOLERANCES: &[f64] = &[5e-2];
+
+/// The 2D dam break of [`dam_break_case`] (a = 0.2 m, no-slip walls, 2x2 particles per cell,
+/// steps of 2 ms split into CFL-1 substeps) with PIC, FLIP 0.97 and APIC, and the same column
+/// in anim-mpm's weakly compressible fluid (the scene of [`super::mpm`]'s study: sticky walls,
+/// 2x2 particles per cell, c = 50 m/s), at several grid resolutions. Error: the rms relative
+/// surge-front error against Martin & Moyce (1952), the gated measure of both conformance cases;
+/// time: one run to T = 3.33 (t = 0.34 s).
+fn dam_break_study(ctx: &Ctx) -> StudyResult {
+    let flip_cells: &[usize] = if ctx.quick { &[32, 48] } else { &[24, 32, 48, 64, 80, 112, 160] };
+    let mpm_cells: &[usize] = if ctx.quick { &[32, 48, 64] } else { &[32, 48, 64, 96, 128, 192] };
+    // A run that fails shows in the table with a NaN error (and stays off the plot).
+    let failed = |n: usize| Point { param: n as f64, seconds: f64::NAN, error: f64::NAN };
+    let mut series = vec![];
+    for transfer in [Transfer::Pic, Transfer::Flip(0.97), Transfer::Apic] {
+        let points = flip_cells
+            .iter()
+            .map(|&n| match dam_break(n, transfer, true) {
+                Ok((z, _, seconds)) => Point { param: n as f64, seconds, error: front_errors(&z).1 },
+                Err(_) => failed(n),
+            })
+            .collect();
+        series.push(Series { label: format!("{} (anim-flip)", transfer.name()), points });
+    }
+    for (label, transfer) in [
+        ("MPM fluid, MLS-MPM (anim-mpm)", anim_mpm::Transfer::Mls),
+        ("MPM fluid, APIC (anim-mpm)", anim_mpm::Transfer::Apic),
+    ] {
+        let points = mpm_cells
+            .iter()
+            .map(|&n| match super::mpm::dam_break(n, 2, transfer, anim_mpm::Kernel::Quadratic) {
+                Ok(r) => Point { param: n as f64, seconds: r.seconds, error: front_errors(&r.z).1 },
+                Err(_) => failed(n),
+            })
+            .collect();
+        series.push(Series { label: label.into(), points });
+    }
+    StudyResult {
+        title: "2D dam break: incompressible PIC/FLIP/APIC vs weakly compressible MPM, surge front vs Martin & Moyce (1952)"
+            .into(),
+        slug: DAM_BREAK_SLUG.into(),
+        error_label: "rms relative surge-front error over T = 0.41..3.33".into(),
+        param_label: "grid cells per metre".into(),
+        series,
+    }
 }
 
 /// The dam break advanced in 0.05 s steps with `cfl = 10`: each step is split into substeps that

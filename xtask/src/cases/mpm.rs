@@ -478,7 +478,12 @@ pub(crate) const MARTIN_MOYCE: [(f64, f64); 15] = [
 /// A 2D dam break: a water column `a x 2a` (a = 0.2 m) collapsing along a 1 m tank. Returns the
 /// surge front `Z = x / a` at the table's times `T`, the whole history `(T, Z)` (every step), and
 /// the wall time.
-fn dam_break(n: usize, per_cell: usize, transfer: Transfer, kernel: Kernel) -> Result<DamBreak, MpmError> {
+pub(crate) fn dam_break(
+    n: usize,
+    per_cell: usize,
+    transfer: Transfer,
+    kernel: Kernel,
+) -> Result<DamBreak, MpmError> {
     let mut params = MpmParams::with_resolution(n);
     params.transfer = transfer;
     params.kernel = kernel;
@@ -514,10 +519,10 @@ fn dam_break(n: usize, per_cell: usize, transfer: Transfer, kernel: Kernel) -> R
     Ok(DamBreak { z, history, seconds: start.elapsed().as_secs_f64() })
 }
 
-struct DamBreak {
-    z: Vec<f64>,
-    history: Vec<(f64, f64)>,
-    seconds: f64,
+pub(crate) struct DamBreak {
+    pub(crate) z: Vec<f64>,
+    pub(crate) history: Vec<(f64, f64)>,
+    pub(crate) seconds: f64,
 }
 
 pub(crate) fn front_errors(z: &[f64]) -> (f64, f64) {
