@@ -299,7 +299,10 @@ pub fn taylor_green_run(
 
 fn taylor_green(ctx: &Ctx) -> Vec<Check> {
     let (nu, t_end) = (0.01, 1.0);
-    // CI runs N = 64 with one scheme; the full suite runs N = 128 with every scheme.
+    // CI runs N = 64 with one scheme; the full suite runs N = 128 with every scheme. Linear
+    // semi-Lagrangian advection misses 2% at N = 128 at every CFL from 0.25 to 4 (2.86% at 0.5,
+    // best 2.66% at 1: numerical viscosity plus the O(dt) advection-projection splitting error;
+    // table in docs/guides/anim-fluid.md), so its check is expected to fail.
     let (n, schemes): (usize, &[Advection]) =
         if ctx.quick { (64, &[Advection::MacCormack]) } else { (128, &Advection::ALL) };
     schemes
