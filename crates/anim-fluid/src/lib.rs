@@ -80,7 +80,12 @@
 //! - **Taylor-Green** vortex (unit box, free-slip walls, `nu = 0.01`, CFL 0.5, t = 1): the
 //!   amplitude's relative error against `exp(-2 nu pi^2 t)` at N = 128 is 0.78% with monotone
 //!   cubic, BFECC and MacCormack advection, and 2.9% with linear semi-Lagrangian advection (its
-//!   first-order numerical viscosity); at N = 64, MacCormack: 1.5%.
+//!   first-order numerical viscosity); at N = 64, MacCormack: 1.5%. The second-order schemes'
+//!   error is the first-order splitting of advection and projection, about `2 dt` whatever N;
+//!   linear interpolation adds `h^2 alpha (1 - alpha) / (2 dt)` of numerical viscosity, which
+//!   falls as the CFL number grows while the splitting error rises: linear is within 2% at
+//!   N = 128 at no CFL from 0.25 to 4 (best 2.66% at CFL 1), and at N = 256 from CFL 0.5 to 2
+//!   (table in `docs/guides/anim-fluid.md`, `examples/taylor_green_cfl.rs`).
 //! - **Lid-driven cavity**, Re = 100, run to steady state, max error over Ghia, Ghia and Shin's
 //!   (1982) centreline points (u on x = 0.5 / v on y = 0.5): N = 32: linear 0.021 / 0.022,
 //!   cubic 0.0092 / 0.0080, BFECC 0.011 / 0.0066, MacCormack 0.011 / 0.0071; N = 64: linear
@@ -88,12 +93,16 @@
 //!   N = 128, MacCormack: 0.0027 / 0.0074.
 //! - **Projection**: every solver reaches its relative residual tolerance; on the 2D 64^2 box
 //!   with a sphere at 1e-6: Jacobi 30,890 sweeps, red-black Gauss-Seidel 13,170, CG 304,
-//!   MGPCG 8 iterations.
+//!   MGPCG 8 iterations; at 256^2: Jacobi 428,490 sweeps (254 s on a loaded machine),
+//!   Gauss-Seidel 184,490, CG 1,191, MGPCG 8 (0.44 s). Jacobi's count grows as `N^2`
+//!   ([`pressure::JACOBI_WEIGHT`]).
 //! - **Pressure solvers at N = 512** (the same box, the solve alone): to a relative residual of
 //!   1e-2 MGPCG takes 4 iterations (0.11 s) where 4,000 red-black Gauss-Seidel sweeps (6.0 s)
 //!   only reach 2.3e-2: more than 53x; to 1e-4, 6 iterations (0.094 s) against more than 8.9 s,
 //!   more than 95x. At the loose residual 20 sweeps leave (0.31), 20 sweeps (0.09 s) are cheaper
-//!   than one MGPCG iteration (0.18 s).
+//!   than one MGPCG iteration (0.18 s); a later set of three loaded runs gave medians of 0.054 s
+//!   for the sweeps against 0.052 s for the iteration, and 0.21 s for MGPCG to 1e-4 against
+//!   Gauss-Seidel short of it after 49 to 76 s (at least 236x).
 //!
 //! ## Precision
 //!

@@ -202,14 +202,27 @@ fn divergent_field(
     Ok((f, s))
 }
 
+/// Sweeps damped Jacobi needs on an `n^dim` box with solid walls to bring the smoothest
+/// error mode down by `tol` (see [`anim_fluid::pressure::JACOBI_WEIGHT`]): `ln(1/tol) 2 dim /
+/// (w lambda)` with `lambda = 4 sin^2(pi / (2 n))`, times 1.5 for the obstacle and the mode's
+/// share of the initial residual. 2D, 1e-6: the estimate is 115,000 at N = 128 and 459,000 at
+/// N = 256 (the box with a sphere took 115,190 and 428,490 sweeps); the cap 172,000 and 688,000.
+pub fn jacobi_sweeps_needed(n: usize, dim: usize, tol: f64) -> usize {
+    let lambda = 4.0 * (PI / (2.0 * n as f64)).sin().powi(2);
+    let rate = anim_fluid::pressure::JACOBI_WEIGHT * lambda / (2.0 * dim as f64);
+    (1.5 * (1.0 / tol).ln() / rate).ceil() as usize
+}
+
 fn divergence(ctx: &Ctx) -> Vec<Check> {
     let tol = 1e-6;
     let mut out = Vec::new();
     let cases: &[(usize, usize)] =
         if ctx.quick { &[(2, 64), (3, 16)] } else { &[(2, 128), (2, 256), (3, 32)] };
     for &(dim, n) in cases {
+        // Jacobi's sweep count grows as N^2 (688,000 at 2D N = 256); every solver gets that cap.
+        let cap = jacobi_sweeps_needed(n, dim, tol).max(200_000);
         for method in PressureMethod::ALL {
-            let res = divergent_field(n, dim, method, tol, 200_000).and_then(|(mut f, mut s)| {
+            let res = divergent_field(n, dim, method, tol, cap).and_then(|(mut f, mut s)| {
                 let before = f.max_divergence(&s);
                 let t = Instant::now();
                 let info = f.advance(&mut s, 1e-3)?;
@@ -286,7 +299,10 @@ pub fn taylor_green_run(
 
 fn taylor_green(ctx: &Ctx) -> Vec<Check> {
     let (nu, t_end) = (0.01, 1.0);
-    // CI runs N = 64 with one scheme; the full suite runs N = 128 with every scheme.
+    // CI runs N = 64 with one scheme; the full suite runs N = 128 with every scheme. Linear
+    // semi-Lagrangian advection misses 2% at N = 128 at every CFL from 0.25 to 4 (2.86% at 0.5,
+    // best 2.66% at 1: numerical viscosity plus the O(dt) advection-projection splitting error;
+    // table in docs/guides/anim-fluid.md), so its check is expected to fail.
     let (n, schemes): (usize, &[Advection]) =
         if ctx.quick { (64, &[Advection::MacCormack]) } else { (128, &Advection::ALL) };
     schemes
