@@ -78,3 +78,5 @@ pub use error::FemError;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_quadratic;
