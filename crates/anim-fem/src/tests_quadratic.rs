@@ -489,3 +489,56 @@ fn tet10_steps_are_bitwise_identical_for_any_thread_count_and_solvers_agree() {
         assert!(diff < 1e-8, "{diff}");
     }
 }
+
+#[test]
+fn every_scene_steps_with_tet10_elements() {
+    for name in crate::scenes::NAMES {
+        let scene =
+            crate::scenes::by_name_with_order(name, Some(1), ElementOrder::Quadratic).unwrap().unwrap();
+        assert_eq!(scene.model.order(), ElementOrder::Quadratic);
+        let linear = crate::scenes::by_name(name, Some(1)).unwrap().unwrap();
+        assert_eq!(linear.model.order(), ElementOrder::Linear);
+        assert!(scene.model.vertices() > linear.model.vertices(), "{name}: edge nodes added");
+        let dt = scene.dt;
+        let (mut sim, mut state) = scene.into_simulation().unwrap();
+        let x0 = state.x.clone();
+        for _ in 0..3 {
+            sim.advance(&mut state, dt).unwrap();
+        }
+        let moved = state.x.iter().zip(&x0).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(moved > 1e-6 && moved < 0.1, "{name}: largest displacement {moved}");
+    }
+}
+
+#[test]
+fn bad_tet10_meshes_name_the_element_and_node() {
+    let lin = box_mesh([0.0; 3], [1.0; 3], [1, 1, 1]).unwrap();
+    let good = quadratic(&lin);
+    let mat = material(MaterialModel::NeoHookean);
+    // An edge node off its edge's midpoint.
+    let mut curved = good.clone();
+    let node = curved.elements[2][7];
+    curved.positions[node][0] += 0.01;
+    match FemModel::quadratic(curved, mat) {
+        Err(e @ crate::FemError::CurvedElement { node: n, .. }) => {
+            assert_eq!(n, node);
+            let msg = e.to_string();
+            assert!(msg.contains(&format!("edge node {node}")) && msg.contains("10-node element"), "{msg}");
+        }
+        other => panic!("expected CurvedElement, got {other:?}"),
+    }
+    // An edge node index past the end.
+    let mut out = good.clone();
+    out.elements[3][5] = 10_000;
+    assert!(matches!(
+        FemModel::quadratic(out, mat),
+        Err(crate::FemError::VertexOutOfRange { element: 3, vertex: 10_000, .. })
+    ));
+    // An inverted corner tetrahedron.
+    let mut inverted = good;
+    inverted.elements[1].swap(0, 1);
+    assert!(matches!(
+        FemModel::quadratic(inverted, mat),
+        Err(crate::FemError::InvertedElement { element: 1, .. })
+    ));
+}
