@@ -10,6 +10,11 @@
 //!   backtracking line search ([`newton`]), the stiffness assembled in parallel in
 //!   a fixed order, and a choice of linear solver ([`LinearSolverChoice`]).
 //!
+//! Both steps, the quasi-static solve and the reports work on linear and 10-node bodies alike:
+//! element loops go through the model ([`FemModel::element_forces`], the
+//! [`ElasticBody`](crate::newton::ElasticBody) implementation), and the masses, loads and boundary
+//! conditions are per node.
+//!
 //! The explicit step is written here rather than through anim-core's `MechanicalSystem`
 //! integrators because contact projection and kinematic vertices act on positions after the
 //! update, and the implicit step because anim-core's backward Euler has no line search on an

@@ -542,3 +542,43 @@ fn bad_tet10_meshes_name_the_element_and_node() {
         Err(crate::FemError::InvertedElement { element: 1, .. })
     ));
 }
+
+#[test]
+fn tet10_patch_test_and_centroid_deformation_gradient() {
+    // An affine map x = A X + c of every node: F = A at every quadrature point (so the forces
+    // of interior nodes vanish for a homogeneous stress) and at the centroid reported by
+    // `deformation_gradient`.
+    let mesh = box_mesh([0.0; 3], [1.0, 0.5, 0.5], [2, 2, 2]).unwrap();
+    let m = FemModel::with_order(mesh, material(MaterialModel::NeoHookean), ElementOrder::Quadratic).unwrap();
+    let a = anim_material::nalgebra::Matrix3::new(1.1, 0.2, 0.0, -0.1, 0.95, 0.05, 0.03, 0.0, 1.2);
+    let x: Vec<f64> = m
+        .mesh()
+        .positions
+        .iter()
+        .flat_map(|p| {
+            let q = a * anim_material::nalgebra::Vector3::from(*p);
+            [q[0] + 0.3, q[1] - 0.2, q[2] + 0.1]
+        })
+        .collect();
+    for e in 0..m.elements() {
+        assert!((m.deformation_gradient(e, &x) - a).norm() < 1e-13, "element {e}");
+    }
+    let mut sim = FemSimulation::new(m, FemParams::default()).unwrap();
+    let mut f = vec![0.0; x.len()];
+    sim.internal_forces(&x, &mut f).unwrap();
+    let scale = f.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+    let interior = sim.model().vertices_where(|p| {
+        p[0] > 1e-9
+            && p[0] < 1.0 - 1e-9
+            && p[1] > 1e-9
+            && p[1] < 0.5 - 1e-9
+            && p[2] > 1e-9
+            && p[2] < 0.5 - 1e-9
+    });
+    assert!(!interior.is_empty());
+    for v in interior {
+        for c in 0..3 {
+            assert!(f[3 * v + c].abs() < 1e-12 * scale, "node {v}: {}", f[3 * v + c]);
+        }
+    }
+}
