@@ -35,7 +35,7 @@
 //! element's mass, `rho V / 36` per corner and `4 rho V / 27` per edge node
 //! ([`lumped_mass_coefficient`]), all positive.
 //!
-//! The dynamic body is a [`FemModel`](crate::model::FemModel) built with
+//! The dynamic body is a [`FemModel`] built with
 //! [`FemModel::quadratic`](crate::model::FemModel::quadratic) (every boundary condition, load,
 //! obstacle and both time integrators of the linear body); [`QuadraticModel`] is the
 //! quasi-static front end the conformance cases use.

@@ -12,7 +12,7 @@
 //!
 //! Both steps, the quasi-static solve and the reports work on linear and 10-node bodies alike:
 //! element loops go through the model ([`FemModel::element_forces`], the
-//! [`ElasticBody`](crate::newton::ElasticBody) implementation), and the masses, loads and boundary
+//! [`ElasticBody`] implementation), and the masses, loads and boundary
 //! conditions are per node.
 //!
 //! The explicit step is written here rather than through anim-core's `MechanicalSystem`
