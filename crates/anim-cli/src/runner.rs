@@ -184,13 +184,13 @@ pub fn build(
                 s.into_simulation().map_err(|e| SceneError::invalid(file, "scene.preset", e.to_string()))?;
             Box::new(PbdRunner { name, method, sim, state })
         }
-        Scene::Fem { ref preset, resolution, integrator, linear_solver } => {
+        Scene::Fem { ref preset, resolution, element, integrator, linear_solver } => {
             let mut scene = preset_scene(
                 file,
                 "scene.resolution",
                 preset,
                 &anim_fem::scenes::NAMES,
-                anim_fem::scenes::by_name(preset, resolution),
+                anim_fem::scenes::by_name_with_order(preset, resolution, element.unwrap_or_default()),
             )?;
             if let Some(i) = integrator {
                 scene.params.integrator = i;
@@ -624,7 +624,11 @@ impl Runner for FemRunner {
 
     fn method(&self) -> String {
         let p = self.sim.params();
-        format!("{} / {}", p.integrator.name(), p.linear_solver.name())
+        let method = format!("{} / {}", p.integrator.name(), p.linear_solver.name());
+        match self.sim.model().order() {
+            anim_fem::model::ElementOrder::Linear => method,
+            order => format!("{method} / {}", order.name()),
+        }
     }
 
     fn state(&self) -> &State {

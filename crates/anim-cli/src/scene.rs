@@ -122,6 +122,10 @@ pub enum Scene {
         /// absent).
         #[serde(default)]
         linear_solver: Option<anim_fem::sim::LinearSolverChoice>,
+        /// The element: `"tet4"` (linear tetrahedra, the default) or `"tet10"` (10-node
+        /// tetrahedra on the same mesh: no locking in bending, 4 to 7 times the nodes).
+        #[serde(default)]
+        element: Option<anim_fem::model::ElementOrder>,
     },
     /// A material-point-method scene of anim-mpm (`three-materials` in 2D, `dam-break-3d`,
     /// `snowball`, `benchmark-2d`, `benchmark-3d`); each step may take CFL substeps.
@@ -1015,6 +1019,27 @@ mod tests {
     fn missing_file_names_the_path() {
         let msg = load(Path::new("/no/such/scene.toml")).unwrap_err().to_string();
         assert!(msg.contains("/no/such/scene.toml"), "{msg}");
+    }
+
+    #[test]
+    fn fem_element_order_parses_and_a_bad_one_names_its_line() {
+        let s = parse(
+            &BEAM
+                .replace("preset = \"cantilever-beam\"", "preset = \"cantilever-beam\"\nelement = \"tet10\""),
+            Path::new("s.toml"),
+        )
+        .unwrap();
+        assert!(matches!(
+            s.scene,
+            Scene::Fem { element: Some(anim_fem::model::ElementOrder::Quadratic), .. }
+        ));
+        let s = parse(BEAM, Path::new("s.toml")).unwrap();
+        assert!(matches!(s.scene, Scene::Fem { element: None, .. }));
+        let msg =
+            err(&BEAM
+                .replace("preset = \"cantilever-beam\"", "preset = \"cantilever-beam\"\nelement = \"tet7\""));
+        // The tagged `[scene]` table (line 8) is where the toml parser places the error.
+        assert!(msg.starts_with("s.toml:8:") && msg.contains("tet7") && msg.contains("tet10"), "{msg}");
     }
 
     #[test]

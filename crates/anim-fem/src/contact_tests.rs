@@ -5,7 +5,7 @@ use crate::boundary::Obstacle;
 use crate::friction;
 use crate::generate::box_mesh;
 use crate::material::{Material, MaterialModel};
-use crate::model::{EARTH_GRAVITY, FemModel};
+use crate::model::{EARTH_GRAVITY, ElementOrder, FemModel};
 use crate::scenes;
 use crate::sim::{FemParams, FemSimulation, TimeIntegrator};
 use anim_core::integrate::State;
@@ -91,13 +91,24 @@ fn frictionless_contact_keeps_horizontal_momentum() {
 /// tilted by `theta` about the y axis (normal `(sin, 0, cos)`), gravity straight down, with
 /// friction `mu`.
 fn block_on_incline(theta: f64, mu: f64, integrator: TimeIntegrator, eps_v: f64) -> (FemSimulation, State) {
+    block_on_incline_of(ElementOrder::Linear, theta, mu, integrator, eps_v)
+}
+
+/// [`block_on_incline`] of linear or 10-node tetrahedra.
+fn block_on_incline_of(
+    order: ElementOrder,
+    theta: f64,
+    mu: f64,
+    integrator: TimeIntegrator,
+    eps_v: f64,
+) -> (FemSimulation, State) {
     let mut mesh = box_mesh([0.0; 3], [0.1; 3], [1, 1, 1]).unwrap();
     let (s, c) = theta.sin_cos();
     for p in &mut mesh.positions {
         *p = [c * p[0] + s * p[2], p[1], -s * p[0] + c * p[2]];
     }
     let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0).unwrap();
-    let mut model = FemModel::new(mesh, material).unwrap().with_gravity(EARTH_GRAVITY);
+    let mut model = FemModel::with_order(mesh, material, order).unwrap().with_gravity(EARTH_GRAVITY);
     model.add_obstacle_with_friction(Obstacle::Plane { normal: [s, 0.0, c], offset: 0.0 }, 1e6, mu).unwrap();
     let params = FemParams::new(integrator).with_friction_eps_v(eps_v);
     let sim = FemSimulation::new(model, params).unwrap();
@@ -220,13 +231,19 @@ fn a_block_sticks_on_an_incline_below_the_friction_angle() {
 fn a_block_slides_down_an_incline_at_the_coulomb_acceleration() {
     let theta = 30f64.to_radians();
     let g = -EARTH_GRAVITY[2];
-    for mu in [0.3, 0.0] {
-        let want = g * (theta.sin() - mu * theta.cos());
-        for (integrator, dt) in integrators() {
-            let (mut sim, mut state) = block_on_incline(theta, mu, integrator, friction::DEFAULT_EPS_V);
-            let samples = run(&mut sim, &mut state, theta, dt, 1.0);
-            let a = fitted_acceleration(&samples, 0.2);
-            assert!((a / want - 1.0).abs() < 0.03, "{integrator:?} mu {mu}: a = {a}, want {want}");
+    for order in [ElementOrder::Linear, ElementOrder::Quadratic] {
+        for mu in [0.3, 0.0] {
+            let want = g * (theta.sin() - mu * theta.cos());
+            for (integrator, dt) in integrators() {
+                let (mut sim, mut state) =
+                    block_on_incline_of(order, theta, mu, integrator, friction::DEFAULT_EPS_V);
+                let samples = run(&mut sim, &mut state, theta, dt, 1.0);
+                let a = fitted_acceleration(&samples, 0.2);
+                assert!(
+                    (a / want - 1.0).abs() < 0.03,
+                    "{order:?} {integrator:?} mu {mu}: a = {a}, want {want}"
+                );
+            }
         }
     }
 }

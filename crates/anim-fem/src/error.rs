@@ -84,6 +84,21 @@ pub enum FemError {
         /// Six times its signed rest volume.
         volume6: f64,
     },
+    /// A 10-node element whose edge node is not at the midpoint of its edge (only straight-edged,
+    /// affine 10-node elements are supported).
+    #[error(
+        "10-node element {element}: edge node {node} lies {offset:e} from the midpoint of its edge (edge length {edge:e}); only straight-edged elements are supported"
+    )]
+    CurvedElement {
+        /// Element index.
+        element: usize,
+        /// The edge node's index in the mesh.
+        node: usize,
+        /// Its distance from the edge midpoint.
+        offset: f64,
+        /// The edge's length.
+        edge: f64,
+    },
     /// Bad material parameters (Young's modulus, Poisson's ratio).
     #[error("material: {0}")]
     Material(#[from] MaterialError),

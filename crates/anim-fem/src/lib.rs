@@ -10,14 +10,19 @@
 //! | [`material`] | the six hyperelastic models (linear, StVK, corotated linear, Neo-Hookean, fixed corotated, stable Neo-Hookean) with Lamé parameters from `(E, nu)` | 5.1 |
 //! | [`element`] | the linear tetrahedron: `Dm^-1`, `W = abs(det Dm)/6`, `F = Ds Dm^-1`, forces `H = -W P(F) Dm^-T`, `f4 = -(f1+f2+f3)`, stiffness | 5.2 |
 //! | [`assembly`] | ordered parallel assembly of forces and the sparse stiffness (identical for any thread count) | 5.2 |
-//! | [`model`] | a body: precomputed rest data, lumped or consistent mass, gravity, loads, pinned and kinematic vertices, obstacles with a friction coefficient each | 5.2 |
+//! | [`model`] | a body of linear or 10-node tetrahedra ([`ElementOrder`](model::ElementOrder)): precomputed rest data, lumped or consistent mass, gravity, loads, pinned and kinematic vertices, obstacles with a friction coefficient each | 5.2 |
 //! | [`boundary`] | kinematic motions, ground and sphere obstacles | - |
 //! | [`friction`] | Coulomb friction at obstacle contacts: velocity-level in explicit steps, IPC's lagged smoothed potential (Li et al. 2020, section 5) in backward Euler | - |
 //! | [`newton`] | Newton on the incremental potential with a backtracking line search, Rayleigh damping `gamma` | 5.2 |
 //! | [`sim`] | symplectic Euler and backward Euler steps, quasi-static solves, the `Solver` implementation | 2, 5.2 |
-//! | [`quadratic`] | 10-node tetrahedra for locking-free quasi-static solves | - |
+//! | [`quadratic`] | 10-node tetrahedra (no locking in bending or near incompressibility): 4-point quadrature, closed-form consistent mass, HRZ lumping; in both time steppers and quasi-static solves | - |
 //! | [`ldlt`] | sparse `L D L^T` (faer) for symmetric indefinite Newton matrices | - |
 //! | [`scenes`] | cantilever beam, soft cube drop, twisted bar | - |
+//!
+//! **Element order.** [`FemModel::new`](model::FemModel::new) builds linear tetrahedra,
+//! [`FemModel::quadratic`](model::FemModel::quadratic) and
+//! [`FemModel::with_order`](model::FemModel::with_order) 10-node ones; the simulation, the
+//! scenes ([`scenes::by_name_with_order`]) and checkpoints do not care which.
 //!
 //! **Model / data split.** A [`FemModel`](model::FemModel) is built once and never modified by an
 //! algorithm; a [`FemSimulation`](sim::FemSimulation) owns the settings and every scratch buffer
@@ -82,3 +87,5 @@ pub use error::FemError;
 mod contact_tests;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_quadratic;

@@ -1,17 +1,30 @@
 //! The finite element model: an immutable description of a body (rest mesh, precomputed
 //! `Dm^-1` and `W` per element, material, masses, loads, boundary conditions, obstacles) that
 //! algorithms read and never modify.
+//!
+//! A body is made of linear (4-node, [`FemModel::new`]) or quadratic (10-node,
+//! [`FemModel::quadratic`], [`quadratic`](crate::quadratic)) tetrahedra ([`ElementOrder`]).
+//! Everything else (masses, gravity, loads, pinned and kinematic nodes, obstacles, both time
+//! integrators) works the same for both; the nodes of a 10-node body are its corner vertices
+//! followed by its edge nodes, and [`FemModel::mesh`] holds all of them as positions with the
+//! corner tetrahedra as elements (so [`FemModel::surface`] is the corner triangulation, used for
+//! output).
 
 use crate::assembly::Assembly;
 use crate::boundary::{KinematicGroup, Motion, Obstacle};
-use crate::element::{add_stiffness, deformation_gradient, gather, gradients, nodal_forces, rest_shape};
+use crate::element::{
+    add_stiffness, deformation_gradient, force_differential, gather, gradients, nodal_forces, rest_shape,
+};
 use crate::error::FemError;
+use crate::generate::{TET10_EDGES, Tet10Mesh};
 use crate::material::Material;
 use crate::mesh::{TetMesh, validate};
 use crate::newton::ElasticBody;
+use crate::quadratic::{Tet10Elements, consistent_mass_coefficient, lumped_mass_coefficient};
 use anim_core::linalg::CsrMatrix;
 use anim_material::nalgebra::Matrix3;
 use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
 
 /// Standard gravity, z-up (m/s^2).
 pub const EARTH_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
@@ -20,17 +33,55 @@ pub const EARTH_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum MassKind {
-    /// Diagonal: each element gives a quarter of its mass `rho W` to each vertex.
+    /// Diagonal: each linear element gives a quarter of its mass `rho W` to each vertex; a
+    /// 10-node element gives `rho W / 36` to each corner and `4 rho W / 27` to each edge node
+    /// (HRZ lumping, see [`quadratic`](crate::quadratic)).
     Lumped,
-    /// The consistent mass matrix of linear shape functions,
-    /// `M_ab = rho W (1 + delta_ab) / 20 I_3` per element.
+    /// The consistent mass matrix of the shape functions, `M_ab = rho int N_a N_b dV I_3`:
+    /// `rho W (1 + delta_ab) / 20 I_3` per linear element, the table of
+    /// [`quadratic`](crate::quadratic) for 10-node elements.
     Consistent,
+}
+
+/// The element of a body.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum ElementOrder {
+    /// Linear 4-node tetrahedra (`"tet4"`): constant strain, one point per element.
+    #[default]
+    #[serde(rename = "tet4")]
+    Linear,
+    /// Quadratic 10-node tetrahedra (`"tet10"`): linear strain, four quadrature points; no
+    /// locking in bending or near incompressibility, smaller stable explicit time steps.
+    #[serde(rename = "tet10")]
+    Quadratic,
+}
+
+impl ElementOrder {
+    /// The name used in scene files (`tet4`, `tet10`).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            ElementOrder::Linear => "tet4",
+            ElementOrder::Quadratic => "tet10",
+        }
+    }
+
+    /// Nodes per element.
+    #[must_use]
+    pub fn nodes(self) -> usize {
+        match self {
+            ElementOrder::Linear => 4,
+            ElementOrder::Quadratic => 10,
+        }
+    }
 }
 
 /// A tetrahedral body (see the [module docs](self)).
 #[derive(Debug, Clone)]
 pub struct FemModel {
     mesh: TetMesh,
+    /// The 10-node elements and their quadrature data (quadratic bodies only).
+    tet10: Option<Tet10Elements>,
     surface: Vec<[usize; 3]>,
     material: Material,
     dm_inv: Vec<Matrix3<f64>>,
@@ -39,6 +90,9 @@ pub struct FemModel {
     lumped_mass: Vec<f64>,
     mass_kind: MassKind,
     consistent_mass: CsrMatrix,
+    /// Row sums of the consistent mass per node (quadratic bodies only: for linear elements
+    /// they equal the lumped masses), the gravity weights with consistent mass.
+    consistent_row_sums: Option<Vec<f64>>,
     assembly: Assembly,
     gravity: [f64; 3],
     loads: Vec<f64>,
@@ -50,7 +104,8 @@ pub struct FemModel {
 }
 
 impl FemModel {
-    /// A body from a mesh and a material, with lumped mass, no gravity, no boundary conditions.
+    /// A body of linear tetrahedra from a mesh and a material, with lumped mass, no gravity, no
+    /// boundary conditions.
     ///
     /// Precomputes `Dm^-1` and `W` of every element (seed 5.2, Algorithm 1, PRECOMPUTATION).
     ///
@@ -59,6 +114,43 @@ impl FemModel {
     /// elements named by index).
     pub fn new(mesh: TetMesh, material: Material) -> Result<Self, FemError> {
         validate(&mesh.positions, &mesh.tets)?;
+        Self::build(mesh, None, material)
+    }
+
+    /// A body of 10-node tetrahedra (from [`generate::quadratic`](crate::generate::quadratic)),
+    /// with HRZ-lumped mass, no gravity, no boundary conditions. Every node (corner and edge)
+    /// is a degree of freedom; [`mesh`](Self::mesh) holds them all with the corner tetrahedra as
+    /// elements.
+    ///
+    /// # Errors
+    /// The mesh errors of [`validate`] on the corner tetrahedra, an edge node out of range
+    /// ([`FemError::VertexOutOfRange`]) or away from its edge's midpoint
+    /// ([`FemError::CurvedElement`]).
+    pub fn quadratic(mesh: Tet10Mesh, material: Material) -> Result<Self, FemError> {
+        let corners: Vec<[usize; 4]> = mesh.elements.iter().map(|e| [e[0], e[1], e[2], e[3]]).collect();
+        validate(&mesh.positions, &corners)?;
+        let tet10 = Tet10Elements::new(&mesh)?;
+        Self::build(TetMesh { positions: mesh.positions, tets: corners }, Some(tet10), material)
+    }
+
+    /// A body of `order` elements on a linear mesh: the mesh itself for
+    /// [`ElementOrder::Linear`], its 10-node refinement
+    /// ([`generate::quadratic`](crate::generate::quadratic)) for [`ElementOrder::Quadratic`].
+    ///
+    /// # Errors
+    /// As [`FemModel::new`].
+    pub fn with_order(mesh: TetMesh, material: Material, order: ElementOrder) -> Result<Self, FemError> {
+        match order {
+            ElementOrder::Linear => Self::new(mesh, material),
+            ElementOrder::Quadratic => {
+                validate(&mesh.positions, &mesh.tets)?;
+                Self::quadratic(crate::generate::quadratic(&mesh), material)
+            }
+        }
+    }
+
+    /// The body from a validated mesh (corner tetrahedra) and the 10-node data if quadratic.
+    fn build(mesh: TetMesh, tet10: Option<Tet10Elements>, material: Material) -> Result<Self, FemError> {
         let n = mesh.positions.len();
         let m = mesh.tets.len();
         let mut dm_inv = Vec::with_capacity(m);
@@ -75,30 +167,62 @@ impl FemModel {
             dm_inv.push(inv);
             volume.push(w);
             shape_grad.push(gradients(&inv));
-            for &v in t {
-                lumped_mass[v] += 0.25 * material.density * w;
-            }
-        }
-        let flat: Vec<usize> = mesh.tets.iter().flatten().copied().collect();
-        let assembly = Assembly::new(n, 4, &flat);
-        // Consistent mass: per-element 12 x 12 blocks rho W / 20 (1 + delta_ab) I_3.
-        let mut blocks = vec![0.0; m * 144];
-        for e in 0..m {
-            let c = material.density * volume[e] / 20.0;
-            for a in 0..4 {
-                for b in 0..4 {
-                    let v = if a == b { 2.0 * c } else { c };
-                    for i in 0..3 {
-                        blocks[e * 144 + (3 * a + i) * 12 + 3 * b + i] = v;
-                    }
+            if tet10.is_none() {
+                for &v in t {
+                    lumped_mass[v] += 0.25 * material.density * w;
                 }
             }
         }
-        let mut consistent_mass = assembly.matrix();
-        assembly.gather_matrix(&blocks, &mut consistent_mass);
+        let (assembly, consistent_mass, consistent_row_sums) = match &tet10 {
+            None => {
+                let flat: Vec<usize> = mesh.tets.iter().flatten().copied().collect();
+                let assembly = Assembly::new(n, 4, &flat);
+                // Consistent mass: per-element 12 x 12 blocks rho W / 20 (1 + delta_ab) I_3.
+                let mut blocks = vec![0.0; m * 144];
+                for e in 0..m {
+                    let c = material.density * volume[e] / 20.0;
+                    for a in 0..4 {
+                        for b in 0..4 {
+                            let v = if a == b { 2.0 * c } else { c };
+                            for i in 0..3 {
+                                blocks[e * 144 + (3 * a + i) * 12 + 3 * b + i] = v;
+                            }
+                        }
+                    }
+                }
+                let mut consistent_mass = assembly.matrix();
+                assembly.gather_matrix(&blocks, &mut consistent_mass);
+                (assembly, consistent_mass, None)
+            }
+            Some(q) => {
+                let flat: Vec<usize> = q.elements.iter().flatten().copied().collect();
+                let assembly = Assembly::new(n, 10, &flat);
+                let coef: [[f64; 10]; 10] =
+                    std::array::from_fn(|a| std::array::from_fn(|b| consistent_mass_coefficient(a, b)));
+                let lumped: [f64; 10] = std::array::from_fn(lumped_mass_coefficient);
+                let mut row_sums = vec![0.0; n];
+                let mut blocks = vec![0.0; m * 900];
+                for (e, el) in q.elements.iter().enumerate() {
+                    let c = material.density * volume[e];
+                    for a in 0..10 {
+                        lumped_mass[el[a]] += c * lumped[a];
+                        row_sums[el[a]] += c * coef[a].iter().sum::<f64>();
+                        for b in 0..10 {
+                            for i in 0..3 {
+                                blocks[e * 900 + (3 * a + i) * 30 + 3 * b + i] = c * coef[a][b];
+                            }
+                        }
+                    }
+                }
+                let mut consistent_mass = assembly.matrix();
+                assembly.gather_matrix(&blocks, &mut consistent_mass);
+                (assembly, consistent_mass, Some(row_sums))
+            }
+        };
         let surface = mesh.boundary_triangles();
         Ok(Self {
             mesh,
+            tet10,
             surface,
             material,
             dm_inv,
@@ -107,6 +231,7 @@ impl FemModel {
             lumped_mass,
             mass_kind: MassKind::Lumped,
             consistent_mass,
+            consistent_row_sums,
             assembly,
             gravity: [0.0; 3],
             loads: vec![0.0; 3 * n],
@@ -270,8 +395,22 @@ impl FemModel {
 
     /// Adds the consistent nodal loads of a uniform traction `t` (force per rest area) on the
     /// boundary triangles whose centroid satisfies `select`: each vertex of a triangle of area
-    /// `A` gets `A t / 3`. Returns the loaded area.
+    /// `A` gets `A t / 3` (linear elements); on the 6-node face of a 10-node element the corners
+    /// get 0 and the three edge nodes `A t / 3` each. Returns the loaded area.
     pub fn add_traction(&mut self, select: impl Fn([f64; 3]) -> bool, t: [f64; 3]) -> f64 {
+        let edge_nodes: HashMap<(usize, usize), usize> = match &self.tet10 {
+            None => HashMap::new(),
+            Some(q) => q
+                .elements
+                .iter()
+                .flat_map(|el| {
+                    TET10_EDGES
+                        .iter()
+                        .enumerate()
+                        .map(|(k, [a, b])| ((el[*a].min(el[*b]), el[*a].max(el[*b])), el[4 + k]))
+                })
+                .collect(),
+        };
         let mut total = 0.0;
         for tri in &self.surface {
             let p = tri.map(|v| self.mesh.positions[v]);
@@ -284,7 +423,15 @@ impl FemModel {
             let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
             let area = 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
             total += area;
-            for &vtx in tri {
+            let loaded = if self.tet10.is_some() {
+                [(0, 1), (1, 2), (0, 2)].map(|(a, b)| {
+                    let (i, j) = (tri[a].min(tri[b]), tri[a].max(tri[b]));
+                    edge_nodes.get(&(i, j)).copied()
+                })
+            } else {
+                tri.map(Some)
+            };
+            for vtx in loaded.into_iter().flatten() {
                 for c in 0..3 {
                     self.loads[3 * vtx + c] += area * t[c] / 3.0;
                 }
@@ -293,13 +440,27 @@ impl FemModel {
         total
     }
 
-    /// The rest mesh.
+    /// The rest mesh: every node's position (for a 10-node body, the corners then the edge
+    /// nodes) and the (corner) tetrahedra.
     #[must_use]
     pub fn mesh(&self) -> &TetMesh {
         &self.mesh
     }
 
-    /// Number of vertices.
+    /// The element order.
+    #[must_use]
+    pub fn order(&self) -> ElementOrder {
+        if self.tet10.is_some() { ElementOrder::Quadratic } else { ElementOrder::Linear }
+    }
+
+    /// The node indices of a 10-node body's elements (four corners, then the edge nodes in
+    /// [`TET10_EDGES`] order); `None` for a linear body.
+    #[must_use]
+    pub fn quadratic_elements(&self) -> Option<&[[usize; 10]]> {
+        self.tet10.as_ref().map(|q| q.elements.as_slice())
+    }
+
+    /// Number of vertices (nodes: corners and, for 10-node elements, edge nodes).
     #[must_use]
     pub fn vertices(&self) -> usize {
         self.mesh.positions.len()
@@ -323,7 +484,7 @@ impl FemModel {
         &self.material
     }
 
-    /// `Dm^-1` per element.
+    /// `Dm^-1` per element (of the corner tetrahedron for 10-node elements).
     #[must_use]
     pub fn dm_inv(&self) -> &[Matrix3<f64>] {
         &self.dm_inv
@@ -335,7 +496,7 @@ impl FemModel {
         &self.volume
     }
 
-    /// Lumped vertex masses.
+    /// Lumped vertex masses (HRZ lumping for 10-node elements).
     #[must_use]
     pub fn lumped_mass(&self) -> &[f64] {
         &self.lumped_mass
@@ -402,11 +563,18 @@ impl FemModel {
         self.mesh.positions.iter().flatten().copied().collect()
     }
 
-    /// Writes the external force: `m_i g` plus the nodal loads, times `scale`.
+    /// Writes the external force: `m_i g` plus the nodal loads, times `scale`. The gravity
+    /// weights `m_i` are the lumped masses, or with consistent mass on a 10-node body the row
+    /// sums of `M` (`rho int N_i dV`, negative at the corners), so that `M^-1 f` is exactly `g`
+    /// for a free body with either mass.
     pub fn external_force(&self, scale: f64, out: &mut [f64]) {
+        let weights = match (&self.consistent_row_sums, self.mass_kind) {
+            (Some(rows), MassKind::Consistent) => rows,
+            _ => &self.lumped_mass,
+        };
         for (i, o) in out.chunks_mut(3).enumerate() {
             for c in 0..3 {
-                o[c] = scale * (self.lumped_mass[i] * self.gravity[c] + self.loads[3 * i + c]);
+                o[c] = scale * (weights[i] * self.gravity[c] + self.loads[3 * i + c]);
             }
         }
     }
@@ -427,20 +595,69 @@ impl FemModel {
         (0..self.elements()).map(|e| self.element(e, x, None, None, false)).sum()
     }
 
-    /// The deformation gradient of element `e` at positions `x`.
+    /// The deformation gradient of element `e` at positions `x` (for a 10-node element, at its
+    /// centroid, where the corner shape functions have zero gradient and edge node `(a, b)` has
+    /// `grad L_a + grad L_b`).
     #[must_use]
     pub fn deformation_gradient(&self, e: usize, x: &[f64]) -> Matrix3<f64> {
-        deformation_gradient(&gather(x, &self.mesh.tets[e]), &self.dm_inv[e])
+        match &self.tet10 {
+            None => deformation_gradient(&gather(x, &self.mesh.tets[e]), &self.dm_inv[e]),
+            Some(q) => {
+                let b = &self.shape_grad[e];
+                let el = &q.elements[e];
+                let mut f = Matrix3::zeros();
+                for (k, [a, c]) in TET10_EDGES.iter().enumerate() {
+                    let v = el[4 + k];
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            f[(i, j)] += x[3 * v + i] * (b[*a][j] + b[*c][j]);
+                        }
+                    }
+                }
+                f
+            }
+        }
     }
 
-    /// The elastic nodal forces of element `e` (seed 5.2: `H = -W P(F) Dm^-T`, `f_4 = -(f_1 +
-    /// f_2 + f_3)`).
+    /// The elastic nodal forces of element `e` into `out` (3 per element node, `3 x 4` or
+    /// `3 x 10` values): seed 5.2's `H = -W P(F) Dm^-T`, `f_4 = -(f_1 + f_2 + f_3)` for linear
+    /// elements, `-sum_q w_q P(F_q) grad N_a(X_q)` for 10-node elements.
     #[inline]
-    #[must_use]
-    pub fn element_forces(&self, e: usize, x: &[f64]) -> [[f64; 3]; 4] {
-        let f = self.deformation_gradient(e, x);
-        let p = self.material.model.pk1(&self.material.lame, &f);
-        nodal_forces(self.volume[e], &p, &self.dm_inv[e])
+    pub fn element_forces(&self, e: usize, x: &[f64], out: &mut [f64]) {
+        self.element_forces_damped(e, x, None, out);
+    }
+
+    /// The elastic forces of element `e` plus, with `damping = Some((gamma, v))`, the Rayleigh
+    /// damping forces `-gamma K_e(x) v` (matrix-free).
+    #[inline]
+    pub(crate) fn element_forces_damped(
+        &self,
+        e: usize,
+        x: &[f64],
+        damping: Option<(f64, &[f64])>,
+        out: &mut [f64],
+    ) {
+        if let Some(q) = &self.tet10 {
+            q.forces(&self.material, e, x, damping, out);
+            return;
+        }
+        let fd = self.deformation_gradient(e, x);
+        let mat = &self.material;
+        let p = mat.model.pk1(&mat.lame, &fd);
+        let mut f = nodal_forces(self.volume[e], &p, &self.dm_inv[e]);
+        if let Some((gamma, v)) = damping {
+            let tangent = mat.model.dpdf(&mat.lame, &fd);
+            let u = gather(v, &self.mesh.tets[e]);
+            let d = force_differential(self.volume[e], &self.dm_inv[e], &tangent, &u);
+            for a in 0..4 {
+                for i in 0..3 {
+                    f[a][i] += gamma * d[a][i];
+                }
+            }
+        }
+        for a in 0..4 {
+            out[3 * a..3 * a + 3].copy_from_slice(&f[a]);
+        }
     }
 }
 
@@ -450,7 +667,7 @@ impl ElasticBody for FemModel {
     }
 
     fn per_element(&self) -> usize {
-        4
+        self.order().nodes()
     }
 
     #[inline]
@@ -462,6 +679,9 @@ impl ElasticBody for FemModel {
         hess: Option<&mut [f64]>,
         project: bool,
     ) -> f64 {
+        if let Some(q) = &self.tet10 {
+            return q.element(&self.material, e, x, grad, hess, project);
+        }
         let f = self.deformation_gradient(e, x);
         let w = self.volume[e];
         let mat = &self.material;
@@ -483,6 +703,9 @@ impl ElasticBody for FemModel {
     }
 
     fn det_f(&self, e: usize, x: &[f64]) -> f64 {
-        self.deformation_gradient(e, x).determinant()
+        match &self.tet10 {
+            Some(q) => q.det_f(e, x),
+            None => self.deformation_gradient(e, x).determinant(),
+        }
     }
 }

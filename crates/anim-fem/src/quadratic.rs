@@ -1,6 +1,6 @@
-//! Quadratic (10-node) tetrahedra for quasi-static solves: the element that does not lock where
-//! linear tetrahedra do (bending-dominated beams, nearly incompressible materials such as Cook's
-//! membrane with `nu = 0.4999`).
+//! Quadratic (10-node) tetrahedra: the element that does not lock where linear tetrahedra do
+//! (bending-dominated beams, nearly incompressible materials such as Cook's membrane with
+//! `nu = 0.4999`), for time stepping and quasi-static solves.
 //!
 //! Shape functions in barycentric coordinates `L0..L3`: corners `N_a = L_a (2 L_a - 1)`, edge
 //! `(a, b)` nodes `N_ab = 4 L_a L_b` (node order of [`TET10_EDGES`]). The deformation gradient
@@ -12,21 +12,43 @@
 //! E_e = sum_q w_q |det J_q| psi(F_q),   dE_e/dx_a = sum_q w_q |det J_q| P(F_q) grad N_a(X_q)
 //! ```
 //!
-//! Edge nodes sit at the midpoints of straight edges (affine elements), so `J` is constant per
-//! element. Equilibrium is found by the same Newton minimisation as the linear body
-//! ([`newton::minimize`]).
+//! Edge nodes sit at the midpoints of straight edges (affine elements, checked on
+//! construction), so `J` is constant per element.
+//!
+//! **Mass.** The consistent mass `M_ab = rho int N_a N_b dV` has a degree-4 integrand; for an
+//! affine element of volume `V` it is `rho V / 420` times (from
+//! `int L0^i L1^j L2^k L3^l dV = 6 V i! j! k! l! / (i + j + k + l + 3)!`):
+//!
+//! | pair | coefficient |
+//! | --- | --- |
+//! | corner, same corner | 6 |
+//! | corner, other corner | 1 |
+//! | corner, edge through it | -4 |
+//! | corner, edge not through it | -6 |
+//! | edge, same edge | 32 |
+//! | edge, edge sharing a corner | 16 |
+//! | edge, opposite edge | 8 |
+//!
+//! ([`consistent_mass_coefficient`]). Its row sums, `-rho V / 20` at the corners and
+//! `rho V / 5` at the edge nodes, make row-sum lumping useless (negative corner masses), so the
+//! lumped mass is **HRZ (diagonal-scaling) lumping**: the diagonal of `M` scaled to carry the
+//! element's mass, `rho V / 36` per corner and `4 rho V / 27` per edge node
+//! ([`lumped_mass_coefficient`]), all positive.
+//!
+//! The dynamic body is a [`FemModel`] built with
+//! [`FemModel::quadratic`](crate::model::FemModel::quadratic) (every boundary condition, load,
+//! obstacle and both time integrators of the linear body); [`QuadraticModel`] is the
+//! quasi-static front end the conformance cases use.
 
-use crate::assembly::Assembly;
 use crate::element::add_stiffness;
 use crate::error::FemError;
 use crate::generate::{TET10_EDGES, Tet10Mesh};
 use crate::material::Material;
-use crate::mesh::{TetMesh, validate};
+use crate::model::FemModel;
 use crate::newton::{self, ElasticBody, NewtonData, NewtonInfo, NewtonSettings, Potential};
 use crate::sim::LinearSolverChoice;
 use anim_core::linalg::{IterativeParams, LinearSolver};
 use anim_material::nalgebra::{Matrix3, Vector3};
-use std::collections::HashSet;
 
 const QA: f64 = 0.585_410_196_624_968_5;
 const QB: f64 = 0.138_196_601_125_010_5;
@@ -52,32 +74,77 @@ fn reference_gradients(p: [f64; 3]) -> [[f64; 3]; 10] {
     g
 }
 
-/// A body of 10-node tetrahedra with fixed coordinates and nodal loads, solved quasi-statically.
-#[derive(Debug, Clone)]
-pub struct QuadraticModel {
-    mesh: Tet10Mesh,
-    material: Material,
-    weights: Vec<[f64; 4]>,
-    grads: Vec<[[[f64; 3]; 10]; 4]>,
-    assembly: Assembly,
-    fixed: Vec<bool>,
-    loads: Vec<f64>,
-    boundary: Vec<[usize; 3]>,
+/// The corners of node `k` of a 10-node element (a corner twice for a corner node).
+fn node_corners(k: usize) -> [usize; 2] {
+    if k < 4 { [k, k] } else { TET10_EDGES[k - 4] }
 }
 
-impl QuadraticModel {
-    /// A body from a 10-node mesh (from [`generate::quadratic`](crate::generate::quadratic)).
-    ///
-    /// # Errors
-    /// The validation errors of the corner mesh (degenerate or inverted elements).
-    pub fn new(mesh: Tet10Mesh, material: Material) -> Result<Self, FemError> {
-        let corners: Vec<[usize; 4]> = mesh.elements.iter().map(|e| [e[0], e[1], e[2], e[3]]).collect();
-        validate(&mesh.positions, &corners)?;
+/// `M_ab / (rho V)`: the consistent mass of nodes `a` and `b` (`0..10`, corners then the edge
+/// nodes of [`TET10_EDGES`]) of an affine 10-node element of volume `V` (see the
+/// [module docs](self)).
+#[must_use]
+pub fn consistent_mass_coefficient(a: usize, b: usize) -> f64 {
+    let (ca, cb) = (node_corners(a), node_corners(b));
+    let num = match (a < 4, b < 4) {
+        (true, true) => {
+            if a == b {
+                6.0
+            } else {
+                1.0
+            }
+        }
+        (true, false) | (false, true) => {
+            let (corner, edge) = if a < 4 { (a, cb) } else { (b, ca) };
+            if edge.contains(&corner) { -4.0 } else { -6.0 }
+        }
+        (false, false) => match ca.iter().filter(|c| cb.contains(c)).count() {
+            2 => 32.0,
+            1 => 16.0,
+            _ => 8.0,
+        },
+    };
+    num / 420.0
+}
+
+/// The HRZ lumped mass of node `a` of an affine 10-node element over `rho V`: `M_aa` scaled so
+/// that the ten masses sum to one (`1/36` at a corner, `4/27` at an edge node).
+#[must_use]
+pub fn lumped_mass_coefficient(a: usize) -> f64 {
+    let trace: f64 = (0..10).map(|k| consistent_mass_coefficient(k, k)).sum();
+    consistent_mass_coefficient(a, a) / trace
+}
+
+/// Quadrature data of a mesh of 10-node tetrahedra: `|det J| w` and the shape-function gradients
+/// at the four points of every element.
+#[derive(Debug, Clone)]
+pub(crate) struct Tet10Elements {
+    pub(crate) elements: Vec<[usize; 10]>,
+    weights: Vec<[f64; 4]>,
+    grads: Vec<[[[f64; 3]; 10]; 4]>,
+}
+
+impl Tet10Elements {
+    /// Precomputes the quadrature data. The corner elements must have been validated; checks
+    /// the edge nodes (in range, at their edge's midpoint).
+    pub(crate) fn new(mesh: &Tet10Mesh) -> Result<Self, FemError> {
         let n = mesh.positions.len();
         let ref_grads = POINTS.map(reference_gradients);
         let mut weights = Vec::with_capacity(mesh.elements.len());
         let mut grads = Vec::with_capacity(mesh.elements.len());
         for (e, el) in mesh.elements.iter().enumerate() {
+            for &v in el {
+                if v >= n {
+                    return Err(FemError::VertexOutOfRange { element: e, vertex: v, vertices: n });
+                }
+            }
+            for (k, [a, b]) in TET10_EDGES.iter().enumerate() {
+                let (p, q, m) = (mesh.positions[el[*a]], mesh.positions[el[*b]], mesh.positions[el[4 + k]]);
+                let edge = (0..3).map(|c| (q[c] - p[c]).powi(2)).sum::<f64>().sqrt();
+                let offset = (0..3).map(|c| (m[c] - 0.5 * (p[c] + q[c])).powi(2)).sum::<f64>().sqrt();
+                if !(offset <= 1e-9 * edge) {
+                    return Err(FemError::CurvedElement { element: e, node: el[4 + k], offset, edge });
+                }
+            }
             let mut w = [0.0; 4];
             let mut g = [[[0.0; 3]; 10]; 4];
             for q in 0..4 {
@@ -105,144 +172,13 @@ impl QuadraticModel {
             weights.push(w);
             grads.push(g);
         }
-        let flat: Vec<usize> = mesh.elements.iter().flatten().copied().collect();
-        let assembly = Assembly::new(n, 10, &flat);
-        let boundary = TetMesh { positions: mesh.positions.clone(), tets: corners }.boundary_triangles();
-        Ok(Self {
-            mesh,
-            material,
-            weights,
-            grads,
-            assembly,
-            fixed: vec![false; 3 * n],
-            loads: vec![0.0; 3 * n],
-            boundary,
-        })
+        Ok(Self { elements: mesh.elements.clone(), weights, grads })
     }
 
-    /// The mesh.
-    #[must_use]
-    pub fn mesh(&self) -> &Tet10Mesh {
-        &self.mesh
-    }
-
-    /// Number of nodes.
-    #[must_use]
-    pub fn nodes(&self) -> usize {
-        self.mesh.positions.len()
-    }
-
-    /// Fixes the coordinates `mask` of every node for which `select(X)` holds; returns how many
-    /// nodes were selected.
-    pub fn fix_where(&mut self, select: impl Fn([f64; 3]) -> bool, mask: [bool; 3]) -> usize {
-        let mut count = 0;
-        for (i, p) in self.mesh.positions.iter().enumerate() {
-            if select(*p) {
-                count += 1;
-                for c in 0..3 {
-                    self.fixed[3 * i + c] |= mask[c];
-                }
-            }
-        }
-        count
-    }
-
-    /// Adds the consistent nodal loads of a uniform traction `t` (force per rest area) on the
-    /// boundary faces whose centroid satisfies `select`: on a 6-node triangle of area `A` the
-    /// corners get 0 and the edge nodes `A t / 3` each. Returns the loaded area.
-    pub fn add_traction(&mut self, select: impl Fn([f64; 3]) -> bool, t: [f64; 3]) -> f64 {
-        let faces: HashSet<[usize; 3]> = self
-            .boundary
-            .iter()
-            .map(|f| {
-                let mut s = *f;
-                s.sort_unstable();
-                s
-            })
-            .collect();
-        // Local faces with their edge nodes.
-        const FACES: [([usize; 3], [usize; 3]); 4] =
-            [([0, 1, 2], [4, 5, 6]), ([0, 1, 3], [4, 8, 7]), ([0, 2, 3], [6, 9, 7]), ([1, 2, 3], [5, 9, 8])];
-        let mut area_total = 0.0;
-        for el in &self.mesh.elements {
-            for (corner, edge) in FACES {
-                let mut key = corner.map(|c| el[c]);
-                key.sort_unstable();
-                if !faces.contains(&key) {
-                    continue;
-                }
-                let p = corner.map(|c| Vector3::from(self.mesh.positions[el[c]]));
-                let centroid = (p[0] + p[1] + p[2]) / 3.0;
-                if !select([centroid[0], centroid[1], centroid[2]]) {
-                    continue;
-                }
-                let area = 0.5 * (p[1] - p[0]).cross(&(p[2] - p[0])).norm();
-                area_total += area;
-                for e in edge {
-                    for c in 0..3 {
-                        self.loads[3 * el[e] + c] += area * t[c] / 3.0;
-                    }
-                }
-            }
-        }
-        area_total
-    }
-
-    /// Rest positions, flat.
-    #[must_use]
-    pub fn rest_positions(&self) -> Vec<f64> {
-        self.mesh.positions.iter().flatten().copied().collect()
-    }
-
-    /// Static equilibrium under the nodal loads applied in `load_steps` increments; `x` holds
-    /// the initial guess (fixed coordinates at their values) and receives the solution.
-    /// `tolerance` bounds the last Newton update (length units).
-    ///
-    /// # Errors
-    /// As [`newton::minimize`].
-    pub fn solve_static(
-        &self,
-        x: &mut [f64],
-        load_steps: usize,
-        tolerance: f64,
-        solver: LinearSolverChoice,
-        project: bool,
-    ) -> Result<NewtonInfo, FemError> {
-        let mut data = NewtonData::new(&self.assembly, self.mesh.elements.len());
-        let mut linear: Box<dyn LinearSolver> = solver.build(IterativeParams::new(1e-10, 100_000));
-        let lumped = vec![0.0; self.nodes()];
-        let mut external = vec![0.0; x.len()];
-        let steps = load_steps.max(1);
-        let mut total = NewtonInfo::default();
-        for s in 1..=steps {
-            let scale = s as f64 / steps as f64;
-            for (e, l) in external.iter_mut().zip(&self.loads) {
-                *e = scale * l;
-            }
-            let pot = Potential {
-                inertia: None,
-                lumped_mass: &lumped,
-                consistent_mass: None,
-                damping: None,
-                external: &external,
-                obstacles: &[],
-                contact_stiffness: 0.0,
-                friction: &[],
-                fixed: &self.fixed,
-                project,
-            };
-            let settings = NewtonSettings { tolerance, max_iterations: 100, step: s as u64 };
-            let info = newton::minimize(self, &self.assembly, &pot, x, &mut data, linear.as_mut(), settings)?;
-            total.iterations += info.iterations;
-            total.linear_iterations += info.linear_iterations;
-            total.last_update = info.last_update;
-            total.energy = info.energy;
-        }
-        Ok(total)
-    }
-
-    fn deformation_gradient(&self, e: usize, q: usize, x: &[f64]) -> Matrix3<f64> {
-        let el = &self.mesh.elements[e];
+    /// `F` at quadrature point `q` of element `e`.
+    #[inline]
+    pub(crate) fn deformation_gradient(&self, e: usize, q: usize, x: &[f64]) -> Matrix3<f64> {
+        let el = &self.elements[e];
         let g = &self.grads[e][q];
         let mut f = Matrix3::zeros();
         for a in 0..10 {
@@ -255,26 +191,18 @@ impl QuadraticModel {
         }
         f
     }
-}
 
-impl ElasticBody for QuadraticModel {
-    fn elements(&self) -> usize {
-        self.mesh.elements.len()
-    }
-
-    fn per_element(&self) -> usize {
-        10
-    }
-
-    fn element(
+    /// The element's energy, gradient and Hessian (see [`ElasticBody::element`]).
+    #[inline]
+    pub(crate) fn element(
         &self,
+        mat: &Material,
         e: usize,
         x: &[f64],
         mut grad: Option<&mut [f64]>,
         mut hess: Option<&mut [f64]>,
         project: bool,
     ) -> f64 {
-        let mat = &self.material;
         let mut energy = 0.0;
         if let Some(g) = grad.as_deref_mut() {
             g.fill(0.0);
@@ -301,7 +229,174 @@ impl ElasticBody for QuadraticModel {
         energy
     }
 
-    fn det_f(&self, e: usize, x: &[f64]) -> f64 {
+    /// The elastic nodal forces `-dE_e/dx` of element `e` into `out` (30 values), plus the
+    /// Rayleigh damping forces `-gamma K_e(x) v` when `damping = Some((gamma, v))`
+    /// (matrix-free: `dF_q = sum_b v_b grad N_b^T`, `f_a -= gamma w_q (dP/dF)[dF_q] grad N_a`).
+    #[inline]
+    pub(crate) fn forces(
+        &self,
+        mat: &Material,
+        e: usize,
+        x: &[f64],
+        damping: Option<(f64, &[f64])>,
+        out: &mut [f64],
+    ) {
+        out.fill(0.0);
+        for q in 0..4 {
+            let f = self.deformation_gradient(e, q, x);
+            let w = self.weights[e][q];
+            let mut p = mat.model.pk1(&mat.lame, &f);
+            if let Some((gamma, v)) = damping {
+                let df = self.deformation_gradient(e, q, v);
+                p += mat.model.dpdf(&mat.lame, &f).apply(&df) * gamma;
+            }
+            let grads = &self.grads[e][q];
+            for a in 0..10 {
+                let r = p * Vector3::from(grads[a]) * w;
+                for i in 0..3 {
+                    out[3 * a + i] -= r[i];
+                }
+            }
+        }
+    }
+
+    /// The smallest `det F` over the element's quadrature points.
+    pub(crate) fn det_f(&self, e: usize, x: &[f64]) -> f64 {
         (0..4).map(|q| self.deformation_gradient(e, q, x).determinant()).fold(f64::INFINITY, f64::min)
+    }
+}
+
+/// A body of 10-node tetrahedra with fixed coordinates and nodal loads, solved quasi-statically:
+/// a [`FemModel::quadratic`] without mass, gravity or contact, with its own Newton scratch per
+/// solve.
+#[derive(Debug, Clone)]
+pub struct QuadraticModel {
+    mesh: Tet10Mesh,
+    model: FemModel,
+}
+
+impl QuadraticModel {
+    /// A body from a 10-node mesh (from [`generate::quadratic`](crate::generate::quadratic)).
+    ///
+    /// # Errors
+    /// The validation errors of the corner mesh (degenerate or inverted elements), edge nodes
+    /// out of range or off their edge's midpoint ([`FemError::CurvedElement`]).
+    pub fn new(mesh: Tet10Mesh, material: Material) -> Result<Self, FemError> {
+        let model = FemModel::quadratic(mesh.clone(), material)?;
+        Ok(Self { mesh, model })
+    }
+
+    /// The mesh.
+    #[must_use]
+    pub fn mesh(&self) -> &Tet10Mesh {
+        &self.mesh
+    }
+
+    /// The underlying body.
+    #[must_use]
+    pub fn model(&self) -> &FemModel {
+        &self.model
+    }
+
+    /// Number of nodes.
+    #[must_use]
+    pub fn nodes(&self) -> usize {
+        self.mesh.positions.len()
+    }
+
+    /// Fixes the coordinates `mask` of every node for which `select(X)` holds; returns how many
+    /// nodes were selected.
+    pub fn fix_where(&mut self, select: impl Fn([f64; 3]) -> bool, mask: [bool; 3]) -> usize {
+        let mut count = 0;
+        for i in self.model.vertices_where(select) {
+            if self.model.pin(i, mask).is_ok() {
+                count += 1;
+            }
+        }
+        count
+    }
+
+    /// Adds the consistent nodal loads of a uniform traction `t` (force per rest area) on the
+    /// boundary faces whose centroid satisfies `select`: on a 6-node triangle of area `A` the
+    /// corners get 0 and the edge nodes `A t / 3` each. Returns the loaded area.
+    pub fn add_traction(&mut self, select: impl Fn([f64; 3]) -> bool, t: [f64; 3]) -> f64 {
+        self.model.add_traction(select, t)
+    }
+
+    /// Rest positions, flat.
+    #[must_use]
+    pub fn rest_positions(&self) -> Vec<f64> {
+        self.model.rest_positions()
+    }
+
+    /// Static equilibrium under the nodal loads applied in `load_steps` increments; `x` holds
+    /// the initial guess (fixed coordinates at their values) and receives the solution.
+    /// `tolerance` bounds the last Newton update (length units).
+    ///
+    /// # Errors
+    /// As [`newton::minimize`].
+    pub fn solve_static(
+        &self,
+        x: &mut [f64],
+        load_steps: usize,
+        tolerance: f64,
+        solver: LinearSolverChoice,
+        project: bool,
+    ) -> Result<NewtonInfo, FemError> {
+        let model = &self.model;
+        let mut data = NewtonData::new(model.assembly(), model.elements());
+        let mut linear: Box<dyn LinearSolver> = solver.build(IterativeParams::new(1e-10, 100_000));
+        let lumped = vec![0.0; self.nodes()];
+        let mut external = vec![0.0; x.len()];
+        let steps = load_steps.max(1);
+        let mut total = NewtonInfo::default();
+        for s in 1..=steps {
+            model.external_force(s as f64 / steps as f64, &mut external);
+            let pot = Potential {
+                inertia: None,
+                lumped_mass: &lumped,
+                consistent_mass: None,
+                damping: None,
+                external: &external,
+                obstacles: &[],
+                contact_stiffness: 0.0,
+                friction: &[],
+                fixed: model.fixed(),
+                project,
+            };
+            let settings = NewtonSettings { tolerance, max_iterations: 100, step: s as u64 };
+            let info =
+                newton::minimize(model, model.assembly(), &pot, x, &mut data, linear.as_mut(), settings)?;
+            total.iterations += info.iterations;
+            total.linear_iterations += info.linear_iterations;
+            total.last_update = info.last_update;
+            total.energy = info.energy;
+        }
+        Ok(total)
+    }
+}
+
+impl ElasticBody for QuadraticModel {
+    fn elements(&self) -> usize {
+        self.model.elements()
+    }
+
+    fn per_element(&self) -> usize {
+        10
+    }
+
+    fn element(
+        &self,
+        e: usize,
+        x: &[f64],
+        grad: Option<&mut [f64]>,
+        hess: Option<&mut [f64]>,
+        project: bool,
+    ) -> f64 {
+        self.model.element(e, x, grad, hess, project)
+    }
+
+    fn det_f(&self, e: usize, x: &[f64]) -> f64 {
+        self.model.det_f(e, x)
     }
 }

@@ -7,8 +7,14 @@
 //! | `soft-cube-drop` | a 0.3 m jelly cube (E = 50 kPa) dropped from 0.5 m bounces on the ground | stable Neo-Hookean, backward Euler, dt = 1/120 s, penalty contact | impact, large compression |
 //! | `twisted-bar` | a bar clamped at one end while the other end turns about the bar axis at half a turn per second | fixed corotated, backward Euler, dt = 1/60 s | large rotations and shear; corotated models stay defined |
 //!
-//! Output: positions are in the state (`x = [x0, y0, z0, ...]`); the model's
-//! [`surface`](FemModel::surface) gives the outward boundary triangles for drawing.
+//! Every scene is built of linear tetrahedra by default; [`by_name_with_order`] builds it of
+//! 10-node tetrahedra on the same mesh ([`ElementOrder::Quadratic`]: the beam then bends as
+//! Euler-Bernoulli theory says instead of locking, with 4 to 7 times the nodes and 4 quadrature
+//! points per element).
+//!
+//! Output: positions are in the state (`x = [x0, y0, z0, ...]`, the edge nodes after the corners
+//! for 10-node bodies); the model's [`surface`](FemModel::surface) gives the outward boundary
+//! triangles (of the corners) for drawing.
 //!
 //! ```
 //! use anim_core::solver::Solver;
@@ -26,7 +32,7 @@ use crate::boundary::{Motion, Obstacle};
 use crate::error::FemError;
 use crate::generate::box_mesh;
 use crate::material::{Material, MaterialModel};
-use crate::model::{EARTH_GRAVITY, FemModel};
+use crate::model::{EARTH_GRAVITY, ElementOrder, FemModel};
 use crate::sim::{FemParams, FemSimulation};
 use anim_core::integrate::State;
 
@@ -73,10 +79,21 @@ pub const NAMES: [&str; 3] = ["cantilever-beam", "soft-cube-drop", "twisted-bar"
 /// along each side of the cube (6 by default).
 #[must_use]
 pub fn by_name(name: &str, resolution: Option<usize>) -> Option<Result<FemScene, FemError>> {
+    by_name_with_order(name, resolution, ElementOrder::Linear)
+}
+
+/// [`by_name`] with the element order of the body (the same mesh, refined to 10-node elements
+/// for [`ElementOrder::Quadratic`]).
+#[must_use]
+pub fn by_name_with_order(
+    name: &str,
+    resolution: Option<usize>,
+    order: ElementOrder,
+) -> Option<Result<FemScene, FemError>> {
     Some(match name {
-        "cantilever-beam" => cantilever_beam(resolution.unwrap_or(4)),
-        "soft-cube-drop" => soft_cube_drop(resolution.unwrap_or(6)),
-        "twisted-bar" => twisted_bar(resolution.unwrap_or(4)),
+        "cantilever-beam" => cantilever_beam_of(resolution.unwrap_or(4), order),
+        "soft-cube-drop" => soft_cube_drop_of(resolution.unwrap_or(6), order),
+        "twisted-bar" => twisted_bar_of(resolution.unwrap_or(4), order),
         _ => return None,
     })
 }
@@ -120,10 +137,14 @@ pub fn benchmark_beam(cells: usize) -> Result<FemScene, FemError> {
 /// # Errors
 /// [`FemError::BadParameter`] for a zero resolution.
 pub fn cantilever_beam(resolution: usize) -> Result<FemScene, FemError> {
+    cantilever_beam_of(resolution, ElementOrder::Linear)
+}
+
+fn cantilever_beam_of(resolution: usize, order: ElementOrder) -> Result<FemScene, FemError> {
     let n = resolution;
     let mesh = box_mesh([0.0, -0.05, 0.5], [1.0, 0.1, 0.1], [10 * n, n, n])?;
     let material = Material::new(MaterialModel::StableNeoHookean, 1e7, 0.3, 1000.0)?;
-    let mut model = FemModel::new(mesh, material)?.with_gravity(EARTH_GRAVITY);
+    let mut model = FemModel::with_order(mesh, material, order)?.with_gravity(EARTH_GRAVITY);
     let clamp = model.vertices_where(|p| p[0] < 1e-9);
     model.pin_vertices(&clamp)?;
     Ok(FemScene {
@@ -142,10 +163,14 @@ pub fn cantilever_beam(resolution: usize) -> Result<FemScene, FemError> {
 /// # Errors
 /// [`FemError::BadParameter`] for a zero resolution.
 pub fn soft_cube_drop(resolution: usize) -> Result<FemScene, FemError> {
+    soft_cube_drop_of(resolution, ElementOrder::Linear)
+}
+
+fn soft_cube_drop_of(resolution: usize, order: ElementOrder) -> Result<FemScene, FemError> {
     let n = resolution;
     let mesh = box_mesh([-0.15, -0.15, 0.5], [0.3, 0.3, 0.3], [n, n, n])?;
     let material = Material::new(MaterialModel::StableNeoHookean, 5e4, 0.3, 1000.0)?;
-    let mut model = FemModel::new(mesh, material)?.with_gravity(EARTH_GRAVITY);
+    let mut model = FemModel::with_order(mesh, material, order)?.with_gravity(EARTH_GRAVITY);
     model.add_obstacle(Obstacle::ground(0.0), 1e7)?;
     let mut state = initial_state(&model);
     // A slight spin so the landing is not symmetric.
@@ -170,10 +195,14 @@ pub fn soft_cube_drop(resolution: usize) -> Result<FemScene, FemError> {
 /// # Errors
 /// [`FemError::BadParameter`] for a zero resolution.
 pub fn twisted_bar(resolution: usize) -> Result<FemScene, FemError> {
+    twisted_bar_of(resolution, ElementOrder::Linear)
+}
+
+fn twisted_bar_of(resolution: usize, order: ElementOrder) -> Result<FemScene, FemError> {
     let n = resolution;
     let mesh = box_mesh([0.0, -0.05, 0.45], [1.0, 0.1, 0.1], [10 * n, n, n])?;
     let material = Material::new(MaterialModel::FixedCorotated, 1e6, 0.3, 1000.0)?;
-    let mut model = FemModel::new(mesh, material)?;
+    let mut model = FemModel::with_order(mesh, material, order)?;
     let left = model.vertices_where(|p| p[0] < 1e-9);
     let right = model.vertices_where(|p| p[0] > 1.0 - 1e-9);
     model.pin_vertices(&left)?;

@@ -11,6 +11,11 @@
 //!   backtracking line search ([`newton`]), the stiffness assembled in parallel in
 //!   a fixed order, and a choice of linear solver ([`LinearSolverChoice`]).
 //!
+//! Both steps, the quasi-static solve and the reports work on linear and 10-node bodies alike:
+//! element loops go through the model ([`FemModel::element_forces`], the
+//! [`ElasticBody`] implementation), and the masses, loads and boundary
+//! conditions are per node.
+//!
 //! The explicit step is written here rather than through anim-core's `MechanicalSystem`
 //! integrators because contact projection and kinematic vertices act on positions after the
 //! update, and the implicit step because anim-core's backward Euler has no line search on an
@@ -22,12 +27,11 @@
 //! [`FemError::NonFiniteElement`] (the element and its `det F`), with messages that begin with
 //! `anim-fem: step N:`.
 
-use crate::element::{force_differential, gather};
 use crate::error::{FemError, StateField};
 use crate::friction::{self, FrictionContact};
 use crate::ldlt::SparseLdlt;
 use crate::model::{FemModel, MassKind};
-use crate::newton::{self, NewtonData, NewtonInfo, NewtonSettings, Potential};
+use crate::newton::{self, ElasticBody, NewtonData, NewtonInfo, NewtonSettings, Potential};
 use anim_core::integrate::State;
 use anim_core::linalg::{
     CsrMatrix, IterativeParams, LinearSolver, LinearSolverKind, SparseCholesky, SystemMatrix,
@@ -35,6 +39,9 @@ use anim_core::linalg::{
 use anim_core::solver::{Solver, StepReport};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+
+/// Elements per rayon task in the explicit force loop.
+const ELEMENT_CHUNK: usize = 256;
 
 /// The time integrator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -289,7 +296,7 @@ impl FemSimulation {
             solver,
             mass_solver: LinearSolverKind::JacobiPcgAssembled.build(IterativeParams::new(1e-12, 1000)),
             mass_fixed,
-            elem_forces: vec![0.0; 12 * model.elements()],
+            elem_forces: vec![0.0; 3 * model.order().nodes() * model.elements()],
             force: vec![0.0; n],
             external: vec![0.0; n],
             acc: vec![0.0; n],
@@ -381,32 +388,19 @@ impl FemSimulation {
     fn elastic_forces(&mut self, x: &[f64], v: &[f64]) -> Result<(), FemError> {
         let model = &self.model;
         let gamma = self.params.rayleigh_gamma;
-        self.elem_forces.par_chunks_mut(12 * 256).enumerate().for_each(|(c, out)| {
-            for (k, o) in out.chunks_mut(12).enumerate() {
-                let e = c * 256 + k;
-                let mut f = model.element_forces(e, x);
-                if gamma > 0.0 {
-                    let fd = model.deformation_gradient(e, x);
-                    let tangent = model.material().model.dpdf(&model.material().lame, &fd);
-                    let u = gather(v, &model.mesh().tets[e]);
-                    let d = force_differential(model.rest_volume()[e], &model.dm_inv()[e], &tangent, &u);
-                    for a in 0..4 {
-                        for i in 0..3 {
-                            f[a][i] += gamma * d[a][i];
-                        }
-                    }
-                }
-                for a in 0..4 {
-                    o[3 * a..3 * a + 3].copy_from_slice(&f[a]);
-                }
+        let damping = if gamma > 0.0 { Some((gamma, v)) } else { None };
+        let ne = 3 * model.order().nodes();
+        self.elem_forces.par_chunks_mut(ne * ELEMENT_CHUNK).enumerate().for_each(|(c, out)| {
+            for (k, o) in out.chunks_mut(ne).enumerate() {
+                model.element_forces_damped(c * ELEMENT_CHUNK + k, x, damping, o);
             }
         });
         if let Some(p) = anim_core::diagnostics::first_non_finite(&self.elem_forces) {
-            let element = p / 12;
+            let element = p / ne;
             return Err(FemError::NonFiniteElement {
                 step: self.steps,
                 element,
-                det_f: model.deformation_gradient(element, x).determinant(),
+                det_f: model.det_f(element, x),
             });
         }
         model.assembly().gather_vector(&self.elem_forces, &mut self.force);
@@ -677,20 +671,38 @@ impl FemSimulation {
         kinetic + self.model.elastic_energy(&state.x) - anim_core::linalg::dot(&self.external, &state.x)
     }
 
-    /// Linear and angular momentum (about the origin) with lumped masses.
+    /// Linear and angular momentum (about the origin): `sum_i m_i v_i` and
+    /// `sum_i x_i x m_i v_i` with lumped mass, `sum_i (M v)_i` and `sum_i x_i x (M v)_i` with
+    /// consistent mass (the quantities the equations of motion conserve under internal forces).
     #[must_use]
     pub fn momentum(&self, state: &State) -> ([f64; 3], [f64; 3]) {
         let mut p = [0.0; 3];
         let mut l = [0.0; 3];
+        let consistent = self.model.mass_kind() == MassKind::Consistent;
+        let mass = self.model.consistent_mass();
         for (i, m) in self.model.lumped_mass().iter().enumerate() {
             let x = &state.x[3 * i..3 * i + 3];
-            let v = &state.v[3 * i..3 * i + 3];
-            for c in 0..3 {
-                p[c] += m * v[c];
+            if consistent {
+                let mut mv = [0.0; 3];
+                for (c, out) in mv.iter_mut().enumerate() {
+                    let (cols, vals) = mass.row(3 * i + c);
+                    *out = cols.iter().zip(vals).map(|(&j, &a)| a * state.v[j]).sum();
+                }
+                for c in 0..3 {
+                    p[c] += mv[c];
+                }
+                l[0] += x[1] * mv[2] - x[2] * mv[1];
+                l[1] += x[2] * mv[0] - x[0] * mv[2];
+                l[2] += x[0] * mv[1] - x[1] * mv[0];
+            } else {
+                let v = &state.v[3 * i..3 * i + 3];
+                for c in 0..3 {
+                    p[c] += m * v[c];
+                }
+                l[0] += m * (x[1] * v[2] - x[2] * v[1]);
+                l[1] += m * (x[2] * v[0] - x[0] * v[2]);
+                l[2] += m * (x[0] * v[1] - x[1] * v[0]);
             }
-            l[0] += m * (x[1] * v[2] - x[2] * v[1]);
-            l[1] += m * (x[2] * v[0] - x[0] * v[2]);
-            l[2] += m * (x[0] * v[1] - x[1] * v[0]);
         }
         (p, l)
     }
