@@ -25,6 +25,7 @@
 
 use crate::kernel::Kernel;
 use rayon::prelude::*;
+use wide::f32x4;
 
 /// Nodes per block side.
 pub(crate) const BLOCK: usize = 4;
@@ -71,16 +72,15 @@ pub(crate) struct SparseGrid<const D: usize> {
     /// Sorted slot -> particle block slot.
     pub slot_block: Vec<u32>,
     cursor: Vec<u32>,
-    /// Particle-block windows: `pblocks.len() * WINDOW^D` nodes of `D + 1` floats.
-    pub windows: Vec<f32>,
-    /// Grid blocks: `gblocks.len() * BLOCK^D` nodes of `D + 1` floats (mass, then momentum or
-    /// velocity).
-    pub nodes: Vec<f32>,
+    /// Particle-block windows: `pblocks.len() * WINDOW^D` nodes, each one 4-lane vector (mass,
+    /// then momentum or velocity; the lanes past `D + 1` are zero in 2D).
+    pub windows: Vec<f32x4>,
+    /// Grid blocks: `gblocks.len() * BLOCK^D` nodes laid out as the windows' (mass, then
+    /// momentum or velocity).
+    pub nodes: Vec<f32x4>,
 }
 
 impl<const D: usize> SparseGrid<D> {
-    /// Floats per node.
-    pub const STRIDE: usize = D + 1;
     /// Nodes per window.
     pub const WN: usize = pow(WINDOW, D);
     /// Nodes per block.
@@ -208,8 +208,8 @@ impl<const D: usize> SparseGrid<D> {
         for (g, &k) in self.gblocks.iter().enumerate() {
             self.gblock_of[k as usize] = g as u32;
         }
-        self.windows.resize(self.pblocks.len() * Self::WN * Self::STRIDE, 0.0);
-        self.nodes.resize(self.gblocks.len() * Self::BN * Self::STRIDE, 0.0);
+        self.windows.resize(self.pblocks.len() * Self::WN, f32x4::ZERO);
+        self.nodes.resize(self.gblocks.len() * Self::BN, f32x4::ZERO);
     }
 
     /// Number of allocated grid nodes.
