@@ -61,6 +61,8 @@ pub(crate) struct SparseGrid<const D: usize> {
     count: Vec<u32>,
     /// Keys of the occupied particle blocks, increasing.
     pub pblocks: Vec<u32>,
+    /// Block coordinates of each occupied particle block (`coords(pblocks[j])`).
+    pub pcoords: Vec<[i32; D]>,
     /// `pstart[j]..pstart[j + 1]` are the sorted slots of particle block `j`.
     pub pstart: Vec<u32>,
     /// Keys of the allocated grid blocks, increasing.
@@ -98,6 +100,7 @@ impl<const D: usize> SparseGrid<D> {
             gblock_of: vec![NONE; cells],
             count: vec![0; cells],
             pblocks: Vec::new(),
+            pcoords: Vec::new(),
             pstart: Vec::new(),
             gblocks: Vec::new(),
             keys: Vec::new(),
@@ -133,6 +136,7 @@ impl<const D: usize> SparseGrid<D> {
             self.gblock_of[k as usize] = NONE;
         }
         self.pblocks.clear();
+        self.pcoords.clear();
         self.pstart.clear();
         self.gblocks.clear();
         self.keys.resize(np, 0);
@@ -141,20 +145,20 @@ impl<const D: usize> SparseGrid<D> {
 
         let nb = self.nb;
         let max_block = (nb - 2) as i32;
-        self.keys.par_chunks_mut(4096).enumerate().for_each(|(c, keys)| {
-            for (i, key) in keys.iter_mut().enumerate() {
-                let p = c * 4096 + i;
+        let off = match kernel {
+            Kernel::Quadratic => 0.5f32,
+            Kernel::Cubic => 1.0,
+        };
+        self.keys.par_chunks_mut(4096).zip(x.par_chunks(4096 * D)).for_each(|(keys, x)| {
+            for (key, x) in keys.iter_mut().zip(x.chunks_exact(D)) {
                 let mut k = 0usize;
                 for a in (0..D).rev() {
-                    let xs = x[p * D + a] * inv_h;
-                    // Positions are clamped to the domain, so `xs >= 2` and the truncating
-                    // cast is the floor (the kernels compute the same base).
-                    let base = match kernel {
-                        Kernel::Quadratic => (xs - 0.5).max(0.0) as i32,
-                        Kernel::Cubic => xs.max(0.0) as i32 - 1,
-                    };
-                    // The clamp only guarantees an in-range index whatever the input.
-                    let b = (base >> 2).clamp(0, max_block);
+                    // Positions are clamped to the domain, so `xs >= 2` and the truncating cast
+                    // is the floor (the kernels compute the same base node, `floor(xs - off)`).
+                    let base = (x[a] * inv_h - off).max(0.0) as i32;
+                    // The clamp only guarantees an in-range index whatever the input (`max`
+                    // and `min`, not `clamp`, which compiles to a data-dependent branch).
+                    let b = (base >> 2).max(0).min(max_block);
                     k = k * nb + b as usize;
                 }
                 *key = k as u32;
@@ -172,6 +176,7 @@ impl<const D: usize> SparseGrid<D> {
         self.cursor.clear();
         let mut run = 0u32;
         for (j, &k) in self.pblocks.iter().enumerate() {
+            self.pcoords.push(self.coords(k));
             self.pblock_of[k as usize] = j as u32;
             self.pstart.push(run);
             self.cursor.push(run);

@@ -4,10 +4,10 @@
 use crate::boundary::{Boundary, Collider};
 use crate::grid::SparseGrid;
 use crate::kernel::{Cubic, Kernel, Quadratic, Spline};
-use crate::material::{Compiled, Material, energy};
+use crate::material::{Compiled, Kind, Material, energy};
 use crate::particles::Particles;
 use crate::transfer::{self, Ctx};
-use crate::{MpmError, Vector};
+use crate::{Mat, MpmError, Vector};
 use anim_core::solver::{Solver, StepReport};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -376,15 +376,15 @@ impl<const D: usize> MpmSimulation<D> {
             .into_par_iter()
             .map(|chunk| {
                 let r = chunk * CHUNK..((chunk + 1) * CHUNK).min(n);
-                // `|bits| >= 0x7f80_0000` is an infinity or a NaN.
-                let worst_bits = |a: &[f32]| a.iter().fold(0u32, |m, c| m.max(c.to_bits() & 0x7fff_ffff));
+                // An infinity or a NaN has all exponent bits set.
+                let any_non_finite =
+                    |a: &[f32]| a.iter().fold(false, |m, c| m | (c.to_bits() & 0x7f80_0000 == 0x7f80_0000));
                 let out_of_range =
                     st.x[r.start * D..r.end * D].iter().fold(false, |b, c| b | !(*c >= lo && *c <= hi));
                 let material = st.material[r.clone()].iter().fold(0u16, |m, &k| m.max(k));
-                let non_finite = worst_bits(&st.v[r.start * D..r.end * D])
-                    .max(worst_bits(&st.f[r.start * D * D..r.end * D * D]))
-                    .max(worst_bits(&st.c[r.start * D * D..r.end * D * D]))
-                    >= 0x7f80_0000;
+                let non_finite = any_non_finite(&st.v[r.start * D..r.end * D])
+                    | any_non_finite(&st.f[r.start * D * D..r.end * D * D])
+                    | any_non_finite(&st.c[r.start * D * D..r.end * D * D]);
                 let non_positive = st.mass[r.clone()]
                     .iter()
                     .chain(&st.volume[r.clone()])
@@ -393,14 +393,49 @@ impl<const D: usize> MpmSimulation<D> {
                     let p = r.clone().find(|&p| !ok(p)).unwrap_or(r.start);
                     return (0.0f32, 0.0f32, p);
                 }
-                let (mut v2, mut c2) = (0.0f32, 0.0f32);
-                for p in r {
-                    let v = &st.v[p * D..p * D + D];
-                    v2 = v2.max(v.iter().map(|c| c * c).sum::<f32>());
-                    let m = &compiled[usize::from(st.material[p])];
-                    let j = anim_material::decomposition::determinant(&st.deformation(p));
-                    c2 = c2.max(m.wave_speed2(st.plastic[p], j));
-                }
+                // `min` and `max` of finite values, without the NaN handling of `f32::min`.
+                let (fmin, fmax) =
+                    (|a: f32, b: f32| if b < a { b } else { a }, |a: f32, b: f32| if b > a { b } else { a });
+                let v2 = st.v[r.start * D..r.end * D]
+                    .chunks_exact(D)
+                    .fold(0.0f32, |m, v| fmax(m, v.iter().map(|c| c * c).sum::<f32>()));
+                let c2 = if !st.material[r.clone()].iter().fold(false, |b, &k| b | (k != material)) {
+                    // One material: its wave speed is monotone in J (fluid) or J_P (snow) and
+                    // constant otherwise, so the largest is at one end of their range.
+                    let m = &compiled[usize::from(material)];
+                    match m.kind {
+                        Kind::Fluid => {
+                            let (lo_j, hi_j) = st.f[r.start * D * D..r.end * D * D].chunks_exact(D * D).fold(
+                                (f32::INFINITY, f32::NEG_INFINITY),
+                                |(a, b), f| {
+                                    // The clamp of `wave_speed2` (which also turns the NaN of
+                                    // an overflowing determinant into 1e-3).
+                                    let j = anim_material::decomposition::determinant(
+                                        &Mat::<D>::from_column_slice(f),
+                                    )
+                                    .max(1e-3);
+                                    (fmin(a, j), fmax(b, j))
+                                },
+                            );
+                            m.wave_speed2(1.0, lo_j).max(m.wave_speed2(1.0, hi_j))
+                        }
+                        Kind::Snow => {
+                            let (lo_p, hi_p) = st.plastic[r.clone()]
+                                .iter()
+                                .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &jp| {
+                                    (fmin(a, jp), fmax(b, jp))
+                                });
+                            m.wave_speed2(lo_p, 1.0).max(m.wave_speed2(hi_p, 1.0))
+                        }
+                        _ => m.wave_speed2(1.0, 1.0),
+                    }
+                } else {
+                    r.clone().fold(0.0f32, |c2, p| {
+                        let m = &compiled[usize::from(st.material[p])];
+                        let j = anim_material::decomposition::determinant(&st.deformation(p));
+                        c2.max(m.wave_speed2(st.plastic[p], j))
+                    })
+                };
                 (v2, c2, usize::MAX)
             })
             .reduce(|| (0.0, 0.0, usize::MAX), |a, b| (a.0.max(b.0), a.1.max(b.1), a.2.min(b.2)));

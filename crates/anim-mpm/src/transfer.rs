@@ -62,12 +62,19 @@ fn stencil<const D: usize, K: Spline>(x: &[f32], inv_h: f32, h: f32, block: &[i3
     let mut s = Stencil { base: 0, w: [[0.0; 4]; D], dw: [[0.0; 4]; D], dx: [[0.0; 4]; D] };
     for a in 0..D {
         let xs = x[a] * inv_h;
-        let (base, w, dw) = K::weights(xs);
-        let local = (base - block[a] * BLOCK as i32).clamp(0, (WINDOW - K::N) as i32) as usize;
+        // The base node `floor(xs - OFFSET)` lies in the particle's block, `origin + local` with
+        // `local` in [0, 3]: `t` is exact (`xs - OFFSET` and `origin` are multiples of the ulp
+        // of `xs`), so counting the integers it reaches gives `local` without a branch or a
+        // float-to-int conversion, and `fx` is the one `K::weights` computes. Whatever the
+        // input, `local` stays in [0, 3] and the window index in range.
+        let origin = (block[a] * BLOCK as i32) as f32;
+        let t = xs - K::OFFSET - origin;
+        let local = usize::from(t >= 1.0) + usize::from(t >= 2.0) + usize::from(t >= 3.0);
         s.base += local * wstride(a);
+        let fx = xs - (origin + local as f32);
+        let (w, dw) = K::weights_at(fx);
         s.w[a] = w;
         s.dw[a] = dw;
-        let fx = xs - base as f32;
         for k in 0..K::N {
             s.dx[a][k] = (k as f32 - fx) * h;
         }
@@ -129,11 +136,10 @@ fn p2g_with<const D: usize, K: Spline, const APIC: bool>(
     ctx: &Ctx<'_, D>,
 ) {
     let wn = SparseGrid::<D>::WN;
-    let nb = grid.nb;
-    let (pblocks, pstart, order) = (&grid.pblocks, &grid.pstart, &grid.order);
+    let (pcoords, pstart, order) = (&grid.pcoords, &grid.pstart, &grid.order);
     grid.windows.par_chunks_mut(wn).enumerate().for_each(|(j, win)| {
         win.fill(f32x4::ZERO);
-        let block = block_coords::<D>(pblocks[j], nb);
+        let block = pcoords[j];
         for &p in &order[pstart[j] as usize..pstart[j + 1] as usize] {
             p2g_particle::<D, K, APIC>(win, st, p as usize, &block, ctx);
         }
@@ -464,16 +470,14 @@ fn g2p_with<const D: usize, K: Spline, const APIC: bool>(
     ctx: &Ctx<'_, D>,
 ) -> G2pOutcome {
     let wn = SparseGrid::<D>::WN;
-    let nb = grid.nb;
     let d_inv = K::D_INV * ctx.inv_h * ctx.inv_h;
     let dd = D * D;
-    let (order, slot_block, pblocks, windows) = (&grid.order, &grid.slot_block, &grid.pblocks, &grid.windows);
-    // Sorted slot `s` of the particle `order[s]`: its new state, and whether it left the domain
-    // and whether the result is finite.
+    let (order, slot_block, pcoords, windows) = (&grid.order, &grid.slot_block, &grid.pcoords, &grid.windows);
+    // Sorted slot `s` of the particle `order[s]`: its new state, and whether it left the domain.
     let particle = |s: usize, x: &mut [f32], v: &mut [f32], c: &mut [f32], f: &mut [f32], pl: &mut f32| {
         let p = order[s] as usize;
         let j = slot_block[s] as usize;
-        let block = block_coords::<D>(pblocks[j], nb);
+        let block = pcoords[j];
         let win = &windows[j * wn..(j + 1) * wn];
         let xp = &st.x[p * D..p * D + D];
         let sten = stencil::<D, K>(xp, ctx.inv_h, ctx.h, &block);
@@ -485,8 +489,6 @@ fn g2p_with<const D: usize, K: Spline, const APIC: bool>(
         let mut plastic = st.plastic[p];
         project(mat, &mut fnew, &mut plastic);
         let mut xnew = Vector::<D>::from_column_slice(xp) + vel * ctx.dt;
-        // Any NaN or infinity makes the sum non-finite.
-        let finite = (xnew.sum() + vel.sum() + fnew.sum() + cmat.sum() + plastic).is_finite();
         let mut outside = false;
         for a in 0..D {
             if !(xnew[a] >= ctx.lo && xnew[a] <= ctx.hi) && xnew[a].is_finite() {
@@ -499,7 +501,7 @@ fn g2p_with<const D: usize, K: Spline, const APIC: bool>(
         c.copy_from_slice(cmat.as_slice());
         f.copy_from_slice(fnew.as_slice());
         *pl = plastic;
-        (outside, finite)
+        outside
     };
     (
         out.x.par_chunks_mut(G2P_CHUNK * D),
@@ -520,7 +522,7 @@ fn g2p_with<const D: usize, K: Spline, const APIC: bool>(
             let s0 = chunk * G2P_CHUNK;
             for i in 0..pl.len() {
                 let s = s0 + i;
-                let (outside, finite) = particle(
+                let outside = particle(
                     s,
                     &mut x[i * D..i * D + D],
                     &mut v[i * D..i * D + D],
@@ -530,15 +532,26 @@ fn g2p_with<const D: usize, K: Spline, const APIC: bool>(
                 );
                 rm[i] = outside;
                 r.outside += u64::from(outside);
-                if !finite && r.first_bad == u32::MAX {
-                    r.first_bad = s as u32;
-                }
                 // The particle constants follow the sorted order.
                 let p = order[s] as usize;
                 mass[i] = st.mass[p];
                 vol[i] = st.volume[p];
                 mat[i] = st.material[p];
                 id[i] = st.id[p];
+            }
+            // Non-finite results, checked once per chunk off the particles' dependency chains
+            // (`|bits| >= 0x7f80_0000` is an infinity or a NaN).
+            let worst = |a: &[f32]| a.iter().fold(0u32, |m, c| m.max(c.to_bits() & 0x7fff_ffff));
+            if worst(x).max(worst(v)).max(worst(c)).max(worst(f)).max(worst(pl)) >= 0x7f80_0000 {
+                let bad = (0..pl.len()).find(|&i| {
+                    worst(&x[i * D..i * D + D])
+                        .max(worst(&v[i * D..i * D + D]))
+                        .max(worst(&c[i * dd..i * dd + dd]))
+                        .max(worst(&f[i * dd..i * dd + dd]))
+                        .max(worst(std::slice::from_ref(&pl[i])))
+                        >= 0x7f80_0000
+                });
+                r.first_bad = bad.map_or(u32::MAX, |i| (s0 + i) as u32);
             }
             r
         })
