@@ -532,12 +532,26 @@ fn g2p_with<const D: usize, K: Spline, const APIC: bool>(
                 );
                 rm[i] = outside;
                 r.outside += u64::from(outside);
-                // The particle constants follow the sorted order.
-                let p = order[s] as usize;
-                mass[i] = st.mass[p];
-                vol[i] = st.volume[p];
-                mat[i] = st.material[p];
-                id[i] = st.id[p];
+            }
+            // The particle constants follow the sorted order: a block copy where the chunk's
+            // particles kept their order (most chunks, the state being sorted by the previous
+            // step), else one by one.
+            let n = pl.len();
+            let order = &order[s0..s0 + n];
+            let p0 = order[0] as usize;
+            if order.iter().enumerate().all(|(i, &p)| p as usize == p0 + i) {
+                mass.copy_from_slice(&st.mass[p0..p0 + n]);
+                vol.copy_from_slice(&st.volume[p0..p0 + n]);
+                mat.copy_from_slice(&st.material[p0..p0 + n]);
+                id.copy_from_slice(&st.id[p0..p0 + n]);
+            } else {
+                for (i, &p) in order.iter().enumerate() {
+                    let p = p as usize;
+                    mass[i] = st.mass[p];
+                    vol[i] = st.volume[p];
+                    mat[i] = st.material[p];
+                    id[i] = st.id[p];
+                }
             }
             // Non-finite results, checked once per chunk off the particles' dependency chains
             // (`|bits| >= 0x7f80_0000` is an infinity or a NaN).
