@@ -107,8 +107,14 @@ pub trait Spline: Copy + Send + Sync + 'static {
     const N: usize;
     /// `D_p^-1 = D_INV / h^2 I`.
     const D_INV: f32;
+    /// The base node is `floor(xs - OFFSET)`: `1/2` quadratic, `1` cubic.
+    const OFFSET: f32;
     /// Base node, weights and `dN/d(x/h)` for the coordinate `xs = x/h` (first `N` entries).
     fn weights(xs: f32) -> (i32, [f32; 4], [f32; 4]);
+    /// Weights and `dN/d(x/h)` for the particle at `fx = xs - base` cells from its base node
+    /// (`fx` in `[1/2, 3/2)` quadratic, `[1, 2)` cubic): what [`weights`](Self::weights) returns
+    /// after finding the base node.
+    fn weights_at(fx: f32) -> ([f32; 4], [f32; 4]);
 }
 
 /// The quadratic B-spline.
@@ -118,18 +124,24 @@ pub struct Quadratic;
 impl Spline for Quadratic {
     const N: usize = 3;
     const D_INV: f32 = 4.0;
+    const OFFSET: f32 = 0.5;
 
     #[inline(always)]
     fn weights(xs: f32) -> (i32, [f32; 4], [f32; 4]) {
         // Coordinates are positive (particles stay at least 2 cells inside the domain), so the
         // truncating cast is the floor; it avoids a libm call on baseline x86-64.
         let base = (xs - 0.5).max(0.0) as i32 as f32;
-        let fx = xs - base; // in [0.5, 1.5): distance from the base node in cells
+        let (w, dw) = Self::weights_at(xs - base);
+        (base as i32, w, dw)
+    }
+
+    #[inline(always)]
+    fn weights_at(fx: f32) -> ([f32; 4], [f32; 4]) {
+        // fx in [0.5, 1.5): distance from the base node in cells.
         let a = 1.5 - fx;
         let b = fx - 1.0;
         let c = fx - 0.5;
         (
-            base as i32,
             [0.5 * a * a, 0.75 - b * b, 0.5 * c * c, 0.0],
             // d/dxs of N(xs - i): N'(d) with d = fx - k.
             [-a, -2.0 * b, c, 0.0],
@@ -144,12 +156,19 @@ pub struct Cubic;
 impl Spline for Cubic {
     const N: usize = 4;
     const D_INV: f32 = 3.0;
+    const OFFSET: f32 = 1.0;
 
     #[inline(always)]
     fn weights(xs: f32) -> (i32, [f32; 4], [f32; 4]) {
         let base = xs.max(0.0) as i32 as f32 - 1.0;
-        let fx = xs - base; // in [1, 2)
-        // Signed distances particle - node: d0 in [1,2), d1 in [0,1), d2 in [-1,0), d3 in [-2,-1).
+        let (w, dw) = Self::weights_at(xs - base);
+        (base as i32, w, dw)
+    }
+
+    #[inline(always)]
+    fn weights_at(fx: f32) -> ([f32; 4], [f32; 4]) {
+        // fx in [1, 2). Signed distances particle - node: d0 in [1,2), d1 in [0,1), d2 in
+        // [-1,0), d3 in [-2,-1).
         let d0 = fx;
         let d1 = fx - 1.0;
         let d2 = 2.0 - fx; // |fx - 2|
@@ -165,7 +184,7 @@ impl Spline for Cubic {
             -0.5 * t * t
         };
         let dnear = |a: f32| 1.5 * a * a - 2.0 * a;
-        (base as i32, [far(d0), near(d1), near(d2), far(d3)], [dfar(d0), dnear(d1), -dnear(d2), -dfar(d3)])
+        ([far(d0), near(d1), near(d2), far(d3)], [dfar(d0), dnear(d1), -dnear(d2), -dfar(d3)])
     }
 }
 

@@ -25,6 +25,7 @@
 
 use crate::kernel::Kernel;
 use rayon::prelude::*;
+use wide::f32x4;
 
 /// Nodes per block side.
 pub(crate) const BLOCK: usize = 4;
@@ -60,6 +61,8 @@ pub(crate) struct SparseGrid<const D: usize> {
     count: Vec<u32>,
     /// Keys of the occupied particle blocks, increasing.
     pub pblocks: Vec<u32>,
+    /// Block coordinates of each occupied particle block (`coords(pblocks[j])`).
+    pub pcoords: Vec<[i32; D]>,
     /// `pstart[j]..pstart[j + 1]` are the sorted slots of particle block `j`.
     pub pstart: Vec<u32>,
     /// Keys of the allocated grid blocks, increasing.
@@ -71,16 +74,15 @@ pub(crate) struct SparseGrid<const D: usize> {
     /// Sorted slot -> particle block slot.
     pub slot_block: Vec<u32>,
     cursor: Vec<u32>,
-    /// Particle-block windows: `pblocks.len() * WINDOW^D` nodes of `D + 1` floats.
-    pub windows: Vec<f32>,
-    /// Grid blocks: `gblocks.len() * BLOCK^D` nodes of `D + 1` floats (mass, then momentum or
-    /// velocity).
-    pub nodes: Vec<f32>,
+    /// Particle-block windows: `pblocks.len() * WINDOW^D` nodes, each one 4-lane vector (mass,
+    /// then momentum or velocity; the lanes past `D + 1` are zero in 2D).
+    pub windows: Vec<f32x4>,
+    /// Grid blocks: `gblocks.len() * BLOCK^D` nodes laid out as the windows' (mass, then
+    /// momentum or velocity).
+    pub nodes: Vec<f32x4>,
 }
 
 impl<const D: usize> SparseGrid<D> {
-    /// Floats per node.
-    pub const STRIDE: usize = D + 1;
     /// Nodes per window.
     pub const WN: usize = pow(WINDOW, D);
     /// Nodes per block.
@@ -98,6 +100,7 @@ impl<const D: usize> SparseGrid<D> {
             gblock_of: vec![NONE; cells],
             count: vec![0; cells],
             pblocks: Vec::new(),
+            pcoords: Vec::new(),
             pstart: Vec::new(),
             gblocks: Vec::new(),
             keys: Vec::new(),
@@ -133,6 +136,7 @@ impl<const D: usize> SparseGrid<D> {
             self.gblock_of[k as usize] = NONE;
         }
         self.pblocks.clear();
+        self.pcoords.clear();
         self.pstart.clear();
         self.gblocks.clear();
         self.keys.resize(np, 0);
@@ -141,20 +145,20 @@ impl<const D: usize> SparseGrid<D> {
 
         let nb = self.nb;
         let max_block = (nb - 2) as i32;
-        self.keys.par_chunks_mut(4096).enumerate().for_each(|(c, keys)| {
-            for (i, key) in keys.iter_mut().enumerate() {
-                let p = c * 4096 + i;
+        let off = match kernel {
+            Kernel::Quadratic => 0.5f32,
+            Kernel::Cubic => 1.0,
+        };
+        self.keys.par_chunks_mut(4096).zip(x.par_chunks(4096 * D)).for_each(|(keys, x)| {
+            for (key, x) in keys.iter_mut().zip(x.chunks_exact(D)) {
                 let mut k = 0usize;
                 for a in (0..D).rev() {
-                    let xs = x[p * D + a] * inv_h;
-                    // Positions are clamped to the domain, so `xs >= 2` and the truncating
-                    // cast is the floor (the kernels compute the same base).
-                    let base = match kernel {
-                        Kernel::Quadratic => (xs - 0.5).max(0.0) as i32,
-                        Kernel::Cubic => xs.max(0.0) as i32 - 1,
-                    };
-                    // The clamp only guarantees an in-range index whatever the input.
-                    let b = (base >> 2).clamp(0, max_block);
+                    // Positions are clamped to the domain, so `xs >= 2` and the truncating cast
+                    // is the floor (the kernels compute the same base node, `floor(xs - off)`).
+                    let base = (x[a] * inv_h - off).max(0.0) as i32;
+                    // The clamp only guarantees an in-range index whatever the input (`max`
+                    // and `min`, not `clamp`, which compiles to a data-dependent branch).
+                    let b = (base >> 2).max(0).min(max_block);
                     k = k * nb + b as usize;
                 }
                 *key = k as u32;
@@ -172,6 +176,7 @@ impl<const D: usize> SparseGrid<D> {
         self.cursor.clear();
         let mut run = 0u32;
         for (j, &k) in self.pblocks.iter().enumerate() {
+            self.pcoords.push(self.coords(k));
             self.pblock_of[k as usize] = j as u32;
             self.pstart.push(run);
             self.cursor.push(run);
@@ -208,8 +213,8 @@ impl<const D: usize> SparseGrid<D> {
         for (g, &k) in self.gblocks.iter().enumerate() {
             self.gblock_of[k as usize] = g as u32;
         }
-        self.windows.resize(self.pblocks.len() * Self::WN * Self::STRIDE, 0.0);
-        self.nodes.resize(self.gblocks.len() * Self::BN * Self::STRIDE, 0.0);
+        self.windows.resize(self.pblocks.len() * Self::WN, f32x4::ZERO);
+        self.nodes.resize(self.gblocks.len() * Self::BN, f32x4::ZERO);
     }
 
     /// Number of allocated grid nodes.

@@ -270,7 +270,7 @@ impl Compiled {
 
 /// The Kirchhoff stress `tau = P(F) F^T` of a particle (`f` is `F`, or `F_E` for snow and
 /// sand; `plastic` the plastic scalar).
-#[inline]
+#[inline(always)]
 pub(crate) fn kirchhoff<const D: usize>(m: &Compiled, f: &Mat<D>, plastic: f32) -> Mat<D> {
     match m.kind {
         Kind::FixedCorotated => FixedCorotated.pk1(&m.lame, f) * f.transpose(),

@@ -4,10 +4,10 @@
 use crate::boundary::{Boundary, Collider};
 use crate::grid::SparseGrid;
 use crate::kernel::{Cubic, Kernel, Quadratic, Spline};
-use crate::material::{Compiled, Material, energy};
+use crate::material::{Compiled, Kind, Material, energy};
 use crate::particles::Particles;
 use crate::transfer::{self, Ctx};
-use crate::{MpmError, Vector};
+use crate::{Mat, MpmError, Vector};
 use anim_core::solver::{Solver, StepReport};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -271,13 +271,12 @@ impl<const D: usize> MpmSimulation<D> {
     /// Grid nodes of the last substep with mass: `(position, mass, velocity)` (velocities after
     /// the grid update). For diagnostics and tests.
     pub fn grid_nodes(&self) -> impl Iterator<Item = (Vector<D>, f32, Vector<D>)> + '_ {
-        let stride = D + 1;
         let bn = SparseGrid::<D>::BN;
         let h = self.params.h() as f32;
         self.grid.gblocks.iter().enumerate().flat_map(move |(g, &key)| {
             let block = self.grid.coords(key);
             (0..bn).filter_map(move |l| {
-                let node = &self.grid.nodes[(g * bn + l) * stride..(g * bn + l + 1) * stride];
+                let node = self.grid.nodes[g * bn + l].to_array();
                 if node[0] <= 0.0 {
                     return None;
                 }
@@ -287,7 +286,7 @@ impl<const D: usize> MpmSimulation<D> {
                     x[a] = (block[a] as usize * 4 + r % 4) as f32 * h;
                     r /= 4;
                 }
-                Some((x, node[0], Vector::<D>::from_column_slice(&node[1..])))
+                Some((x, node[0], Vector::<D>::from_fn(|a, _| node[1 + a])))
             })
         })
     }
@@ -359,27 +358,85 @@ impl<const D: usize> MpmSimulation<D> {
         let (lo, hi) = (lo as f32, hi as f32);
         let nmat = self.compiled.len();
         let compiled = &self.compiled;
-        // (max |v|^2, max c^2, first bad particle)
-        let (v2, c2, bad) = (0..st.len())
+        let n = st.len();
+        let ok = |p: usize| {
+            let x = &st.x[p * D..p * D + D];
+            usize::from(st.material[p]) < nmat
+                && x.iter().all(|c| *c >= lo && *c <= hi)
+                && st.v[p * D..p * D + D].iter().all(|c| c.is_finite())
+                && st.f[p * D * D..(p + 1) * D * D].iter().all(|c| c.is_finite())
+                && st.c[p * D * D..(p + 1) * D * D].iter().all(|c| c.is_finite())
+                && st.mass[p] > 0.0
+                && st.volume[p] > 0.0
+        };
+        // Per chunk of particles: (max |v|^2, max c^2, first bad particle). The checks run as
+        // flat passes over each array (integer tests on the bits where that is exact); only a
+        // chunk that fails one is searched particle by particle.
+        let (v2, c2, bad) = (0..n.div_ceil(CHUNK))
             .into_par_iter()
-            .with_min_len(1024)
-            .map(|p| {
-                let x = &st.x[p * D..p * D + D];
-                let v = st.velocity(p);
-                let mi = usize::from(st.material[p]);
-                let ok = mi < nmat
-                    && x.iter().all(|c| *c >= lo && *c <= hi)
-                    && v.iter().all(|c| c.is_finite())
-                    && st.f[p * D * D..(p + 1) * D * D].iter().all(|c| c.is_finite())
-                    && st.c[p * D * D..(p + 1) * D * D].iter().all(|c| c.is_finite())
-                    && st.mass[p] > 0.0
-                    && st.volume[p] > 0.0;
-                if !ok {
+            .map(|chunk| {
+                let r = chunk * CHUNK..((chunk + 1) * CHUNK).min(n);
+                // An infinity or a NaN has all exponent bits set.
+                let any_non_finite =
+                    |a: &[f32]| a.iter().fold(false, |m, c| m | (c.to_bits() & 0x7f80_0000 == 0x7f80_0000));
+                let out_of_range =
+                    st.x[r.start * D..r.end * D].iter().fold(false, |b, c| b | !(*c >= lo && *c <= hi));
+                let material = st.material[r.clone()].iter().fold(0u16, |m, &k| m.max(k));
+                let non_finite = any_non_finite(&st.v[r.start * D..r.end * D])
+                    | any_non_finite(&st.f[r.start * D * D..r.end * D * D])
+                    | any_non_finite(&st.c[r.start * D * D..r.end * D * D]);
+                let non_positive = st.mass[r.clone()]
+                    .iter()
+                    .chain(&st.volume[r.clone()])
+                    .fold(false, |b, m| b | !(*m > 0.0));
+                if out_of_range || usize::from(material) >= nmat || non_finite || non_positive {
+                    let p = r.clone().find(|&p| !ok(p)).unwrap_or(r.start);
                     return (0.0f32, 0.0f32, p);
                 }
-                let m = &compiled[mi];
-                let j = anim_material::decomposition::determinant(&st.deformation(p));
-                (v.norm_squared(), m.wave_speed2(st.plastic[p], j), usize::MAX)
+                // `min` and `max` of finite values, without the NaN handling of `f32::min`.
+                let (fmin, fmax) =
+                    (|a: f32, b: f32| if b < a { b } else { a }, |a: f32, b: f32| if b > a { b } else { a });
+                let v2 = st.v[r.start * D..r.end * D]
+                    .chunks_exact(D)
+                    .fold(0.0f32, |m, v| fmax(m, v.iter().map(|c| c * c).sum::<f32>()));
+                let c2 = if !st.material[r.clone()].iter().fold(false, |b, &k| b | (k != material)) {
+                    // One material: its wave speed is monotone in J (fluid) or J_P (snow) and
+                    // constant otherwise, so the largest is at one end of their range.
+                    let m = &compiled[usize::from(material)];
+                    match m.kind {
+                        Kind::Fluid => {
+                            let (lo_j, hi_j) = st.f[r.start * D * D..r.end * D * D].chunks_exact(D * D).fold(
+                                (f32::INFINITY, f32::NEG_INFINITY),
+                                |(a, b), f| {
+                                    // The clamp of `wave_speed2` (which also turns the NaN of
+                                    // an overflowing determinant into 1e-3).
+                                    let j = anim_material::decomposition::determinant(
+                                        &Mat::<D>::from_column_slice(f),
+                                    )
+                                    .max(1e-3);
+                                    (fmin(a, j), fmax(b, j))
+                                },
+                            );
+                            m.wave_speed2(1.0, lo_j).max(m.wave_speed2(1.0, hi_j))
+                        }
+                        Kind::Snow => {
+                            let (lo_p, hi_p) = st.plastic[r.clone()]
+                                .iter()
+                                .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &jp| {
+                                    (fmin(a, jp), fmax(b, jp))
+                                });
+                            m.wave_speed2(lo_p, 1.0).max(m.wave_speed2(hi_p, 1.0))
+                        }
+                        _ => m.wave_speed2(1.0, 1.0),
+                    }
+                } else {
+                    r.clone().fold(0.0f32, |c2, p| {
+                        let m = &compiled[usize::from(st.material[p])];
+                        let j = anim_material::decomposition::determinant(&st.deformation(p));
+                        c2.max(m.wave_speed2(st.plastic[p], j))
+                    })
+                };
+                (v2, c2, usize::MAX)
             })
             .reduce(|| (0.0, 0.0, usize::MAX), |a, b| (a.0.max(b.0), a.1.max(b.1), a.2.min(b.2)));
         if bad != usize::MAX {
@@ -425,13 +482,7 @@ impl<const D: usize> MpmSimulation<D> {
         self.out.resize(n);
         let removing = self.params.out_of_domain == OutOfDomain::Remove;
         self.remove.resize(n, false);
-        let outcome = transfer::g2p::<D, K>(
-            &self.grid,
-            st,
-            &mut self.out,
-            if removing { Some(&mut self.remove) } else { None },
-            &ctx,
-        );
+        let outcome = transfer::g2p::<D, K>(&self.grid, st, &mut self.out, &mut self.remove, &ctx);
         if outcome.first_bad != u32::MAX {
             let s = outcome.first_bad as usize;
             let p = self.grid.order[s] as usize;

@@ -26,6 +26,7 @@ use crate::particles::Particles;
 use crate::plasticity::project;
 use crate::{Mat, Vector};
 use rayon::prelude::*;
+use wide::f32x4;
 
 /// What a substep needs besides the particles and the grid.
 #[derive(Clone, Copy)]
@@ -48,8 +49,8 @@ pub(crate) struct Ctx<'a, const D: usize> {
 
 /// Per-axis stencil data of one particle.
 struct Stencil<const D: usize> {
-    /// Window offset of the base node, per axis (0..=3).
-    local: [usize; D],
+    /// Window index of the base node.
+    base: usize,
     w: [[f32; 4]; D],
     dw: [[f32; 4]; D],
     /// `x_i - x_p` per axis and stencil node.
@@ -58,14 +59,22 @@ struct Stencil<const D: usize> {
 
 #[inline(always)]
 fn stencil<const D: usize, K: Spline>(x: &[f32], inv_h: f32, h: f32, block: &[i32; D]) -> Stencil<D> {
-    let mut s = Stencil { local: [0; D], w: [[0.0; 4]; D], dw: [[0.0; 4]; D], dx: [[0.0; 4]; D] };
+    let mut s = Stencil { base: 0, w: [[0.0; 4]; D], dw: [[0.0; 4]; D], dx: [[0.0; 4]; D] };
     for a in 0..D {
         let xs = x[a] * inv_h;
-        let (base, w, dw) = K::weights(xs);
-        s.local[a] = (base - block[a] * BLOCK as i32).clamp(0, (WINDOW - K::N) as i32) as usize;
+        // The base node `floor(xs - OFFSET)` lies in the particle's block, `origin + local` with
+        // `local` in [0, 3]: `t` is exact (`xs - OFFSET` and `origin` are multiples of the ulp
+        // of `xs`), so counting the integers it reaches gives `local` without a branch or a
+        // float-to-int conversion, and `fx` is the one `K::weights` computes. Whatever the
+        // input, `local` stays in [0, 3] and the window index in range.
+        let origin = (block[a] * BLOCK as i32) as f32;
+        let t = xs - K::OFFSET - origin;
+        let local = usize::from(t >= 1.0) + usize::from(t >= 2.0) + usize::from(t >= 3.0);
+        s.base += local * wstride(a);
+        let fx = xs - (origin + local as f32);
+        let (w, dw) = K::weights_at(fx);
         s.w[a] = w;
         s.dw[a] = dw;
-        let fx = xs - base as f32;
         for k in 0..K::N {
             s.dx[a][k] = (k as f32 - fx) * h;
         }
@@ -73,238 +82,286 @@ fn stencil<const D: usize, K: Spline>(x: &[f32], inv_h: f32, h: f32, block: &[i3
     s
 }
 
-/// Calls `f` on every stencil node `k in [0, N)^D`, in the order `k_0` fastest, as nested
-/// loops the compiler unrolls (`D` and `N` are constants).
+/// Window strides per axis.
+const fn wstride(a: usize) -> usize {
+    pow(WINDOW, a)
+}
+
+/// Window nodes from a stencil's base node to its last node, inclusive: a particle's scatter
+/// and gather stay in `base..base + span` (one bounds check per particle).
+const fn span(d: usize, n: usize) -> usize {
+    (n - 1) * (1 + wstride(1) + if d == 3 { wstride(2) } else { 0 }) + 1
+}
+
+/// Column `col` of `m`, times `scale`, in lanes `1..=D` of a node vector (lane 0, the mass, and
+/// the lanes past `D` are zero).
 #[inline(always)]
-fn for_each_node<const D: usize, const N: usize>(mut f: impl FnMut([usize; D])) {
-    let mut k = [0usize; D];
+fn column<const D: usize>(m: &Mat<D>, col: usize, scale: f32) -> f32x4 {
+    let mut a = [0.0f32; 4];
+    for r in 0..D {
+        a[1 + r] = m[(r, col)] * scale;
+    }
+    f32x4::new(a)
+}
+
+#[inline(always)]
+fn splat(x: f32) -> f32x4 {
+    f32x4::splat(x)
+}
+
+/// Block coordinates of a key.
+#[inline(always)]
+fn block_coords<const D: usize>(key: u32, nb: usize) -> [i32; D] {
+    let mut key = key as usize;
+    let mut block = [0i32; D];
+    for a in 0..D {
+        block[a] = (key % nb) as i32;
+        key /= nb;
+    }
+    block
+}
+
+/// P2G into the per-block windows; each particle's stress `-dt V_p tau_p` is computed here.
+pub(crate) fn p2g<const D: usize, K: Spline>(grid: &mut SparseGrid<D>, st: &Particles<D>, ctx: &Ctx<'_, D>) {
+    if ctx.apic {
+        p2g_with::<D, K, true>(grid, st, ctx);
+    } else {
+        p2g_with::<D, K, false>(grid, st, ctx);
+    }
+}
+
+fn p2g_with<const D: usize, K: Spline, const APIC: bool>(
+    grid: &mut SparseGrid<D>,
+    st: &Particles<D>,
+    ctx: &Ctx<'_, D>,
+) {
+    let wn = SparseGrid::<D>::WN;
+    let (pcoords, pstart, order) = (&grid.pcoords, &grid.pstart, &grid.order);
+    grid.windows.par_chunks_mut(wn).enumerate().for_each(|(j, win)| {
+        win.fill(f32x4::ZERO);
+        let block = pcoords[j];
+        for &p in &order[pstart[j] as usize..pstart[j + 1] as usize] {
+            p2g_particle::<D, K, APIC>(win, st, p as usize, &block, ctx);
+        }
+    });
+}
+
+/// One particle's scatter into its block's window. Each node gets the 4-lane vector
+/// `w (m_p, m_p v_p + A_p dx)` (`A_p` the affine momentum matrix), plus `-dt V_p tau_p grad w`
+/// for APIC; the sum `m_p v_p + A_p dx` is built row by row (the part of the outer axes first).
+#[inline(always)]
+fn p2g_particle<const D: usize, K: Spline, const APIC: bool>(
+    win: &mut [f32x4],
+    st: &Particles<D>,
+    p: usize,
+    block: &[i32; D],
+    ctx: &Ctx<'_, D>,
+) {
+    let s = stencil::<D, K>(&st.x[p * D..p * D + D], ctx.inv_h, ctx.h, block);
+    let m = st.mass[p];
+    let d_inv = K::D_INV * ctx.inv_h * ctx.inv_h;
+    // -dt V_p tau_p.
+    let mat = &ctx.materials[st.material[p] as usize];
+    let sp = kirchhoff(mat, &st.deformation(p), st.plastic[p]) * (-ctx.dt * st.volume[p]);
+    let cm = st.affine(p);
+    let aff = if APIC { cm * m } else { cm * m + sp * d_inv };
+    let mut q = [0.0f32; 4];
+    q[0] = m;
+    for a in 0..D {
+        q[1 + a] = st.v[p * D + a] * m;
+    }
+    let q = f32x4::new(q);
+    let acol: [f32x4; D] = std::array::from_fn(|c| column(&aff, c, 1.0));
+    // APIC: sp grad w = sum_c sp[:, c] dN_c / h prod_{b != c} N_b.
+    let scol: [f32x4; D] =
+        std::array::from_fn(|c| if APIC { column(&sp, c, ctx.inv_h) } else { f32x4::ZERO });
+    let n = K::N;
+    let win = &mut win[s.base..s.base + span(D, K::N)];
     if D == 2 {
-        for j in 0..N {
-            for i in 0..N {
-                k[0] = i;
-                k[1] = j;
-                f(k);
+        for j in 0..n {
+            let wy = s.w[1][j];
+            let r = q + acol[1] * splat(s.dx[1][j]);
+            let (g0, g1) = if APIC { (scol[0] * splat(wy), scol[1] * splat(s.dw[1][j])) } else { (q, q) };
+            let row = j * wstride(1);
+            for i in 0..n {
+                let mut t = (r + acol[0] * splat(s.dx[0][i])) * splat(s.w[0][i] * wy);
+                if APIC {
+                    t += g0 * splat(s.dw[0][i]) + g1 * splat(s.w[0][i]);
+                }
+                win[row + i] += t;
             }
         }
     } else {
-        for l in 0..N {
-            for j in 0..N {
-                for i in 0..N {
-                    k[0] = i;
-                    k[1] = j;
-                    k[2] = l;
-                    f(k);
+        for k in 0..n {
+            let wz = s.w[2][k];
+            let rz = q + acol[2] * splat(s.dx[2][k]);
+            for j in 0..n {
+                let wy = s.w[1][j];
+                let wyz = wy * wz;
+                let r = rz + acol[1] * splat(s.dx[1][j]);
+                let (g0, g1) = if APIC {
+                    (
+                        scol[0] * splat(wyz),
+                        scol[1] * splat(s.dw[1][j] * wz) + scol[2] * splat(wy * s.dw[2][k]),
+                    )
+                } else {
+                    (q, q)
+                };
+                let row = j * wstride(1) + k * wstride(2);
+                for i in 0..n {
+                    let mut t = (r + acol[0] * splat(s.dx[0][i])) * splat(s.w[0][i] * wyz);
+                    if APIC {
+                        t += g0 * splat(s.dw[0][i]) + g1 * splat(s.w[0][i]);
+                    }
+                    win[row + i] += t;
                 }
             }
         }
     }
 }
 
-/// Window strides per axis.
-const fn wstride(a: usize) -> usize {
-    pow(WINDOW, a)
-}
-
-/// P2G into the per-block windows; each particle's stress `-dt V_p tau_p` is computed here.
-pub(crate) fn p2g<const D: usize, K: Spline>(grid: &mut SparseGrid<D>, st: &Particles<D>, ctx: &Ctx<'_, D>) {
-    let stride = D + 1;
-    let wlen = SparseGrid::<D>::WN * stride;
-    let nb = grid.nb;
-    let (pblocks, pstart, order) = (&grid.pblocks, &grid.pstart, &grid.order);
-    let d_inv = K::D_INV * ctx.inv_h * ctx.inv_h;
-    grid.windows.par_chunks_mut(wlen).enumerate().for_each(|(j, win)| {
-        win.fill(0.0);
-        let mut key = pblocks[j] as usize;
-        let mut block = [0i32; D];
-        for a in 0..D {
-            block[a] = (key % nb) as i32;
-            key /= nb;
-        }
-        for &p in &order[pstart[j] as usize..pstart[j + 1] as usize] {
-            let p = p as usize;
-            let s = stencil::<D, K>(&st.x[p * D..p * D + D], ctx.inv_h, ctx.h, &block);
-            let m = st.mass[p];
-            let mv = st.velocity(p) * m;
-            // -dt V_p tau_p.
-            let mat = &ctx.materials[st.material[p] as usize];
-            let sp = kirchhoff(mat, &st.deformation(p), st.plastic[p]) * (-ctx.dt * st.volume[p]);
-            let aff = if ctx.apic { st.affine(p) * m } else { st.affine(p) * m + sp * d_inv };
-            let body = |k: [usize; D], win: &mut [f32]| {
-                let mut w = 1.0f32;
-                let mut idx = 0usize;
-                let mut dx = Vector::<D>::zeros();
-                for a in 0..D {
-                    w *= s.w[a][k[a]];
-                    idx += (s.local[a] + k[a]) * wstride(a);
-                    dx[a] = s.dx[a][k[a]];
-                }
-                let mut mom = (mv + aff * dx) * w;
-                if ctx.apic {
-                    // grad w_ip = (N'_a / h) prod_{b != a} N_b.
-                    let mut gw = Vector::<D>::zeros();
-                    for a in 0..D {
-                        let mut g = s.dw[a][k[a]] * ctx.inv_h;
-                        for b in 0..D {
-                            if b != a {
-                                g *= s.w[b][k[b]];
-                            }
-                        }
-                        gw[a] = g;
-                    }
-                    mom += sp * gw;
-                }
-                let node = &mut win[idx * stride..idx * stride + stride];
-                node[0] += w * m;
-                for a in 0..D {
-                    node[1 + a] += mom[a];
-                }
-            };
-            if K::N == 3 {
-                for_each_node::<D, 3>(|k| body(k, win));
-            } else {
-                for_each_node::<D, 4>(|k| body(k, win));
+/// Calls `f(l, w)` for the nodes of a grid block (`l` its index in the block, `w` the index in a
+/// particle window of the same node, given the offset `off` of the block's first node in that
+/// window), in increasing `l`.
+#[inline(always)]
+fn for_block_nodes<const D: usize>(off: usize, mut f: impl FnMut(usize, usize)) {
+    let zs = if D == 3 { BLOCK } else { 1 };
+    let mut l = 0;
+    for z in 0..zs {
+        for y in 0..BLOCK {
+            let w = off + y * wstride(1) + z * wstride(2);
+            for x in 0..BLOCK {
+                f(l, w + x);
+                l += 1;
             }
         }
-    });
+    }
+}
+
+/// Offset in a window of the grid block `o in {0,1}^D` (bit `a` for axis `a`) after the window's own block.
+#[inline(always)]
+fn corner_offset<const D: usize>(o: usize) -> usize {
+    let mut off = 0;
+    for a in 0..D {
+        off += ((o >> a) & 1) * BLOCK * wstride(a);
+    }
+    off
 }
 
 /// Sums the windows into the grid blocks (fixed order) and updates the grid velocities:
 /// `v = (m v) / m + dt g`, boundary conditions; zero where there is no mass.
 pub(crate) fn grid_update<const D: usize>(grid: &mut SparseGrid<D>, ctx: &Ctx<'_, D>) {
-    let stride = D + 1;
-    let blen = SparseGrid::<D>::BN * stride;
-    let wlen = SparseGrid::<D>::WN * stride;
-    let nb = grid.nb as i32;
+    let bn = SparseGrid::<D>::BN;
+    let wn = SparseGrid::<D>::WN;
+    let nb = grid.nb;
     let n = grid.n;
     let corners = pow(2, D);
     let (gblocks, pblock_of, windows) = (&grid.gblocks, &grid.pblock_of, &grid.windows);
     let t_end = ctx.time + ctx.dt;
-    grid.nodes.par_chunks_mut(blen).enumerate().for_each(|(g, nodes)| {
-        nodes.fill(0.0);
-        let mut key = gblocks[g] as i32;
-        let mut block = [0i32; D];
-        for a in 0..D {
-            block[a] = key % nb;
-            key /= nb;
-        }
+    let gdt = ctx.gravity * ctx.dt;
+    let wall_lo = ctx.wall_nodes;
+    let wall_hi = n + 1 - ctx.wall_nodes.min(n + 1);
+    grid.nodes.par_chunks_mut(bn).enumerate().for_each(|(g, nodes)| {
+        nodes.fill(f32x4::ZERO);
+        let block = block_coords::<D>(gblocks[g], nb);
         for o in 0..corners {
-            let mut pk = 0i32;
+            let mut pk = 0usize;
             let mut ok = true;
             for a in (0..D).rev() {
                 let c = block[a] - ((o >> a) & 1) as i32;
                 if c < 0 {
                     ok = false;
                 }
-                pk = pk * nb + c;
+                pk = pk * nb + c.max(0) as usize;
             }
             if !ok {
                 continue;
             }
-            let j = pblock_of[pk as usize];
+            let j = pblock_of[pk];
             if j == crate::grid::NONE {
                 continue;
             }
-            let win = &windows[j as usize * wlen..(j as usize + 1) * wlen];
-            // Node l of this block is node l + 4 o of the window.
-            let mut off = 0;
-            for a in 0..D {
-                off += ((o >> a) & 1) * BLOCK * wstride(a);
-            }
-            for l in 0..SparseGrid::<D>::BN {
-                let mut wi = off;
-                let mut r = l;
-                for a in 0..D {
-                    wi += (r % BLOCK) * wstride(a);
-                    r /= BLOCK;
-                }
-                let src = &win[wi * stride..wi * stride + stride];
-                let dst = &mut nodes[l * stride..l * stride + stride];
-                for c in 0..stride {
-                    dst[c] += src[c];
-                }
-            }
+            let win = &windows[j as usize * wn..(j as usize + 1) * wn];
+            for_block_nodes::<D>(corner_offset::<D>(o), |l, w| nodes[l] += win[w]);
         }
-        for l in 0..SparseGrid::<D>::BN {
-            let node = &mut nodes[l * stride..l * stride + stride];
+        let origin: [usize; D] = std::array::from_fn(|a| block[a] as usize * BLOCK);
+        // Whether the block touches a wall layer or a collider may be present.
+        let near_wall = (0..D).any(|a| origin[a] < wall_lo || origin[a] + BLOCK > wall_hi);
+        for l in 0..bn {
+            let node = nodes[l].to_array();
             let m = node[0];
             if !(m > 0.0) {
-                for c in 1..stride {
-                    node[c] = 0.0;
-                }
+                nodes[l] = f32x4::new([m, 0.0, 0.0, 0.0]);
                 continue;
             }
-            let mut v = Vector::<D>::from_fn(|a, _| node[1 + a] / m) + ctx.gravity * ctx.dt;
-            let mut idx = [0usize; D];
-            let mut r = l;
-            for a in 0..D {
-                idx[a] = block[a] as usize * BLOCK + r % BLOCK;
-                r /= BLOCK;
-            }
-            // Domain walls.
-            for a in 0..D {
-                let mut normal = Vector::<D>::zeros();
-                if idx[a] < ctx.wall_nodes {
-                    normal[a] = 1.0;
-                } else if idx[a] + ctx.wall_nodes > n {
-                    normal[a] = -1.0;
-                } else {
-                    continue;
+            let mut v = Vector::<D>::from_fn(|a, _| node[1 + a] / m) + gdt;
+            if near_wall || !ctx.colliders.is_empty() {
+                let mut idx = [0usize; D];
+                let mut r = l;
+                for a in 0..D {
+                    idx[a] = origin[a] + r % BLOCK;
+                    r /= BLOCK;
                 }
-                ctx.wall.apply(&mut v, &normal);
-            }
-            // Colliders, at the end of the substep.
-            if !ctx.colliders.is_empty() {
-                let xi = Vector::<D>::from_fn(|a, _| idx[a] as f32 * ctx.h);
-                for c in ctx.colliders {
-                    let (phi, normal) = c.sdf(&xi, t_end);
-                    if phi <= 0.0 {
-                        let vc = c.vel::<D>();
-                        let mut rel = v - vc;
-                        c.boundary.apply(&mut rel, &normal);
-                        v = rel + vc;
+                // Domain walls.
+                for a in 0..D {
+                    let mut normal = Vector::<D>::zeros();
+                    if idx[a] < wall_lo {
+                        normal[a] = 1.0;
+                    } else if idx[a] + ctx.wall_nodes > n {
+                        normal[a] = -1.0;
+                    } else {
+                        continue;
+                    }
+                    ctx.wall.apply(&mut v, &normal);
+                }
+                // Colliders, at the end of the substep.
+                if !ctx.colliders.is_empty() {
+                    let xi = Vector::<D>::from_fn(|a, _| idx[a] as f32 * ctx.h);
+                    for c in ctx.colliders {
+                        let (phi, normal) = c.sdf(&xi, t_end);
+                        if phi <= 0.0 {
+                            let vc = c.vel::<D>();
+                            let mut rel = v - vc;
+                            c.boundary.apply(&mut rel, &normal);
+                            v = rel + vc;
+                        }
                     }
                 }
             }
+            let mut out = [m, 0.0, 0.0, 0.0];
             for a in 0..D {
-                node[1 + a] = v[a];
+                out[1 + a] = v[a];
             }
+            nodes[l] = f32x4::new(out);
         }
     });
 }
 
 /// Copies the grid velocities into each particle block's window.
 pub(crate) fn gather<const D: usize>(grid: &mut SparseGrid<D>) {
-    let stride = D + 1;
-    let blen = SparseGrid::<D>::BN * stride;
-    let wlen = SparseGrid::<D>::WN * stride;
+    let bn = SparseGrid::<D>::BN;
+    let wn = SparseGrid::<D>::WN;
     let nb = grid.nb;
     let corners = pow(2, D);
     let (pblocks, gblock_of, nodes) = (&grid.pblocks, &grid.gblock_of, &grid.nodes);
-    grid.windows.par_chunks_mut(wlen).enumerate().for_each(|(j, win)| {
+    grid.windows.par_chunks_mut(wn).enumerate().for_each(|(j, win)| {
         let key = pblocks[j] as usize;
         for o in 0..corners {
             let mut gk = key;
             let mut s = 1;
-            let mut off = 0;
             for a in 0..D {
                 gk += ((o >> a) & 1) * s;
                 s *= nb;
-                off += ((o >> a) & 1) * BLOCK * wstride(a);
             }
             let g = gblock_of[gk] as usize;
-            let src = &nodes[g * blen..(g + 1) * blen];
-            for l in 0..SparseGrid::<D>::BN {
-                let mut wi = off;
-                let mut r = l;
-                for a in 0..D {
-                    wi += (r % BLOCK) * wstride(a);
-                    r /= BLOCK;
-                }
-                win[wi * stride..wi * stride + stride].copy_from_slice(&src[l * stride..l * stride + stride]);
-            }
+            let src = &nodes[g * bn..(g + 1) * bn];
+            for_block_nodes::<D>(corner_offset::<D>(o), |l, w| win[w] = src[l]);
         }
     });
 }
+
+/// Particles per task of G2P.
+const G2P_CHUNK: usize = 256;
 
 /// What G2P found.
 #[derive(Debug, Clone, Copy, Default)]
@@ -316,83 +373,122 @@ pub(crate) struct G2pOutcome {
 }
 
 /// G2P: new velocities, affine matrices, positions, deformation gradients (with the return
-/// maps), written in sorted order into `out`; `remove` flags particles that left the domain when
-/// they are to be removed instead of clamped.
+/// maps), written in sorted order into `out`; `remove` flags the particles that left the domain
+/// (for when they are to be removed instead of clamped).
 pub(crate) fn g2p<const D: usize, K: Spline>(
     grid: &SparseGrid<D>,
     st: &Particles<D>,
     out: &mut Particles<D>,
-    remove: Option<&mut [bool]>,
+    remove: &mut [bool],
     ctx: &Ctx<'_, D>,
 ) -> G2pOutcome {
-    let stride = D + 1;
-    let wlen = SparseGrid::<D>::WN * stride;
-    let nb = grid.nb;
+    if ctx.apic {
+        g2p_with::<D, K, true>(grid, st, out, remove, ctx)
+    } else {
+        g2p_with::<D, K, false>(grid, st, out, remove, ctx)
+    }
+}
+
+/// One particle's gather from its block's window: `(v_p, B_p, sum v_i grad w_ip^T)` with
+/// `B_p = sum w_ip v_i dx^T` (the last one only for APIC, else zero). The sums over the
+/// innermost axis are done first, per row of the stencil.
+#[inline(always)]
+fn g2p_gather<const D: usize, K: Spline, const APIC: bool>(
+    win: &[f32x4],
+    s: &Stencil<D>,
+    inv_h: f32,
+) -> (Vector<D>, Mat<D>, Mat<D>) {
+    let n = K::N;
+    let mut wdx = [[0.0f32; 4]; D];
+    for a in 0..D {
+        for k in 0..n {
+            wdx[a][k] = s.w[a][k] * s.dx[a][k];
+        }
+    }
+    let win = &win[s.base..s.base + span(D, K::N)];
+    let mut vel = f32x4::ZERO;
+    let mut bcol = [f32x4::ZERO; D];
+    let mut gcol = [f32x4::ZERO; D];
+    // Sums along x of w v, w dx v and (APIC) dw v over one stencil row.
+    let row_sums = |row: usize| {
+        let (mut s0, mut s1, mut s2) = (f32x4::ZERO, f32x4::ZERO, f32x4::ZERO);
+        for i in 0..n {
+            let node = win[row + i];
+            s0 += node * splat(s.w[0][i]);
+            s1 += node * splat(wdx[0][i]);
+            if APIC {
+                s2 += node * splat(s.dw[0][i]);
+            }
+        }
+        (s0, s1, s2)
+    };
+    if D == 2 {
+        for j in 0..n {
+            let (s0, s1, s2) = row_sums(j * wstride(1));
+            let wy = splat(s.w[1][j]);
+            vel += s0 * wy;
+            bcol[0] += s1 * wy;
+            bcol[1] += s0 * splat(wdx[1][j]);
+            if APIC {
+                gcol[0] += s2 * wy;
+                gcol[1] += s0 * splat(s.dw[1][j]);
+            }
+        }
+    } else {
+        for k in 0..n {
+            for j in 0..n {
+                let (s0, s1, s2) = row_sums(j * wstride(1) + k * wstride(2));
+                let (wy, wz) = (s.w[1][j], s.w[2][k]);
+                let wyz = splat(wy * wz);
+                vel += s0 * wyz;
+                bcol[0] += s1 * wyz;
+                bcol[1] += s0 * splat(wdx[1][j] * wz);
+                bcol[2] += s0 * splat(wy * wdx[2][k]);
+                if APIC {
+                    gcol[0] += s2 * wyz;
+                    gcol[1] += s0 * splat(s.dw[1][j] * wz);
+                    gcol[2] += s0 * splat(wy * s.dw[2][k]);
+                }
+            }
+        }
+    }
+    let vel = vel.to_array();
+    let bcol = bcol.map(f32x4::to_array);
+    let gcol = gcol.map(f32x4::to_array);
+    (
+        Vector::<D>::from_fn(|r, _| vel[1 + r]),
+        Mat::<D>::from_fn(|r, c| bcol[c][1 + r]),
+        if APIC { Mat::<D>::from_fn(|r, c| gcol[c][1 + r] * inv_h) } else { Mat::<D>::zeros() },
+    )
+}
+
+fn g2p_with<const D: usize, K: Spline, const APIC: bool>(
+    grid: &SparseGrid<D>,
+    st: &Particles<D>,
+    out: &mut Particles<D>,
+    remove: &mut [bool],
+    ctx: &Ctx<'_, D>,
+) -> G2pOutcome {
+    let wn = SparseGrid::<D>::WN;
     let d_inv = K::D_INV * ctx.inv_h * ctx.inv_h;
     let dd = D * D;
-    let (order, slot_block, pblocks, windows) = (&grid.order, &grid.slot_block, &grid.pblocks, &grid.windows);
-    let flag_removal = remove.is_some();
-    let mut dummy: [bool; 0] = [];
-    let remove_flags: &mut [bool] = match remove {
-        Some(r) => r,
-        None => &mut dummy,
-    };
-    let outcome = |s: usize, x: &mut [f32], v: &mut [f32], c: &mut [f32], f: &mut [f32], pl: &mut f32| {
+    let (order, slot_block, pcoords, windows) = (&grid.order, &grid.slot_block, &grid.pcoords, &grid.windows);
+    // Sorted slot `s` of the particle `order[s]`: its new state, and whether it left the domain.
+    let particle = |s: usize, x: &mut [f32], v: &mut [f32], c: &mut [f32], f: &mut [f32], pl: &mut f32| {
         let p = order[s] as usize;
         let j = slot_block[s] as usize;
-        let mut key = pblocks[j] as usize;
-        let mut block = [0i32; D];
-        for a in 0..D {
-            block[a] = (key % nb) as i32;
-            key /= nb;
-        }
-        let win = &windows[j * wlen..(j + 1) * wlen];
+        let block = pcoords[j];
+        let win = &windows[j * wn..(j + 1) * wn];
         let xp = &st.x[p * D..p * D + D];
         let sten = stencil::<D, K>(xp, ctx.inv_h, ctx.h, &block);
-        let mut vel = Vector::<D>::zeros();
-        let mut b = Mat::<D>::zeros();
-        let mut grad = Mat::<D>::zeros();
-        let mut body = |k: [usize; D]| {
-            let mut w = 1.0f32;
-            let mut idx = 0usize;
-            let mut dx = Vector::<D>::zeros();
-            for a in 0..D {
-                w *= sten.w[a][k[a]];
-                idx += (sten.local[a] + k[a]) * wstride(a);
-                dx[a] = sten.dx[a][k[a]];
-            }
-            let vi = Vector::<D>::from_column_slice(&win[idx * stride + 1..idx * stride + stride]);
-            let wv = vi * w;
-            vel += wv;
-            b += wv * dx.transpose();
-            if ctx.apic {
-                let mut gw = Vector::<D>::zeros();
-                for a in 0..D {
-                    let mut g = sten.dw[a][k[a]] * ctx.inv_h;
-                    for bb in 0..D {
-                        if bb != a {
-                            g *= sten.w[bb][k[bb]];
-                        }
-                    }
-                    gw[a] = g;
-                }
-                grad += vi * gw.transpose();
-            }
-        };
-        if K::N == 3 {
-            for_each_node::<D, 3>(&mut body);
-        } else {
-            for_each_node::<D, 4>(&mut body);
-        }
+        let (vel, b, grad) = g2p_gather::<D, K, APIC>(win, &sten, ctx.inv_h);
         let cmat = b * d_inv;
-        let l = if ctx.apic { grad } else { cmat };
+        let l = if APIC { grad } else { cmat };
         let mat = &ctx.materials[st.material[p] as usize];
         let mut fnew = (Mat::<D>::identity() + l * ctx.dt) * st.deformation(p);
         let mut plastic = st.plastic[p];
         project(mat, &mut fnew, &mut plastic);
         let mut xnew = Vector::<D>::from_column_slice(xp) + vel * ctx.dt;
-        // Any NaN or infinity makes the sum non-finite.
-        let finite = (xnew.sum() + vel.sum() + fnew.sum() + cmat.sum() + plastic).is_finite();
         let mut outside = false;
         for a in 0..D {
             if !(xnew[a] >= ctx.lo && xnew[a] <= ctx.hi) && xnew[a].is_finite() {
@@ -405,70 +501,76 @@ pub(crate) fn g2p<const D: usize, K: Spline>(
         c.copy_from_slice(cmat.as_slice());
         f.copy_from_slice(fnew.as_slice());
         *pl = plastic;
-        (outside, finite)
+        outside
     };
-    let combine = |a: G2pOutcome, b: G2pOutcome| G2pOutcome {
-        outside: a.outside + b.outside,
-        first_bad: a.first_bad.min(b.first_bad),
-    };
-    let identity = || G2pOutcome { outside: 0, first_bad: u32::MAX };
-    let n = st.len();
-    let result = if flag_removal {
-        (
-            out.x.par_chunks_mut(D),
-            out.v.par_chunks_mut(D),
-            out.c.par_chunks_mut(dd),
-            out.f.par_chunks_mut(dd),
-            out.plastic.par_iter_mut(),
-            remove_flags.par_iter_mut(),
-        )
-            .into_par_iter()
-            .enumerate()
-            .with_min_len(64)
-            .map(|(s, (x, v, c, f, pl, rm))| {
-                let (outside, finite) = outcome(s, x, v, c, f, pl);
-                *rm = outside;
-                G2pOutcome {
-                    outside: u64::from(outside),
-                    first_bad: if finite { u32::MAX } else { s as u32 },
+    (
+        out.x.par_chunks_mut(G2P_CHUNK * D),
+        out.v.par_chunks_mut(G2P_CHUNK * D),
+        out.c.par_chunks_mut(G2P_CHUNK * dd),
+        out.f.par_chunks_mut(G2P_CHUNK * dd),
+        out.plastic.par_chunks_mut(G2P_CHUNK),
+        out.mass.par_chunks_mut(G2P_CHUNK),
+        out.volume.par_chunks_mut(G2P_CHUNK),
+        out.material.par_chunks_mut(G2P_CHUNK),
+        out.id.par_chunks_mut(G2P_CHUNK),
+        remove.par_chunks_mut(G2P_CHUNK),
+    )
+        .into_par_iter()
+        .enumerate()
+        .map(|(chunk, (x, v, c, f, pl, mass, vol, mat, id, rm))| {
+            let mut r = G2pOutcome { outside: 0, first_bad: u32::MAX };
+            let s0 = chunk * G2P_CHUNK;
+            for i in 0..pl.len() {
+                let s = s0 + i;
+                let outside = particle(
+                    s,
+                    &mut x[i * D..i * D + D],
+                    &mut v[i * D..i * D + D],
+                    &mut c[i * dd..i * dd + dd],
+                    &mut f[i * dd..i * dd + dd],
+                    &mut pl[i],
+                );
+                rm[i] = outside;
+                r.outside += u64::from(outside);
+            }
+            // The particle constants follow the sorted order: a block copy where the chunk's
+            // particles kept their order (most chunks, the state being sorted by the previous
+            // step), else one by one.
+            let n = pl.len();
+            let order = &order[s0..s0 + n];
+            let p0 = order[0] as usize;
+            if order.iter().enumerate().all(|(i, &p)| p as usize == p0 + i) {
+                mass.copy_from_slice(&st.mass[p0..p0 + n]);
+                vol.copy_from_slice(&st.volume[p0..p0 + n]);
+                mat.copy_from_slice(&st.material[p0..p0 + n]);
+                id.copy_from_slice(&st.id[p0..p0 + n]);
+            } else {
+                for (i, &p) in order.iter().enumerate() {
+                    let p = p as usize;
+                    mass[i] = st.mass[p];
+                    vol[i] = st.volume[p];
+                    mat[i] = st.material[p];
+                    id[i] = st.id[p];
                 }
-            })
-            .reduce(identity, combine)
-    } else {
-        (
-            out.x.par_chunks_mut(D),
-            out.v.par_chunks_mut(D),
-            out.c.par_chunks_mut(dd),
-            out.f.par_chunks_mut(dd),
-            out.plastic.par_iter_mut(),
+            }
+            // Non-finite results, checked once per chunk off the particles' dependency chains
+            // (`|bits| >= 0x7f80_0000` is an infinity or a NaN).
+            let worst = |a: &[f32]| a.iter().fold(0u32, |m, c| m.max(c.to_bits() & 0x7fff_ffff));
+            if worst(x).max(worst(v)).max(worst(c)).max(worst(f)).max(worst(pl)) >= 0x7f80_0000 {
+                let bad = (0..pl.len()).find(|&i| {
+                    worst(&x[i * D..i * D + D])
+                        .max(worst(&v[i * D..i * D + D]))
+                        .max(worst(&c[i * dd..i * dd + dd]))
+                        .max(worst(&f[i * dd..i * dd + dd]))
+                        .max(worst(std::slice::from_ref(&pl[i])))
+                        >= 0x7f80_0000
+                });
+                r.first_bad = bad.map_or(u32::MAX, |i| (s0 + i) as u32);
+            }
+            r
+        })
+        .reduce(
+            || G2pOutcome { outside: 0, first_bad: u32::MAX },
+            |a, b| G2pOutcome { outside: a.outside + b.outside, first_bad: a.first_bad.min(b.first_bad) },
         )
-            .into_par_iter()
-            .enumerate()
-            .with_min_len(64)
-            .map(|(s, (x, v, c, f, pl))| {
-                let (outside, finite) = outcome(s, x, v, c, f, pl);
-                G2pOutcome {
-                    outside: u64::from(outside),
-                    first_bad: if finite { u32::MAX } else { s as u32 },
-                }
-            })
-            .reduce(identity, combine)
-    };
-    // The particle constants follow the sorted order.
-    out.mass.par_iter_mut().zip(out.volume.par_iter_mut()).enumerate().with_min_len(1024).for_each(
-        |(s, (m, vol))| {
-            let p = order[s] as usize;
-            *m = st.mass[p];
-            *vol = st.volume[p];
-        },
-    );
-    out.material.par_iter_mut().zip(out.id.par_iter_mut()).enumerate().with_min_len(1024).for_each(
-        |(s, (mat, id))| {
-            let p = order[s] as usize;
-            *mat = st.material[p];
-            *id = st.id[p];
-        },
-    );
-    debug_assert!(n == out.len());
-    result
 }
