@@ -30,6 +30,7 @@
 //! # Ok::<(), anim_core::integrate::IntegrateError>(())
 //! ```
 
+pub mod alloc_count;
 pub mod bspline;
 pub mod diagnostics;
 pub mod integrate;

@@ -4,48 +4,17 @@
 //! of 2 threads perform no heap allocation. Counted by a wrapping global allocator, so this file is its own
 //! test binary.
 
-#![allow(unsafe_code, clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use anim_core::alloc_count::CountingAllocator;
 use anim_fem::boundary::{Motion, Obstacle};
 use anim_fem::generate::box_mesh;
 use anim_fem::material::{Material, MaterialModel};
 use anim_fem::model::{EARTH_GRAVITY, ElementOrder, FemModel, MassKind};
 use anim_fem::sim::{FemParams, FemSimulation, LinearSolverChoice, TimeIntegrator};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-
-struct Counting;
-
-static COUNT: AtomicUsize = AtomicUsize::new(0);
-static ON: AtomicBool = AtomicBool::new(false);
-
-// SAFETY: every call is forwarded unchanged to the system allocator; the counter has no effect on
-// the memory handed out.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if ON.load(Ordering::Relaxed) {
-            COUNT.fetch_add(1, Ordering::Relaxed);
-        }
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: `ptr` came from `System.alloc` with this layout.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if ON.load(Ordering::Relaxed) {
-            COUNT.fetch_add(1, Ordering::Relaxed);
-        }
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
 
 #[global_allocator]
-static ALLOC: Counting = Counting;
+static ALLOC: CountingAllocator = CountingAllocator::new();
 
 #[test]
 fn steps_do_not_allocate() {
@@ -79,13 +48,12 @@ fn steps_do_not_allocate() {
                 sim.advance(&mut state, 1e-5).expect("first step");
                 let mut blocks = Vec::with_capacity(3);
                 for _ in 0..3 {
-                    COUNT.store(0, Ordering::Relaxed);
-                    ON.store(true, Ordering::Relaxed);
-                    for _ in 0..20 {
-                        sim.advance(&mut state, 1e-5).expect("step");
-                    }
-                    ON.store(false, Ordering::Relaxed);
-                    blocks.push(COUNT.load(Ordering::Relaxed));
+                    let counted = ALLOC.count(|| {
+                        for _ in 0..20 {
+                            sim.advance(&mut state, 1e-5).expect("step");
+                        }
+                    });
+                    blocks.push(counted);
                     if blocks.last() == Some(&0) {
                         break;
                     }

@@ -3,44 +3,11 @@
 //! performs no heap allocation. Counted by a wrapping global allocator, so this file is its own
 //! test binary.
 
-#![allow(unsafe_code)]
-
+use anim_core::alloc_count::CountingAllocator;
 use anim_mpm::scenes;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-
-struct Counting;
-
-static COUNT: AtomicUsize = AtomicUsize::new(0);
-static ON: AtomicBool = AtomicBool::new(false);
-
-// SAFETY: every call is forwarded unchanged to the system allocator; the counter has no effect on
-// the memory handed out.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if ON.load(Ordering::Relaxed) {
-            COUNT.fetch_add(1, Ordering::Relaxed);
-        }
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: `ptr` came from `System.alloc` with this layout.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if ON.load(Ordering::Relaxed) {
-            COUNT.fetch_add(1, Ordering::Relaxed);
-        }
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
 
 #[global_allocator]
-static ALLOC: Counting = Counting;
+static ALLOC: CountingAllocator = CountingAllocator::new();
 
 #[test]
 fn steps_do_not_allocate() {
@@ -53,15 +20,13 @@ fn steps_do_not_allocate() {
             for _ in 0..20 {
                 scene.step().expect("step");
             }
-            COUNT.store(0, Ordering::Relaxed);
-            ON.store(true, Ordering::Relaxed);
             let mut ok = true;
-            for _ in 0..5 {
-                ok &= scene.step().is_ok();
-            }
-            ON.store(false, Ordering::Relaxed);
+            let count = ALLOC.count(|| {
+                for _ in 0..5 {
+                    ok &= scene.step().is_ok();
+                }
+            });
             assert!(ok, "{name}: step failed");
-            let count = COUNT.load(Ordering::Relaxed);
             assert_eq!(count, 0, "{name}: {count} allocations in 5 steps");
         }
     });

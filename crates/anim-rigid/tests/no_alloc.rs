@@ -4,12 +4,11 @@
 //! damping and limits on) perform no heap allocation. Counted by a wrapping global allocator, so
 //! this file is its own test binary.
 
-#![allow(unsafe_code, clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use anim_core::alloc_count::CountingAllocator;
 
 use anim_core::solver::Solver;
 use anim_rigid::config::neutral;
@@ -20,48 +19,16 @@ use anim_rigid::{
     nonlinear_effects, potential_energy, rnea, spatial_momentum,
 };
 
-struct Counting;
-
-static COUNT: AtomicUsize = AtomicUsize::new(0);
-static ON: AtomicBool = AtomicBool::new(false);
-
-// SAFETY: every call is forwarded unchanged to the system allocator; the counter has no effect on
-// the memory handed out.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if ON.load(Ordering::Relaxed) {
-            COUNT.fetch_add(1, Ordering::Relaxed);
-        }
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: `ptr` came from `System.alloc` with this layout.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if ON.load(Ordering::Relaxed) {
-            COUNT.fetch_add(1, Ordering::Relaxed);
-        }
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
 #[global_allocator]
-static ALLOC: Counting = Counting;
+static ALLOC: CountingAllocator = CountingAllocator::new();
 
 fn counted(mut f: impl FnMut()) -> usize {
     f();
-    COUNT.store(0, Ordering::Relaxed);
-    ON.store(true, Ordering::Relaxed);
-    for _ in 0..5 {
-        f();
-    }
-    ON.store(false, Ordering::Relaxed);
-    COUNT.load(Ordering::Relaxed)
+    ALLOC.count(|| {
+        for _ in 0..5 {
+            f();
+        }
+    })
 }
 
 #[test]
