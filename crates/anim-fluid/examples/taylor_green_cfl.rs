@@ -10,7 +10,6 @@
 //! corresponds to, `nu_num = -ln(A / A_exact) / (2 pi^2 t)`.
 
 use anim_fluid::advection::Advection;
-use anim_fluid::mac::{MacFluid, MacParams, Wall};
 use std::f64::consts::PI;
 
 fn list<T: std::str::FromStr>(arg: Option<&String>, default: &str) -> Result<Vec<T>, String> {
@@ -33,39 +32,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         })
         .collect::<Result<_, _>>()?;
     let t_end = 1.0;
-    let mode =
-        |p: [f64; 3]| [(PI * p[0]).sin() * (PI * p[1]).cos(), -(PI * p[0]).cos() * (PI * p[1]).sin(), 0.0];
     for &n in &sizes {
         for &cfl in &cfls {
             for &advection in &schemes {
-                let params = MacParams {
-                    viscosity: nu,
-                    advection,
-                    pressure_tolerance: 1e-10,
-                    walls: [[Wall::FreeSlip; 2]; 3],
-                    ..MacParams::default()
-                };
-                let h = 1.0 / n as f64;
-                let (mut fluid, mut state) = MacFluid::new([n, n, 1], 2, h, params)?;
-                fluid.set_velocity(&mut state, mode);
-                let steps = (t_end / (cfl * h)).ceil() as usize;
-                let dt = t_end / steps as f64;
                 let start = std::time::Instant::now();
-                for _ in 0..steps {
-                    fluid.advance(&mut state, dt)?;
-                }
+                let r = anim_fluid::scenes::taylor_green_decay(n, advection, nu, t_end, cfl)?;
                 let secs = start.elapsed().as_secs_f64();
-                let d = fluid.face_dims(0);
-                let (mut num, mut den) = (0.0, 0.0);
-                for j in 0..d[1] {
-                    for i in 0..d[0] {
-                        let m = mode(fluid.face_centre(0, i, j, 0))[0];
-                        num += m * state.vel[0][i + d[0] * j];
-                        den += m * m;
-                    }
-                }
-                let a = num / den;
-                let exact = (-2.0 * nu * PI * PI * t_end).exp();
+                let (a, exact, steps) = (r.amplitude, r.exact, r.steps);
                 let nu_num = -(a / exact).ln() / (2.0 * PI * PI * t_end);
                 println!(
                     "{{\"n\":{n},\"cfl\":{cfl},\"scheme\":\"{}\",\"steps\":{steps},\"amplitude\":{a:.6},\"exact\":{exact:.6},\"rel_err\":{:.5},\"nu_num\":{nu_num:.3e},\"seconds\":{secs:.1}}}",

@@ -1247,42 +1247,12 @@ impl Solver for MacFluid {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::f64::consts::PI;
 
     /// Taylor-Green vortex in the unit box with free-slip walls: `u = sin(pi x) cos(pi y)`,
     /// `v = -cos(pi x) sin(pi y)` decays as `exp(-2 nu pi^2 t)`.
     pub(super) fn taylor_green(n: usize, advection: Advection, nu: f64, t_end: f64) -> (f64, f64) {
-        let params = MacParams {
-            viscosity: nu,
-            advection,
-            pressure_tolerance: 1e-10,
-            walls: [[Wall::FreeSlip; 2]; 3],
-            ..MacParams::default()
-        };
-        let h = 1.0 / n as f64;
-        let (mut fluid, mut state) = MacFluid::new([n, n, 1], 2, h, params).unwrap();
-        let mode = |p: [f64; 3]| {
-            [(PI * p[0]).sin() * (PI * p[1]).cos(), -(PI * p[0]).cos() * (PI * p[1]).sin(), 0.0]
-        };
-        fluid.set_velocity(&mut state, mode);
-        let amplitude = |fluid: &MacFluid, state: &MacState| {
-            let (mut num, mut den) = (0.0, 0.0);
-            let d = fluid.face_dims(0);
-            for j in 0..d[1] {
-                for i in 0..d[0] {
-                    let m = mode(fluid.face_centre(0, i, j, 0))[0];
-                    num += m * state.vel[0][idx(d, i, j, 0)];
-                    den += m * m;
-                }
-            }
-            num / den
-        };
-        let steps = (t_end / (0.5 * h)).ceil() as usize;
-        let dt = t_end / steps as f64;
-        for _ in 0..steps {
-            fluid.advance(&mut state, dt).unwrap();
-        }
-        (amplitude(&fluid, &state), (-2.0 * nu * PI * PI * t_end).exp())
+        let r = crate::scenes::taylor_green_decay(n, advection, nu, t_end, 0.5).unwrap();
+        (r.amplitude, r.exact)
     }
 
     #[test]

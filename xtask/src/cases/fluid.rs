@@ -12,7 +12,7 @@ use crate::registry::{
 };
 use anim_fluid::FluidError;
 use anim_fluid::advection::Advection;
-use anim_fluid::mac::{MacFluid, MacParams, MacState, Wall};
+use anim_fluid::mac::{MacFluid, MacParams, MacState};
 use anim_fluid::pressure::PressureMethod;
 use anim_fluid::scenes::{self, FluidSim};
 use anim_fluid::seed::{SeedFluid, SeedParams};
@@ -268,33 +268,8 @@ pub fn taylor_green_run(
     t_end: f64,
     cfl: f64,
 ) -> Result<(f64, f64), FluidError> {
-    let params = MacParams {
-        viscosity: nu,
-        advection,
-        pressure_tolerance: 1e-10,
-        walls: [[Wall::FreeSlip; 2]; 3],
-        ..MacParams::default()
-    };
-    let h = 1.0 / n as f64;
-    let (mut fluid, mut state) = MacFluid::new([n, n, 1], 2, h, params)?;
-    let mode =
-        |p: [f64; 3]| [(PI * p[0]).sin() * (PI * p[1]).cos(), -(PI * p[0]).cos() * (PI * p[1]).sin(), 0.0];
-    fluid.set_velocity(&mut state, mode);
-    let steps = (t_end / (cfl * h)).ceil() as usize;
-    let dt = t_end / steps as f64;
-    for _ in 0..steps {
-        fluid.advance(&mut state, dt)?;
-    }
-    let d = fluid.face_dims(0);
-    let (mut num, mut den) = (0.0, 0.0);
-    for j in 0..d[1] {
-        for i in 0..d[0] {
-            let m = mode(fluid.face_centre(0, i, j, 0))[0];
-            num += m * state.vel[0][i + d[0] * j];
-            den += m * m;
-        }
-    }
-    Ok((num / den, (-2.0 * nu * PI * PI * t_end).exp()))
+    let r = anim_fluid::scenes::taylor_green_decay(n, advection, nu, t_end, cfl)?;
+    Ok((r.amplitude, r.exact))
 }
 
 fn taylor_green(ctx: &Ctx) -> Vec<Check> {
