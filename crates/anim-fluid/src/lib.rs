@@ -18,7 +18,9 @@
 //!   against the C transcription under `xtask/peers/fluid/` at N = 64 and 128, 100 steps).
 //! - [`mac`]: a staggered (MAC) grid in 2D or 3D (one code base), velocity advection by
 //!   semi-Lagrangian steps with linear or monotone cubic interpolation, or BFECC / MacCormack
-//!   with a limiter ([`advection`]); implicit viscosity; projection by Jacobi, red-black
+//!   with a limiter ([`advection`]); the seed's advect-then-project splitting or
+//!   advection-reflection (Zehnder et al. 2018, [`advection::Splitting`]), second order in
+//!   time; implicit viscosity; projection by Jacobi, red-black
 //!   Gauss-Seidel, conjugate gradients or multigrid-preconditioned CG ([`pressure`]); solid
 //!   obstacles, no-slip (moving), free-slip and open walls, inflow boxes; buoyant smoke
 //!   (density and temperature) with vorticity confinement.
@@ -77,15 +79,17 @@
 //!
 //! ## Accuracy (measured here)
 //!
-//! - **Taylor-Green** vortex (unit box, free-slip walls, `nu = 0.01`, CFL 0.5, t = 1): the
-//!   amplitude's relative error against `exp(-2 nu pi^2 t)` at N = 128 is 0.78% with monotone
-//!   cubic, BFECC and MacCormack advection, and 2.9% with linear semi-Lagrangian advection (its
-//!   first-order numerical viscosity); at N = 64, MacCormack: 1.5%. The second-order schemes'
-//!   error is the first-order splitting of advection and projection, about `2 dt` whatever N;
-//!   linear interpolation adds `h^2 alpha (1 - alpha) / (2 dt)` of numerical viscosity, which
-//!   falls as the CFL number grows while the splitting error rises: linear is within 2% at
-//!   N = 128 at no CFL from 0.25 to 4 (best 2.66% at CFL 1), and at N = 256 from CFL 0.5 to 2
-//!   (table in `docs/guides/anim-fluid.md`, `examples/taylor_green_cfl.rs`).
+//! - **Taylor-Green** vortex (unit box, free-slip walls, `nu = 0.01`, t = 1): the amplitude's
+//!   relative error against `exp(-2 nu pi^2 t)` at N = 128.
+//!   - Advect-then-project, CFL 0.5: 0.78% with monotone cubic, BFECC and MacCormack, 2.9%
+//!     with linear semi-Lagrangian advection. The second-order schemes' error is the
+//!     first-order splitting of advection and projection, about `2 dt` whatever N. Linear
+//!     interpolation adds a numerical viscosity `h^2 alpha (1 - alpha) / (2 dt)` that falls as
+//!     the CFL number grows while the splitting error rises: under this splitting linear is
+//!     within 2% at N = 128 at no CFL from 0.25 to 4 (best 2.66% at CFL 1).
+//!   - Advection-reflection removes the splitting error: at CFL 2, 0.012-0.013% with the three
+//!     higher-order schemes and 1.14% with linear (0.60% at CFL 4), for two projections per
+//!     step (table in `docs/guides/anim-fluid.md`, `examples/taylor_green_cfl.rs`).
 //! - **Lid-driven cavity**, Re = 100, run to steady state, max error over Ghia, Ghia and Shin's
 //!   (1982) centreline points (u on x = 0.5 / v on y = 0.5): N = 32: linear 0.021 / 0.022,
 //!   cubic 0.0092 / 0.0080, BFECC 0.011 / 0.0066, MacCormack 0.011 / 0.0071; N = 64: linear

@@ -18,7 +18,7 @@
 //! # Ok::<(), anim_fluid::FluidError>(())
 //! ```
 
-use crate::advection::Advection;
+use crate::advection::{Advection, Splitting};
 use crate::error::FluidError;
 use crate::mac::{MacFluid, MacParams, MacState, Source, Wall};
 use crate::pressure::PressureMethod;
@@ -501,7 +501,7 @@ pub struct TaylorGreenDecay {
 
 /// Runs the Taylor-Green vortex `u = sin(pi x) cos(pi y)`, `v = -cos(pi x) sin(pi y)` on an
 /// `n x n` MAC grid of the unit square with free-slip walls, viscosity `nu`, the given advection
-/// and the pressure solved to 1e-10, for `t_end` at the CFL number `cfl` (of the unit velocity
+/// and splitting and the pressure solved to 1e-10, for `t_end` at the CFL number `cfl` (of the unit velocity
 /// scale), and measures the mode's decay.
 ///
 /// # Errors
@@ -509,6 +509,7 @@ pub struct TaylorGreenDecay {
 pub fn taylor_green_decay(
     n: usize,
     advection: Advection,
+    splitting: Splitting,
     nu: f64,
     t_end: f64,
     cfl: f64,
@@ -517,6 +518,7 @@ pub fn taylor_green_decay(
     let params = MacParams {
         viscosity: nu,
         advection,
+        splitting,
         pressure_tolerance: 1e-10,
         walls: [[Wall::FreeSlip; 2]; 3],
         ..MacParams::default()
