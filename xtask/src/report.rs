@@ -54,7 +54,7 @@ fn no_problem(_quick: bool) -> Vec<(&'static str, f64)> {
 }
 
 /// The studies `anim run --tolerance` picks from.
-pub const SCENE_FAMILIES: [SceneFamily; 6] = [
+pub const SCENE_FAMILIES: [SceneFamily; 8] = [
     SceneFamily {
         study: "core-oscillator",
         scene: "harmonic-oscillator",
@@ -91,6 +91,13 @@ pub const SCENE_FAMILIES: [SceneFamily; 6] = [
         horizon: None,
         problem: no_problem,
     },
+    SceneFamily {
+        study: "pbd-cloth-position",
+        scene: "pbd/hanging-cloth",
+        horizon: Some(crate::cases::pbd::STUDY_T),
+        problem: crate::cases::pbd::study_problem,
+    },
+    SceneFamily { study: "mpm_dam_break", scene: "mpm/dam-break-2d", horizon: None, problem: no_problem },
 ];
 
 /// Everything the report shows.
@@ -962,9 +969,13 @@ mod tests {
         // A report with the FEM, spring and cavity studies too, and a point that failed (NaN).
         let mut r = tiny_report();
         r.studies[0].1.series[1].points.push(Point { param: 0.05, seconds: f64::NAN, error: f64::NAN });
-        for (krate, slug) in
-            [("anim-fem", "fem-beam"), ("anim-springs", "springs-cloth"), ("anim-fluid", "fluid_cavity_ghia")]
-        {
+        for (krate, slug) in [
+            ("anim-fem", "fem-beam"),
+            ("anim-springs", "springs-cloth"),
+            ("anim-fluid", "fluid_cavity_ghia"),
+            ("anim-pbd", "pbd-cloth-position"),
+            ("anim-mpm", "mpm_dam_break"),
+        ] {
             r.studies.push((krate, StudyResult { slug: slug.into(), ..tiny() }));
         }
         let text_all = serde_json::to_string_pretty(&cheapest_table(&r)).unwrap();
@@ -978,7 +989,7 @@ mod tests {
         assert_eq!(v["mode"], "quick");
         assert_eq!(v["tolerances"], serde_json::json!([1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8]));
         let families = v["families"].as_array().unwrap();
-        assert_eq!(families.len(), 5);
+        assert_eq!(families.len(), 7);
         let osc = &families[0];
         assert_eq!(osc["study"], "core-oscillator");
         assert_eq!(osc["crate"], "anim-core");
@@ -1034,6 +1045,17 @@ mod tests {
         let cloth = &families[3];
         assert_eq!(cloth["problem"]["n"], 6.0, "quick mode's cloth is 6 x 6");
         assert!(families[4]["horizon"].is_null() && families[4]["scene"] == "fluid/lid-driven-cavity");
+        let pbd = &families[5];
+        assert_eq!(pbd["scene"], "pbd/hanging-cloth");
+        assert_eq!(pbd["horizon"], 0.5);
+        assert_eq!(
+            pbd["problem"],
+            serde_json::json!({ "n": 8.0, "dt": 1.0 / 60.0 }),
+            "quick mode's cloth is 8 x 8"
+        );
+        let mpm = &families[6];
+        assert_eq!(mpm["scene"], "mpm/dam-break-2d");
+        assert!(mpm["horizon"].is_null() && mpm.get("problem").is_none());
         // And it reads back into the typed form.
         let table: CheapestTable = serde_json::from_str(&text).unwrap();
         assert_eq!(table.families[0].picks[3].method.as_deref(), Some("slow-accurate"));

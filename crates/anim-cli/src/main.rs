@@ -111,8 +111,9 @@ struct RunArgs {
     #[arg(long)]
     checkpoint_every: Option<usize>,
     /// The accuracy the run needs instead of a method: the method (integrator, solver, time
-    /// step, resolution or pressure tolerance) comes from the report's measured work-precision
-    /// studies (oscillator, Kepler, FEM beam, hanging cloth, lid-driven cavity, smoke plume), and
+    /// step, resolution, pressure tolerance, PBD iterations and substeps, MPM transfer and kernel)
+    /// comes from the report's measured work-precision studies (oscillator, Kepler, FEM beam,
+    /// hanging cloth, lid-driven cavity, smoke plume, PBD cloth, MPM dam break), and
     /// the run's error on the study's measure is printed at the end where the scene has a
     /// reference.
     #[arg(long, allow_hyphen_values = true)]

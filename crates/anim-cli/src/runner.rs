@@ -32,6 +32,12 @@ pub trait Runner {
     fn exact_error(&self) -> Option<f64> {
         None
     }
+    /// The run's error so far on the measure of the report study whose problem the scene is,
+    /// where the scene carries the study's reference (the MPM dam break: the rms relative
+    /// surge-front error against Martin & Moyce at the table's times passed so far).
+    fn study_error(&self) -> Option<f64> {
+        None
+    }
     /// The frame format that suits the scene.
     fn natural_format(&self) -> OutputFormat;
     /// How the scene is drawn and written (fixed for the run).
@@ -170,15 +176,32 @@ pub fn build(
             )?;
             Box::new(RigidRunner::new(scene).map_err(|e| SceneError::invalid(file, "scene.preset", e))?)
         }
-        Scene::Pbd { ref preset, resolution } => {
-            let s = preset_scene(
+        Scene::Pbd { ref preset, resolution, method, iterations, substeps } => {
+            let mut s = preset_scene(
                 file,
                 "scene.resolution",
                 preset,
                 &anim_pbd::scenes::NAMES,
                 anim_pbd::scenes::by_name(preset, resolution),
             )?;
-            let method = format!("{:?} / {:?}", s.params.method, s.params.solver).to_lowercase();
+            if let Some(m) = method {
+                s.params.method = m;
+            }
+            if let Some(i) = iterations {
+                s.params.iterations = i;
+            }
+            if let Some(k) = substeps {
+                s.params.substeps = k;
+            }
+            let method = format!(
+                "{} / {}, {} iteration{} x {} substep{}",
+                format!("{:?}", s.params.method).to_lowercase(),
+                format!("{:?}", s.params.solver).to_lowercase(),
+                s.params.iterations,
+                if s.params.iterations == 1 { "" } else { "s" },
+                s.params.substeps,
+                if s.params.substeps == 1 { "" } else { "s" },
+            );
             let name = format!("pbd/{}", s.name);
             let (sim, state) =
                 s.into_simulation().map_err(|e| SceneError::invalid(file, "scene.preset", e.to_string()))?;
@@ -204,14 +227,34 @@ pub fn build(
                 .map_err(|e| SceneError::invalid(file, "scene.preset", e.to_string()))?;
             Box::new(FemRunner { name, sim, state })
         }
-        Scene::Mpm { ref preset, resolution } => {
-            let scene = preset_scene(
+        Scene::Mpm { ref preset, resolution, transfer, kernel, particles_per_cell } => {
+            if particles_per_cell.is_some()
+                && preset != "dam-break-2d"
+                && anim_mpm::scenes::NAMES.contains(&preset.as_str())
+            {
+                return Err(SceneError::invalid(
+                    file,
+                    "scene.particles_per_cell",
+                    format!("{preset} places its own particles; only dam-break-2d takes particles_per_cell"),
+                ));
+            }
+            let mut scene = preset_scene(
                 file,
                 "scene.resolution",
                 preset,
                 &anim_mpm::scenes::NAMES,
-                anim_mpm::scenes::by_name(preset, resolution),
+                anim_mpm::scenes::by_name_with(preset, resolution, particles_per_cell),
             )?;
+            if transfer.is_some() || kernel.is_some() {
+                let params = match &scene {
+                    anim_mpm::scenes::MpmScene::Two(s) => s.sim.params(),
+                    anim_mpm::scenes::MpmScene::Three(s) => s.sim.params(),
+                };
+                let t = transfer.map_or(params.transfer, |t| t.transfer());
+                let k = kernel.map_or(params.kernel, |k| k.kernel());
+                let field = if transfer.is_some() { "scene.transfer" } else { "scene.kernel" };
+                scene.set_method(t, k).map_err(|e| SceneError::invalid(file, field, e.to_string()))?;
+            }
             Box::new(MpmRunner::new(scene))
         }
         Scene::Fluid { ref preset, resolution, pressure_solver, pressure_tolerance } => {
@@ -685,14 +728,23 @@ struct MpmRunner {
     name: String,
     scene: anim_mpm::scenes::MpmScene,
     display: State,
+    /// The dam break's surge front at Martin & Moyce's times (the `dam-break-2d` preset only).
+    front: Option<anim_mpm::scenes::SurgeFront>,
 }
 
 impl MpmRunner {
     fn new(scene: anim_mpm::scenes::MpmScene) -> Self {
+        let front = match &scene {
+            anim_mpm::scenes::MpmScene::Two(s) if s.name == "dam-break-2d" => {
+                Some(anim_mpm::scenes::SurgeFront::new(s.sim.params(), &s.state))
+            }
+            _ => None,
+        };
         let mut runner = Self {
             name: format!("mpm/{}", scene.name()),
             scene,
             display: State::new(Vec::new(), Vec::new()),
+            front,
         };
         runner.refresh();
         runner
@@ -725,7 +777,20 @@ impl Runner for MpmRunner {
     }
 
     fn method(&self) -> String {
-        format!("{}D MLS-MPM, quadratic B-splines, CFL substeps", self.scene.dim())
+        let params = match &self.scene {
+            anim_mpm::scenes::MpmScene::Two(s) => s.sim.params(),
+            anim_mpm::scenes::MpmScene::Three(s) => s.sim.params(),
+        };
+        let transfer = match params.transfer {
+            anim_mpm::Transfer::Apic => "APIC",
+            anim_mpm::Transfer::Mls => "MLS-MPM",
+        };
+        let kernel = crate::scene::MpmKernel::of(params.kernel).name();
+        format!("{}D {transfer}, {kernel} B-splines, CFL substeps", self.scene.dim())
+    }
+
+    fn study_error(&self) -> Option<f64> {
+        self.front.as_ref().and_then(|f| f.errors()).map(|(_, rms)| rms)
     }
 
     fn state(&self) -> &State {
@@ -738,15 +803,21 @@ impl Runner for MpmRunner {
             anim_mpm::scenes::MpmScene::Three(s) => s.sim.step(&mut s.state, dt),
         }
         .map_err(|e| e.to_string())?;
+        if let (Some(front), anim_mpm::scenes::MpmScene::Two(s)) = (&mut self.front, &self.scene) {
+            front.observe(s.sim.time(), s.sim.params(), &s.state);
+        }
         self.refresh();
         Ok(report)
     }
 
     fn save(&self) -> serde_json::Value {
         match &self.scene {
-            anim_mpm::scenes::MpmScene::Two(s) => {
-                serde_json::json!({ "dim": 2, "particles": s.state, "simulation": s.sim.memory() })
-            }
+            anim_mpm::scenes::MpmScene::Two(s) => serde_json::json!({
+                "dim": 2,
+                "particles": s.state,
+                "simulation": s.sim.memory(),
+                "surge_front": self.front,
+            }),
             anim_mpm::scenes::MpmScene::Three(s) => {
                 serde_json::json!({ "dim": 3, "particles": s.state, "simulation": s.sim.memory() })
             }
@@ -773,6 +844,9 @@ impl Runner for MpmRunner {
         match &mut self.scene {
             anim_mpm::scenes::MpmScene::Two(s) => restore(s, saved, memory)?,
             anim_mpm::scenes::MpmScene::Three(s) => restore(s, saved, memory)?,
+        }
+        if self.front.is_some() {
+            self.front = Some(field(saved, "surge_front")?);
         }
         self.refresh();
         Ok(())
@@ -1363,6 +1437,65 @@ mod tests {
         let mut runner = build(&file.scene, Path::new("s.toml"), None).unwrap();
         let report = runner.step(1e-2).unwrap();
         assert!(report.iterations >= 1 && report.residual.is_some(), "{report:?}");
+    }
+
+    #[test]
+    fn pbd_method_fields_reach_the_simulation() {
+        let text = scene::builtin("pbd-cloth").unwrap().replace(
+            "preset = \"hanging-cloth\"",
+            "preset = \"hanging-cloth\"\nresolution = 4\nmethod = \"pbd\"\niterations = 3\nsubsteps = 5",
+        );
+        let file = scene::parse(&text, Path::new("s.toml")).unwrap();
+        let mut runner = build(&file.scene, Path::new("s.toml"), None).unwrap();
+        assert_eq!(runner.method(), "pbd / gaussseidel, 3 iterations x 5 substeps");
+        // Each substep's iterations report into the step's iteration count: 3 x 5.
+        assert_eq!(runner.step(1.0 / 60.0).unwrap().iterations, 15);
+        let plain = scene::parse(scene::builtin("pbd-cloth").unwrap(), Path::new("s.toml")).unwrap();
+        let runner = build(&plain.scene, Path::new("s.toml"), None).unwrap();
+        assert_eq!(runner.method(), "xpbd / gaussseidel, 1 iteration x 8 substeps");
+    }
+
+    #[test]
+    fn mpm_method_fields_reach_the_simulation_and_the_dam_break_measures_its_front() {
+        let dam = |fields: &str| {
+            let text = scene::builtin("dam-break-2d-mpm").unwrap().replace("resolution = 64", fields);
+            let file = scene::parse(&text, Path::new("s.toml")).unwrap();
+            build(&file.scene, Path::new("s.toml"), None)
+        };
+        let runner = dam("resolution = 32\ntransfer = \"apic\"\nkernel = \"cubic\"").unwrap();
+        assert_eq!(runner.method(), "2D APIC, cubic B-splines, CFL substeps");
+        // The column 0.2 x 0.4 m at h = 1/32 holds floor(6.4 k) x floor(12.8 k) particles.
+        for (k, count) in [(2, 12 * 25), (3, 19 * 38)] {
+            let runner = dam(&format!("resolution = 32\nparticles_per_cell = {k}")).unwrap();
+            assert_eq!(runner.state().x.len(), 3 * count, "{k} per cell");
+            assert_eq!(runner.method(), "2D MLS-MPM, quadratic B-splines, CFL substeps");
+        }
+        let three = scene::builtin("mpm")
+            .unwrap()
+            .replace("preset = \"three-materials\"", "preset = \"three-materials\"\nparticles_per_cell = 3");
+        let file = scene::parse(&three, Path::new("s.toml")).unwrap();
+        let msg = build(&file.scene, Path::new("s.toml"), None).err().unwrap().to_string();
+        assert!(
+            msg.contains(
+                "s.toml: field `scene.particles_per_cell`: three-materials places its own particles"
+            ),
+            "{msg}"
+        );
+        // The surge-front error appears once the run passes Martin & Moyce's first time,
+        // T = 0.41, t = 0.41 / sqrt(2 g / a) = 0.0414 s.
+        let mut runner = dam("resolution = 32").unwrap();
+        let dt = anim_mpm::scenes::dam_break_2d_dt(32);
+        assert_eq!(runner.study_error(), None);
+        let first = 0.41 / (2.0 * 9.81 / 0.2f64).sqrt();
+        while runner.state().t + dt < first {
+            runner.step(dt).unwrap();
+        }
+        assert_eq!(runner.study_error(), None, "before T = 0.41");
+        runner.step(dt).unwrap();
+        let e = runner.study_error().unwrap();
+        assert!(e.is_finite() && e > 0.0 && e < 1.0, "{e}");
+        // Other scenes carry no study reference.
+        assert_eq!(runner_of("mpm").study_error(), None);
     }
 
     #[test]

@@ -98,13 +98,23 @@ pub enum Scene {
         preset: String,
     },
     /// A position-based-dynamics scene of anim-pbd (`cloth-drape`, `flag`, `rope`, `soft-blob`,
-    /// `balloon`, `benchmark-cloth`) with its own solver settings.
+    /// `balloon`, `hanging-cloth`, `benchmark-cloth`) with its own solver settings unless
+    /// overridden.
     Pbd {
         /// The preset's name.
         preset: String,
         /// Resolution (the preset's default when absent).
         #[serde(default)]
         resolution: Option<usize>,
+        /// `"pbd"` (stiffness) or `"xpbd"` (compliance); the preset's when absent.
+        #[serde(default)]
+        method: Option<anim_pbd::Method>,
+        /// Solver iterations per substep, 1 to [`MAX_PBD_COUNT`] (the preset's when absent).
+        #[serde(default)]
+        iterations: Option<usize>,
+        /// Substeps per step, 1 to [`MAX_PBD_COUNT`] (the preset's when absent).
+        #[serde(default)]
+        substeps: Option<usize>,
     },
     /// A finite element scene of anim-fem (`cantilever-beam`, `soft-cube-drop`, `twisted-bar`).
     Fem {
@@ -127,14 +137,24 @@ pub enum Scene {
         #[serde(default)]
         element: Option<anim_fem::model::ElementOrder>,
     },
-    /// A material-point-method scene of anim-mpm (`three-materials` in 2D, `dam-break-3d`,
-    /// `snowball`, `benchmark-2d`, `benchmark-3d`); each step may take CFL substeps.
+    /// A material-point-method scene of anim-mpm (`three-materials` and `dam-break-2d` in 2D,
+    /// `dam-break-3d`, `snowball`, `benchmark-2d`, `benchmark-3d`); each step may take CFL
+    /// substeps.
     Mpm {
         /// The preset's name.
         preset: String,
         /// Grid cells per axis (the preset's default when absent).
         #[serde(default)]
         resolution: Option<usize>,
+        /// Particle-grid transfer: `"mls-mpm"` (the presets' default) or `"apic"`.
+        #[serde(default)]
+        transfer: Option<MpmTransfer>,
+        /// Interpolation kernel: `"quadratic"` (the presets' default) or `"cubic"` B-splines.
+        #[serde(default)]
+        kernel: Option<MpmKernel>,
+        /// Particles per cell and axis, 1 to 8 (`dam-break-2d` only; default 2).
+        #[serde(default)]
+        particles_per_cell: Option<usize>,
     },
     /// A grid fluid of anim-fluid (`smoke-box-2d`: the seed's stable fluids; `smoke-plume-3d`:
     /// buoyant smoke around a sphere on the 3D MAC grid; `lid-driven-cavity`: the Re = 100
@@ -219,6 +239,87 @@ impl<'de> Deserialize<'de> for PressureSolver {
                 anim_fluid::pressure::PressureMethod::ALL.iter().map(|m| m.name()).collect();
             serde::de::Error::custom(format!("{UNKNOWN_PRESSURE}{name}` (one of {})", names.join(", ")))
         })
+    }
+}
+
+/// The largest iteration or substep count a [`Scene::Pbd`] takes.
+pub const MAX_PBD_COUNT: usize = 100_000;
+
+/// The particle-grid transfer of a [`Scene::Mpm`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MpmTransfer {
+    /// Affine particle-in-cell with grid forces from the kernel gradients.
+    Apic,
+    /// Moving least squares MPM: the stress fused into the affine momentum.
+    MlsMpm,
+}
+
+impl MpmTransfer {
+    /// The anim-mpm transfer.
+    #[must_use]
+    pub fn transfer(self) -> anim_mpm::Transfer {
+        match self {
+            MpmTransfer::Apic => anim_mpm::Transfer::Apic,
+            MpmTransfer::MlsMpm => anim_mpm::Transfer::Mls,
+        }
+    }
+
+    /// The field's value for `transfer`.
+    #[must_use]
+    pub fn of(transfer: anim_mpm::Transfer) -> Self {
+        match transfer {
+            anim_mpm::Transfer::Apic => MpmTransfer::Apic,
+            anim_mpm::Transfer::Mls => MpmTransfer::MlsMpm,
+        }
+    }
+
+    /// The name scene files use.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            MpmTransfer::Apic => "apic",
+            MpmTransfer::MlsMpm => "mls-mpm",
+        }
+    }
+}
+
+/// The interpolation kernel of a [`Scene::Mpm`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MpmKernel {
+    /// Quadratic B-spline (3 nodes per axis).
+    Quadratic,
+    /// Cubic B-spline (4 nodes per axis).
+    Cubic,
+}
+
+impl MpmKernel {
+    /// The anim-mpm kernel.
+    #[must_use]
+    pub fn kernel(self) -> anim_mpm::Kernel {
+        match self {
+            MpmKernel::Quadratic => anim_mpm::Kernel::Quadratic,
+            MpmKernel::Cubic => anim_mpm::Kernel::Cubic,
+        }
+    }
+
+    /// The field's value for `kernel`.
+    #[must_use]
+    pub fn of(kernel: anim_mpm::Kernel) -> Self {
+        match kernel {
+            anim_mpm::Kernel::Quadratic => MpmKernel::Quadratic,
+            anim_mpm::Kernel::Cubic => MpmKernel::Cubic,
+        }
+    }
+
+    /// The name scene files use.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            MpmKernel::Quadratic => "quadratic",
+            MpmKernel::Cubic => "cubic",
+        }
     }
 }
 
@@ -313,7 +414,7 @@ pub enum SceneError {
 }
 
 /// The scenes built into the binary: `(name, description, TOML text)`.
-pub const BUILTIN: [(&str, &str, &str); 27] = [
+pub const BUILTIN: [(&str, &str, &str); 29] = [
     (
         "cloth",
         "a 32x32 cloth pinned at two corners falls and swings, backward Euler + sparse Cholesky",
@@ -325,6 +426,7 @@ pub const BUILTIN: [(&str, &str, &str); 27] = [
     ("flag", "an XPBD flag on a swaying pole in the wind", FLAG),
     ("blob", "a soft tetrahedral blob (XPBD) falling on the ground", BLOB),
     ("pbd-rope", "a 100-link XPBD rope swinging against obstacles", PBD_ROPE),
+    ("pbd-cloth", "the report's 14x14 XPBD cloth pinned at two corners, hanging down for 0.5 s", PBD_CLOTH),
     ("panda", "the Franka Panda swinging under gravity with zero torque (RK4)", PANDA),
     ("chain", "a 32-link pendulum chain (RK4)", CHAIN),
     ("t-handle", "a spinning T-handle flipping about its intermediate axis (free-body midpoint)", T_HANDLE),
@@ -333,6 +435,11 @@ pub const BUILTIN: [(&str, &str, &str); 27] = [
     ("cube", "a soft FEM cube dropped on the ground, backward Euler with penalty contact", CUBE),
     ("twisted-bar", "an FEM bar twisted by a half turn at one end (large rotation)", TWISTED_BAR),
     ("mpm", "MLS-MPM in 2D: a jelly block, a snow block and water falling together", MPM),
+    (
+        "dam-break-2d-mpm",
+        "MLS-MPM in 2D: Martin & Moyce's dam break (0.2 x 0.4 m column), surge front vs the experiment",
+        MPM_DAM_BREAK_2D,
+    ),
     ("dam-break", "MLS-MPM in 3D: a water column collapsing in a tank", DAM_BREAK),
     ("snowball", "MLS-MPM in 3D: a snowball hitting a wall and breaking up", SNOWBALL),
     (
@@ -513,6 +620,31 @@ steps_per_frame = 1
 [scene]
 kind = "pbd"
 preset = "soft-blob"
+"#;
+
+const PBD_CLOTH: &str = r#"name = "pbd-cloth"
+
+[run]
+dt = 0.016666666666666666
+frames = 30
+steps_per_frame = 1
+
+[scene]
+kind = "pbd"
+preset = "hanging-cloth"
+"#;
+
+const MPM_DAM_BREAK_2D: &str = r#"name = "dam-break-2d-mpm"
+
+[run]
+dt = 0.00015625
+frames = 35
+steps_per_frame = 64
+
+[scene]
+kind = "mpm"
+preset = "dam-break-2d"
+resolution = 64
 "#;
 
 const PBD_ROPE: &str = r#"name = "pbd-rope"
@@ -859,11 +991,20 @@ fn validate(s: &SceneFile) -> Result<(), (&'static str, String)> {
             positive("scene.pressure_tolerance", *tol)?;
             return Ok(());
         }
-        Scene::Pbd { .. }
-        | Scene::Rigid { .. }
-        | Scene::Mpm { .. }
-        | Scene::Fem { .. }
-        | Scene::Fluid { .. } => return Ok(()),
+        Scene::Pbd { iterations, substeps, .. } => {
+            for (field, count) in [("scene.iterations", iterations), ("scene.substeps", substeps)] {
+                if let Some(k) = *count
+                    && !(1..=MAX_PBD_COUNT).contains(&k)
+                {
+                    return Err((field, format!("must lie in [1, {MAX_PBD_COUNT}], got {k}")));
+                }
+            }
+            return Ok(());
+        }
+        Scene::Mpm { particles_per_cell: Some(k), .. } if !(1..=8).contains(k) => {
+            return Err(("scene.particles_per_cell", format!("must lie in [1, 8] (per axis), got {k}")));
+        }
+        Scene::Rigid { .. } | Scene::Mpm { .. } | Scene::Fem { .. } | Scene::Fluid { .. } => return Ok(()),
         Scene::Flip { transfer, .. } => {
             if let Some(FlipTransfer::Flip(blend)) = transfer
                 && !(0.0..=1.0).contains(blend)
@@ -1013,6 +1154,57 @@ mod tests {
             msg.contains("field `scene.pressure_tolerance`: must be a positive finite number, got 0"),
             "{msg}"
         );
+    }
+
+    #[test]
+    fn pbd_and_mpm_method_fields_parse_and_bad_ones_name_their_field() {
+        let text = PBD_CLOTH.replace(
+            "preset = \"hanging-cloth\"",
+            "preset = \"hanging-cloth\"\nmethod = \"pbd\"\niterations = 3\nsubsteps = 5",
+        );
+        let s = parse(&text, Path::new("s.toml")).unwrap();
+        assert!(matches!(
+            s.scene,
+            Scene::Pbd { method: Some(anim_pbd::Method::Pbd), iterations: Some(3), substeps: Some(5), .. }
+        ));
+        let msg = err(&text.replace("substeps = 5", "substeps = 0"));
+        assert!(msg.contains("s.toml: field `scene.substeps`: must lie in [1, 100000], got 0"), "{msg}");
+        let msg = err(&text.replace("iterations = 3", "iterations = 100001"));
+        assert!(msg.contains("field `scene.iterations`") && msg.contains("100001"), "{msg}");
+        let msg = err(&text.replace("\"pbd\"", "\"vbd\""));
+        assert!(msg.starts_with("s.toml:") && msg.contains("vbd"), "{msg}");
+        let text = MPM_DAM_BREAK_2D
+            .replace("resolution = 64", "transfer = \"apic\"\nkernel = \"cubic\"\nparticles_per_cell = 3");
+        let s = parse(&text, Path::new("s.toml")).unwrap();
+        assert!(matches!(
+            s.scene,
+            Scene::Mpm {
+                transfer: Some(MpmTransfer::Apic),
+                kernel: Some(MpmKernel::Cubic),
+                particles_per_cell: Some(3),
+                resolution: None,
+                ..
+            }
+        ));
+        // Written back, the names are the ones read.
+        let back = toml::to_string(&s).unwrap();
+        assert!(back.contains("transfer = \"apic\"") && back.contains("kernel = \"cubic\""), "{back}");
+        assert!(
+            toml::to_string(&parse(&text.replace("\"apic\"", "\"mls-mpm\""), Path::new("s.toml")).unwrap())
+                .unwrap()
+                .contains("transfer = \"mls-mpm\"")
+        );
+        let msg = err(&text.replace("particles_per_cell = 3", "particles_per_cell = 9"));
+        assert!(
+            msg.contains("field `scene.particles_per_cell`: must lie in [1, 8] (per axis), got 9"),
+            "{msg}"
+        );
+        let msg = err(&text.replace("particles_per_cell = 3", "particles_per_cell = 0"));
+        assert!(msg.contains("field `scene.particles_per_cell`") && msg.contains("got 0"), "{msg}");
+        for (bad, value) in [("\"apic\"", "\"pic\""), ("\"cubic\"", "\"quartic\"")] {
+            let msg = err(&text.replace(bad, value));
+            assert!(msg.starts_with("s.toml:") && msg.contains(value.trim_matches('"')), "{msg}");
+        }
     }
 
     #[test]

@@ -15,6 +15,8 @@
 //! | `springs`, preset `hanging-cloth` | `springs-cloth` (a 0.5 m cloth, 6 x 6 or 10 x 10, 100 N/m, 0.25 s) | explicit integrator, `dt` | the network; implicit methods are left out (the scene takes one linearised Newton iteration per step, the study converged Newton to 1e-10) | not measured (no reference trajectory in the scene) |
 //! | `fluid`, preset `lid-driven-cavity` | `fluid_cavity_ghia` (the same preset at Re = 100 to steady state) | resolution `N`, pressure solver (at the study's pressure tolerance), `dt <= 1/N` | Re, walls, advection | max error of the final velocity against Ghia et al. (1982) |
 //! | `fluid`, preset `smoke-plume-3d` | `fluid_pressure_divergence` (a 2D box with a sphere) | pressure solver and its tolerance, from the series measured at the grid size nearest the scene's | the grid and everything else | the largest relative pressure residual of the run's projections |
+//! | `pbd`, preset `hanging-cloth` | `pbd-cloth-position` (the same cloth, 8 x 8 or 14 x 14, 0.5 s at dt = 1/60) | method (PBD or XPBD), iterations and substeps, `dt <= 1/60` | the cloth | not measured (the study's reference is a converged XPBD run, not part of the scene) |
+//! | `mpm`, preset `dam-break-2d` | `mpm_dam_break` (the same dam break) | resolution, transfer (APIC or MLS-MPM), kernel (quadratic or cubic), particles per cell, `dt = h / 100` | the water, the tank | rms relative surge-front error against Martin & Moyce (1952) at the table's times the run passed |
 //!
 //! Transfers between a study's problem and a scene's:
 //!
@@ -29,20 +31,24 @@
 //!   with the cell).
 //! - The cloth's step is scaled by the ratio of the highest spring frequencies estimated as
 //!   `sqrt(k_max N / M)` (stiffest spring, particle count, total mass) when the scene's is higher.
+//! - The PBD cloth's iteration or substep count is scaled by the ratio of cloth sides (particles
+//!   per side, scene over study) when the scene's cloth is finer: a Gauss-Seidel sweep carries a
+//!   correction one constraint further per iteration or substep, so crossing the cloth takes
+//!   counts in proportion to its side. A run longer than the study's horizon multiplies the
+//!   substeps by `(T/H)^2` (the first-order bound above, the substep being the step); the series
+//!   that sweep iterations at one substep are then left out (no step to shrink).
 //!
 //! Candidates are ranked by the study's wall time per run times the number of scene steps per
 //! study step (the steps' count differs between methods when the transfer scales their `dt`
 //! differently). The run keeps the scene's frame times: each frame takes `ceil(frame / dt)`
 //! steps.
 //!
-//! Not mapped, and why: the anim-pbd cloth studies measure their own cloth (size, stiffness)
-//! and sweep iterations and substeps, which the PBD presets do not take from scene files; the MPM
-//! dam-break study is a 2D dam break, and no MPM preset is one (`dam-break-3d` is 3D,
-//! `benchmark-2d` a different fluid scene), and the MPM presets do not take transfer or kernel
-//! from scene files. Those scenes, and the other presets, get an error naming the mapped ones.
+//! Not mapped: the other presets (their problems are not a study's), and the `pbd-cloth-constraint`
+//! study (the same cloth and methods as `pbd-cloth-position`, measured on the mean stretch; the
+//! picker reads the position study). Those scenes get an error naming the mapped ones.
 
 use crate::runner::Runner;
-use crate::scene::{PressureSolver, Scene, SceneFile};
+use crate::scene::{MpmKernel, MpmTransfer, PressureSolver, Scene, SceneFile};
 use anim_core::integrate::systems::{HarmonicOscillator, KeplerOrbit};
 use anim_core::integrate::{IntegratorKind, State};
 use anim_fem::material::MaterialModel;
@@ -195,6 +201,36 @@ pub fn fem_label(label: &str) -> Option<(MaterialModel, TimeIntegrator, Option<L
     Some((model, implicit, Some(solver)))
 }
 
+/// A label of the PBD cloth studies: `"<Pbd|Xpbd> substeps (1 iteration)"` (`true`: substeps
+/// swept) or `"<Pbd|Xpbd> iterations (1 substep)"` (`false`).
+#[must_use]
+pub fn pbd_label(label: &str) -> Option<(anim_pbd::Method, bool)> {
+    let (method, rest) = label.split_once(' ')?;
+    let method =
+        [anim_pbd::Method::Pbd, anim_pbd::Method::Xpbd].into_iter().find(|m| format!("{m:?}") == method)?;
+    match rest {
+        "substeps (1 iteration)" => Some((method, true)),
+        "iterations (1 substep)" => Some((method, false)),
+        _ => None,
+    }
+}
+
+/// A label of the MPM dam-break study: `"<MLS-MPM|APIC> <quadratic|cubic>, <k>x<k> ppc"`.
+#[must_use]
+pub fn mpm_label(label: &str) -> Option<(MpmTransfer, MpmKernel, usize)> {
+    let (method, ppc) = label.split_once(", ")?;
+    let (transfer, kernel) = method.split_once(' ')?;
+    let transfer = match transfer {
+        "MLS-MPM" => MpmTransfer::MlsMpm,
+        "APIC" => MpmTransfer::Apic,
+        _ => return None,
+    };
+    let kernel = [MpmKernel::Quadratic, MpmKernel::Cubic].into_iter().find(|k| k.name() == kernel)?;
+    let (a, b) = ppc.strip_suffix(" ppc")?.split_once('x')?;
+    let k: usize = a.parse().ok()?;
+    (b.parse::<usize>().ok()? == k).then_some((transfer, kernel, k))
+}
+
 /// A label of the pressure study: `"<solver> N=<n>"`.
 #[must_use]
 pub fn pressure_label(label: &str) -> Option<(PressureMethod, usize)> {
@@ -243,6 +279,10 @@ enum Settings {
     Springs(IntegratorKind),
     /// A MAC fluid scene's resolution (if picked), pressure solver and tolerance.
     Fluid(Option<usize>, PressureMethod, f64),
+    /// A PBD scene's method, iterations and substeps.
+    Pbd(anim_pbd::Method, usize, usize),
+    /// An MPM scene's resolution, transfer, kernel and particles per cell.
+    Mpm(usize, MpmTransfer, MpmKernel, usize),
 }
 
 /// A measured point the scene can run, and what running it there takes.
@@ -266,6 +306,8 @@ enum Adapter {
     Springs { scale: f64, horizon: f64, duration: f64 },
     Cavity { pressure_tolerance: f64 },
     Pressure { n: usize, nearest: usize },
+    Pbd { scale: f64, study_dt: f64, horizon: f64, duration: f64 },
+    DamBreak,
 }
 
 fn problem(family: &Family, key: &str) -> Result<f64, String> {
@@ -347,6 +389,20 @@ impl Adapter {
                     })?;
                 Adapter::Pressure { n, nearest }
             }
+            Scene::Pbd { preset, resolution, .. } => {
+                let scene = anim_pbd::scenes::by_name(preset, *resolution)
+                    .ok_or_else(|| format!("--tolerance: unknown pbd preset `{preset}`"))?
+                    .map_err(|e| build(e.to_string()))?;
+                // The cloth's side in particles (the scene and the study's cloths are square).
+                let side = ((scene.state.x.len() / 3) as f64).sqrt();
+                Adapter::Pbd {
+                    scale: (side / problem(family, "n")?).max(1.0),
+                    study_dt: problem(family, "dt")?,
+                    horizon: horizon(family)?,
+                    duration,
+                }
+            }
+            Scene::Mpm { preset, .. } if preset.as_str() == "dam-break-2d" => Adapter::DamBreak,
             _ => return Err(format!("--tolerance: the {} study has no mapping to this scene", family.study)),
         })
     }
@@ -414,6 +470,55 @@ impl Adapter {
                 Ok(Candidate {
                     settings: Settings::Fluid(Some(n), solver, pressure_tolerance),
                     dt: Some(1.0 / n as f64),
+                    cost: 1.0,
+                    dt_swept: false,
+                    note: String::new(),
+                })
+            }
+            Adapter::Pbd { scale, study_dt, horizon, duration } => {
+                let (m, substeps) = pbd_label(method).ok_or_else(unknown)?;
+                let k = point.param.round();
+                if !(1.0..=1e4).contains(&k) {
+                    return Err(format!("count {k} out of range"));
+                }
+                let length = horizon_factor(horizon, duration, 1);
+                let (iterations, substeps, note) = if substeps {
+                    let count = (k * scale / length * (1.0 - 1e-12)).ceil();
+                    let note = format!(
+                        "{count} substeps: cloth side ratio {scale:.4} x run length (H/T)^2 = {length:.4}"
+                    );
+                    (1.0, count, note)
+                } else {
+                    if length < 1.0 {
+                        return Err(format!(
+                            "swept iterations at one substep: the error was measured over the study's {horizon} s and \
+                             iterations do not shrink the step, so it does not bound a {duration:.4} s run"
+                        ));
+                    }
+                    let count = (k * scale * (1.0 - 1e-12)).ceil();
+                    (count, 1.0, format!("{count} iterations: cloth side ratio {scale:.4}"))
+                };
+                if iterations.max(substeps) > crate::scene::MAX_PBD_COUNT as f64 {
+                    return Err(format!("{} per step needed on this scene", iterations.max(substeps)));
+                }
+                Ok(Candidate {
+                    settings: Settings::Pbd(m, iterations as usize, substeps as usize),
+                    dt: Some(study_dt),
+                    cost: iterations * substeps / k,
+                    dt_swept: false,
+                    note,
+                })
+            }
+            Adapter::DamBreak => {
+                let (transfer, kernel, ppc) = mpm_label(method).ok_or_else(unknown)?;
+                let n = point.param.round();
+                if !(8.0..=4096.0).contains(&n) {
+                    return Err(format!("resolution {n} out of range"));
+                }
+                let n = n as usize;
+                Ok(Candidate {
+                    settings: Settings::Mpm(n, transfer, kernel, ppc),
+                    dt: Some(anim_mpm::scenes::dam_break_2d_dt(n)),
                     cost: 1.0,
                     dt_swept: false,
                     note: String::new(),
@@ -547,6 +652,9 @@ pub fn choose(file: &mut SceneFile, tol: f64, table: &Table) -> Result<Choice, S
         Some(dt) if candidate.dt_swept && (dt - point.param).abs() > 1e-12 * dt => {
             format!("; on this scene that is dt = {dt:.4e} s ({})", candidate.note)
         }
+        _ if !candidate.dt_swept && !candidate.note.is_empty() => {
+            format!("; on this scene that is {}", candidate.note)
+        }
         _ => String::new(),
     };
     let left_out = if refused.is_empty() {
@@ -612,6 +720,26 @@ fn apply(scene: &mut Scene, settings: Settings) -> Result<String, String> {
                 solver.name()
             )
         }
+        (Scene::Pbd { method, iterations, substeps, .. }, Settings::Pbd(m, i, k)) => {
+            *method = Some(m);
+            *iterations = Some(i);
+            *substeps = Some(k);
+            format!("method = {}, iterations = {i}, substeps = {k}", format!("{m:?}").to_lowercase())
+        }
+        (
+            Scene::Mpm { resolution, transfer, kernel, particles_per_cell, .. },
+            Settings::Mpm(n, t, k, ppc),
+        ) => {
+            *resolution = Some(n);
+            *transfer = Some(t);
+            *kernel = Some(k);
+            *particles_per_cell = Some(ppc);
+            format!(
+                "resolution = {n}, transfer = {}, kernel = {}, particles_per_cell = {ppc}",
+                t.name(),
+                k.name()
+            )
+        }
         _ => return Err(mismatch()),
     })
 }
@@ -675,8 +803,10 @@ pub fn ghia_error(fluid: &anim_fluid::mac::MacFluid, state: &anim_fluid::mac::Ma
 
 /// The run's error on the measure of the study the scene was picked from (`None` for scenes
 /// without a reference in the run): the exact solution of the ODE scenes, Ghia's velocities for
-/// the cavity, and for the other MAC fluid scenes `max_residual`, the largest relative pressure
-/// residual of the run's steps so far.
+/// the cavity, for the other MAC fluid scenes `max_residual`, the largest relative pressure
+/// residual of the run's steps so far, and for the MPM dam break the rms relative surge-front
+/// error against Martin & Moyce at the table's times the run has passed
+/// ([`Runner::study_error`]).
 #[must_use]
 pub fn table_error(scene: &Scene, runner: &dyn Runner, max_residual: Option<f64>) -> Option<f64> {
     match scene {
@@ -684,7 +814,7 @@ pub fn table_error(scene: &Scene, runner: &dyn Runner, max_residual: Option<f64>
             runner.mac().map(|(fluid, state)| ghia_error(fluid, state))
         }
         Scene::Fluid { preset, .. } if preset.as_str() == "smoke-plume-3d" => max_residual,
-        _ => ode_error(scene, runner.state()),
+        _ => ode_error(scene, runner.state()).or_else(|| runner.study_error()),
     }
 }
 

@@ -1,6 +1,7 @@
 //! `anim run SCENE --tolerance TOL`: the picked method's measured error, on the study's measure
-//! against the scene's reference (exact solution, Ghia's cavity, the pressure residual), is within
-//! the tolerance; scenes without a reference run the picked method to the end.
+//! against the scene's reference (exact solution, Ghia's cavity, the pressure residual, Martin &
+//! Moyce's surge front), is within the tolerance; scenes without a reference run the picked method
+//! to the end.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -114,7 +115,11 @@ fn the_cavity_and_the_plume_meet_the_tolerance_on_their_studies_measures() {
 #[test]
 fn the_beam_and_the_cloth_run_the_picked_method_to_the_end() {
     // No reference in these scenes: the picked (scaled) step must at least run stably.
-    for (scene, extra) in [("beam", ["--resolution", "2"]), ("cloth", ["--resolution", "8"])] {
+    for (scene, extra, tol) in [
+        ("beam", ["--resolution", "2"], "1e-2"),
+        ("cloth", ["--resolution", "8"], "1e-2"),
+        ("pbd-cloth", ["--resolution", "6"], "0.1"),
+    ] {
         let dir = std::env::temp_dir().join(format!("anim-tol-{scene}-{}", std::process::id()));
         let out = dir.to_str().unwrap();
         let args = [
@@ -123,7 +128,7 @@ fn the_beam_and_the_cloth_run_the_picked_method_to_the_end() {
             "--frames",
             "3",
             "--tolerance",
-            "1e-2",
+            tol,
             "--out",
             out,
             "--no-preview",
@@ -138,4 +143,30 @@ fn the_beam_and_the_cloth_run_the_picked_method_to_the_end() {
         assert!(m["tolerance_error_final"].is_null(), "{scene}: no reference, no error");
         std::fs::remove_dir_all(&dir).ok();
     }
+}
+
+#[test]
+fn the_mpm_dam_break_meets_the_tolerance_on_martin_and_moyces_front() {
+    let dir = std::env::temp_dir().join(format!("anim-tol-dam-{}", std::process::id()));
+    let out = dir.to_str().unwrap();
+    let args =
+        ["run", "dam-break-2d-mpm", "--tolerance", "0.1", "--out", out, "--no-preview", "--format", "none"];
+    let (ok, stdout, stderr) = run(&args);
+    assert!(ok, "{stderr}\n{stdout}");
+    assert!(
+        stdout.contains("in the mpm_dam_break study") && stdout.contains("particles_per_cell = "),
+        "{stdout}"
+    );
+    let m = metrics(&dir);
+    // The built-in scene's 35 frames of 0.01 s pass all of Martin & Moyce's times (to 0.336 s).
+    assert!((m["simulated_seconds"].as_f64().unwrap() - 0.35).abs() < 1e-9);
+    let last = m["tolerance_error_final"].as_f64().unwrap();
+    assert!(last > 0.0 && last <= 0.1, "surge-front error {last:e}\n{stdout}");
+    assert!(stdout.contains("tolerance 1e-1 met"), "{stdout}");
+    std::fs::remove_dir_all(&dir).ok();
+    // No measured point is within 1e-3: refused, naming the most accurate one.
+    let (ok, _, err) = run(&["run", "dam-break-2d-mpm", "--tolerance", "1e-3", "--out", out]);
+    assert!(!ok);
+    assert!(err.contains("no method of the mpm_dam_break study that this scene can run met it; the most accurate measured is"), "{err}");
+    assert!(!dir.exists());
 }

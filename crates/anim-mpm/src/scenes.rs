@@ -4,6 +4,7 @@
 //! | scene | D | what | materials |
 //! | --- | --- | --- | --- |
 //! | `three-materials` | 2 | the classic jelly, snow and water blocks falling into a box | fixed corotated, snow (seed defaults), fluid |
+//! | `dam-break-2d` | 2 | the dam break of the report's study against Martin & Moyce (1952): a 0.2 x 0.4 m column in a 1 m tank with no-slip walls ([`dam_break_2d`], [`SurgeFront`]) | fluid (`K` = 2.5 MPa) |
 //! | `dam-break-3d` | 3 | a water column collapsing along a box | fluid |
 //! | `snowball` | 3 | a snowball thrown against a wall, flattening and sliding down | snow (seed defaults), box collider with friction |
 //! | `benchmark-2d` | 2 | the `mpm88` fluid scene of the peer benchmark (8192 particles at 128^2) | fluid |
@@ -20,11 +21,13 @@
 //! ```
 
 use crate::material::{Elastic, ElasticModel, Fluid, Material, Snow};
-use crate::{Boundary, Collider, MpmError, MpmParams, MpmSimulation, Particles, Shape};
+use crate::{Boundary, Collider, Kernel, MpmError, MpmParams, MpmSimulation, Particles, Shape, Transfer};
 use anim_core::solver::{Solver, StepReport};
+use serde::{Deserialize, Serialize};
 
 /// The built-in scene names.
-pub const NAMES: [&str; 5] = ["three-materials", "dam-break-3d", "snowball", "benchmark-2d", "benchmark-3d"];
+pub const NAMES: [&str; 6] =
+    ["three-materials", "dam-break-2d", "dam-break-3d", "snowball", "benchmark-2d", "benchmark-3d"];
 
 /// A scene in `D` dimensions: the simulation, its particles and how to step it.
 #[derive(Debug, Clone)]
@@ -128,6 +131,35 @@ impl MpmScene {
         self.len() == 0
     }
 
+    /// Rebuilds the simulation with another transfer and kernel (the particles, materials and
+    /// every other parameter kept), before the first step.
+    ///
+    /// # Errors
+    /// [`MpmError::BadParameter`] once the scene has stepped.
+    pub fn set_method(&mut self, transfer: Transfer, kernel: Kernel) -> Result<(), MpmError> {
+        fn rebuild<const D: usize>(
+            s: &mut Scene<D>,
+            transfer: Transfer,
+            kernel: Kernel,
+        ) -> Result<(), MpmError> {
+            if s.sim.steps() > 0 {
+                return Err(MpmError::BadParameter {
+                    name: "transfer",
+                    reason: "the method can only be changed before the first step".into(),
+                });
+            }
+            let mut params = s.sim.params().clone();
+            params.transfer = transfer;
+            params.kernel = kernel;
+            s.sim = MpmSimulation::new(params, s.sim.materials().to_vec())?;
+            Ok(())
+        }
+        match self {
+            MpmScene::Two(s) => rebuild(s, transfer, kernel),
+            MpmScene::Three(s) => rebuild(s, transfer, kernel),
+        }
+    }
+
     /// Advances by [`dt`](Self::dt).
     ///
     /// # Errors
@@ -177,12 +209,36 @@ impl MpmScene {
 pub fn by_name(name: &str, resolution: Option<usize>) -> Option<Result<MpmScene, MpmError>> {
     Some(match name {
         "three-materials" => three_materials(resolution.unwrap_or(128)).map(MpmScene::Two),
+        "dam-break-2d" => {
+            dam_break_2d(resolution.unwrap_or(64), 2, Transfer::Mls, Kernel::Quadratic).map(MpmScene::Two)
+        }
         "dam-break-3d" => dam_break_3d(resolution.unwrap_or(48)).map(MpmScene::Three),
         "snowball" => snowball(resolution.unwrap_or(64)).map(MpmScene::Three),
         "benchmark-2d" => benchmark_2d(resolution.unwrap_or(128)).map(MpmScene::Two),
         "benchmark-3d" => benchmark_3d(resolution.unwrap_or(64)).map(MpmScene::Three),
         _ => return None,
     })
+}
+
+/// [`by_name`] with the particles per cell and axis of the scenes that take it (`dam-break-2d`;
+/// `None`: 2); the other scenes place their own particles and refuse a count.
+#[must_use]
+pub fn by_name_with(
+    name: &str,
+    resolution: Option<usize>,
+    per_cell: Option<usize>,
+) -> Option<Result<MpmScene, MpmError>> {
+    match (name, per_cell) {
+        (_, None) => by_name(name, resolution),
+        ("dam-break-2d", Some(k)) => Some(
+            dam_break_2d(resolution.unwrap_or(64), k, Transfer::Mls, Kernel::Quadratic).map(MpmScene::Two),
+        ),
+        (_, Some(_)) if NAMES.contains(&name) => Some(Err(MpmError::BadParameter {
+            name: "particles per cell",
+            reason: format!("{name} places its own particles; only dam-break-2d takes a count"),
+        })),
+        _ => None,
+    }
 }
 
 /// A small deterministic generator (SplitMix64) for jittered and random sampling.
@@ -298,6 +354,171 @@ pub fn dam_break_3d(n: usize) -> Result<Scene<3>, MpmError> {
         dt: 1e-3,
         duration: 2.0,
     })
+}
+
+/// The 2D dam break of the report's study (Martin & Moyce 1952): a water column
+/// [`DAM_BREAK_COLUMN`] wide and twice as high, against the left wall of a 1 m tank with no-slip
+/// walls, collapses along the floor. `n` cells per axis, `per_cell x per_cell` particles per cell,
+/// the given transfer and kernel; step [`dam_break_2d_dt`], duration up to Martin & Moyce's last
+/// time `T = 3.33` ([`dam_break_duration`]). [`SurgeFront`] measures the surge front against
+/// [`MARTIN_MOYCE`].
+///
+/// # Errors
+/// [`MpmError`] for a resolution below 8, or `per_cell` outside `1..=8`.
+pub fn dam_break_2d(
+    n: usize,
+    per_cell: usize,
+    transfer: Transfer,
+    kernel: Kernel,
+) -> Result<Scene<2>, MpmError> {
+    if !(1..=8).contains(&per_cell) {
+        return Err(MpmError::BadParameter {
+            name: "particles per cell",
+            reason: format!("{per_cell} per axis is outside 1..=8"),
+        });
+    }
+    let mut params = MpmParams::with_resolution(n);
+    params.transfer = transfer;
+    params.kernel = kernel;
+    // No-slip walls, as the experiment's tank (a frictionless floor lets a thin film run ahead
+    // of the measured front).
+    params.wall = Boundary::Sticky;
+    let h = params.h();
+    let a = DAM_BREAK_COLUMN;
+    let x0 = dam_break_wall(&params);
+    // c = sqrt(K / rho) = 50 m/s, ten times the largest flow speed sqrt(2 g 2a) = 2.8 m/s.
+    let fluid = Material::Fluid(Fluid { bulk: 2.5e6, gamma: 1.0, density: 1000.0 });
+    let sim = MpmSimulation::<2>::new(params, vec![fluid])?;
+    let mut p = Particles::<2>::new();
+    fill(&mut p, h, per_cell, [x0, x0], [x0 + a, x0 + 2.0 * a], 0, 1000.0, [0.0; 2], |_| true)?;
+    Ok(Scene {
+        name: "dam-break-2d",
+        description: "the 2D dam break of Martin & Moyce (1952): a 0.2 x 0.4 m water column collapsing",
+        sim,
+        state: p,
+        dt: dam_break_2d_dt(n),
+        duration: dam_break_duration(),
+    })
+}
+
+/// Width `a` of the dam-break column (m); its height is `2a`.
+pub const DAM_BREAK_COLUMN: f64 = 0.2;
+
+/// Gravity of the dam break (m/s^2), for its time scale.
+const DAM_BREAK_GRAVITY: f64 = 9.81;
+
+/// Simulated time of Martin & Moyce's last tabulated front, `T = 3.33` (s).
+#[must_use]
+pub fn dam_break_duration() -> f64 {
+    MARTIN_MOYCE[MARTIN_MOYCE.len() - 1].0 / dam_break_time_scale()
+}
+
+/// The dam break's step at `n` cells per axis: half a cell per sound crossing (`c = 50` m/s).
+#[must_use]
+pub fn dam_break_2d_dt(n: usize) -> f64 {
+    0.5 * MpmParams::with_resolution(n).h() / 50.0
+}
+
+/// The dam break's dimensionless time scale `sqrt(2 g / a)`: `T = t sqrt(2 g / a)`.
+#[must_use]
+pub fn dam_break_time_scale() -> f64 {
+    (2.0 * DAM_BREAK_GRAVITY / DAM_BREAK_COLUMN).sqrt()
+}
+
+/// Where the dam-break column starts: the inner face of the left wall (`wall_nodes` cells).
+fn dam_break_wall(params: &MpmParams) -> f64 {
+    params.wall_nodes as f64 * params.h()
+}
+
+/// Martin & Moyce (1952), tables 2 and 6, `a` = 2.25 in, `n^2 = 2`: the surge front
+/// `Z = x / a` at `T = t sqrt(2 g / a)`, as `(T, Z)`.
+pub const MARTIN_MOYCE: [(f64, f64); 15] = [
+    (0.41, 1.11),
+    (0.84, 1.22),
+    (1.19, 1.44),
+    (1.43, 1.67),
+    (1.63, 1.89),
+    (1.83, 2.11),
+    (1.98, 2.33),
+    (2.20, 2.56),
+    (2.32, 2.78),
+    (2.51, 3.00),
+    (2.65, 3.22),
+    (2.83, 3.44),
+    (2.98, 3.67),
+    (3.11, 3.89),
+    (3.33, 4.11),
+];
+
+/// The dam break's surge front `Z = (max x - x_wall) / a` of `particles` in a simulation with
+/// `params`.
+#[must_use]
+pub fn surge_front(params: &MpmParams, particles: &Particles<2>) -> f64 {
+    let right = particles.x.chunks_exact(2).map(|c| f64::from(c[0])).fold(f64::MIN, f64::max);
+    (right - dam_break_wall(params)) / DAM_BREAK_COLUMN
+}
+
+/// The study's error of fronts `z` against the first `z.len()` entries of [`MARTIN_MOYCE`]:
+/// `(max, rms)` of `|Z - Z_MM| / Z_MM`.
+#[must_use]
+pub fn surge_front_errors(z: &[f64]) -> (f64, f64) {
+    let mut max: f64 = 0.0;
+    let mut sq = 0.0;
+    for (zi, (_, zr)) in z.iter().zip(MARTIN_MOYCE.iter()) {
+        let e = (zi - zr).abs() / zr;
+        max = max.max(e);
+        sq += e * e;
+    }
+    (max, (sq / z.len().max(1) as f64).sqrt())
+}
+
+/// The surge front of a dam-break run sampled at [`MARTIN_MOYCE`]'s times as the run passes
+/// them: each is interpolated linearly between the fronts after the steps around it (exact when
+/// a step ends on it). No allocation per step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SurgeFront {
+    /// The last observation `(T, Z)`.
+    last: (f64, f64),
+    /// The fronts at the table's times passed so far.
+    z: Vec<f64>,
+}
+
+impl SurgeFront {
+    /// Starts at the run's initial particles (`T = 0`).
+    #[must_use]
+    pub fn new(params: &MpmParams, particles: &Particles<2>) -> Self {
+        Self { last: (0.0, surge_front(params, particles)), z: Vec::with_capacity(MARTIN_MOYCE.len()) }
+    }
+
+    /// Records the front after a step ending at simulated time `time` (s).
+    pub fn observe(&mut self, time: f64, params: &MpmParams, particles: &Particles<2>) {
+        let now = (time * dam_break_time_scale(), surge_front(params, particles));
+        while let Some(&(t, _)) = MARTIN_MOYCE.get(self.z.len()) {
+            if now.0 < t - 1e-9 {
+                break;
+            }
+            let (t0, z0) = self.last;
+            let z = if now.0 > t0 {
+                z0 + (now.1 - z0) * ((t - t0) / (now.0 - t0)).clamp(0.0, 1.0)
+            } else {
+                now.1
+            };
+            self.z.push(z);
+        }
+        self.last = now;
+    }
+
+    /// The fronts at the table's times passed so far.
+    #[must_use]
+    pub fn fronts(&self) -> &[f64] {
+        &self.z
+    }
+
+    /// [`surge_front_errors`] over the times passed so far (`None` before the first).
+    #[must_use]
+    pub fn errors(&self) -> Option<(f64, f64)> {
+        (!self.z.is_empty()).then(|| surge_front_errors(&self.z))
+    }
 }
 
 /// A snowball (radius 0.1, 6 m/s) thrown against a wall (separating contact, Coulomb friction
@@ -422,4 +643,71 @@ pub fn benchmark_3d(n: usize) -> Result<Scene<3>, MpmError> {
         "benchmark-3d",
         "mpm3d fluid (peer benchmark, 3D)",
     )
+}
+
+#[cfg(test)]
+mod dam_break_tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use super::*;
+
+    #[test]
+    fn the_front_error_is_the_relative_distance_to_martin_and_moyce() {
+        let exact: Vec<f64> = MARTIN_MOYCE.iter().map(|(_, z)| *z).collect();
+        assert_eq!(surge_front_errors(&exact), (0.0, 0.0));
+        // 10 % ahead at every time: max and rms are 0.1.
+        let ahead: Vec<f64> = exact.iter().map(|z| z * 1.1).collect();
+        let (max, rms) = surge_front_errors(&ahead);
+        assert!((max - 0.1).abs() < 1e-12 && (rms - 0.1).abs() < 1e-12, "{max} {rms}");
+        // One point 30 % behind among four exact ones: rms sqrt(0.09 / 5), over the first five.
+        let mut one = exact[..5].to_vec();
+        one[2] *= 0.7;
+        let (max, rms) = surge_front_errors(&one);
+        assert!((max - 0.3).abs() < 1e-12 && (rms - (0.09f64 / 5.0).sqrt()).abs() < 1e-12, "{max} {rms}");
+    }
+
+    #[test]
+    fn the_tracker_samples_a_linear_front_exactly_at_the_tables_times() {
+        // One particle whose front runs as Z = 1 + 2 T, observed at steps that miss the table's
+        // times: linear interpolation recovers Z at each exactly (to f32 positions).
+        let params = MpmParams::with_resolution(32);
+        let wall = 3.0 / 32.0;
+        let scale = dam_break_time_scale();
+        let z_at = |t: f64| 1.0 + 2.0 * t * scale;
+        let mut p = Particles::<2>::new();
+        p.push([(wall + DAM_BREAK_COLUMN * z_at(0.0)) as f32, 0.5], [0.0; 2], 1.0, 1.0, 0).unwrap();
+        let mut front = SurgeFront::new(&params, &p);
+        assert_eq!(front.errors(), None);
+        let dt = 0.0037;
+        let mut t = 0.0;
+        while t < dam_break_duration() + dt {
+            t += dt;
+            p.x[0] = (wall + DAM_BREAK_COLUMN * z_at(t)) as f32;
+            front.observe(t, &params, &p);
+            let passed = MARTIN_MOYCE.iter().filter(|(tt, _)| *tt <= t * scale).count();
+            assert_eq!(front.fronts().len(), passed, "t = {t}");
+        }
+        assert_eq!(front.fronts().len(), MARTIN_MOYCE.len());
+        for (z, (tt, _)) in front.fronts().iter().zip(MARTIN_MOYCE) {
+            assert!((z - (1.0 + 2.0 * tt)).abs() < 1e-5, "T = {tt}: {z}");
+        }
+    }
+
+    #[test]
+    fn the_dam_break_fills_the_column_and_takes_its_method() {
+        let s = dam_break_2d(32, 3, Transfer::Apic, Kernel::Cubic).unwrap();
+        // floor(0.2 / (h / 3)) x floor(0.4 / (h / 3)) = 19 x 38 particles at h = 1/32.
+        assert_eq!(s.state.len(), 19 * 38);
+        assert_eq!((s.sim.params().transfer, s.sim.params().kernel), (Transfer::Apic, Kernel::Cubic));
+        assert_eq!(s.dt, 0.5 / 32.0 / 50.0);
+        assert!(dam_break_2d(32, 0, Transfer::Mls, Kernel::Quadratic).is_err());
+        assert!(dam_break_2d(32, 9, Transfer::Mls, Kernel::Quadratic).is_err());
+        // A count is refused by the presets that place their own particles.
+        assert!(matches!(by_name_with("three-materials", Some(16), Some(2)), Some(Err(_))));
+        assert!(by_name_with("no-such-scene", None, Some(2)).is_none());
+        let mut scene = by_name_with("dam-break-2d", Some(16), Some(1)).unwrap().unwrap();
+        assert_eq!(scene.len(), 3 * 6);
+        scene.set_method(Transfer::Apic, Kernel::Quadratic).unwrap();
+        scene.step().unwrap();
+        assert!(scene.set_method(Transfer::Mls, Kernel::Quadratic).is_err(), "after a step");
+    }
 }

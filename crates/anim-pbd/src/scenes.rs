@@ -9,6 +9,7 @@
 //! | [`rope`] | a rope of 100 links pinned at one end swings down over a capsule and a box | XPBD (rigid), sequential Gauss-Seidel, 2 iterations x 16 substeps | a long chain converges slowly with iterations; small steps fix it |
 //! | [`soft_blob`] | a bunny-like tetrahedral blob drops on the ground and bounces | XPBD, coloured Gauss-Seidel, 5 iterations x 4 substeps | tet volume + compliant edges, restitution and friction |
 //! | [`balloon`] | an inflated closed sphere (global volume constraint, pressure 1.5) drops onto a box | XPBD, coloured Gauss-Seidel, 5 iterations x 4 substeps | the global volume constraint |
+//! | [`hanging_cloth`] | the 0.5 m cloth of the report's work-precision studies, pinned at two corners, hanging down | XPBD, sequential Gauss-Seidel, 1 iteration x 8 substeps | the studies' problem, for `anim run --tolerance` |
 //! | [`benchmark_cloth`] | the `N x N` cloth of the benches and peer comparisons | XPBD, sequential Gauss-Seidel, 5 iterations | what pyPBD's and Newton's examples run |
 //!
 //! Output: positions are in the state (`x = [x0, y0, z0, ...]`); the model's
@@ -73,7 +74,8 @@ impl PbdScene {
 }
 
 /// The built-in scene names, for command lines.
-pub const NAMES: [&str; 6] = ["cloth-drape", "flag", "rope", "soft-blob", "balloon", "benchmark-cloth"];
+pub const NAMES: [&str; 7] =
+    ["cloth-drape", "flag", "rope", "soft-blob", "balloon", "hanging-cloth", "benchmark-cloth"];
 
 /// Builds a scene by name (see [`NAMES`]); `None` for an unknown name. The resolution scales the
 /// particle count (cloth side, flag width, rope links, blob cells, balloon subdivisions);
@@ -86,6 +88,7 @@ pub fn by_name(name: &str, resolution: Option<usize>) -> Option<Result<PbdScene,
         "rope" => rope(resolution),
         "soft-blob" => soft_blob(resolution),
         "balloon" => balloon(resolution),
+        "hanging-cloth" => hanging_cloth(resolution),
         "benchmark-cloth" => benchmark_cloth(resolution.unwrap_or(50)),
         _ => return None,
     })
@@ -103,7 +106,7 @@ fn resolution(
         return Err(BuildError::BadParameter {
             shape,
             name: "resolution",
-            requirement: "is out of range for this scene (cloth 2..=1024, flag 3..=512, rope 2..=100000, blob 2..=40, balloon 0..=6)",
+            requirement: "is out of range for this scene (cloth and hanging cloth 2..=1024, flag 3..=512, rope 2..=100000, blob 2..=40, balloon 0..=6)",
             value: n.to_string(),
         });
     }
@@ -315,6 +318,43 @@ pub fn balloon(s: Option<usize>) -> Result<PbdScene, BuildError> {
         dt: 1.0 / 60.0,
         duration: 3.0,
         params: params(Method::Xpbd, SolverKind::ColoredGaussSeidel, 5, 4),
+    })
+}
+
+/// The hanging cloth of the report's work-precision studies (`pbd-cloth-position`,
+/// `pbd-cloth-constraint`): a 0.5 m square of `n x n` particles (default 14), 0.1 kg, in the
+/// horizontal plane `z = 1`, pinned at the two corners of one edge; stiff distances
+/// (compliance 1e-7 m/N, PBD stiffness 1) and soft isometric bending (compliance 5, PBD
+/// stiffness 0.1), so that both PBD and XPBD run it. Steps of 1/60 s over 0.5 s, XPBD with
+/// sequential Gauss-Seidel, 1 iteration x 8 substeps.
+///
+/// # Errors
+/// [`BuildError::BadParameter`] for a resolution outside `[2, 1024]`.
+pub fn hanging_cloth(n: Option<usize>) -> Result<PbdScene, BuildError> {
+    let n = resolution("hanging-cloth", n, 14, 2, 1024)?;
+    let mut b = PbdBuilder::new();
+    b.gravity(EARTH_GRAVITY);
+    let c = b.cloth(&Cloth {
+        nx: n,
+        ny: n,
+        origin: [0.0, 0.0, 1.0],
+        u: [0.5, 0.0, 0.0],
+        v: [0.0, 0.5, 0.0],
+        particle_mass: 0.1 / (n * n) as f64,
+        stretch: ConstraintParams::with_compliance(1e-7),
+        bending: Bending::Isometric(ConstraintParams::with_compliance(5.0).stiffness(0.1)),
+    })?;
+    b.pin(c.at(0, 0)).pin(c.at(n - 1, 0));
+    let model = b.build()?;
+    let state = model.rest_state();
+    Ok(PbdScene {
+        name: "hanging-cloth",
+        description: "the report's hanging cloth, pinned at two corners (XPBD, Gauss-Seidel)",
+        model,
+        state,
+        dt: 1.0 / 60.0,
+        duration: 0.5,
+        params: params(Method::Xpbd, SolverKind::GaussSeidel, 1, 8),
     })
 }
 

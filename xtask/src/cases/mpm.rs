@@ -456,65 +456,33 @@ fn colliding_disks(ctx: &Ctx) -> Vec<Check> {
 // Dam break.
 
 /// Martin & Moyce (1952), tables 2 and 6 (REFERENCES.md), `a` = 2.25 in, `n^2 = 2`:
-/// `T = t sqrt(2 g / a)` and `Z = x / a`.
-pub(crate) const MARTIN_MOYCE: [(f64, f64); 15] = [
-    (0.41, 1.11),
-    (0.84, 1.22),
-    (1.19, 1.44),
-    (1.43, 1.67),
-    (1.63, 1.89),
-    (1.83, 2.11),
-    (1.98, 2.33),
-    (2.20, 2.56),
-    (2.32, 2.78),
-    (2.51, 3.00),
-    (2.65, 3.22),
-    (2.83, 3.44),
-    (2.98, 3.67),
-    (3.11, 3.89),
-    (3.33, 4.11),
-];
+/// `T = t sqrt(2 g / a)` and `Z = x / a` (anim-mpm's copy, which `anim run` measures against).
+pub(crate) const MARTIN_MOYCE: [(f64, f64); 15] = scenes::MARTIN_MOYCE;
 
-/// A 2D dam break: a water column `a x 2a` (a = 0.2 m) collapsing along a 1 m tank. Returns the
-/// surge front `Z = x / a` at the table's times `T`, the whole history `(T, Z)` (every step), and
-/// the wall time.
+/// The 2D dam break of `scenes::dam_break_2d` (a water column `a x 2a`, a = 0.2 m, collapsing
+/// along a 1 m tank). Returns the surge front `Z = x / a` at the table's times `T` (steps end on
+/// them), the whole history `(T, Z)` (every step), and the wall time.
 pub(crate) fn dam_break(
     n: usize,
     per_cell: usize,
     transfer: Transfer,
     kernel: Kernel,
 ) -> Result<DamBreak, MpmError> {
-    let mut params = MpmParams::with_resolution(n);
-    params.transfer = transfer;
-    params.kernel = kernel;
-    // No-slip walls, as the experiment's tank (a frictionless floor lets a thin film run ahead
-    // of the measured front).
-    params.wall = Boundary::Sticky;
-    let h = params.h();
-    let g = 9.81;
-    let a = 0.2;
-    // Walls: nodes < 3 are the wall; the fluid starts at x = 3 h.
-    let x0 = 3.0 * h;
-    // c = sqrt(K / rho) = 50 m/s, ten times the largest flow speed sqrt(2 g 2a) = 2.8 m/s.
-    let fluid = Material::Fluid(Fluid { bulk: 2.5e6, gamma: 1.0, density: 1000.0 });
-    let mut sim = MpmSimulation::<2>::new(params, vec![fluid])?;
-    let mut p = Particles::<2>::new();
-    fill(&mut p, h, per_cell, [x0, x0], [x0 + a, x0 + 2.0 * a], 0, 1000.0, [0.0; 2], |_| true)?;
-    let t_scale = (2.0 * g / a).sqrt();
-    let dt = 0.5 * h / 50.0;
-    let front =
-        |p: &Particles<2>| (p.x.chunks_exact(2).map(|c| f64::from(c[0])).fold(f64::MIN, f64::max) - x0) / a;
+    let scenes::Scene { mut sim, state: mut p, dt, .. } =
+        scenes::dam_break_2d(n, per_cell, transfer, kernel)?;
+    let t_scale = scenes::dam_break_time_scale();
+    let front = |sim: &MpmSimulation<2>, p: &Particles<2>| scenes::surge_front(sim.params(), p);
     let start = std::time::Instant::now();
     let mut z = Vec::with_capacity(MARTIN_MOYCE.len());
-    let mut history = vec![(0.0, front(&p))];
+    let mut history = vec![(0.0, front(&sim, &p))];
     for &(t_star, _) in &MARTIN_MOYCE {
         let t_end = t_star / t_scale;
         while sim.time() < t_end - 1e-12 {
             let step = dt.min(t_end - sim.time());
             sim.advance(&mut p, step)?;
-            history.push((sim.time() * t_scale, front(&p)));
+            history.push((sim.time() * t_scale, front(&sim, &p)));
         }
-        z.push(front(&p));
+        z.push(front(&sim, &p));
     }
     Ok(DamBreak { z, history, seconds: start.elapsed().as_secs_f64() })
 }
@@ -525,15 +493,10 @@ pub(crate) struct DamBreak {
     pub(crate) seconds: f64,
 }
 
+/// The study's error: `(max, rms)` relative surge-front error (anim-mpm's, which `anim run`
+/// reports too).
 pub(crate) fn front_errors(z: &[f64]) -> (f64, f64) {
-    let mut max: f64 = 0.0;
-    let mut sq = 0.0;
-    for (zi, (_, zr)) in z.iter().zip(MARTIN_MOYCE.iter()) {
-        let e = (zi - zr).abs() / zr;
-        max = max.max(e);
-        sq += e * e;
-    }
-    (max, (sq / z.len() as f64).sqrt())
+    scenes::surge_front_errors(z)
 }
 
 /// The time-origin shift `dT` (the experiment's gate takes time to open, so its clock starts

@@ -910,28 +910,25 @@ fn injected_nan(_ctx: &Ctx) -> Outcome {
 // ---------------------------------------------------------------------------------------------
 // The work-precision study: a hanging cloth.
 
-const STUDY_T: f64 = 0.5;
+pub(crate) const STUDY_T: f64 = 0.5;
 const STUDY_DT: f64 = 1.0 / 60.0;
 
-/// The study cloth: `n x n`, 0.5 m, 0.1 kg, pinned at two corners, stiff distances
-/// (`alpha = 1e-7` m/N; PBD `k = 1`), soft isometric bending (`alpha = 5`; PBD `k = 0.1`).
+/// The study cloth: anim-pbd's `hanging-cloth` preset (`n x n`, 0.5 m, 0.1 kg, pinned at two
+/// corners, stiff distances (`alpha = 1e-7` m/N; PBD `k = 1`), soft isometric bending
+/// (`alpha = 5`; PBD `k = 0.1`)), which `anim run --tolerance` maps to this study.
 fn study_model(n: usize) -> Option<PbdModel> {
-    let mut b = PbdBuilder::new();
-    b.gravity(EARTH_GRAVITY);
-    let c = b
-        .cloth(&Cloth {
-            nx: n,
-            ny: n,
-            origin: [0.0, 0.0, 1.0],
-            u: [0.5, 0.0, 0.0],
-            v: [0.0, 0.5, 0.0],
-            particle_mass: 0.1 / (n * n) as f64,
-            stretch: ConstraintParams::with_compliance(1e-7),
-            bending: Bending::Isometric(ConstraintParams::with_compliance(5.0).stiffness(0.1)),
-        })
-        .ok()?;
-    b.pin(c.at(0, 0)).pin(c.at(n - 1, 0));
-    b.build().ok()
+    anim_pbd::scenes::hanging_cloth(Some(n)).ok().map(|s| s.model)
+}
+
+/// The study cloth's side in particles.
+fn study_side(quick: bool) -> usize {
+    if quick { 8 } else { 14 }
+}
+
+/// The study problem's parameters `anim run --tolerance` transfers from: the cloth's side `n`
+/// and the step `dt` (s).
+pub fn study_problem(quick: bool) -> Vec<(&'static str, f64)> {
+    vec![("n", study_side(quick) as f64), ("dt", STUDY_DT)]
 }
 
 fn study_run(model: &PbdModel, method: Method, iters: usize, subs: usize) -> Option<Vec<f64>> {
@@ -960,7 +957,7 @@ fn mean_strain(model: &PbdModel, x: &[f64]) -> f64 {
 }
 
 fn cloth_study(ctx: &Ctx, constraint_error: bool) -> StudyResult {
-    let n = if ctx.quick { 8 } else { 14 };
+    let n = study_side(ctx.quick);
     let (batches, min_batch) = if ctx.quick { (3, 0.002) } else { (5, 0.02) };
     let sweep: Vec<usize> = if ctx.quick { vec![1, 4, 16] } else { vec![1, 2, 4, 8, 16, 32, 64] };
     let model = study_model(n);

@@ -64,6 +64,8 @@ fn the_embedded_table_parses_and_its_scene_families_name_known_methods() {
         "fem/cantilever-beam",
         "fluid/lid-driven-cavity",
         "fluid/smoke-plume-3d",
+        "pbd/hanging-cloth",
+        "mpm/dam-break-2d",
     ] {
         assert!(scenes.contains(&s), "{s} missing from {scenes:?}");
     }
@@ -78,6 +80,8 @@ fn the_embedded_table_parses_and_its_scene_families_name_known_methods() {
                 Some("fem/cantilever-beam") => fem_label(&s.method).is_some(),
                 Some("fluid/lid-driven-cavity") => PressureSolver::by_name(&s.method).is_some(),
                 Some("fluid/smoke-plume-3d") => pressure_label(&s.method).is_some(),
+                Some("pbd/hanging-cloth") => pbd_label(&s.method).is_some(),
+                Some("mpm/dam-break-2d") => mpm_label(&s.method).is_some(),
                 other => panic!("unexpected scene {other:?}"),
             };
             assert!(known, "{}: unknown method {}", f.study, s.method);
@@ -411,4 +415,154 @@ fn the_ghia_error_of_a_cavity_at_rest_is_ghias_largest_interior_speed() {
             .unwrap();
     let anim_fluid::scenes::FluidSim::Mac(fluid, state) = &scene.sim else { panic!("a MAC scene") };
     assert!((ghia_error(fluid, state) - 0.84123).abs() < 1e-12);
+}
+
+#[test]
+fn labels_of_the_pbd_and_mpm_studies_parse_back() {
+    // The PBD studies write `format!("{method:?} ...")`.
+    for m in [anim_pbd::Method::Pbd, anim_pbd::Method::Xpbd] {
+        assert_eq!(pbd_label(&format!("{m:?} substeps (1 iteration)")), Some((m, true)));
+        assert_eq!(pbd_label(&format!("{m:?} iterations (1 substep)")), Some((m, false)));
+    }
+    for bad in ["Xpbd", "Xpbd substeps", "Jacobi substeps (1 iteration)", "xpbd substeps (1 iteration)"] {
+        assert_eq!(pbd_label(bad), None, "{bad}");
+    }
+    assert_eq!(mpm_label("MLS-MPM quadratic, 2x2 ppc"), Some((MpmTransfer::MlsMpm, MpmKernel::Quadratic, 2)));
+    assert_eq!(mpm_label("APIC cubic, 2x2 ppc"), Some((MpmTransfer::Apic, MpmKernel::Cubic, 2)));
+    assert_eq!(mpm_label("MLS-MPM quadratic, 3x3 ppc"), Some((MpmTransfer::MlsMpm, MpmKernel::Quadratic, 3)));
+    for bad in
+        ["MLS-MPM quadratic", "FLIP quadratic, 2x2 ppc", "APIC quartic, 2x2 ppc", "APIC cubic, 2x3 ppc"]
+    {
+        assert_eq!(mpm_label(bad), None, "{bad}");
+    }
+}
+
+fn pbd_table() -> Table {
+    made(vec![family(
+        "pbd-cloth-position",
+        "pbd/hanging-cloth",
+        Some(0.5),
+        &[("n", 8.0), ("dt", 1.0 / 60.0)],
+        &[
+            ("Xpbd iterations (1 substep)", vec![pt(4.0, 1e-3, 1e-3), pt(16.0, 3e-3, 2e-4)]),
+            ("Xpbd substeps (1 iteration)", vec![pt(4.0, 2e-3, 1e-3), pt(16.0, 6e-3, 1e-4)]),
+            ("Pbd substeps (1 iteration)", vec![pt(16.0, 1e-4, 5e-2)]),
+        ],
+    )])
+}
+
+#[test]
+fn the_pbd_cloth_takes_the_studys_method_and_counts_scaled_to_its_side_and_length() {
+    let t = pbd_table();
+    // The preset's cloth is 14 x 14 (anim-pbd scenes docs) against the study's 8 x 8: counts
+    // scale by 14 / 8 = 1.75. The scene runs 30 frames of 1/60 s = the study's 0.5 s.
+    let before = builtin("pbd-cloth");
+    let mut file = before.clone();
+    let c = choose(&mut file, 1e-2, &t).unwrap();
+    // Iterations (1 ms x 7/4) beat substeps (2 ms x 7/4); PBD's cheap point misses 1e-2.
+    assert_eq!((c.method.as_str(), c.param), ("Xpbd iterations (1 substep)", 4.0));
+    assert!(matches!(
+        file.scene,
+        Scene::Pbd { method: Some(anim_pbd::Method::Xpbd), iterations: Some(7), substeps: Some(1), .. }
+    ));
+    assert_fits(&c, &before, &file, 1.0 / 60.0);
+    assert_eq!(c.settings, "method = xpbd, iterations = 7, substeps = 1");
+    // A loose tolerance admits PBD's point: 16 x 1.75 = 28 substeps of one iteration.
+    let mut file = before.clone();
+    let c = choose(&mut file, 0.1, &t).unwrap();
+    assert_eq!(c.method, "Pbd substeps (1 iteration)");
+    assert!(matches!(
+        file.scene,
+        Scene::Pbd { method: Some(anim_pbd::Method::Pbd), iterations: Some(1), substeps: Some(28), .. }
+    ));
+    // Twice the study's length: the iteration series are left out, substeps grow by 2^2 = 4:
+    // ceil(4 x 1.75 x 4) = 28.
+    let mut long = before.clone();
+    long.run.frames = 60;
+    let mut file = long.clone();
+    let c = choose(&mut file, 1e-2, &t).unwrap();
+    assert_eq!((c.method.as_str(), c.param), ("Xpbd substeps (1 iteration)", 4.0));
+    assert!(matches!(file.scene, Scene::Pbd { iterations: Some(1), substeps: Some(28), .. }));
+    assert!(
+        c.why.contains("left out as not this scene's: Xpbd iterations (1 substep) (swept iterations"),
+        "{}",
+        c.why
+    );
+    // A frame of 1/30 s takes two steps of the study's 1/60 s.
+    let mut coarse = before.clone();
+    coarse.run.dt = 1.0 / 30.0;
+    coarse.run.frames = 15;
+    let mut file = coarse.clone();
+    let c = choose(&mut file, 1e-2, &t).unwrap();
+    assert_fits(&c, &coarse, &file, 1.0 / 60.0);
+    assert_eq!(c.steps_per_frame, 2);
+    // Nothing measured meets 1e-5: the most accurate point is named.
+    let e = choose(&mut before.clone(), 1e-5, &t).unwrap_err();
+    assert!(
+        e.contains("the most accurate measured is Xpbd substeps (1 iteration) at p = 16, error 1.000e-4"),
+        "{e}"
+    );
+    // Other PBD presets have no entry.
+    let e = choose(&mut builtin("drape"), 1e-2, &t).unwrap_err();
+    assert!(
+        e.contains("no entry for pbd/cloth-drape scenes (drape)") && e.contains("pbd/hanging-cloth"),
+        "{e}"
+    );
+}
+
+#[test]
+fn the_mpm_dam_break_takes_the_studys_resolution_transfer_kernel_and_particles_per_cell() {
+    let t = made(vec![family(
+        "mpm_dam_break",
+        "mpm/dam-break-2d",
+        None,
+        &[],
+        &[
+            ("MLS-MPM quadratic, 2x2 ppc", vec![pt(32.0, 0.5, 0.2), pt(64.0, 2.0, 0.05)]),
+            ("APIC cubic, 2x2 ppc", vec![pt(32.0, 0.8, 0.08)]),
+            ("MLS-MPM quadratic, 3x3 ppc", vec![pt(48.0, 3.0, 0.04)]),
+        ],
+    )]);
+    let before = builtin("dam-break-2d-mpm");
+    let mut file = before.clone();
+    let c = choose(&mut file, 0.1, &t).unwrap();
+    assert_eq!((c.method.as_str(), c.param), ("APIC cubic, 2x2 ppc", 32.0));
+    assert!(matches!(
+        file.scene,
+        Scene::Mpm {
+            resolution: Some(32),
+            transfer: Some(MpmTransfer::Apic),
+            kernel: Some(MpmKernel::Cubic),
+            particles_per_cell: Some(2),
+            ..
+        }
+    ));
+    assert_eq!(c.settings, "resolution = 32, transfer = apic, kernel = cubic, particles_per_cell = 2");
+    // The study's step: half a cell per sound crossing at c = 50 m/s, h = 1/32 m.
+    assert_fits(&c, &before, &file, 0.5 / 32.0 / 50.0);
+    let mut file = before.clone();
+    let c = choose(&mut file, 0.045, &t).unwrap();
+    assert_eq!((c.method.as_str(), c.param), ("MLS-MPM quadratic, 3x3 ppc", 48.0));
+    assert!(matches!(
+        file.scene,
+        Scene::Mpm {
+            resolution: Some(48),
+            transfer: Some(MpmTransfer::MlsMpm),
+            kernel: Some(MpmKernel::Quadratic),
+            particles_per_cell: Some(3),
+            ..
+        }
+    ));
+    assert_fits(&c, &before, &file, 0.5 / 48.0 / 50.0);
+    let e = choose(&mut before.clone(), 0.01, &t).unwrap_err();
+    assert!(
+        e.contains("the most accurate measured is MLS-MPM quadratic, 3x3 ppc at p = 48, error 4.000e-2 (ask for 4.0e-2 or more)"),
+        "{e}"
+    );
+    // The other MPM presets have no entry.
+    let e = choose(&mut builtin("mpm"), 0.1, &t).unwrap_err();
+    assert!(
+        e.contains("no entry for mpm/three-materials scenes (mpm)") && e.contains("mpm/dam-break-2d"),
+        "{e}"
+    );
 }
