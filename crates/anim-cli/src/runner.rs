@@ -257,7 +257,14 @@ pub fn build(
             }
             Box::new(MpmRunner::new(scene))
         }
-        Scene::Fluid { ref preset, resolution, pressure_solver, pressure_tolerance } => {
+        Scene::Fluid {
+            ref preset,
+            resolution,
+            pressure_solver,
+            pressure_tolerance,
+            advection,
+            splitting,
+        } => {
             let limit = if preset == "smoke-plume-3d" { 128 } else { 2048 };
             if let Some(r) = resolution
                 && r > limit
@@ -268,41 +275,52 @@ pub fn build(
                     format!("{preset} takes at most {limit} cells across, got {r}"),
                 ));
             }
-            let scene = preset_scene(
+            let mut scene = preset_scene(
                 file,
                 "scene.resolution",
                 preset,
                 &anim_fluid::scenes::NAMES,
                 anim_fluid::scenes::by_name(preset, resolution),
             )?;
-            if pressure_solver.is_some() || pressure_tolerance.is_some() {
-                let field = if pressure_solver.is_some() {
-                    "scene.pressure_solver"
-                } else {
-                    "scene.pressure_tolerance"
-                };
-                let mut scene = scene;
+            let fields = [
+                ("scene.pressure_solver", pressure_solver.is_some()),
+                ("scene.pressure_tolerance", pressure_tolerance.is_some()),
+                ("scene.advection", advection.is_some()),
+                ("scene.splitting", splitting.is_some()),
+            ];
+            if let Some(&(field, _)) = fields.iter().find(|(_, set)| *set) {
                 let anim_fluid::scenes::FluidSim::Mac(fluid, _) = &mut scene.sim else {
                     return Err(SceneError::invalid(
                         file,
                         field,
                         format!(
-                            "{preset} runs the seed's solver (20 Gauss-Seidel sweeps), which has no pressure settings"
+                            "{preset} runs the seed's solver (20 Gauss-Seidel sweeps, linear advection), which has no pressure, advection or splitting settings"
                         ),
                     ));
                 };
-                let p = fluid.params();
-                let (method, tol) = (
-                    pressure_solver.map_or(p.pressure, |s| s.0),
-                    pressure_tolerance.unwrap_or(p.pressure_tolerance),
-                );
-                fluid
-                    .set_pressure(method, tol, PRESSURE_MAX_ITERATIONS)
-                    .map_err(|e| SceneError::invalid(file, field, e.to_string()))?;
-                Box::new(FluidRunner::new(scene))
-            } else {
-                Box::new(FluidRunner::new(scene))
+                if pressure_solver.is_some() || pressure_tolerance.is_some() {
+                    let p = fluid.params();
+                    let (method, tol) = (
+                        pressure_solver.map_or(p.pressure, |s| s.0),
+                        pressure_tolerance.unwrap_or(p.pressure_tolerance),
+                    );
+                    let field = if pressure_solver.is_some() {
+                        "scene.pressure_solver"
+                    } else {
+                        "scene.pressure_tolerance"
+                    };
+                    fluid
+                        .set_pressure(method, tol, PRESSURE_MAX_ITERATIONS)
+                        .map_err(|e| SceneError::invalid(file, field, e.to_string()))?;
+                }
+                if let Some(a) = advection {
+                    fluid.set_advection(a.advection());
+                }
+                if let Some(s) = splitting {
+                    fluid.set_splitting(s.splitting());
+                }
             }
+            Box::new(FluidRunner::new(scene))
         }
         Scene::Flip { ref preset, resolution, transfer } => {
             let limit = if preset.ends_with("3d") { 128 } else { 1024 };
@@ -1047,9 +1065,10 @@ impl FluidRunner {
         let method = match &scene.sim {
             FluidSim::Seed(_) => "seed stable fluids (f32, 20 Gauss-Seidel sweeps)".to_string(),
             FluidSim::Mac(f, _) => format!(
-                "{}D MAC, {} advection, {} pressure",
+                "{}D MAC, {} advection, {} splitting, {} pressure",
                 f.dim(),
                 f.params().advection.name(),
+                f.params().splitting.name(),
                 f.params().pressure.name()
             ),
         };
@@ -1418,6 +1437,44 @@ mod tests {
             msg.contains("field `scene.pressure_tolerance`: smoke-box-2d runs the seed's solver"),
             "{msg}"
         );
+    }
+
+    #[test]
+    fn fluid_advection_and_splitting_reach_the_solver_or_are_refused() {
+        use anim_fluid::advection::{Advection, Splitting};
+        let text = scene::builtin("lid-driven-cavity").unwrap().replace(
+            "resolution = 64",
+            "resolution = 8\nadvection = \"sl-linear\"\nsplitting = \"reflection\"",
+        );
+        let file = scene::parse(&text, Path::new("s.toml")).unwrap();
+        let mut runner = build(&file.scene, Path::new("s.toml"), None).unwrap();
+        let p = runner.mac().unwrap().0.params();
+        assert_eq!((p.advection, p.splitting), (Advection::Linear, Splitting::Reflection));
+        // The preset's pressure settings stay when only the advection is set.
+        assert_eq!((p.pressure, p.pressure_tolerance), (anim_fluid::pressure::PressureMethod::Mgpcg, 1e-8));
+        assert!(runner.method().contains("sl-linear advection, reflection splitting"), "{}", runner.method());
+        runner.step(0.01).unwrap();
+        let plain = scene::builtin("lid-driven-cavity").unwrap().replace("64", "8");
+        let runner =
+            build(&scene::parse(&plain, Path::new("s.toml")).unwrap().scene, Path::new("s.toml"), None)
+                .unwrap();
+        let p = runner.mac().unwrap().0.params();
+        assert_eq!((p.advection, p.splitting), (Advection::MacCormack, Splitting::AdvectProject));
+        for (field, line) in
+            [("advection", "advection = \"bfecc\""), ("splitting", "splitting = \"reflection\"")]
+        {
+            let text = scene::builtin("smoke-box-2d").unwrap().replace("resolution = 128", line);
+            let file = scene::parse(&text, Path::new("s.toml")).unwrap();
+            let msg = build(&file.scene, Path::new("s.toml"), None).err().unwrap().to_string();
+            assert!(
+                msg.contains(&format!("field `scene.{field}`: smoke-box-2d runs the seed's solver")),
+                "{msg}"
+            );
+        }
+        let bad =
+            scene::builtin("lid-driven-cavity").unwrap().replace("resolution = 64", "splitting = \"strang\"");
+        let msg = scene::parse(&bad, Path::new("s.toml")).err().unwrap().to_string();
+        assert!(msg.contains("unknown variant `strang`") && msg.contains("reflection"), "{msg}");
     }
 
     #[test]

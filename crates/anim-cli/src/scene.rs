@@ -177,6 +177,14 @@ pub enum Scene {
         /// the preset's when absent).
         #[serde(default)]
         pressure_tolerance: Option<f64>,
+        /// Advection scheme of the MAC presets (`"sl-linear"`, `"sl-monotone-cubic"`, `"bfecc"`,
+        /// `"maccormack"`; the preset's when absent).
+        #[serde(default)]
+        advection: Option<FluidAdvection>,
+        /// How a MAC step splits advection from projection (`"advect-project"`, the seed's
+        /// order, or `"reflection"`, advection-reflection; the preset's when absent).
+        #[serde(default)]
+        splitting: Option<FluidSplitting>,
     },
     /// An incompressible particle fluid of anim-flip (`dam-break-2d`, `dam-break-3d`, `drop-2d`,
     /// `drop-3d`, `sloshing-tank`): particles carry the water, a MAC grid makes it
@@ -319,6 +327,61 @@ impl MpmKernel {
         match self {
             MpmKernel::Quadratic => "quadratic",
             MpmKernel::Cubic => "cubic",
+        }
+    }
+}
+
+/// The advection scheme of a MAC [`Scene::Fluid`], by its name in reports
+/// ([`Advection::name`](anim_fluid::advection::Advection::name)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum FluidAdvection {
+    /// Semi-Lagrangian, linear interpolation.
+    #[serde(rename = "sl-linear")]
+    Linear,
+    /// Semi-Lagrangian, monotone cubic interpolation.
+    #[serde(rename = "sl-monotone-cubic")]
+    MonotoneCubic,
+    /// BFECC over linear semi-Lagrangian steps.
+    #[serde(rename = "bfecc")]
+    Bfecc,
+    /// MacCormack over linear semi-Lagrangian steps.
+    #[serde(rename = "maccormack")]
+    MacCormack,
+}
+
+impl FluidAdvection {
+    /// The anim-fluid scheme.
+    #[must_use]
+    pub fn advection(self) -> anim_fluid::advection::Advection {
+        use anim_fluid::advection::Advection;
+        match self {
+            Self::Linear => Advection::Linear,
+            Self::MonotoneCubic => Advection::MonotoneCubic,
+            Self::Bfecc => Advection::Bfecc,
+            Self::MacCormack => Advection::MacCormack,
+        }
+    }
+}
+
+/// The splitting of a MAC [`Scene::Fluid`] step, by its name in reports
+/// ([`Splitting::name`](anim_fluid::advection::Splitting::name)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum FluidSplitting {
+    /// Advect over `dt`, then project.
+    #[serde(rename = "advect-project")]
+    AdvectProject,
+    /// Advection-reflection.
+    #[serde(rename = "reflection")]
+    Reflection,
+}
+
+impl FluidSplitting {
+    /// The anim-fluid splitting.
+    #[must_use]
+    pub fn splitting(self) -> anim_fluid::advection::Splitting {
+        match self {
+            Self::AdvectProject => anim_fluid::advection::Splitting::AdvectProject,
+            Self::Reflection => anim_fluid::advection::Splitting::Reflection,
         }
     }
 }

@@ -581,6 +581,20 @@ pub fn choose(file: &mut SceneFile, tol: f64, table: &Table) -> Result<Choice, S
             names.join(", ")
         ));
     };
+    if let Scene::Fluid { advection, splitting, .. } = &file.scene {
+        let set: Vec<&str> = [("advection", advection.is_some()), ("splitting", splitting.is_some())]
+            .into_iter()
+            .filter_map(|(name, on)| on.then_some(name))
+            .collect();
+        if !set.is_empty() {
+            return Err(format!(
+                "--tolerance: {} sets `{}`, but the {} study measured the preset's own; remove the field or --tolerance",
+                file.name,
+                set.join("` and `"),
+                family.study
+            ));
+        }
+    }
     let adapter = Adapter::new(file, family)?;
     let mut best: Option<(f64, &str, Point, Candidate)> = None;
     let mut closest: Option<(&str, Point)> = None;

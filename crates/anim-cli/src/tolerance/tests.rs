@@ -307,6 +307,14 @@ fn the_cavity_takes_the_studys_resolution_and_pressure_solver() {
     assert_eq!(file.run.dt, 1.0 / 32.0);
     let e = choose(&mut before.clone(), 1e-3, &t).unwrap_err();
     assert!(e.contains("the most accurate measured is mgpcg at p = 64, error 8.000e-3"), "{e}");
+    // The study measured the preset's advection and splitting: a scene that sets either is
+    // refused rather than given a pick measured with another scheme.
+    let mut changed = before.clone();
+    if let Scene::Fluid { splitting, .. } = &mut changed.scene {
+        *splitting = Some(crate::scene::FluidSplitting::Reflection);
+    }
+    let e = choose(&mut changed, 0.03, &t).unwrap_err();
+    assert!(e.contains("sets `splitting`, but the fluid_cavity_ghia study measured the preset's own"), "{e}");
     // The seed solver's smoke box is not a mapped preset.
     let e = choose(&mut builtin("smoke-box-2d"), 1e-2, &t).unwrap_err();
     assert!(e.contains("no entry for fluid/smoke-box-2d scenes"), "{e}");
