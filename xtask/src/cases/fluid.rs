@@ -82,6 +82,11 @@ pub fn register(r: &mut Registry) {
         name: "pressure solvers: Ghia error vs time",
         run: study_ghia,
     });
+    r.studies.push(Study {
+        crate_name: CRATE,
+        name: "advection and splitting: Taylor-Green error vs time",
+        run: study_taylor_green,
+    });
 }
 
 fn check(
@@ -672,6 +677,40 @@ fn study_ghia(ctx: &Ctx) -> StudyResult {
         slug: "fluid_cavity_ghia".into(),
         error_label: "max |error| over Ghia's centreline points".into(),
         param_label: "N".into(),
+        series,
+    }
+}
+
+/// Every advection scheme under both splittings on the Taylor-Green vortex (`nu = 0.01`, to
+/// `t = 1`, MGPCG to 1e-10), swept over the CFL number at a fixed grid: the amplitude's
+/// relative error against `exp(-2 nu pi^2 t)` against the wall time of the run.
+fn study_taylor_green(ctx: &Ctx) -> StudyResult {
+    let (n, cfls): (usize, &[f64]) =
+        if ctx.quick { (32, &[1.0, 2.0, 4.0]) } else { (64, &[0.5, 1.0, 2.0, 4.0]) };
+    let mut series = Vec::new();
+    for splitting in Splitting::ALL {
+        for advection in Advection::ALL {
+            let mut points = Vec::new();
+            for &cfl in cfls {
+                let t = Instant::now();
+                if let Ok((a, exact)) = taylor_green_run(n, advection, splitting, 0.01, 1.0, cfl) {
+                    points.push(Point {
+                        param: cfl,
+                        seconds: t.elapsed().as_secs_f64(),
+                        error: (a / exact - 1.0).abs(),
+                    });
+                }
+            }
+            series.push(Series { label: format!("{} {}", advection.name(), splitting.name()), points });
+        }
+    }
+    StudyResult {
+        title: format!(
+            "anim-fluid: Taylor-Green vortex at N = {n}, amplitude error at t = 1 against wall time, per advection scheme and splitting"
+        ),
+        slug: "fluid_taylor_green".into(),
+        error_label: "|A / A_exact - 1|".into(),
+        param_label: "CFL".into(),
         series,
     }
 }
