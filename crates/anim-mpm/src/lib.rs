@@ -98,6 +98,8 @@
 //! # Ok::<(), anim_mpm::MpmError>(())
 //! ```
 
+#[cfg(target_arch = "x86_64")]
+mod avx2;
 pub mod boundary;
 mod grid;
 pub mod kernel;
