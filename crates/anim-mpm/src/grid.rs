@@ -172,12 +172,26 @@ impl<const D: usize> SparseGrid<D> {
             );
         });
 
-        for &k in &self.keys {
+        // The counting sort goes by runs of equal keys: the particles come sorted by the
+        // previous step, so most of a block's particles form one run.
+        let keys = &self.keys;
+        let run_end = |i: usize| {
+            let mut e = i + 1;
+            while e < np && keys[e] == keys[i] {
+                e += 1;
+            }
+            e
+        };
+        let mut i = 0;
+        while i < np {
+            let e = run_end(i);
+            let k = keys[i];
             let c = &mut self.count[k as usize];
             if *c == 0 {
                 self.pblocks.push(k);
             }
-            *c += 1;
+            *c += (e - i) as u32;
+            i = e;
         }
         self.pblocks.sort_unstable();
         self.cursor.clear();
@@ -191,12 +205,26 @@ impl<const D: usize> SparseGrid<D> {
             self.count[k as usize] = 0;
         }
         self.pstart.push(run);
-        for (p, &k) in self.keys.iter().enumerate() {
-            let j = self.pblock_of[k as usize];
+        let keys = &self.keys;
+        let run_end = |i: usize| {
+            let mut e = i + 1;
+            while e < np && keys[e] == keys[i] {
+                e += 1;
+            }
+            e
+        };
+        let mut i = 0;
+        while i < np {
+            let e = run_end(i);
+            let j = self.pblock_of[keys[i] as usize];
             let slot = &mut self.cursor[j as usize];
-            self.order[*slot as usize] = p as u32;
-            self.slot_block[*slot as usize] = j;
-            *slot += 1;
+            let s = *slot as usize;
+            for (t, o) in self.order[s..s + (e - i)].iter_mut().enumerate() {
+                *o = (i + t) as u32;
+            }
+            self.slot_block[s..s + (e - i)].fill(j);
+            *slot += (e - i) as u32;
+            i = e;
         }
 
         // Grid blocks: every occupied block and its + {0,1}^D neighbours.
