@@ -637,12 +637,21 @@ pub(crate) fn g2p_chunk<const D: usize, K: Spline, const APIC: bool>(
         let mut plastic = st.plastic[p];
         project(mat, &mut fnew, &mut plastic);
         let mut xnew = Vector::<D>::from_column_slice(xp) + vel * ctx.dt;
+        // A finite coordinate outside `[lo, hi]` is clamped (without a branch); a non-finite
+        // one is left for the check below.
         let mut outside = false;
         for a in 0..D {
-            if !(xnew[a] >= ctx.lo && xnew[a] <= ctx.hi) && xnew[a].is_finite() {
-                outside = true;
-                xnew[a] = xnew[a].clamp(ctx.lo, ctx.hi);
-            }
+            let c = xnew[a];
+            let out = (c < ctx.lo || c > ctx.hi) && c.is_finite();
+            outside |= out;
+            let clamped = if c < ctx.lo {
+                ctx.lo
+            } else if c > ctx.hi {
+                ctx.hi
+            } else {
+                c
+            };
+            xnew[a] = if out { clamped } else { c };
         }
         x.copy_from_slice(xnew.as_slice());
         v.copy_from_slice(vel.as_slice());
