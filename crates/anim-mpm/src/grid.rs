@@ -24,6 +24,7 @@
 //! contiguous in memory and their grid window stays in cache.
 
 use crate::kernel::Kernel;
+use crate::transfer::{Avx2, with_simd};
 use rayon::prelude::*;
 use wide::f32x4;
 
@@ -127,7 +128,7 @@ impl<const D: usize> SparseGrid<D> {
     /// Bins the particles at positions `x` (stride `D`, in cell units after scaling by `inv_h`):
     /// keys, counting sort, occupied blocks and grid blocks, buffer sizes. Allocates only when
     /// the particle or block count exceeds every earlier one.
-    pub fn bin(&mut self, x: &[f32], inv_h: f32, kernel: Kernel) {
+    pub fn bin(&mut self, x: &[f32], inv_h: f32, kernel: Kernel, simd: Option<Avx2>) {
         let np = x.len() / D;
         for &k in &self.pblocks {
             self.pblock_of[k as usize] = NONE;
@@ -150,27 +151,47 @@ impl<const D: usize> SparseGrid<D> {
             Kernel::Cubic => 1.0,
         };
         self.keys.par_chunks_mut(4096).zip(x.par_chunks(4096 * D)).for_each(|(keys, x)| {
-            for (key, x) in keys.iter_mut().zip(x.chunks_exact(D)) {
-                let mut k = 0usize;
-                for a in (0..D).rev() {
-                    // Positions are clamped to the domain, so `xs >= 2` and the truncating cast
-                    // is the floor (the kernels compute the same base node, `floor(xs - off)`).
-                    let base = (x[a] * inv_h - off).max(0.0) as i32;
-                    // The clamp only guarantees an in-range index whatever the input (`max`
-                    // and `min`, not `clamp`, which compiles to a data-dependent branch).
-                    let b = (base >> 2).max(0).min(max_block);
-                    k = k * nb + b as usize;
-                }
-                *key = k as u32;
-            }
+            with_simd(
+                simd,
+                #[inline(always)]
+                || {
+                    for (key, x) in keys.iter_mut().zip(x.chunks_exact(D)) {
+                        let mut k = 0usize;
+                        for a in (0..D).rev() {
+                            // Positions are clamped to the domain, so `xs >= 2` and the truncating cast
+                            // is the floor (the kernels compute the same base node, `floor(xs - off)`).
+                            let base = (x[a] * inv_h - off).max(0.0) as i32;
+                            // The clamp only guarantees an in-range index whatever the input (`max`
+                            // and `min`, not `clamp`, which compiles to a data-dependent branch).
+                            let b = (base >> 2).max(0).min(max_block);
+                            k = k * nb + b as usize;
+                        }
+                        *key = k as u32;
+                    }
+                },
+            );
         });
 
-        for &k in &self.keys {
+        // The counting sort goes by runs of equal keys: the particles come sorted by the
+        // previous step, so most of a block's particles form one run.
+        let keys = &self.keys;
+        let run_end = |i: usize| {
+            let mut e = i + 1;
+            while e < np && keys[e] == keys[i] {
+                e += 1;
+            }
+            e
+        };
+        let mut i = 0;
+        while i < np {
+            let e = run_end(i);
+            let k = keys[i];
             let c = &mut self.count[k as usize];
             if *c == 0 {
                 self.pblocks.push(k);
             }
-            *c += 1;
+            *c += (e - i) as u32;
+            i = e;
         }
         self.pblocks.sort_unstable();
         self.cursor.clear();
@@ -184,12 +205,26 @@ impl<const D: usize> SparseGrid<D> {
             self.count[k as usize] = 0;
         }
         self.pstart.push(run);
-        for (p, &k) in self.keys.iter().enumerate() {
-            let j = self.pblock_of[k as usize];
+        let keys = &self.keys;
+        let run_end = |i: usize| {
+            let mut e = i + 1;
+            while e < np && keys[e] == keys[i] {
+                e += 1;
+            }
+            e
+        };
+        let mut i = 0;
+        while i < np {
+            let e = run_end(i);
+            let j = self.pblock_of[keys[i] as usize];
             let slot = &mut self.cursor[j as usize];
-            self.order[*slot as usize] = p as u32;
-            self.slot_block[*slot as usize] = j;
-            *slot += 1;
+            let s = *slot as usize;
+            for (t, o) in self.order[s..s + (e - i)].iter_mut().enumerate() {
+                *o = (i + t) as u32;
+            }
+            self.slot_block[s..s + (e - i)].fill(j);
+            *slot += (e - i) as u32;
+            i = e;
         }
 
         // Grid blocks: every occupied block and its + {0,1}^D neighbours.
@@ -234,7 +269,7 @@ mod tests {
         // Two clusters far apart, given interleaved.
         let pts = [[10.2, 10.7], [50.1, 40.3], [10.9, 11.1], [50.5, 39.9], [13.6, 10.1]];
         let x: Vec<f32> = pts.iter().flat_map(|p| [p[0] * h, p[1] * h]).collect();
-        g.bin(&x, 1.0 / h, Kernel::Quadratic);
+        g.bin(&x, 1.0 / h, Kernel::Quadratic, None);
         // Keys increase along the sorted order.
         let keys: Vec<u32> = g.order.iter().map(|&p| g.keys[p as usize]).collect();
         assert!(keys.windows(2).all(|w| w[0] <= w[1]));
@@ -245,7 +280,7 @@ mod tests {
         assert_eq!(g.gblocks.len(), 6 + 4);
         assert_eq!(g.allocated_nodes(), 10 * 16);
         // Re-binning elsewhere clears the previous tables.
-        g.bin(&x[..2], 1.0 / h, Kernel::Quadratic);
+        g.bin(&x[..2], 1.0 / h, Kernel::Quadratic, None);
         assert_eq!(g.pblocks.len(), 1);
         assert_eq!(g.gblock_of.iter().filter(|&&b| b != NONE).count(), 4);
     }

@@ -61,6 +61,12 @@
 //! threads, bit for bit. Nothing is allocated per step once the particle and block counts have
 //! been reached (the buffers only grow).
 //!
+//! On x86-64 CPUs with AVX2 the transfers run AVX2 variants of the kernels, chosen at run time
+//! (module `avx2`: in 2D two stencil nodes or two partial sums per 256-bit register; the rest of
+//! the step compiled with AVX2). They use no fused multiply-adds and do the portable kernels'
+//! operations in the same order per lane, so the results are the same bits on any CPU (a test
+//! compares both paths).
+//!
 //! ## Robustness
 //!
 //! Each step measures the advective CFL number `max |v| dt / h` and the elastic-wave number
@@ -98,6 +104,8 @@
 //! # Ok::<(), anim_mpm::MpmError>(())
 //! ```
 
+#[cfg(target_arch = "x86_64")]
+mod avx2;
 pub mod boundary;
 mod grid;
 pub mod kernel;

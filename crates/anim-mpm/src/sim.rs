@@ -154,6 +154,8 @@ pub struct MpmSimulation<const D: usize> {
     backup: Particles<D>,
     remove: Vec<bool>,
     partials: Vec<[f64; 12]>,
+    /// The AVX2 transfer kernels, when the CPU has them (`None`: the portable kernels).
+    pub(crate) simd: Option<transfer::Avx2>,
     steps: u64,
     time: f64,
     stats: StepStats,
@@ -212,6 +214,7 @@ impl<const D: usize> MpmSimulation<D> {
             backup: Particles::new(),
             remove: Vec::new(),
             partials: Vec::new(),
+            simd: transfer::Avx2::detect(),
             steps: 0,
             time: 0.0,
             stats: StepStats::default(),
@@ -375,68 +378,77 @@ impl<const D: usize> MpmSimulation<D> {
         let (v2, c2, bad) = (0..n.div_ceil(CHUNK))
             .into_par_iter()
             .map(|chunk| {
-                let r = chunk * CHUNK..((chunk + 1) * CHUNK).min(n);
-                // An infinity or a NaN has all exponent bits set.
-                let any_non_finite =
-                    |a: &[f32]| a.iter().fold(false, |m, c| m | (c.to_bits() & 0x7f80_0000 == 0x7f80_0000));
-                let out_of_range =
-                    st.x[r.start * D..r.end * D].iter().fold(false, |b, c| b | !(*c >= lo && *c <= hi));
-                let material = st.material[r.clone()].iter().fold(0u16, |m, &k| m.max(k));
-                let non_finite = any_non_finite(&st.v[r.start * D..r.end * D])
-                    | any_non_finite(&st.f[r.start * D * D..r.end * D * D])
-                    | any_non_finite(&st.c[r.start * D * D..r.end * D * D]);
-                let non_positive = st.mass[r.clone()]
-                    .iter()
-                    .chain(&st.volume[r.clone()])
-                    .fold(false, |b, m| b | !(*m > 0.0));
-                if out_of_range || usize::from(material) >= nmat || non_finite || non_positive {
-                    let p = r.clone().find(|&p| !ok(p)).unwrap_or(r.start);
-                    return (0.0f32, 0.0f32, p);
-                }
-                // `min` and `max` of finite values, without the NaN handling of `f32::min`.
-                let (fmin, fmax) =
-                    (|a: f32, b: f32| if b < a { b } else { a }, |a: f32, b: f32| if b > a { b } else { a });
-                let v2 = st.v[r.start * D..r.end * D]
-                    .chunks_exact(D)
-                    .fold(0.0f32, |m, v| fmax(m, v.iter().map(|c| c * c).sum::<f32>()));
-                let c2 = if !st.material[r.clone()].iter().fold(false, |b, &k| b | (k != material)) {
-                    // One material: its wave speed is monotone in J (fluid) or J_P (snow) and
-                    // constant otherwise, so the largest is at one end of their range.
-                    let m = &compiled[usize::from(material)];
-                    match m.kind {
-                        Kind::Fluid => {
-                            let (lo_j, hi_j) = st.f[r.start * D * D..r.end * D * D].chunks_exact(D * D).fold(
-                                (f32::INFINITY, f32::NEG_INFINITY),
-                                |(a, b), f| {
-                                    // The clamp of `wave_speed2` (which also turns the NaN of
-                                    // an overflowing determinant into 1e-3).
-                                    let j = anim_material::decomposition::determinant(
-                                        &Mat::<D>::from_column_slice(f),
-                                    )
-                                    .max(1e-3);
-                                    (fmin(a, j), fmax(b, j))
-                                },
-                            );
-                            m.wave_speed2(1.0, lo_j).max(m.wave_speed2(1.0, hi_j))
+                transfer::with_simd(
+                    self.simd,
+                    #[inline(always)]
+                    || {
+                        let r = chunk * CHUNK..((chunk + 1) * CHUNK).min(n);
+                        // An infinity or a NaN has all exponent bits set.
+                        let any_non_finite = |a: &[f32]| {
+                            a.iter().fold(false, |m, c| m | (c.to_bits() & 0x7f80_0000 == 0x7f80_0000))
+                        };
+                        let out_of_range = st.x[r.start * D..r.end * D]
+                            .iter()
+                            .fold(false, |b, c| b | !(*c >= lo && *c <= hi));
+                        let material = st.material[r.clone()].iter().fold(0u16, |m, &k| m.max(k));
+                        let non_finite = any_non_finite(&st.v[r.start * D..r.end * D])
+                            | any_non_finite(&st.f[r.start * D * D..r.end * D * D])
+                            | any_non_finite(&st.c[r.start * D * D..r.end * D * D]);
+                        let non_positive = st.mass[r.clone()]
+                            .iter()
+                            .chain(&st.volume[r.clone()])
+                            .fold(false, |b, m| b | !(*m > 0.0));
+                        if out_of_range || usize::from(material) >= nmat || non_finite || non_positive {
+                            let p = r.clone().find(|&p| !ok(p)).unwrap_or(r.start);
+                            return (0.0f32, 0.0f32, p);
                         }
-                        Kind::Snow => {
-                            let (lo_p, hi_p) = st.plastic[r.clone()]
-                                .iter()
-                                .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &jp| {
-                                    (fmin(a, jp), fmax(b, jp))
-                                });
-                            m.wave_speed2(lo_p, 1.0).max(m.wave_speed2(hi_p, 1.0))
-                        }
-                        _ => m.wave_speed2(1.0, 1.0),
-                    }
-                } else {
-                    r.clone().fold(0.0f32, |c2, p| {
-                        let m = &compiled[usize::from(st.material[p])];
-                        let j = anim_material::decomposition::determinant(&st.deformation(p));
-                        c2.max(m.wave_speed2(st.plastic[p], j))
-                    })
-                };
-                (v2, c2, usize::MAX)
+                        // `min` and `max` of finite values, without the NaN handling of `f32::min`.
+                        let (fmin, fmax) = (
+                            |a: f32, b: f32| if b < a { b } else { a },
+                            |a: f32, b: f32| if b > a { b } else { a },
+                        );
+                        let v2 = st.v[r.start * D..r.end * D]
+                            .chunks_exact(D)
+                            .fold(0.0f32, |m, v| fmax(m, v.iter().map(|c| c * c).sum::<f32>()));
+                        let c2 = if !st.material[r.clone()].iter().fold(false, |b, &k| b | (k != material)) {
+                            // One material: its wave speed is monotone in J (fluid) or J_P (snow) and
+                            // constant otherwise, so the largest is at one end of their range.
+                            let m = &compiled[usize::from(material)];
+                            match m.kind {
+                                Kind::Fluid => {
+                                    let (lo_j, hi_j) = st.f[r.start * D * D..r.end * D * D]
+                                        .chunks_exact(D * D)
+                                        .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), f| {
+                                            // The clamp of `wave_speed2` (which also turns the NaN of
+                                            // an overflowing determinant into 1e-3).
+                                            let j = anim_material::decomposition::determinant(
+                                                &Mat::<D>::from_column_slice(f),
+                                            )
+                                            .max(1e-3);
+                                            (fmin(a, j), fmax(b, j))
+                                        });
+                                    m.wave_speed2(1.0, lo_j).max(m.wave_speed2(1.0, hi_j))
+                                }
+                                Kind::Snow => {
+                                    let (lo_p, hi_p) = st.plastic[r.clone()]
+                                        .iter()
+                                        .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &jp| {
+                                            (fmin(a, jp), fmax(b, jp))
+                                        });
+                                    m.wave_speed2(lo_p, 1.0).max(m.wave_speed2(hi_p, 1.0))
+                                }
+                                _ => m.wave_speed2(1.0, 1.0),
+                            }
+                        } else {
+                            r.clone().fold(0.0f32, |c2, p| {
+                                let m = &compiled[usize::from(st.material[p])];
+                                let j = anim_material::decomposition::determinant(&st.deformation(p));
+                                c2.max(m.wave_speed2(st.plastic[p], j))
+                            })
+                        };
+                        (v2, c2, usize::MAX)
+                    },
+                )
             })
             .reduce(|| (0.0, 0.0, usize::MAX), |a, b| (a.0.max(b.0), a.1.max(b.1), a.2.min(b.2)));
         if bad != usize::MAX {
@@ -473,12 +485,13 @@ impl<const D: usize> MpmSimulation<D> {
             lo: lo as f32,
             hi: hi as f32,
             materials: &self.compiled,
+            simd: self.simd,
         };
         let n = st.len();
-        self.grid.bin(&st.x, ctx.inv_h, self.params.kernel);
+        self.grid.bin(&st.x, ctx.inv_h, self.params.kernel, self.simd);
         transfer::p2g::<D, K>(&mut self.grid, st, &ctx);
         transfer::grid_update(&mut self.grid, &ctx);
-        transfer::gather(&mut self.grid);
+        transfer::gather(&mut self.grid, self.simd);
         self.out.resize(n);
         let removing = self.params.out_of_domain == OutOfDomain::Remove;
         self.remove.resize(n, false);

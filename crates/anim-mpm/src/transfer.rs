@@ -45,20 +45,55 @@ pub(crate) struct Ctx<'a, const D: usize> {
     pub lo: f32,
     pub hi: f32,
     pub materials: &'a [Compiled],
+    /// The AVX2 kernels' token when they are to be used (x86-64 CPUs with AVX2), else `None`.
+    pub simd: Option<Avx2>,
+}
+
+#[cfg(target_arch = "x86_64")]
+pub(crate) use crate::avx2::Avx2;
+
+/// No AVX2 kernels off x86-64.
+#[cfg(not(target_arch = "x86_64"))]
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Avx2 {}
+
+/// Runs `f`, compiled with AVX2 enabled when `simd` is `Some` (same results either way: the
+/// arithmetic is the same, only the instruction selection differs). `f` should be
+/// `#[inline(always)]` so that it is compiled into the AVX2 function.
+#[inline(always)]
+pub(crate) fn with_simd<R>(simd: Option<Avx2>, f: impl FnOnce() -> R) -> R {
+    match simd {
+        #[cfg(target_arch = "x86_64")]
+        Some(cpu) => crate::avx2::run(cpu, f),
+        _ => f(),
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+impl Avx2 {
+    /// Never available off x86-64.
+    pub(crate) fn detect() -> Option<Self> {
+        None
+    }
 }
 
 /// Per-axis stencil data of one particle.
-struct Stencil<const D: usize> {
+pub(crate) struct Stencil<const D: usize> {
     /// Window index of the base node.
-    base: usize,
-    w: [[f32; 4]; D],
-    dw: [[f32; 4]; D],
+    pub base: usize,
+    pub w: [[f32; 4]; D],
+    pub dw: [[f32; 4]; D],
     /// `x_i - x_p` per axis and stencil node.
-    dx: [[f32; 4]; D],
+    pub dx: [[f32; 4]; D],
 }
 
 #[inline(always)]
-fn stencil<const D: usize, K: Spline>(x: &[f32], inv_h: f32, h: f32, block: &[i32; D]) -> Stencil<D> {
+pub(crate) fn stencil<const D: usize, K: Spline>(
+    x: &[f32],
+    inv_h: f32,
+    h: f32,
+    block: &[i32; D],
+) -> Stencil<D> {
     let mut s = Stencil { base: 0, w: [[0.0; 4]; D], dw: [[0.0; 4]; D], dx: [[0.0; 4]; D] };
     for a in 0..D {
         let xs = x[a] * inv_h;
@@ -83,13 +118,13 @@ fn stencil<const D: usize, K: Spline>(x: &[f32], inv_h: f32, h: f32, block: &[i3
 }
 
 /// Window strides per axis.
-const fn wstride(a: usize) -> usize {
+pub(crate) const fn wstride(a: usize) -> usize {
     pow(WINDOW, a)
 }
 
 /// Window nodes from a stencil's base node to its last node, inclusive: a particle's scatter
 /// and gather stay in `base..base + span` (one bounds check per particle).
-const fn span(d: usize, n: usize) -> usize {
+pub(crate) const fn span(d: usize, n: usize) -> usize {
     (n - 1) * (1 + wstride(1) + if d == 3 { wstride(2) } else { 0 }) + 1
 }
 
@@ -105,7 +140,7 @@ fn column<const D: usize>(m: &Mat<D>, col: usize, scale: f32) -> f32x4 {
 }
 
 #[inline(always)]
-fn splat(x: f32) -> f32x4 {
+pub(crate) fn splat(x: f32) -> f32x4 {
     f32x4::splat(x)
 }
 
@@ -138,43 +173,42 @@ fn p2g_with<const D: usize, K: Spline, const APIC: bool>(
     let wn = SparseGrid::<D>::WN;
     let (pcoords, pstart, order) = (&grid.pcoords, &grid.pstart, &grid.order);
     grid.windows.par_chunks_mut(wn).enumerate().for_each(|(j, win)| {
-        win.fill(f32x4::ZERO);
-        let block = pcoords[j];
-        for &p in &order[pstart[j] as usize..pstart[j + 1] as usize] {
-            p2g_particle::<D, K, APIC>(win, st, p as usize, &block, ctx);
+        let slots = &order[pstart[j] as usize..pstart[j + 1] as usize];
+        match ctx.simd {
+            #[cfg(target_arch = "x86_64")]
+            Some(cpu) => crate::avx2::p2g_block::<D, K, APIC>(cpu, win, st, slots, &pcoords[j], ctx),
+            _ => p2g_block::<D, K, APIC>(win, st, slots, &pcoords[j], ctx),
         }
     });
+}
+
+/// P2G of one particle block (`slots` its particles in sorted order) into its window.
+#[inline(always)]
+pub(crate) fn p2g_block<const D: usize, K: Spline, const APIC: bool>(
+    win: &mut [f32x4],
+    st: &Particles<D>,
+    slots: &[u32],
+    block: &[i32; D],
+    ctx: &Ctx<'_, D>,
+) {
+    win.fill(f32x4::ZERO);
+    for &p in slots {
+        p2g_particle::<D, K, APIC>(win, st, p as usize, block, ctx);
+    }
 }
 
 /// One particle's scatter into its block's window. Each node gets the 4-lane vector
 /// `w (m_p, m_p v_p + A_p dx)` (`A_p` the affine momentum matrix), plus `-dt V_p tau_p grad w`
 /// for APIC; the sum `m_p v_p + A_p dx` is built row by row (the part of the outer axes first).
 #[inline(always)]
-fn p2g_particle<const D: usize, K: Spline, const APIC: bool>(
+pub(crate) fn p2g_particle<const D: usize, K: Spline, const APIC: bool>(
     win: &mut [f32x4],
     st: &Particles<D>,
     p: usize,
     block: &[i32; D],
     ctx: &Ctx<'_, D>,
 ) {
-    let s = stencil::<D, K>(&st.x[p * D..p * D + D], ctx.inv_h, ctx.h, block);
-    let m = st.mass[p];
-    let d_inv = K::D_INV * ctx.inv_h * ctx.inv_h;
-    // -dt V_p tau_p.
-    let mat = &ctx.materials[st.material[p] as usize];
-    let sp = kirchhoff(mat, &st.deformation(p), st.plastic[p]) * (-ctx.dt * st.volume[p]);
-    let cm = st.affine(p);
-    let aff = if APIC { cm * m } else { cm * m + sp * d_inv };
-    let mut q = [0.0f32; 4];
-    q[0] = m;
-    for a in 0..D {
-        q[1 + a] = st.v[p * D + a] * m;
-    }
-    let q = f32x4::new(q);
-    let acol: [f32x4; D] = std::array::from_fn(|c| column(&aff, c, 1.0));
-    // APIC: sp grad w = sum_c sp[:, c] dN_c / h prod_{b != c} N_b.
-    let scol: [f32x4; D] =
-        std::array::from_fn(|c| if APIC { column(&sp, c, ctx.inv_h) } else { f32x4::ZERO });
+    let (s, q, acol, scol) = p2g_prepare::<D, K, APIC>(st, p, block, ctx);
     let n = K::N;
     let win = &mut win[s.base..s.base + span(D, K::N)];
     if D == 2 {
@@ -220,6 +254,37 @@ fn p2g_particle<const D: usize, K: Spline, const APIC: bool>(
     }
 }
 
+/// A particle's P2G data: its stencil, `(m_p, m_p v_p)` as a node vector, the columns of the
+/// affine momentum matrix and (APIC) of `-dt V_p tau_p / h`, each in lanes `1..=D`.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+pub(crate) fn p2g_prepare<const D: usize, K: Spline, const APIC: bool>(
+    st: &Particles<D>,
+    p: usize,
+    block: &[i32; D],
+    ctx: &Ctx<'_, D>,
+) -> (Stencil<D>, f32x4, [f32x4; D], [f32x4; D]) {
+    let s = stencil::<D, K>(&st.x[p * D..p * D + D], ctx.inv_h, ctx.h, block);
+    let m = st.mass[p];
+    let d_inv = K::D_INV * ctx.inv_h * ctx.inv_h;
+    // -dt V_p tau_p.
+    let mat = &ctx.materials[st.material[p] as usize];
+    let sp = kirchhoff(mat, &st.deformation(p), st.plastic[p]) * (-ctx.dt * st.volume[p]);
+    let cm = st.affine(p);
+    let aff = if APIC { cm * m } else { cm * m + sp * d_inv };
+    let mut q = [0.0f32; 4];
+    q[0] = m;
+    for a in 0..D {
+        q[1 + a] = st.v[p * D + a] * m;
+    }
+    let q = f32x4::new(q);
+    let acol: [f32x4; D] = std::array::from_fn(|c| column(&aff, c, 1.0));
+    // APIC: sp grad w = sum_c sp[:, c] dN_c / h prod_{b != c} N_b.
+    let scol: [f32x4; D] =
+        std::array::from_fn(|c| if APIC { column(&sp, c, ctx.inv_h) } else { f32x4::ZERO });
+    (s, q, acol, scol)
+}
+
 /// Calls `f(l, w)` for the nodes of a grid block (`l` its index in the block, `w` the index in a
 /// particle window of the same node, given the offset `off` of the block's first node in that
 /// window), in increasing `l`.
@@ -262,101 +327,113 @@ pub(crate) fn grid_update<const D: usize>(grid: &mut SparseGrid<D>, ctx: &Ctx<'_
     let wall_lo = ctx.wall_nodes;
     let wall_hi = n + 1 - ctx.wall_nodes.min(n + 1);
     grid.nodes.par_chunks_mut(bn).enumerate().for_each(|(g, nodes)| {
-        nodes.fill(f32x4::ZERO);
-        let block = block_coords::<D>(gblocks[g], nb);
-        for o in 0..corners {
-            let mut pk = 0usize;
-            let mut ok = true;
-            for a in (0..D).rev() {
-                let c = block[a] - ((o >> a) & 1) as i32;
-                if c < 0 {
-                    ok = false;
-                }
-                pk = pk * nb + c.max(0) as usize;
-            }
-            if !ok {
-                continue;
-            }
-            let j = pblock_of[pk];
-            if j == crate::grid::NONE {
-                continue;
-            }
-            let win = &windows[j as usize * wn..(j as usize + 1) * wn];
-            for_block_nodes::<D>(corner_offset::<D>(o), |l, w| nodes[l] += win[w]);
-        }
-        let origin: [usize; D] = std::array::from_fn(|a| block[a] as usize * BLOCK);
-        // Whether the block touches a wall layer or a collider may be present.
-        let near_wall = (0..D).any(|a| origin[a] < wall_lo || origin[a] + BLOCK > wall_hi);
-        for l in 0..bn {
-            let node = nodes[l].to_array();
-            let m = node[0];
-            if !(m > 0.0) {
-                nodes[l] = f32x4::new([m, 0.0, 0.0, 0.0]);
-                continue;
-            }
-            let mut v = Vector::<D>::from_fn(|a, _| node[1 + a] / m) + gdt;
-            if near_wall || !ctx.colliders.is_empty() {
-                let mut idx = [0usize; D];
-                let mut r = l;
-                for a in 0..D {
-                    idx[a] = origin[a] + r % BLOCK;
-                    r /= BLOCK;
-                }
-                // Domain walls.
-                for a in 0..D {
-                    let mut normal = Vector::<D>::zeros();
-                    if idx[a] < wall_lo {
-                        normal[a] = 1.0;
-                    } else if idx[a] + ctx.wall_nodes > n {
-                        normal[a] = -1.0;
-                    } else {
+        with_simd(
+            ctx.simd,
+            #[inline(always)]
+            || {
+                nodes.fill(f32x4::ZERO);
+                let block = block_coords::<D>(gblocks[g], nb);
+                for o in 0..corners {
+                    let mut pk = 0usize;
+                    let mut ok = true;
+                    for a in (0..D).rev() {
+                        let c = block[a] - ((o >> a) & 1) as i32;
+                        if c < 0 {
+                            ok = false;
+                        }
+                        pk = pk * nb + c.max(0) as usize;
+                    }
+                    if !ok {
                         continue;
                     }
-                    ctx.wall.apply(&mut v, &normal);
+                    let j = pblock_of[pk];
+                    if j == crate::grid::NONE {
+                        continue;
+                    }
+                    let win = &windows[j as usize * wn..(j as usize + 1) * wn];
+                    for_block_nodes::<D>(corner_offset::<D>(o), |l, w| nodes[l] += win[w]);
                 }
-                // Colliders, at the end of the substep.
-                if !ctx.colliders.is_empty() {
-                    let xi = Vector::<D>::from_fn(|a, _| idx[a] as f32 * ctx.h);
-                    for c in ctx.colliders {
-                        let (phi, normal) = c.sdf(&xi, t_end);
-                        if phi <= 0.0 {
-                            let vc = c.vel::<D>();
-                            let mut rel = v - vc;
-                            c.boundary.apply(&mut rel, &normal);
-                            v = rel + vc;
+                let origin: [usize; D] = std::array::from_fn(|a| block[a] as usize * BLOCK);
+                // Whether the block touches a wall layer or a collider may be present.
+                let near_wall = (0..D).any(|a| origin[a] < wall_lo || origin[a] + BLOCK > wall_hi);
+                for l in 0..bn {
+                    let node = nodes[l].to_array();
+                    let m = node[0];
+                    if !(m > 0.0) {
+                        nodes[l] = f32x4::new([m, 0.0, 0.0, 0.0]);
+                        continue;
+                    }
+                    let mut v = Vector::<D>::from_fn(|a, _| node[1 + a] / m) + gdt;
+                    if near_wall || !ctx.colliders.is_empty() {
+                        let mut idx = [0usize; D];
+                        let mut r = l;
+                        for a in 0..D {
+                            idx[a] = origin[a] + r % BLOCK;
+                            r /= BLOCK;
+                        }
+                        // Domain walls.
+                        for a in 0..D {
+                            let mut normal = Vector::<D>::zeros();
+                            if idx[a] < wall_lo {
+                                normal[a] = 1.0;
+                            } else if idx[a] + ctx.wall_nodes > n {
+                                normal[a] = -1.0;
+                            } else {
+                                continue;
+                            }
+                            ctx.wall.apply(&mut v, &normal);
+                        }
+                        // Colliders, at the end of the substep.
+                        if !ctx.colliders.is_empty() {
+                            let xi = Vector::<D>::from_fn(|a, _| idx[a] as f32 * ctx.h);
+                            for c in ctx.colliders {
+                                let (phi, normal) = c.sdf(&xi, t_end);
+                                if phi <= 0.0 {
+                                    let vc = c.vel::<D>();
+                                    let mut rel = v - vc;
+                                    c.boundary.apply(&mut rel, &normal);
+                                    v = rel + vc;
+                                }
+                            }
                         }
                     }
+                    let mut out = [m, 0.0, 0.0, 0.0];
+                    for a in 0..D {
+                        out[1 + a] = v[a];
+                    }
+                    nodes[l] = f32x4::new(out);
                 }
-            }
-            let mut out = [m, 0.0, 0.0, 0.0];
-            for a in 0..D {
-                out[1 + a] = v[a];
-            }
-            nodes[l] = f32x4::new(out);
-        }
+            },
+        );
     });
 }
 
 /// Copies the grid velocities into each particle block's window.
-pub(crate) fn gather<const D: usize>(grid: &mut SparseGrid<D>) {
+pub(crate) fn gather<const D: usize>(grid: &mut SparseGrid<D>, simd: Option<Avx2>) {
     let bn = SparseGrid::<D>::BN;
     let wn = SparseGrid::<D>::WN;
     let nb = grid.nb;
     let corners = pow(2, D);
     let (pblocks, gblock_of, nodes) = (&grid.pblocks, &grid.gblock_of, &grid.nodes);
     grid.windows.par_chunks_mut(wn).enumerate().for_each(|(j, win)| {
-        let key = pblocks[j] as usize;
-        for o in 0..corners {
-            let mut gk = key;
-            let mut s = 1;
-            for a in 0..D {
-                gk += ((o >> a) & 1) * s;
-                s *= nb;
-            }
-            let g = gblock_of[gk] as usize;
-            let src = &nodes[g * bn..(g + 1) * bn];
-            for_block_nodes::<D>(corner_offset::<D>(o), |l, w| win[w] = src[l]);
-        }
+        with_simd(
+            simd,
+            #[inline(always)]
+            || {
+                let key = pblocks[j] as usize;
+                for o in 0..corners {
+                    let mut gk = key;
+                    let mut s = 1;
+                    for a in 0..D {
+                        gk += ((o >> a) & 1) * s;
+                        s *= nb;
+                    }
+                    let g = gblock_of[gk] as usize;
+                    let src = &nodes[g * bn..(g + 1) * bn];
+                    for_block_nodes::<D>(corner_offset::<D>(o), |l, w| win[w] = src[l]);
+                }
+            },
+        );
     });
 }
 
@@ -393,11 +470,11 @@ pub(crate) fn g2p<const D: usize, K: Spline>(
 /// `B_p = sum w_ip v_i dx^T` (the last one only for APIC, else zero). The sums over the
 /// innermost axis are done first, per row of the stencil.
 #[inline(always)]
-fn g2p_gather<const D: usize, K: Spline, const APIC: bool>(
+pub(crate) fn g2p_gather<const D: usize, K: Spline, const APIC: bool>(
     win: &[f32x4],
     s: &Stencil<D>,
     inv_h: f32,
-) -> (Vector<D>, Mat<D>, Mat<D>) {
+) -> Gathered<D> {
     let n = K::N;
     let mut wdx = [[0.0f32; 4]; D];
     for a in 0..D {
@@ -452,6 +529,18 @@ fn g2p_gather<const D: usize, K: Spline, const APIC: bool>(
             }
         }
     }
+    gathered::<D, APIC>(vel, bcol, gcol, inv_h)
+}
+
+/// The gather's result from its sums: `sum w v_i` (`vel`), the columns of `B_p` (`bcol`) and
+/// (APIC) of `h sum v_i grad w_ip^T` (`gcol`), each in lanes `1..=D`.
+#[inline(always)]
+pub(crate) fn gathered<const D: usize, const APIC: bool>(
+    vel: f32x4,
+    bcol: [f32x4; D],
+    gcol: [f32x4; D],
+    inv_h: f32,
+) -> Gathered<D> {
     let vel = vel.to_array();
     let bcol = bcol.map(f32x4::to_array);
     let gcol = gcol.map(f32x4::to_array);
@@ -462,6 +551,23 @@ fn g2p_gather<const D: usize, K: Spline, const APIC: bool>(
     )
 }
 
+/// One G2P chunk's outputs (sorted slots `chunk * G2P_CHUNK ..`).
+pub(crate) struct ChunkOut<'a> {
+    pub x: &'a mut [f32],
+    pub v: &'a mut [f32],
+    pub c: &'a mut [f32],
+    pub f: &'a mut [f32],
+    pub plastic: &'a mut [f32],
+    pub mass: &'a mut [f32],
+    pub volume: &'a mut [f32],
+    pub material: &'a mut [u16],
+    pub id: &'a mut [u32],
+    pub remove: &'a mut [bool],
+}
+
+/// A particle's gather: `(v_p, B_p, sum v_i grad w_ip^T)` from its window and stencil.
+pub(crate) type Gathered<const D: usize> = (Vector<D>, Mat<D>, Mat<D>);
+
 fn g2p_with<const D: usize, K: Spline, const APIC: bool>(
     grid: &SparseGrid<D>,
     st: &Particles<D>,
@@ -469,40 +575,7 @@ fn g2p_with<const D: usize, K: Spline, const APIC: bool>(
     remove: &mut [bool],
     ctx: &Ctx<'_, D>,
 ) -> G2pOutcome {
-    let wn = SparseGrid::<D>::WN;
-    let d_inv = K::D_INV * ctx.inv_h * ctx.inv_h;
     let dd = D * D;
-    let (order, slot_block, pcoords, windows) = (&grid.order, &grid.slot_block, &grid.pcoords, &grid.windows);
-    // Sorted slot `s` of the particle `order[s]`: its new state, and whether it left the domain.
-    let particle = |s: usize, x: &mut [f32], v: &mut [f32], c: &mut [f32], f: &mut [f32], pl: &mut f32| {
-        let p = order[s] as usize;
-        let j = slot_block[s] as usize;
-        let block = pcoords[j];
-        let win = &windows[j * wn..(j + 1) * wn];
-        let xp = &st.x[p * D..p * D + D];
-        let sten = stencil::<D, K>(xp, ctx.inv_h, ctx.h, &block);
-        let (vel, b, grad) = g2p_gather::<D, K, APIC>(win, &sten, ctx.inv_h);
-        let cmat = b * d_inv;
-        let l = if APIC { grad } else { cmat };
-        let mat = &ctx.materials[st.material[p] as usize];
-        let mut fnew = (Mat::<D>::identity() + l * ctx.dt) * st.deformation(p);
-        let mut plastic = st.plastic[p];
-        project(mat, &mut fnew, &mut plastic);
-        let mut xnew = Vector::<D>::from_column_slice(xp) + vel * ctx.dt;
-        let mut outside = false;
-        for a in 0..D {
-            if !(xnew[a] >= ctx.lo && xnew[a] <= ctx.hi) && xnew[a].is_finite() {
-                outside = true;
-                xnew[a] = xnew[a].clamp(ctx.lo, ctx.hi);
-            }
-        }
-        x.copy_from_slice(xnew.as_slice());
-        v.copy_from_slice(vel.as_slice());
-        c.copy_from_slice(cmat.as_slice());
-        f.copy_from_slice(fnew.as_slice());
-        *pl = plastic;
-        outside
-    };
     (
         out.x.par_chunks_mut(G2P_CHUNK * D),
         out.v.par_chunks_mut(G2P_CHUNK * D),
@@ -517,60 +590,124 @@ fn g2p_with<const D: usize, K: Spline, const APIC: bool>(
     )
         .into_par_iter()
         .enumerate()
-        .map(|(chunk, (x, v, c, f, pl, mass, vol, mat, id, rm))| {
-            let mut r = G2pOutcome { outside: 0, first_bad: u32::MAX };
-            let s0 = chunk * G2P_CHUNK;
-            for i in 0..pl.len() {
-                let s = s0 + i;
-                let outside = particle(
-                    s,
-                    &mut x[i * D..i * D + D],
-                    &mut v[i * D..i * D + D],
-                    &mut c[i * dd..i * dd + dd],
-                    &mut f[i * dd..i * dd + dd],
-                    &mut pl[i],
-                );
-                rm[i] = outside;
-                r.outside += u64::from(outside);
+        .map(|(chunk, (x, v, c, f, plastic, mass, volume, material, id, remove))| {
+            let o = ChunkOut { x, v, c, f, plastic, mass, volume, material, id, remove };
+            match ctx.simd {
+                #[cfg(target_arch = "x86_64")]
+                Some(cpu) => crate::avx2::g2p_chunk::<D, K, APIC>(cpu, grid, st, ctx, chunk, o),
+                _ => g2p_chunk::<D, K, APIC>(grid, st, ctx, chunk, o, |win, s| {
+                    g2p_gather::<D, K, APIC>(win, s, ctx.inv_h)
+                }),
             }
-            // The particle constants follow the sorted order: a block copy where the chunk's
-            // particles kept their order (most chunks, the state being sorted by the previous
-            // step), else one by one.
-            let n = pl.len();
-            let order = &order[s0..s0 + n];
-            let p0 = order[0] as usize;
-            if order.iter().enumerate().all(|(i, &p)| p as usize == p0 + i) {
-                mass.copy_from_slice(&st.mass[p0..p0 + n]);
-                vol.copy_from_slice(&st.volume[p0..p0 + n]);
-                mat.copy_from_slice(&st.material[p0..p0 + n]);
-                id.copy_from_slice(&st.id[p0..p0 + n]);
-            } else {
-                for (i, &p) in order.iter().enumerate() {
-                    let p = p as usize;
-                    mass[i] = st.mass[p];
-                    vol[i] = st.volume[p];
-                    mat[i] = st.material[p];
-                    id[i] = st.id[p];
-                }
-            }
-            // Non-finite results, checked once per chunk off the particles' dependency chains
-            // (`|bits| >= 0x7f80_0000` is an infinity or a NaN).
-            let worst = |a: &[f32]| a.iter().fold(0u32, |m, c| m.max(c.to_bits() & 0x7fff_ffff));
-            if worst(x).max(worst(v)).max(worst(c)).max(worst(f)).max(worst(pl)) >= 0x7f80_0000 {
-                let bad = (0..pl.len()).find(|&i| {
-                    worst(&x[i * D..i * D + D])
-                        .max(worst(&v[i * D..i * D + D]))
-                        .max(worst(&c[i * dd..i * dd + dd]))
-                        .max(worst(&f[i * dd..i * dd + dd]))
-                        .max(worst(std::slice::from_ref(&pl[i])))
-                        >= 0x7f80_0000
-                });
-                r.first_bad = bad.map_or(u32::MAX, |i| (s0 + i) as u32);
-            }
-            r
         })
         .reduce(
             || G2pOutcome { outside: 0, first_bad: u32::MAX },
             |a, b| G2pOutcome { outside: a.outside + b.outside, first_bad: a.first_bad.min(b.first_bad) },
         )
+}
+
+/// G2P of one chunk of sorted slots, with `gather` the particles' gather.
+#[inline(always)]
+pub(crate) fn g2p_chunk<const D: usize, K: Spline, const APIC: bool>(
+    grid: &SparseGrid<D>,
+    st: &Particles<D>,
+    ctx: &Ctx<'_, D>,
+    chunk: usize,
+    o: ChunkOut<'_>,
+    gather: impl Fn(&[f32x4], &Stencil<D>) -> Gathered<D>,
+) -> G2pOutcome {
+    let wn = SparseGrid::<D>::WN;
+    let d_inv = K::D_INV * ctx.inv_h * ctx.inv_h;
+    let dd = D * D;
+    let (order, slot_block, pcoords, windows) = (&grid.order, &grid.slot_block, &grid.pcoords, &grid.windows);
+    let ChunkOut { x, v, c, f, plastic: pl, mass, volume: vol, material: mat, id, remove: rm } = o;
+    // Sorted slot `s` of the particle `order[s]`: its new state, and whether it left the domain.
+    let particle = |s: usize, x: &mut [f32], v: &mut [f32], c: &mut [f32], f: &mut [f32], pl: &mut f32| {
+        let p = order[s] as usize;
+        let j = slot_block[s] as usize;
+        let block = pcoords[j];
+        let win = &windows[j * wn..(j + 1) * wn];
+        let xp = &st.x[p * D..p * D + D];
+        let sten = stencil::<D, K>(xp, ctx.inv_h, ctx.h, &block);
+        let (vel, b, grad) = gather(win, &sten);
+        let cmat = b * d_inv;
+        let l = if APIC { grad } else { cmat };
+        let mat = &ctx.materials[st.material[p] as usize];
+        let mut fnew = (Mat::<D>::identity() + l * ctx.dt) * st.deformation(p);
+        let mut plastic = st.plastic[p];
+        project(mat, &mut fnew, &mut plastic);
+        let mut xnew = Vector::<D>::from_column_slice(xp) + vel * ctx.dt;
+        // A finite coordinate outside `[lo, hi]` is clamped (without a branch); a non-finite
+        // one is left for the check below.
+        let mut outside = false;
+        for a in 0..D {
+            let c = xnew[a];
+            let out = (c < ctx.lo || c > ctx.hi) && c.is_finite();
+            outside |= out;
+            let clamped = if c < ctx.lo {
+                ctx.lo
+            } else if c > ctx.hi {
+                ctx.hi
+            } else {
+                c
+            };
+            xnew[a] = if out { clamped } else { c };
+        }
+        x.copy_from_slice(xnew.as_slice());
+        v.copy_from_slice(vel.as_slice());
+        c.copy_from_slice(cmat.as_slice());
+        f.copy_from_slice(fnew.as_slice());
+        *pl = plastic;
+        outside
+    };
+    let mut r = G2pOutcome { outside: 0, first_bad: u32::MAX };
+    let s0 = chunk * G2P_CHUNK;
+    for i in 0..pl.len() {
+        let s = s0 + i;
+        let outside = particle(
+            s,
+            &mut x[i * D..i * D + D],
+            &mut v[i * D..i * D + D],
+            &mut c[i * dd..i * dd + dd],
+            &mut f[i * dd..i * dd + dd],
+            &mut pl[i],
+        );
+        rm[i] = outside;
+        r.outside += u64::from(outside);
+    }
+    // The particle constants follow the sorted order: a block copy where the chunk's
+    // particles kept their order (most chunks, the state being sorted by the previous
+    // step), else one by one.
+    let n = pl.len();
+    let order = &order[s0..s0 + n];
+    let p0 = order[0] as usize;
+    if order.iter().enumerate().all(|(i, &p)| p as usize == p0 + i) {
+        mass.copy_from_slice(&st.mass[p0..p0 + n]);
+        vol.copy_from_slice(&st.volume[p0..p0 + n]);
+        mat.copy_from_slice(&st.material[p0..p0 + n]);
+        id.copy_from_slice(&st.id[p0..p0 + n]);
+    } else {
+        for (i, &p) in order.iter().enumerate() {
+            let p = p as usize;
+            mass[i] = st.mass[p];
+            vol[i] = st.volume[p];
+            mat[i] = st.material[p];
+            id[i] = st.id[p];
+        }
+    }
+    // Non-finite results, checked once per chunk off the particles' dependency chains
+    // (`|bits| >= 0x7f80_0000` is an infinity or a NaN).
+    let worst = |a: &[f32]| a.iter().fold(0u32, |m, c| m.max(c.to_bits() & 0x7fff_ffff));
+    if worst(x).max(worst(v)).max(worst(c)).max(worst(f)).max(worst(pl)) >= 0x7f80_0000 {
+        let bad = (0..pl.len()).find(|&i| {
+            worst(&x[i * D..i * D + D])
+                .max(worst(&v[i * D..i * D + D]))
+                .max(worst(&c[i * dd..i * dd + dd]))
+                .max(worst(&f[i * dd..i * dd + dd]))
+                .max(worst(std::slice::from_ref(&pl[i])))
+                >= 0x7f80_0000
+        });
+        r.first_bad = bad.map_or(u32::MAX, |i| (s0 + i) as u32);
+    }
+    r
 }
