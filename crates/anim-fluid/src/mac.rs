@@ -1345,6 +1345,11 @@ mod tests {
         assert!((a / exact - 1.0).abs() < 0.02, "{a} vs {exact}");
     }
 
+    /// A box of smoke (density and temperature 1) near the floor.
+    fn smoke_source() -> Source {
+        Source { min: [0.3, 0.0, 0.3], max: [0.6, 0.2, 0.6], density: 1.0, temperature: 1.0, velocity: None }
+    }
+
     /// The Taylor-Green vortex is a steady Euler flow whose advection term is a gradient: the
     /// splitting error of advect-then-project (first order, about `2 dt` of the amplitude at
     /// `t = 1`) is the whole error of MacCormack at N = 32, CFL 2 (dt = 1/16). Advection-
@@ -1375,13 +1380,7 @@ mod tests {
                         pressure_tolerance: 1e-8,
                         viscosity: 0.01,
                         buoyancy_temperature: 1.0,
-                        sources: vec![Source {
-                            min: [0.3, 0.0, 0.3],
-                            max: [0.6, 0.2, 0.6],
-                            density: 1.0,
-                            temperature: 1.0,
-                            velocity: None,
-                        }],
+                        sources: vec![smoke_source()],
                         ..MacParams::default()
                     };
                     let (mut f, mut s) = MacFluid::new(dims, dim, 1.0 / 16.0, params).unwrap();
@@ -1472,13 +1471,7 @@ mod tests {
                     splitting: Splitting::ALL[(k / 2) % 2],
                     buoyancy_temperature: 1.0,
                     vorticity_confinement: 1.0,
-                    sources: vec![Source {
-                        min: [0.3, 0.0, 0.3],
-                        max: [0.6, 0.2, 0.6],
-                        density: 1.0,
-                        temperature: 1.0,
-                        velocity: None,
-                    }],
+                    sources: vec![smoke_source()],
                     ..MacParams::default()
                 };
                 let build = || {

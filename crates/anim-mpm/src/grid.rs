@@ -174,24 +174,13 @@ impl<const D: usize> SparseGrid<D> {
 
         // The counting sort goes by runs of equal keys: the particles come sorted by the
         // previous step, so most of a block's particles form one run.
-        let keys = &self.keys;
-        let run_end = |i: usize| {
-            let mut e = i + 1;
-            while e < np && keys[e] == keys[i] {
-                e += 1;
-            }
-            e
-        };
-        let mut i = 0;
-        while i < np {
-            let e = run_end(i);
-            let k = keys[i];
+        for run in self.keys[..np].chunk_by(|a, b| a == b) {
+            let k = run[0];
             let c = &mut self.count[k as usize];
             if *c == 0 {
                 self.pblocks.push(k);
             }
-            *c += (e - i) as u32;
-            i = e;
+            *c += run.len() as u32;
         }
         self.pblocks.sort_unstable();
         self.cursor.clear();
@@ -205,26 +194,18 @@ impl<const D: usize> SparseGrid<D> {
             self.count[k as usize] = 0;
         }
         self.pstart.push(run);
-        let keys = &self.keys;
-        let run_end = |i: usize| {
-            let mut e = i + 1;
-            while e < np && keys[e] == keys[i] {
-                e += 1;
-            }
-            e
-        };
         let mut i = 0;
-        while i < np {
-            let e = run_end(i);
-            let j = self.pblock_of[keys[i] as usize];
+        for run in self.keys[..np].chunk_by(|a, b| a == b) {
+            let n = run.len();
+            let j = self.pblock_of[run[0] as usize];
             let slot = &mut self.cursor[j as usize];
             let s = *slot as usize;
-            for (t, o) in self.order[s..s + (e - i)].iter_mut().enumerate() {
+            for (t, o) in self.order[s..s + n].iter_mut().enumerate() {
                 *o = (i + t) as u32;
             }
-            self.slot_block[s..s + (e - i)].fill(j);
-            *slot += (e - i) as u32;
-            i = e;
+            self.slot_block[s..s + n].fill(j);
+            *slot += n as u32;
+            i += n;
         }
 
         // Grid blocks: every occupied block and its + {0,1}^D neighbours.
