@@ -962,7 +962,7 @@ impl MacFluid {
     fn outflow(&self, vel: &[Vec<f64>; 3], out: &mut [f64]) {
         let d = self.dims;
         let dim = self.dim;
-        let fds: Vec<[usize; 3]> = (0..3).map(|a| self.face_dims(a)).collect();
+        let fds: [[usize; 3]; 3] = std::array::from_fn(|a| self.face_dims(a));
         let solid = &self.solid;
         out.par_chunks_mut(d[0]).enumerate().for_each(|(line, row)| {
             let (j, k) = (line % d[1], line / d[1]);
