@@ -29,15 +29,16 @@ fn parse_bencher(out: &str) -> Vec<Row> {
 
 pub fn run(filter: Option<&str>) -> bool {
     if std::env::args().skip(2).any(|a| a == "--peers") {
-        // `--filter` picks peers by name (springs, rigid, pbd, fem, mpm, fluid).
+        // `--filter` picks peers by name (springs, rigid, pbd, fem, mpm, fluid, flip).
         type Peer = (&'static str, fn() -> bool);
-        let peers: [Peer; 6] = [
+        let peers: [Peer; 7] = [
             ("springs", peers::run),
             ("rigid", peers_rigid::run),
             ("pbd", peers_pbd::run),
             ("fem", peers_fem::run),
             ("mpm", peers_mpm::run),
             ("fluid", peers_fluid::run),
+            ("flip", peers_flip::run),
         ];
         let mut ok = true;
         for (name, run) in peers {
@@ -139,6 +140,10 @@ mod peers_mpm;
 /// anim-fluid's peers (the seed's C routines, Taichi stable fluids), in its own file.
 #[path = "peers_fluid.rs"]
 mod peers_fluid;
+
+/// anim-flip's peer (Taichi MLS-MPM 3D as a dam break), in its own file.
+#[path = "peers_flip.rs"]
+mod peers_flip;
 
 /// `cargo xtask bench --peers`: our per-step time against peer libraries on the same problem,
 /// same integrator and same thread count, measured side by side in one run.

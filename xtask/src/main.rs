@@ -5,7 +5,7 @@
 //! | `conformance [--quick] [--filter S]` | every reference case with metric, error, tolerance and verdict; exit 1 on any failure |
 //! | `stability [--quick] [--filter S]` | the named hard cases of every crate with their outcomes; exit 1 on an unexpected outcome |
 //! | `stability --long [--quick] [--filter S] [--out DIR]` | soak: each crate's hard case for `10^5` steps or ten minutes with its energy bound; written to `docs/report/soak.md` |
-//! | `bench [--filter S]` | the criterion benches under `benches/`, printed as a table and written to `target/xtask/bench.csv`; `--peers [--filter S]`: the peer comparisons (springs, rigid, pbd, fem, mpm, fluid), their ratios merged into `docs/report/peers.csv` (a filtered run replaces only its crates' rows) |
+//! | `bench [--filter S]` | the criterion benches under `benches/`, printed as a table and written to `target/xtask/bench.csv`; `--peers [--filter S]`: the peer comparisons (springs, rigid, pbd, fem, mpm, fluid, flip), their ratios merged into `docs/report/peers.csv` (a filtered run replaces only its crates' rows) |
 //! | `report [--quick] [--filter S] [--out DIR] [--threads 1,2,...]` | conformance, stability and work-precision studies, the cheapest method per tolerance (also `cheapest.json`), thread scaling (1 and all cores unless `--threads`) and the peer ratios of `docs/report/peers.csv`, written to `docs/report/` (Markdown + SVG, and every measured part in `data.json`); `--filter` re-runs only the parts of matching crates or names and keeps the rest from `data.json`; prints its duration |
 //! | `ci` | what CI runs: format, clippy, tests (with doc tests), docs, quick conformance and stability |
 

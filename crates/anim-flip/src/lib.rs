@@ -37,7 +37,9 @@
 //!   [`Transfer::Apic`] with the B-splines of [`anim_core::bspline`] (shared with `anim-mpm`);
 //! - [`project`]: body forces, solid walls and the pressure projection through
 //!   `anim_fluid::pressure` (MGPCG, CG, Gauss-Seidel, Jacobi);
-//! - [`sim`]: [`FlipSimulation`] with CFL substeps, the non-finite guard and checkpoints;
+//! - [`sim`]: [`FlipSimulation`] with CFL substeps, the non-finite guard and checkpoints, and
+//!   optional wall-time measurement of each substep's parts ([`StepTimes`]: transfer,
+//!   projection, advection, other; [`FlipSimulation::set_timing`], off by default);
 //! - [`reseed`]: optional per-cell particle count control after advection ([`Reseed`] in
 //!   [`FlipParams::reseed`]): sparse interior cells topped up, crowded cells thinned;
 //! - [`surface`]: a surface for output, [`ParticleSurface`]: Zhu & Bridson's particle level set
@@ -46,7 +48,8 @@
 //! - [`tank`]: [`TankMotion`], a tank shaken or accelerated along one axis, simulated in its
 //!   own frame (body force `g - a_tank(t)`, `FlipParams::tank_motion`);
 //! - [`scenes`]: seeding ([`scenes::fill_box`], [`scenes::fill_region`]), still water, the dam
-//!   break in 2D ([`scenes::dam_break`]) and 3D ([`scenes::dam_break_3d`]), a rotating disk, a
+//!   break in 2D ([`scenes::dam_break`]) and 3D ([`scenes::dam_break_3d`], and the benchmark
+//!   block [`scenes::benchmark_dam_break_3d`]: `n^3 / 2` particles), a rotating disk, a
 //!   drop falling into a pool ([`scenes::drop_into_pool`], 2D and 3D), a sloshing tank
 //!   ([`scenes::sloshing_tank`], 2D and 3D), and the presets of the `anim` command
 //!   ([`scenes::by_name`]: `dam-break-2d`, `dam-break-3d`, `drop-2d`, `drop-3d`,
@@ -94,7 +97,7 @@ mod tests;
 pub use error::FlipError;
 pub use particles::Particles;
 pub use reseed::Reseed;
-pub use sim::{FlipParams, FlipSimulation, StepInfo};
+pub use sim::{FlipParams, FlipSimulation, StepInfo, StepTimes};
 pub use surface::{Contour, Mesh, ParticleSurface, SurfaceParams};
 pub use tank::TankMotion;
 pub use transfer::Transfer;

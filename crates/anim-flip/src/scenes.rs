@@ -150,6 +150,35 @@ pub fn dam_break_3d(
     Ok((sim, p, lo[0]))
 }
 
+/// The benchmark dam break (`cargo xtask bench --peers --filter flip`): a cube of `n` cells per
+/// axis of size `1/n` m (`n` a multiple of 4, at least 8) and a block of `n/4 x n/2 x n/2`
+/// cells (x, y up, z) in the corner of the fluid box, seeded with 2 particles per cell and axis
+/// (8 per cell), at rest: `n^3 / 2` particles, 1 048 576 at `n = 128`. The block fills 1/16 of
+/// the box and collapses along x.
+///
+/// # Errors
+/// [`FlipError::BadParameter`] for `n` not a multiple of 4 or below 8; otherwise as
+/// [`FlipSimulation::new`].
+pub fn benchmark_dam_break_3d(
+    n: usize,
+    params: FlipParams<3>,
+) -> Result<(FlipSimulation<3>, Particles<3>), FlipError> {
+    if n < 8 || !n.is_multiple_of(4) {
+        return Err(FlipError::BadParameter {
+            name: "n",
+            requirement: "must be a multiple of 4 and at least 8",
+            value: n.to_string(),
+        });
+    }
+    let h = 1.0 / n as f64;
+    let sim = FlipSimulation::new([n; 3], h, params)?;
+    let (lo, _) = sim.fluid_box();
+    let q = (n / 4) as f64 * h;
+    let mut p = Particles::new();
+    fill_box(&mut p, h, 2, lo, [lo[0] + q, lo[1] + 2.0 * q, lo[2] + 2.0 * q], |_| [0.0; 3]);
+    Ok((sim, p))
+}
+
 /// Depth of the pool of [`drop_into_pool`], m.
 pub const POOL_DEPTH: f64 = 0.3;
 /// Radius of the drop of [`drop_into_pool`], m.

@@ -131,6 +131,57 @@ pub struct StepInfo {
     pub seeded: usize,
     /// Particles removed by reseeding, summed over the substeps.
     pub removed: usize,
+    /// Wall time of the parts of the substeps, summed over them; all zero unless timing is on
+    /// ([`FlipSimulation::set_timing`]).
+    pub times: StepTimes,
+}
+
+/// Wall time of the parts of the substeps of one [`FlipSimulation::advance`], seconds, summed
+/// over its substeps. Measured only when [`FlipSimulation::set_timing`] is on (otherwise no clock
+/// is read and every field is zero); the four parts add up to the time spent in the substep loop.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StepTimes {
+    /// Particle-to-grid and grid-to-particle transfers (P2G, G2P).
+    pub transfer: f64,
+    /// The pressure projection: divergence before and after, the volume-correction target,
+    /// (re)building the pressure operator and its multigrid hierarchy, the solve (MGPCG by
+    /// default) and the velocity update.
+    pub projection: f64,
+    /// Advection of the positions and the push out of solid cells.
+    pub advection: f64,
+    /// Everything else: the CFL limit, binning and cell labels, velocity extrapolation, body
+    /// forces and walls, reseeding and the non-finite guard.
+    pub other: f64,
+}
+
+impl StepTimes {
+    /// The sum of the four parts, seconds.
+    #[must_use]
+    pub fn total(&self) -> f64 {
+        self.transfer + self.projection + self.advection + self.other
+    }
+}
+
+/// A clock read only when timing is on: [`Lap::lap`] returns the seconds since the previous lap
+/// (or the start), and 0 without reading the clock when off.
+struct Lap(Option<std::time::Instant>);
+
+impl Lap {
+    fn start(on: bool) -> Self {
+        Self(on.then(std::time::Instant::now))
+    }
+
+    fn lap(&mut self) -> f64 {
+        match &mut self.0 {
+            Some(t) => {
+                let now = std::time::Instant::now();
+                let d = now.duration_since(*t).as_secs_f64();
+                *t = now;
+                d
+            }
+            None => 0.0,
+        }
+    }
 }
 
 /// An incompressible particle fluid on a MAC grid in `D` dimensions (2 or 3).
@@ -152,6 +203,7 @@ pub struct FlipSimulation<const D: usize> {
     steps: u64,
     time: f64,
     last: StepInfo,
+    timing: bool,
 }
 
 impl<const D: usize> FlipSimulation<D> {
@@ -245,6 +297,7 @@ impl<const D: usize> FlipSimulation<D> {
             steps: 0,
             time: 0.0,
             last: StepInfo::default(),
+            timing: false,
         })
     }
 
@@ -259,6 +312,18 @@ impl<const D: usize> FlipSimulation<D> {
                 *s = true;
             }
         }
+    }
+
+    /// Turns the per-part wall-time measurement of [`StepInfo::times`] on or off (default off:
+    /// then no clock is read). Timing does not change the results.
+    pub fn set_timing(&mut self, on: bool) {
+        self.timing = on;
+    }
+
+    /// Whether [`StepInfo::times`] is measured.
+    #[must_use]
+    pub fn timing(&self) -> bool {
+        self.timing
     }
 
     /// The parameters.
@@ -356,6 +421,8 @@ impl<const D: usize> FlipSimulation<D> {
         let mut info = StepInfo::default();
         let mut t = 0.0;
         while t < dt {
+            let mut whole = Lap::start(self.timing);
+            let before = info.times.transfer + info.times.projection + info.times.advection;
             let limit = self.cfl_dt(particles);
             let remaining = dt - t;
             let sub = if remaining <= limit * (1.0 + 1e-9) { remaining } else { limit };
@@ -369,6 +436,8 @@ impl<const D: usize> FlipSimulation<D> {
             }
             self.substep(particles, self.time + t, sub, &mut info)?;
             self.check_finite(particles)?;
+            let parts = info.times.transfer + info.times.projection + info.times.advection;
+            info.times.other += (whole.lap() - (parts - before)).max(0.0);
             self.steps += 1;
             t = if sub == remaining { dt } else { t + sub };
         }
@@ -393,7 +462,9 @@ impl<const D: usize> FlipSimulation<D> {
         classify(&self.solid, &self.bins, &mut self.labels);
         info.fluid_cells = self.labels.iter().filter(|&&l| l == CellLabel::Fluid).count();
         let apic = self.params.transfer == Transfer::Apic;
+        let mut lap = Lap::start(self.timing);
         transfer::p2g(&mut self.grid, particles, &self.bins, self.params.kernel, apic);
+        info.times.transfer += lap.lap();
         project::mark_weighted_faces(&mut self.grid);
         let layers = self.layers();
         self.grid.extrapolate(layers);
@@ -406,6 +477,7 @@ impl<const D: usize> FlipSimulation<D> {
             dv[tank.axis] -= tank.velocity_change(time, dt);
         }
         project::body_forces_and_walls(&mut self.grid, &self.solid, dv);
+        lap.lap();
         let settings = PressureSettings {
             method: self.params.pressure,
             tolerance: self.params.tolerance,
@@ -454,13 +526,17 @@ impl<const D: usize> FlipSimulation<D> {
             self.rhs.par_iter_mut().zip(self.target.par_iter()).for_each(|(r, t)| *r -= t);
         }
         info.max_divergence = info.max_divergence.max(max_abs(&self.rhs) / h);
+        info.times.projection += lap.lap();
         project::mark_fluid_faces(&mut self.grid, &self.labels);
         self.grid.extrapolate(layers);
         if self.params.no_slip {
             project::no_slip(&mut self.grid, &self.solid);
         }
+        lap.lap();
         transfer::g2p(&self.grid, particles, self.params.kernel, self.params.transfer);
+        info.times.transfer += lap.lap();
         info.pushed_out += self.advect(particles, dt);
+        info.times.advection += lap.lap();
         if let Some(bounds) = self.params.reseed {
             let field = reseed::Field {
                 grid: &self.grid,

@@ -291,3 +291,33 @@ fn volume_correction_keeps_volume() {
     assert!((kept - 1.0).abs() < 0.03, "with correction: {kept}");
     assert!(lost < 0.9, "without correction: {lost}");
 }
+
+/// Timing is off by default and then reads no clock (every part zero); on, the four parts are
+/// measured, add up to at most the wall time of the calls measured outside, and the trajectory
+/// is bitwise the one without timing.
+#[test]
+fn step_times_measure_the_parts_without_changing_the_run() {
+    let params = FlipParams::<2>::default();
+    let (mut plain, mut p1, _) = scenes::dam_break(32, 0.3, params).unwrap();
+    let (mut timed, mut p2, _) = scenes::dam_break(32, 0.3, params).unwrap();
+    assert!(!timed.timing());
+    timed.set_timing(true);
+    let mut outside = 0.0;
+    let mut parts = crate::StepTimes::default();
+    for _ in 0..5 {
+        let info = plain.advance(&mut p1, 0.02).unwrap();
+        assert_eq!(info.times, crate::StepTimes::default());
+        let start = std::time::Instant::now();
+        let info = timed.advance(&mut p2, 0.02).unwrap();
+        outside += start.elapsed().as_secs_f64();
+        let t = info.times;
+        parts.transfer += t.transfer;
+        parts.projection += t.projection;
+        parts.advection += t.advection;
+        parts.other += t.other;
+    }
+    assert_eq!(p1, p2);
+    assert!(parts.transfer > 0.0 && parts.projection > 0.0 && parts.advection > 0.0 && parts.other > 0.0);
+    assert!(parts.total() <= outside, "{parts:?} against {outside} s measured outside");
+    assert!(parts.total() > 0.5 * outside, "{parts:?} against {outside} s measured outside");
+}

@@ -144,6 +144,20 @@ fn tank_frame_force_is_minus_the_tank_acceleration() {
 /// few steps keep every particle inside the fluid box.
 #[test]
 fn seeded_volumes_and_particles_stay_in_the_tank() {
+    // The benchmark block: n/4 x n/2 x n/2 cells at 8 particles per cell, n^3 / 2 particles, on
+    // the lattice at (k + 1/2) h / 2 from the fluid box corner.
+    for n in [8, 16, 32] {
+        let h = 1.0 / n as f64;
+        let (sim, p) = scenes::benchmark_dam_break_3d(n, FlipParams::default()).unwrap();
+        assert_eq!(p.len(), n * n * n / 2);
+        let (lo, _) = sim.fluid_box();
+        let hi = [lo[0] + 0.25, lo[1] + 0.5, lo[2] + 0.5];
+        for a in 0..3 {
+            let min = p.x.iter().map(|x| x[a]).fold(f64::INFINITY, f64::min);
+            let max = p.x.iter().map(|x| x[a]).fold(f64::NEG_INFINITY, f64::max);
+            assert!((min - (lo[a] + h / 4.0)).abs() < 1e-12 && (max - (hi[a] - h / 4.0)).abs() < 1e-12);
+        }
+    }
     let n = 16;
     let h = 1.0 / n as f64;
     let (mut sim, mut p, x0) = scenes::dam_break_3d(n, 0.25, FlipParams::default()).unwrap();
@@ -206,6 +220,8 @@ fn bad_scene_and_tank_parameters_are_named() {
     let p3 = FlipParams::<3>::default;
     assert_eq!(name(scenes::dam_break_3d(16, 0.0, p3()).map(|_| ())), "a");
     assert_eq!(name(scenes::dam_break_3d(16, 0.6, p3()).map(|_| ())), "a");
+    assert_eq!(name(scenes::benchmark_dam_break_3d(4, p3()).map(|_| ())), "n");
+    assert_eq!(name(scenes::benchmark_dam_break_3d(18, p3()).map(|_| ())), "n");
     assert_eq!(name(scenes::drop_into_pool::<2>(2, p()).map(|_| ())), "cells[0]");
     assert_eq!(name(scenes::drop_into_pool::<2>(0, p()).map(|_| ())), "h");
     // Scene files without the field still parse (tank at rest).
