@@ -7,6 +7,7 @@
 //! (median of steps 2..5 from rest) measured side by side; pbatoolkit is installed with pip when
 //! missing and skipped with a visible note when that fails.
 
+use crate::python::json_field as field;
 use anim_fem::scenes;
 use std::process::Command;
 use std::time::Instant;
@@ -14,13 +15,6 @@ use std::time::Instant;
 const SCRIPT: &str = "peers/fem/pbat_beam.py";
 const CELLS: usize = 50;
 const STEPS: usize = 5;
-
-fn field(line: &str, key: &str) -> Option<String> {
-    let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
-    let rest = rest.trim_start();
-    let end = rest.find([',', '}']).unwrap_or(rest.len());
-    Some(rest[..end].trim().trim_matches('"').to_string())
-}
 
 /// Ours: per-step seconds (median of steps 2..), Newton iterations, tip z.
 fn ours() -> Result<(usize, f64, Vec<usize>, f64), String> {

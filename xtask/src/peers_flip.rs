@@ -11,9 +11,9 @@
 //! 1e-4 s at 128^3). So the ratio is quoted both per step and per simulated second. Taichi is
 //! installed with pip when missing; if that fails the peer is skipped with a visible note.
 
+use crate::python::json_field as field;
 use anim_flip::{FlipParams, StepTimes, scenes};
 use std::io::Write;
-use std::process::Command;
 
 const SCRIPT: &str = "peers/flip/taichi_mpm3d_dam_break.py";
 /// Grid cells per axis.
@@ -28,13 +28,6 @@ const REPEATS: usize = 3;
 /// Taichi: warm-up steps (compilation and the first motion), timed steps per repeat.
 const TAICHI_WARMUP: usize = 20;
 const TAICHI_STEPS: usize = 5;
-
-fn field(line: &str, key: &str) -> Option<String> {
-    let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
-    let rest = rest.trim_start();
-    let end = rest.find([',', '}']).unwrap_or(rest.len());
-    Some(rest[..end].trim().trim_matches('"').to_string())
-}
 
 /// Our timed frames: the median frame by time per substep.
 struct Ours {
@@ -91,24 +84,12 @@ fn ours(threads: usize) -> Result<Ours, String> {
 
 /// Taichi's time per step, its dt and the front position.
 fn taichi(threads: usize) -> Result<(f64, f64, f64, String), String> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(SCRIPT);
-    let out = Command::new(crate::python::python())
-        .arg(&path)
-        .args(["--n", &N.to_string(), "--steps", &TAICHI_STEPS.to_string()])
-        .args(["--repeats", &REPEATS.to_string(), "--threads", &threads.to_string()])
-        .args(["--warmup", &TAICHI_WARMUP.to_string()])
-        .output()
-        .map_err(|e| format!("could not run {}: {e}", crate::python::python()))?;
-    if !out.status.success() {
-        return Err(format!(
-            "taichi script failed: {}",
-            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
-        ));
-    }
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let line = stdout.lines().find(|l| l.starts_with('{')).ok_or("no result line")?;
-    let get = |k: &str| field(line, k).and_then(|v| v.parse::<f64>().ok()).ok_or(format!("no {k}"));
-    Ok((get("per_step_s")?, get("dt")?, get("front")?, field(line, "taichi").unwrap_or_default()))
+    let args = [("--n", N), ("--steps", TAICHI_STEPS), ("--repeats", REPEATS), ("--threads", threads)];
+    let mut args: Vec<String> = args.iter().flat_map(|(k, v)| [k.to_string(), v.to_string()]).collect();
+    args.extend(["--warmup".to_string(), TAICHI_WARMUP.to_string()]);
+    let line = crate::python::result_line(SCRIPT, &args, &[])?;
+    let get = |k: &str| field(&line, k).and_then(|v| v.parse::<f64>().ok()).ok_or(format!("no {k}"));
+    Ok((get("per_step_s")?, get("dt")?, get("front")?, field(&line, "taichi").unwrap_or_default()))
 }
 
 pub fn run() -> bool {

@@ -12,18 +12,12 @@
 //!    missing; on failure it is skipped with a visible note.
 
 use crate::cases::fluid::compile_c;
+use crate::python::json_field;
 use anim_fluid::mac::{MacFluid, MacParams};
 use anim_fluid::pressure::{PressureMethod, PressureSolver};
 use anim_fluid::seed::{SeedFluid, SeedParams};
 use std::process::Command;
 use std::time::Instant;
-
-fn field(line: &str, key: &str) -> Option<f64> {
-    let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
-    let rest = rest.trim_start();
-    let end = rest.find([',', '}']).unwrap_or(rest.len());
-    rest[..end].trim().parse().ok()
-}
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -63,7 +57,7 @@ fn c_per_step(exe: &std::path::Path, n: usize, steps: usize, repeats: usize) -> 
     for _ in 0..repeats {
         let out = Command::new(exe).args(["time", &n.to_string(), &steps.to_string()]).output().ok()?;
         let s = String::from_utf8_lossy(&out.stdout);
-        v.push(field(s.lines().find(|l| l.starts_with('{'))?, "per_step_s")?);
+        v.push(json_field(s.lines().find(|l| l.starts_with('{'))?, "per_step_s")?.parse().ok()?);
     }
     Some(median(v))
 }
@@ -104,23 +98,9 @@ fn projection(n: usize, method: PressureMethod, tol: f64, cap: usize) -> Option<
 }
 
 fn taichi(threads: usize) -> Result<f64, String> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("peers/fluid/taichi_stable_fluid.py");
-    let out = Command::new(crate::python::python())
-        .arg(&path)
-        .args(["--res", "512", "--steps", "10", "--threads", &threads.to_string()])
-        .output()
-        .map_err(|e| format!("could not run {}: {e}", crate::python::python()))?;
-    if !out.status.success() {
-        return Err(format!(
-            "taichi script failed: {}",
-            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
-        ));
-    }
-    let s = String::from_utf8_lossy(&out.stdout);
-    s.lines()
-        .find(|l| l.starts_with('{'))
-        .and_then(|l| field(l, "per_step_s"))
-        .ok_or_else(|| "no result".into())
+    let args = ["--res", "512", "--steps", "10", "--threads", &threads.to_string()].map(String::from);
+    let line = crate::python::result_line("peers/fluid/taichi_stable_fluid.py", &args, &[])?;
+    json_field(&line, "per_step_s").and_then(|v| v.parse().ok()).ok_or_else(|| "no per_step_s".into())
 }
 
 pub fn run() -> bool {

@@ -6,35 +6,17 @@
 //! is skipped with a visible note.
 
 use crate::cases::mpm::peer_benchmark;
+use crate::python::json_field as field;
 use std::io::Write;
-use std::process::Command;
 
 const SCRIPT: &str = "peers/mpm/taichi_mpm.py";
 
-fn field(line: &str, key: &str) -> Option<String> {
-    let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
-    let rest = rest.trim_start();
-    let end = rest.find([',', '}']).unwrap_or(rest.len());
-    Some(rest[..end].trim().trim_matches('"').to_string())
-}
-
 fn taichi(dim: usize, n: usize, steps: usize, repeats: usize, threads: usize) -> Result<(f64, f64), String> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(SCRIPT);
-    let out = Command::new(crate::python::python())
-        .arg(&path)
-        .args(["--dim", &dim.to_string(), "--n", &n.to_string(), "--steps", &steps.to_string()])
-        .args(["--repeats", &repeats.to_string(), "--threads", &threads.to_string()])
-        .output()
-        .map_err(|e| format!("could not run {}: {e}", crate::python::python()))?;
-    if !out.status.success() {
-        return Err(format!(
-            "taichi script failed: {}",
-            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
-        ));
-    }
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let line = stdout.lines().find(|l| l.starts_with('{')).ok_or("no result line")?;
-    let get = |k: &str| field(line, k).and_then(|v| v.parse::<f64>().ok()).ok_or(format!("no {k}"));
+    let args =
+        [("--dim", dim), ("--n", n), ("--steps", steps), ("--repeats", repeats), ("--threads", threads)];
+    let args: Vec<String> = args.iter().flat_map(|(k, v)| [k.to_string(), v.to_string()]).collect();
+    let line = crate::python::result_line(SCRIPT, &args, &[])?;
+    let get = |k: &str| field(&line, k).and_then(|v| v.parse::<f64>().ok()).ok_or(format!("no {k}"));
     Ok((get("per_step_s")?, get("mean_y")?))
 }
 

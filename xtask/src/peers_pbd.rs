@@ -10,21 +10,14 @@
 //! are installed with pip when missing; if that fails the peer is skipped with a visible note.
 
 use crate::cases::pbd::peer_cloth;
+use crate::python::json_field as field;
 use anim_pbd::SolverKind;
 use std::io::Write;
-use std::process::Command;
 
 const PYPBD: &str = "peers/pbd/pypbd_cloth.py";
 const NEWTON: &str = "peers/pbd/newton_cloth.py";
 
 /// A value of a flat JSON object line.
-fn field(line: &str, key: &str) -> Option<String> {
-    let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
-    let rest = rest.trim_start();
-    let end = rest.find([',', '}']).unwrap_or(rest.len());
-    Some(rest[..end].trim().trim_matches('"').to_string())
-}
-
 struct Row {
     n: usize,
     iterations: usize,
@@ -42,25 +35,9 @@ fn run_script(
     steps: usize,
     repeats: usize,
 ) -> Result<String, String> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(script);
-    let out = Command::new(crate::python::python())
-        .arg(&path)
-        .args(["--n", &n.to_string(), "--iterations", &iterations.to_string()])
-        .args(["--steps", &steps.to_string(), "--repeats", &repeats.to_string()])
-        .env("OMP_NUM_THREADS", "1")
-        .output()
-        .map_err(|e| format!("could not run {}: {e}", crate::python::python()))?;
-    if !out.status.success() {
-        return Err(format!(
-            "{script} failed: {}",
-            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
-        ));
-    }
-    String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .find(|l| l.starts_with('{'))
-        .map(str::to_string)
-        .ok_or_else(|| format!("{script} printed no result"))
+    let args = [("--n", n), ("--iterations", iterations), ("--steps", steps), ("--repeats", repeats)];
+    let args: Vec<String> = args.iter().flat_map(|(k, v)| [k.to_string(), v.to_string()]).collect();
+    crate::python::result_line(script, &args, &[("OMP_NUM_THREADS", "1")])
 }
 
 pub fn run() -> bool {

@@ -12,6 +12,7 @@
 //! timed in both of its conventions (LOCAL, its default, and WORLD) and compared with the faster
 //! one. Needs Python with `pin==4.1.0` and `cmeel-eigen` (installed with pip when missing) and g++.
 
+use crate::python::json_field as field;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -205,13 +206,6 @@ fn run_peer(bin: &Path, file: &Path) -> Result<Vec<(String, f64)>, String> {
             Some((field(line, "kernel")?, ns))
         })
         .collect())
-}
-
-fn field(line: &str, key: &str) -> Option<String> {
-    let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
-    let rest = rest.trim_start();
-    let end = rest.find([',', '}']).unwrap_or(rest.len());
-    Some(rest[..end].trim().trim_matches('"').to_string())
 }
 
 /// One row of the table: robot, kernel, ours, Pinocchio (best convention), Pinocchio detail.

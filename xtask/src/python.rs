@@ -38,3 +38,47 @@ pub fn ensure(module: &str, packages: &[&str], hint: &str) -> Result<(), String>
     }
     Ok(())
 }
+
+/// Runs the peer script `script` (a path under `xtask/`) with `args` and the environment
+/// variables `envs`, and returns the first line it printed that starts with `{` (its result).
+pub fn result_line(script: &str, args: &[String], envs: &[(&str, &str)]) -> Result<String, String> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(script);
+    let out = Command::new(python())
+        .arg(&path)
+        .args(args)
+        .envs(envs.iter().copied())
+        .output()
+        .map_err(|e| format!("could not run {}: {e}", python()))?;
+    if !out.status.success() {
+        return Err(format!(
+            "{script} failed: {}",
+            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
+        ));
+    }
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .find(|l| l.starts_with('{'))
+        .map(str::to_string)
+        .ok_or_else(|| format!("{script} printed no result"))
+}
+
+/// The value of `key` in a one-line JSON object printed by a peer script, as text (quotes
+/// removed); `None` when the key is absent.
+pub fn json_field(line: &str, key: &str) -> Option<String> {
+    let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
+    let rest = rest.trim_start();
+    let end = rest.find([',', '}']).unwrap_or(rest.len());
+    Some(rest[..end].trim().trim_matches('"').to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn json_field_reads_numbers_strings_and_absent_keys() {
+        let line = r#"{"per_step_s": 0.25, "taichi": "1.7.4", "front":3}"#;
+        assert_eq!(super::json_field(line, "per_step_s").as_deref(), Some("0.25"));
+        assert_eq!(super::json_field(line, "taichi").as_deref(), Some("1.7.4"));
+        assert_eq!(super::json_field(line, "front").as_deref(), Some("3"));
+        assert_eq!(super::json_field(line, "dt"), None);
+    }
+}
