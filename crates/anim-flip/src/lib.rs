@@ -11,18 +11,23 @@
 //! project u   -= grad s,  A s = -h div u over fluid cells, s = 0 in air  (free surface)
 //! G2P     v_p  = sum_i w_ip u_i                    (PIC; FLIP adds the change; APIC also C_p)
 //!         C_p  = D_p^-1 sum_i w_ip u_i (x_i - x_p)^T,  D_p^-1 = 4/h^2 (quadratic B-spline)
-//! advect  x_p += dt u(x_p + dt/2 u(x_p))   (midpoint rule through the projected grid field)
+//! advect  x_p += dt u(x_p + dt/2 u(x_p))   (midpoint rule through the projected grid field,
+//!                                           u read multilinearly between the faces)
 //! ```
 //!
-//! Two choices depart from the seed's listing, both switchable in [`FlipParams`]: positions
-//! are advected through the divergence-free grid velocity (`grid_advection`, default on; off
-//! gives the seed's `x_p += dt v_p`), and an optional volume correction (`volume_correction`)
-//! adds a target outflow in cells whose particle density exceeds the rest density. Without it
-//! particles compressed in a violent flow are never spread apart again: in the 2D collapse of a
-//! 0.25 x 0.5 m column on a 32^2 grid the density-based volume estimate falls by about 30% over
-//! 10 s; with `volume_correction = 0.5` it ends within 0.2% (largest excursion 2.2%), with
-//! `volume_correction = 1` within 0.2% (largest excursion 0.95%), as measured by
-//! `cargo xtask conformance --filter anim-flip`.
+//! The B-splines do not interpolate, so the faces behind the box walls hold the mirror image of
+//! the faces in front with opposite sign, and a kernel sample at a wall has zero normal velocity.
+//!
+//! Choices that depart from the seed's listing, switchable in [`FlipParams`]: positions are
+//! advected through the divergence-free grid velocity (`grid_advection`, default on; off gives
+//! the seed's `x_p += dt v_p`), read multilinearly between the faces (`advection_sampling`,
+//! [`Sampling::Linear`], default; [`Sampling::Kernel`] reads it with the transfer's kernel), and
+//! an optional volume correction (`volume_correction`) adds a target outflow in cells whose
+//! particle density exceeds the rest density. Without it particles compressed in a violent flow
+//! are never spread apart again: in the 2D collapse of a 0.25 x 0.5 m column on a 32^2 grid the
+//! density-based volume estimate falls by about 30% over 10 s. With `volume_correction = 1` it
+//! ends within 0.2%, and its largest drop over the 10 s is below 1% (FLIP and APIC at CFL 1, PIC
+//! at CFL 0.5; `cargo xtask conformance --filter anim-flip`).
 //!
 //! Optional reseeding ([`reseed`]) keeps every interior cell's particle count between bounds. It
 //! is a sampling tool, not a volume fix: particles are the fluid's mass, and topping up cells that
@@ -97,7 +102,7 @@ mod tests;
 pub use error::FlipError;
 pub use particles::Particles;
 pub use reseed::Reseed;
-pub use sim::{FlipParams, FlipSimulation, StepInfo, StepTimes};
+pub use sim::{FlipParams, FlipSimulation, Sampling, StepInfo, StepTimes};
 pub use surface::{Contour, Mesh, ParticleSurface, SurfaceParams};
 pub use tank::TankMotion;
 pub use transfer::Transfer;

@@ -53,6 +53,10 @@ pub struct FlipParams<const D: usize> {
     /// and has zero normal velocity at walls, so particles neither pile up against walls nor
     /// compress along their paths as much. Default true.
     pub grid_advection: bool,
+    /// How `grid_advection` reads the grid velocity at a point. Default [`Sampling::Linear`]
+    /// (absent from a parameter file means linear).
+    #[serde(default)]
+    pub advection_sampling: Sampling,
     /// Volume correction strength `beta` (0 = off, the default): cells whose particle density
     /// `rho_c` exceeds `rest_per_cell` get a target outflow `beta h (rho_c / rest - 1) / dt`
     /// in the projection, which spreads compressed particles apart again. With it on, the
@@ -73,6 +77,25 @@ pub struct FlipParams<const D: usize> {
     /// excess. Default `None` (off); absent from a parameter file means off.
     #[serde(default)]
     pub reseed: Option<Reseed>,
+}
+
+/// How particle advection through the grid ([`FlipParams::grid_advection`]) reads the grid
+/// velocity at a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Sampling {
+    /// Multilinear between the faces of each component's lattice (the MAC grid's own
+    /// interpolation). It is exact at the faces, so a particle sees exactly the wall faces'
+    /// zero normal velocity and the projected flux through each face. The default: in the
+    /// sloshing column of the volume conformance case (64^2, volume correction 1, CFL 1) the
+    /// largest drop of the density-estimated volume over 10 s is 0.84% (APIC), 0.87% (FLIP
+    /// 0.97) and 1.02% (PIC) with it, against 1.04% (APIC) and 2.02% (PIC) with the kernel.
+    #[default]
+    Linear,
+    /// The transfer's B-spline kernel ([`FlipParams::kernel`]), as in the grid-to-particle
+    /// transfer. Smoother, but not interpolating: a particle next to a wall sees a weighted
+    /// share of the faces behind it.
+    Kernel,
 }
 
 mod serde_array {
@@ -102,6 +125,7 @@ impl<const D: usize> Default for FlipParams<D> {
             require_convergence: true,
             no_slip: false,
             grid_advection: true,
+            advection_sampling: Sampling::Linear,
             volume_correction: 0.0,
             rest_per_cell: (1usize << D) as f64,
             tank_motion: None,
@@ -468,6 +492,7 @@ impl<const D: usize> FlipSimulation<D> {
         project::mark_weighted_faces(&mut self.grid);
         let layers = self.layers();
         self.grid.extrapolate(layers);
+        self.grid.reflect_walls(self.border);
         for a in 0..D {
             let (u, old) = (&self.grid.u[a], &mut self.grid.u_old[a]);
             old.copy_from_slice(u);
@@ -532,6 +557,7 @@ impl<const D: usize> FlipSimulation<D> {
         if self.params.no_slip {
             project::no_slip(&mut self.grid, &self.solid);
         }
+        self.grid.reflect_walls(self.border);
         lap.lap();
         transfer::g2p(&self.grid, particles, self.params.kernel, self.params.transfer);
         info.times.transfer += lap.lap();
@@ -556,14 +582,20 @@ impl<const D: usize> FlipSimulation<D> {
     /// nearest point of the nearest non-solid cell and lose the velocity component into the
     /// solid. Returns how many were moved.
     fn advect(&self, particles: &mut Particles<D>, dt: f64) -> usize {
-        if self.params.grid_advection {
+        let grid_advection = self.params.grid_advection;
+        if grid_advection {
             let grid = &self.grid;
             let kernel = self.params.kernel;
             let (lo, hi) = self.fluid_box();
+            let sampling = self.params.advection_sampling;
+            let sample = |x: &[f64; D]| match sampling {
+                Sampling::Linear => transfer::sample_linear(grid, x),
+                Sampling::Kernel => transfer::sample(grid, kernel, x),
+            };
             particles.x.par_iter_mut().for_each(|xp| {
-                let u0 = transfer::sample(grid, kernel, xp);
+                let u0 = sample(xp);
                 let mid: [f64; D] = std::array::from_fn(|a| (xp[a] + 0.5 * dt * u0[a]).clamp(lo[a], hi[a]));
-                let u1 = transfer::sample(grid, kernel, &mid);
+                let u1 = sample(&mid);
                 for a in 0..D {
                     xp[a] += dt * u1[a];
                 }
@@ -574,7 +606,6 @@ impl<const D: usize> FlipSimulation<D> {
         let (lo, hi) = self.fluid_box();
         let inset = 1e-6 * h;
         let solid = &self.solid;
-        let grid_advection = self.params.grid_advection;
         let Particles { x, v, .. } = particles;
         x.par_iter_mut()
             .zip(v.par_iter_mut())
@@ -651,6 +682,7 @@ impl<const D: usize> FlipSimulation<D> {
         project::mark_weighted_faces(&mut self.grid);
         let layers = self.layers();
         self.grid.extrapolate(layers);
+        self.grid.reflect_walls(self.border);
         for a in 0..D {
             let (u, old) = (&self.grid.u[a], &mut self.grid.u_old[a]);
             old.copy_from_slice(u);

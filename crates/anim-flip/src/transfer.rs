@@ -270,3 +270,37 @@ pub(crate) fn sample<const D: usize>(grid: &MacGrid<D>, kernel: Kernel, x: &[f64
         sum
     })
 }
+
+/// The grid velocity at `x` (m), multilinear between the faces of each lattice (the MAC grid's
+/// own interpolation: exact at the faces, so zero normal velocity at a wall face).
+pub(crate) fn sample_linear<const D: usize>(grid: &MacGrid<D>, x: &[f64; D]) -> [f64; D] {
+    let inv_h = 1.0 / grid.h;
+    std::array::from_fn(|a| {
+        let fd = grid.face_dims(a);
+        let mut base = [0usize; D];
+        let mut frac = [0.0f64; D];
+        for b in 0..D {
+            // Face lattice coordinate: along a at i h, along the others at (j + 1/2) h.
+            let g = x[b] * inv_h - if b == a { 0.0 } else { 0.5 };
+            let g = g.clamp(0.0, (fd[b] - 1) as f64);
+            let i = (g.floor() as usize).min(fd[b].saturating_sub(2));
+            base[b] = i;
+            frac[b] = g - i as f64;
+        }
+        let mut sum = 0.0;
+        for corner in 0..(1usize << D) {
+            let mut w = 1.0;
+            let mut idx = base;
+            for b in 0..D {
+                if corner >> b & 1 == 1 {
+                    idx[b] += 1;
+                    w *= frac[b];
+                } else {
+                    w *= 1.0 - frac[b];
+                }
+            }
+            sum += w * grid.u[a][crate::mac::flatten(fd, idx)];
+        }
+        sum
+    })
+}
