@@ -341,8 +341,8 @@ fn dam_break(n: usize, transfer: Transfer, no_slip: bool) -> Result<SurgeFront, 
 ///
 /// The largest error within 5% is not met, and grid refinement does not approach it. The
 /// converged inviscid solution runs ahead of the experiment: with free-slip walls FLIP 0.97 has
-/// max errors of 12.9%, 17.0% and 19.1% at 80, 120 and 160 cells per metre (APIC 13.9% and 17.5%
-/// at 80 and 120), rms 10-13%. A time-origin shift for the gate's opening does not close the gap
+/// max errors of 12.9%, 17.1% and 19.0% at 80, 120 and 160 cells per metre (APIC 14.0%, 17.5%
+/// and 19.0%), rms 10-13%. A time-origin shift for the gate's opening does not close the gap
 /// either: the best shift leaves 7.2-7.5% at every one of those resolutions, because the
 /// simulated front also moves faster late in the run (`dZ/dT` about 1.56 against the
 /// experiment's 1.34 over `T = 2.83..3.33`). No-slip walls slow the front by a drag of one cell's
