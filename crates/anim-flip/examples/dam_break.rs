@@ -5,38 +5,14 @@
 //!
 //! A water column `a x 2a` (`a = 0.2 m`) collapses along the floor of a 1 m tank. The surge front
 //! `Z = (x_front - x0) / a` (the rightmost particle) is compared with the experiment's readings at
-//! `T = t sqrt(2 g / a)` (Martin & Moyce's tables 2 and 6, `REFERENCES.md`; the readings advance
-//! in steps of a quarter inch, 0.11 in `Z`). Printed per run: the front at each reading, the
-//! largest and rms relative error, the same with the time origin shifted by the `dT` in
-//! `[0, 0.6]` that minimises the largest error (the experiment's gate takes time to open), the
-//! density-estimated volume change and the wall time.
+//! `T = t sqrt(2 g / a)` (Martin & Moyce's tables 2 and 6, `REFERENCES.md`, as anim-mpm's dam
+//! break holds them; the readings advance in steps of a quarter inch, 0.11 in `Z`). Printed per
+//! run: the front at each reading, the largest and rms relative error, the same with the time
+//! origin shifted by the `dT` in `[0, 0.6]` that minimises the largest error (the experiment's
+//! gate takes time to open), the density-estimated volume change and the wall time.
 
 use anim_flip::{FlipParams, Particles, Transfer, scenes};
-
-/// Martin & Moyce (1952), `n^2 = 2`, `a = 2.25 in`: `(T, Z)` (`REFERENCES.md`, section 2).
-const MARTIN_MOYCE: [(f64, f64); 15] = [
-    (0.41, 1.11),
-    (0.84, 1.22),
-    (1.19, 1.44),
-    (1.43, 1.67),
-    (1.63, 1.89),
-    (1.83, 2.11),
-    (1.98, 2.33),
-    (2.20, 2.56),
-    (2.32, 2.78),
-    (2.51, 3.00),
-    (2.65, 3.22),
-    (2.83, 3.44),
-    (2.98, 3.67),
-    (3.11, 3.89),
-    (3.33, 4.11),
-];
-
-/// Largest and rms relative error of `z` against the table.
-fn errors(z: &[f64]) -> (f64, f64) {
-    let e: Vec<f64> = z.iter().zip(MARTIN_MOYCE).map(|(z, (_, r))| (z - r).abs() / r).collect();
-    (e.iter().copied().fold(0.0, f64::max), (e.iter().map(|e| e * e).sum::<f64>() / e.len() as f64).sqrt())
-}
+use anim_mpm::scenes::{MARTIN_MOYCE, surge_front_errors as errors};
 
 /// The front at `t`, linear between recorded steps (`Z(0)` before the start).
 fn front_at(history: &[(f64, f64)], t: f64) -> f64 {
