@@ -63,7 +63,10 @@ pub fn result_line(script: &str, args: &[String], envs: &[(&str, &str)]) -> Resu
 }
 
 /// The value of `key` in a one-line JSON object printed by a peer script, as text (quotes
-/// removed); `None` when the key is absent.
+/// removed); `None` when the key is absent. Read by hand rather than with `serde_json`: Python's
+/// `json.dumps` writes a diverged peer's non-finite numbers as `NaN` or `Infinity`, which
+/// `serde_json` refuses for the whole line, losing the other fields (the timing, the
+/// divergence flag). The scripts print flat objects of numbers and comma-free strings.
 pub fn json_field(line: &str, key: &str) -> Option<String> {
     let rest = &line[line.find(&format!("\"{key}\":"))? + key.len() + 3..];
     let rest = rest.trim_start();
@@ -80,5 +83,14 @@ mod tests {
         assert_eq!(super::json_field(line, "taichi").as_deref(), Some("1.7.4"));
         assert_eq!(super::json_field(line, "front").as_deref(), Some("3"));
         assert_eq!(super::json_field(line, "dt"), None);
+        // A diverged peer's NaN does not hide the other fields.
+        let line = r#"{"per_step_s": 0.5, "min_height": NaN, "diverged": true}"#;
+        assert!(
+            super::json_field(line, "min_height")
+                .and_then(|v| v.parse::<f64>().ok())
+                .is_some_and(f64::is_nan)
+        );
+        assert_eq!(super::json_field(line, "per_step_s").as_deref(), Some("0.5"));
+        assert_eq!(super::json_field(line, "diverged").as_deref(), Some("true"));
     }
 }

@@ -143,12 +143,11 @@ impl<const D: usize> MacGrid<D> {
             let stride = strides(fd)[a];
             let (lo_wall, hi_wall) = (border, self.n[a] - border);
             let u = &mut self.u[a];
-            let lines = u.len() / fd[a];
-            let inner = stride;
-            for line in 0..lines {
-                // Face (i along a) of this line: base + i stride, base = outer * stride * fd[a] + rest.
-                let (outer, rest) = (line / inner, line % inner);
-                let base = outer * inner * fd[a] + rest;
+            // The faces of one line along `a` are `base + i stride`, with the axes below `a`
+            // (`rest`) and above it (`outer`) fixed.
+            for line in 0..u.len() / fd[a] {
+                let (outer, rest) = (line / stride, line % stride);
+                let base = outer * stride * fd[a] + rest;
                 for k in 1..=border {
                     u[base + (lo_wall - k) * stride] = -u[base + (lo_wall + k) * stride];
                     u[base + (hi_wall + k) * stride] = -u[base + (hi_wall - k) * stride];
