@@ -9,6 +9,7 @@
 //! | [`linalg`] | linear operators, CG / Jacobi-PCG, Jacobi and Gauss-Seidel, CSR matrices with faer interop, a sparse direct solve, the Schur-complement block solve, 3x3 SVD and polar decomposition | 2.1, 5.1, 7.1 |
 //! | [`integrate`] | second-order systems `x'' = M^-1 f(x, v)` and the integrators of seed section 2: explicit, symplectic and backward Euler, the beta-blend, position Verlet, leapfrog, velocity Verlet, implicit midpoint and RK4 | 2, 2.1, 2.2 |
 //! | [`solver`] | the time-stepping [`Solver`](solver::Solver) trait and the [`StepReport`](solver::StepReport) every step returns | - |
+//! | [`scene`] | the contracts of a runnable scene: [`Checkpoint`](scene::Checkpoint), [`View`](scene::View), the object-safe [`DynScene`](scene::DynScene), and the [`SceneKind`](scene::SceneKind) and [`Preset`](scene::Preset) a crate registers | - |
 //! | [`diagnostics`] | detection of non-finite state at the step that produced it | - |
 //! | [`scalar`] | the [`Real`](scalar::Real) trait that lets kernels run in `f32` or `f64` | - |
 //!
@@ -37,6 +38,7 @@ pub mod integrate;
 pub mod lie;
 pub mod linalg;
 pub mod scalar;
+pub mod scene;
 pub mod solver;
 
 pub use glam;

@@ -1,0 +1,364 @@
+//! anim-core's own scenes: the reference systems with exact solutions
+//! ([`HarmonicOscillator`], [`KeplerOrbit`]) under any integrator, as two scene kinds.
+//!
+//! | kind | preset | what | reference |
+//! | --- | --- | --- | --- |
+//! | `harmonic-oscillator` | `oscillator` | a lightly damped oscillator, implicit midpoint | the exact damped solution |
+//! | `kepler-orbit` | `kepler` | a planet on an `e = 0.5` ellipse, velocity Verlet, about 3 orbits | Kepler's equation |
+//!
+//! [`View::reference_error`] is the Euclidean distance of `(x, v)` from the exact solution.
+
+use super::checkpoint::{Checkpoint, CheckpointError, saved_state};
+use super::dynamic::{DynScene, Simulated};
+use super::preset::{BuildContext, BuildError, Preset, RunDefaults, SceneKind, params};
+use super::view::{Context, Frame, Prop, View};
+use crate::integrate::systems::{HarmonicOscillator, KeplerOrbit};
+use crate::integrate::{IntegrateError, IntegratorKind, MechanicalSystem, Simulation, State};
+use crate::solver::{Solver, StepReport};
+use serde::{Deserialize, Serialize};
+
+/// The scene kinds of anim-core, for the workspace registry.
+pub const KINDS: [SceneKind; 2] = [
+    SceneKind {
+        kind: "harmonic-oscillator",
+        crate_name: "anim-core",
+        summary: "a damped harmonic oscillator m x'' = -k x - c x' with its exact solution",
+        presets: oscillator_presets,
+        build: build_oscillator,
+    },
+    SceneKind {
+        kind: "kepler-orbit",
+        crate_name: "anim-core",
+        summary: "a planet on an ellipse around a fixed sun (a = mu = 1), exact by Kepler's equation",
+        presets: kepler_presets,
+        build: build_kepler,
+    },
+];
+
+/// Scene-file parameters of a `harmonic-oscillator` scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OscillatorParams {
+    /// Mass (> 0).
+    pub mass: f64,
+    /// Stiffness (> 0).
+    pub stiffness: f64,
+    /// Damping (>= 0). Default 0.
+    #[serde(default)]
+    pub damping: f64,
+    /// Initial position.
+    pub x0: f64,
+    /// Initial velocity.
+    pub v0: f64,
+    /// Integrator.
+    pub integrator: IntegratorKind,
+}
+
+/// Scene-file parameters of a `kepler-orbit` scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeplerParams {
+    /// Eccentricity in `[0, 1)`.
+    pub eccentricity: f64,
+    /// Integrator.
+    pub integrator: IntegratorKind,
+}
+
+fn oscillator_presets() -> Vec<Preset> {
+    vec![Preset {
+        name: "oscillator",
+        description: "a lightly damped harmonic oscillator, implicit midpoint",
+        run: RunDefaults::new(0.01, 500, 2),
+        params: serde_json::json!({
+            "mass": 1.0, "stiffness": 40.0, "damping": 0.2, "x0": 1.0, "v0": 0.0,
+            "integrator": "implicit-midpoint",
+        }),
+        quick_params: None,
+    }]
+}
+
+fn kepler_presets() -> Vec<Preset> {
+    vec![Preset {
+        name: "kepler",
+        description: "a planet on an e = 0.5 ellipse, velocity Verlet, about 3 orbits",
+        run: RunDefaults::new(0.005, 400, 10),
+        params: serde_json::json!({ "eccentricity": 0.5, "integrator": "velocity-verlet" }),
+        quick_params: None,
+    }]
+}
+
+fn positive(field: &str, x: f64) -> Result<(), BuildError> {
+    if x > 0.0 && x.is_finite() {
+        Ok(())
+    } else {
+        Err(BuildError::invalid(field, format!("must be a positive finite number, got {x}")))
+    }
+}
+
+fn finite(field: &str, x: f64) -> Result<(), BuildError> {
+    if x.is_finite() { Ok(()) } else { Err(BuildError::invalid(field, format!("must be finite, got {x}"))) }
+}
+
+fn build_oscillator(
+    value: &serde_json::Value,
+    _: &BuildContext<'_>,
+) -> Result<Box<dyn DynScene>, BuildError> {
+    let p: OscillatorParams = params(value)?;
+    positive("mass", p.mass)?;
+    positive("stiffness", p.stiffness)?;
+    if !(p.damping.is_finite() && p.damping >= 0.0) {
+        return Err(BuildError::invalid(
+            "damping",
+            format!("must be a non-negative finite number, got {}", p.damping),
+        ));
+    }
+    finite("x0", p.x0)?;
+    finite("v0", p.v0)?;
+    p.integrator.validate().map_err(|m| BuildError::invalid("integrator", m))?;
+    Ok(Simulated::new(ExactSystem::oscillator(&p), State::new(vec![p.x0], vec![p.v0])).boxed())
+}
+
+fn build_kepler(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
+    let p: KeplerParams = params(value)?;
+    if !(0.0..1.0).contains(&p.eccentricity) {
+        return Err(BuildError::invalid(
+            "eccentricity",
+            format!("must lie in [0, 1), got {}", p.eccentricity),
+        ));
+    }
+    p.integrator.validate().map_err(|m| BuildError::invalid("integrator", m))?;
+    let (scene, state) = ExactSystem::kepler(&p);
+    Ok(Simulated::new(scene, state).boxed())
+}
+
+/// Which reference system, with what its exact solution needs.
+#[derive(Debug, Clone, Copy)]
+enum Exact {
+    Oscillator { system: HarmonicOscillator, x0: f64, v0: f64 },
+    Kepler(KeplerOrbit),
+}
+
+/// A reference system of a few unknowns under an integrator, with its exact solution: the
+/// solver of both anim-core kinds.
+pub struct ExactSystem {
+    sim: Simulation<dyn MechanicalSystem + Send>,
+    method: String,
+    exact: Exact,
+    /// The plane region the motion stays in.
+    extent: ([f64; 2], [f64; 2]),
+}
+
+impl ExactSystem {
+    fn oscillator(p: &OscillatorParams) -> Self {
+        let system = HarmonicOscillator::damped(p.mass, p.stiffness, p.damping);
+        let a = p.x0.abs().max(1e-3);
+        Self {
+            sim: Simulation::new(Box::new(system), p.integrator.build(1)),
+            method: p.integrator.label(),
+            exact: Exact::Oscillator { system, x0: p.x0, v0: p.v0 },
+            extent: ([-1.5 * a, -0.3 * a], [1.5 * a, 0.3 * a]),
+        }
+    }
+
+    fn kepler(p: &KeplerParams) -> (Self, State) {
+        let e = p.eccentricity;
+        let system = KeplerOrbit::ellipse(e);
+        let (x0, v0) = system.initial();
+        let b = (1.0 - e * e).sqrt();
+        let scene = Self {
+            sim: Simulation::new(Box::new(system), p.integrator.build(2)),
+            method: p.integrator.label(),
+            exact: Exact::Kepler(system),
+            extent: ([-1.0 - e - 0.1, -b - 0.1], [1.0 - e + 0.1, b + 0.1]),
+        };
+        (scene, State::new(x0.to_vec(), v0.to_vec()))
+    }
+}
+
+impl Solver for ExactSystem {
+    type State = State;
+    type Error = IntegrateError;
+
+    fn step(&mut self, state: &mut State, dt: f64) -> Result<StepReport, IntegrateError> {
+        self.sim.step(state, dt)
+    }
+}
+
+impl Checkpoint for ExactSystem {
+    const VERSION: u32 = 1;
+
+    fn time(&self, state: &State) -> f64 {
+        state.t
+    }
+
+    fn save(&self, state: &State) -> serde_json::Value {
+        serde_json::json!({ "state": state, "integrator": self.sim.memory() })
+    }
+
+    fn restore(&mut self, state: &mut State, saved: &serde_json::Value) -> Result<(), CheckpointError> {
+        let restored = saved_state(saved, "state", state)?;
+        let memory =
+            saved.get("integrator").ok_or_else(|| CheckpointError::Missing { field: "integrator".into() })?;
+        // The integrator's memory is checked and taken whole, or not at all.
+        self.sim.restore_memory(memory).map_err(|e| CheckpointError::invalid("integrator", e.to_string()))?;
+        *state = restored;
+        Ok(())
+    }
+
+    fn provoke_overflow(&mut self, state: &mut State) -> Option<String> {
+        // Both: a position alone gives a vanishing pull, a velocity alone a finite drift.
+        state.x[0] = f64::MAX;
+        state.v[0] = f64::MAX;
+        Some("position and velocity 0 set to f64::MAX".into())
+    }
+}
+
+impl View for ExactSystem {
+    fn method(&self) -> String {
+        self.method.clone()
+    }
+
+    fn context(&self, state: &State) -> Context {
+        let (lo, hi) = self.extent;
+        let mut context = Context {
+            point_dim: state.x.len(),
+            bounds: Some(([lo[0], lo[1], 0.0], [hi[0], hi[1], 0.0])),
+            ..Context::default()
+        };
+        context.props.push(match self.exact {
+            Exact::Kepler(_) => Prop::Attractor { at: [0.0; 3] },
+            Exact::Oscillator { .. } => Prop::Anchor { at: [lo[0], 0.0, 0.0], point: 0 },
+        });
+        context
+    }
+
+    fn frame(&self, state: &State, out: &mut Frame) {
+        out.time = state.t;
+        out.points.clone_from(&state.x);
+        out.field_mut("velocity", state.v.len()).extend_from_slice(&state.v);
+    }
+
+    fn reference_error(&self, s: &State) -> Option<f64> {
+        Some(match self.exact {
+            Exact::Oscillator { system, x0, v0 } => {
+                let (x, v) = system.exact(x0, v0, s.t);
+                ((s.x[0] - x).powi(2) + (s.v[0] - v).powi(2)).sqrt()
+            }
+            Exact::Kepler(system) => {
+                let (x, v) = system.exact(s.t);
+                let e = [x[0], x[1], v[0], v[1]];
+                s.x.iter().chain(&s.v).zip(e).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt()
+            }
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Frame;
+
+    fn scene(kind: &str) -> (Box<dyn DynScene>, Preset) {
+        let k = KINDS.iter().find(|k| k.kind == kind).expect("kind");
+        let preset = (k.presets)().remove(0);
+        ((k.build)(&preset.params, &BuildContext::default()).expect("build"), preset)
+    }
+
+    #[test]
+    fn the_oscillator_follows_its_exact_solution_and_the_error_says_how_far() {
+        let (mut s, preset) = scene("harmonic-oscillator");
+        assert_eq!(s.reference_error(), Some(0.0));
+        for _ in 0..200 {
+            s.step(preset.run.dt).expect("step");
+        }
+        // Implicit midpoint lags in phase by omega^3 dt^2 t / 12 = 4.22e-3 rad at omega =
+        // sqrt(40), dt = 0.01, t = 2 s; the error is then dominated by the velocity's,
+        // phase lag x omega x amplitude e^(-c t / 2m) = 4.22e-3 x 6.32 x 0.819 = 0.0218.
+        let e = s.reference_error().expect("exact");
+        assert!((e / 0.0218 - 1.0).abs() < 0.1, "{e}");
+        let mut f = Frame::default();
+        s.frame(&mut f);
+        assert_eq!((f.points.len(), f.field("velocity").map(|v| v.values.len())), (1, Some(1)));
+        // The library's exact solution against the closed form written out here.
+        let HarmonicOscillatorCheck { x, v } = HarmonicOscillatorCheck::at(f.time);
+        let d = ((f.points[0] - x).powi(2) + (f.field("velocity").expect("v").values[0] - v).powi(2)).sqrt();
+        assert!((d - e).abs() < 1e-12, "{d} {e}");
+    }
+
+    /// The preset's exact solution, written out: `x = e^(-zeta w t) (cos(w_d t) + zeta w / w_d sin(w_d t))`.
+    struct HarmonicOscillatorCheck {
+        x: f64,
+        v: f64,
+    }
+
+    impl HarmonicOscillatorCheck {
+        fn at(t: f64) -> Self {
+            let (m, k, c) = (1.0f64, 40.0f64, 0.2f64);
+            let gamma = c / (2.0 * m);
+            let wd = (k / m - gamma * gamma).sqrt();
+            let (s, co) = (wd * t).sin_cos();
+            let decay = (-gamma * t).exp();
+            let x = decay * (co + gamma / wd * s);
+            let v = decay * (-(wd + gamma * gamma / wd) * s);
+            Self { x, v }
+        }
+    }
+
+    #[test]
+    fn a_checkpoint_resumes_bit_for_bit_and_a_foreign_one_is_refused() {
+        for kind in ["harmonic-oscillator", "kepler-orbit"] {
+            let (mut a, preset) = scene(kind);
+            let dt = preset.run.dt;
+            for _ in 0..7 {
+                a.step(dt).expect("step");
+            }
+            let text = a.save().to_string();
+            for _ in 0..9 {
+                a.step(dt).expect("step");
+            }
+            let (mut b, _) = scene(kind);
+            b.restore(&serde_json::from_str(&text).expect("json")).expect("restore");
+            for _ in 0..9 {
+                b.step(dt).expect("step");
+            }
+            assert_eq!(a.save(), b.save(), "{kind}");
+            assert_eq!(a.time().to_bits(), b.time().to_bits(), "{kind}");
+        }
+        let (oscillator, _) = scene("harmonic-oscillator");
+        let (mut kepler, _) = scene("kepler-orbit");
+        let before = kepler.save();
+        let err = kepler.restore(&oscillator.save()).expect_err("another scene");
+        assert!(err.to_string().contains("1 positions and 1 velocities; this scene has 2 and 2"), "{err}");
+        let mut old = before.clone();
+        old["version"] = serde_json::json!(0);
+        assert_eq!(kepler.restore(&old), Err(CheckpointError::Version { found: 0, expected: 1 }));
+        assert_eq!(kepler.save(), before);
+    }
+
+    #[test]
+    fn an_overflow_fails_the_step_and_leaves_the_scene_as_it_was() {
+        let (mut s, preset) = scene("kepler-orbit");
+        s.step(preset.run.dt).expect("step");
+        assert!(s.provoke_overflow().is_some());
+        let before = s.save();
+        let err = s.step(preset.run.dt).expect_err("overflow");
+        assert!(err.to_string().contains("non-finite"), "{err}");
+        assert_eq!(s.save(), before);
+    }
+
+    #[test]
+    fn bad_parameters_name_their_field() {
+        let k = &KINDS[0];
+        let mut p = (k.presets)()[0].params.clone();
+        p["mass"] = serde_json::json!(-1.0);
+        let err = (k.build)(&p, &BuildContext::default()).err().expect("refused");
+        assert_eq!(err.to_string(), "field `mass`: must be a positive finite number, got -1");
+        p["mas"] = serde_json::json!(1.0);
+        let err = (k.build)(&p, &BuildContext::default()).err().expect("refused");
+        assert!(err.to_string().contains("unknown field `mas`"), "{err}");
+        let k = &KINDS[1];
+        let p = serde_json::json!({ "eccentricity": 1.0, "integrator": "rk4" });
+        let err = (k.build)(&p, &BuildContext::default()).err().expect("refused");
+        assert_eq!(err.to_string(), "field `eccentricity`: must lie in [0, 1), got 1");
+    }
+}

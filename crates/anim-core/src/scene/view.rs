@@ -1,0 +1,188 @@
+//! [`View`]: what a scene looks like, apart from how it is stepped.
+//!
+//! Everything is in one world frame with **z up** and gravity along `-z`; a crate whose solver
+//! works in another frame (a fluid with y up, a 2D solver in its plane) turns its points into
+//! this one in [`View::frame`].
+
+use crate::solver::Solver;
+
+/// The static part of a scene's picture, fixed for the run: the cells that join the points,
+/// the props around them (ground, colliders, walls), pinned points and the region the motion
+/// stays in. Built once by [`View::context`].
+#[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
+pub struct Context {
+    /// Coordinates per point in a [`Frame`]: 1 or 2 for a system of a few unknowns drawn in the
+    /// plane (an oscillator, an orbit), 3 for particles and meshes. 0 for an image grid, whose
+    /// frames have no points.
+    pub point_dim: usize,
+    /// Line segments between points (springs, rope links, robot links).
+    pub lines: Vec<[usize; 2]>,
+    /// Surface triangles (cloth, the boundary of a solid), counter-clockwise seen from outside.
+    pub triangles: Vec<[usize; 3]>,
+    /// Tetrahedra of a volume mesh.
+    pub tetrahedra: Vec<[usize; 4]>,
+    /// Points held in place by the scene (pins, clamped vertices, attachments).
+    pub pins: Vec<usize>,
+    /// Radius of a point when drawn as a disc (particles), in metres; 0 for none.
+    pub point_radius: f64,
+    /// What surrounds the points: ground, colliders, walls, attractors.
+    pub props: Vec<Prop>,
+    /// The region the motion of the scene stays in: corners `(lo, hi)`, for framing a picture.
+    pub bounds: Option<([f64; 3], [f64; 3])>,
+    /// The grid of an image scene (a grid fluid), whose frames hold cell fields and no points.
+    pub image: Option<ImageGrid>,
+}
+
+/// A thing in the scene that is not simulated but is part of its picture.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum Prop {
+    /// The ground plane `z = height`.
+    Ground {
+        /// Height of the plane (m).
+        height: f64,
+    },
+    /// A static sphere (a collider).
+    Sphere {
+        /// Centre (m).
+        center: [f64; 3],
+        /// Radius (m).
+        radius: f64,
+    },
+    /// A static capsule: the points within `radius` of the segment `a`-`b`.
+    Capsule {
+        /// One end of the axis (m).
+        a: [f64; 3],
+        /// The other end (m).
+        b: [f64; 3],
+        /// Radius (m).
+        radius: f64,
+    },
+    /// An axis-aligned solid box (a collider).
+    Cuboid {
+        /// Lower corner (m).
+        lo: [f64; 3],
+        /// Upper corner (m).
+        hi: [f64; 3],
+    },
+    /// The walls of an open-topped tank that holds the scene (a fluid's container), inner
+    /// corners.
+    Tank {
+        /// Lower inner corner (m).
+        lo: [f64; 3],
+        /// Upper inner corner (m).
+        hi: [f64; 3],
+    },
+    /// A fixed attracting centre (the sun of an orbit).
+    Attractor {
+        /// Position.
+        at: [f64; 3],
+    },
+    /// A fixed anchor tied to point `point` (the wall end of an oscillator's spring).
+    Anchor {
+        /// Position of the anchor.
+        at: [f64; 3],
+        /// The point it is tied to.
+        point: usize,
+    },
+}
+
+/// A regular grid of cells whose fields an image scene writes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImageGrid {
+    /// Cells along x, y, z (1 along z in 2D).
+    pub dims: [usize; 3],
+    /// 2 or 3.
+    pub dim: usize,
+    /// Lower corner of the grid (m).
+    pub origin: [f64; 3],
+    /// Cell size (m).
+    pub spacing: f64,
+    /// The name of the scalar field a picture shows (`"density"`).
+    pub shown: &'static str,
+    /// The values at the ends of the colour scale of that field, fixed for the run.
+    pub range: (f64, f64),
+}
+
+impl ImageGrid {
+    /// Number of cells.
+    #[must_use]
+    pub fn cells(&self) -> usize {
+        self.dims.iter().product()
+    }
+}
+
+/// One named field of a frame, per point or (for an image grid) per cell, x fastest.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Field {
+    /// Its name in the frame files (`"velocity"`, `"density"`).
+    pub name: &'static str,
+    /// Components per point or cell (1 for a scalar, 3 for a vector).
+    pub components: usize,
+    /// The values, `components` per point or cell.
+    pub values: Vec<f64>,
+}
+
+/// A scene at one output time: the points (flat, [`Context::point_dim`] per point) and named
+/// fields. Buffers are reused from frame to frame: [`View::frame`] overwrites them in place.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Frame {
+    /// Simulated time (s).
+    pub time: f64,
+    /// Point coordinates, flat.
+    pub points: Vec<f64>,
+    /// Named fields, in a fixed order per scene (velocity first, where there is one).
+    pub fields: Vec<Field>,
+}
+
+impl Frame {
+    /// Number of points.
+    #[must_use]
+    pub fn len(&self, point_dim: usize) -> usize {
+        self.points.len().checked_div(point_dim).unwrap_or(0)
+    }
+
+    /// The field named `name`, if the frame has one.
+    #[must_use]
+    pub fn field(&self, name: &str) -> Option<&Field> {
+        self.fields.iter().find(|f| f.name == name)
+    }
+
+    /// The values of field `name` with `components` per element, emptied for refilling: the
+    /// field is created the first time and its buffer reused after, so a frame written into the
+    /// same `Frame` allocates nothing once the sizes are reached.
+    pub fn field_mut(&mut self, name: &'static str, components: usize) -> &mut Vec<f64> {
+        let at = match self.fields.iter().position(|f| f.name == name) {
+            Some(at) => at,
+            None => {
+                self.fields.push(Field { name, components, values: Vec::new() });
+                self.fields.len() - 1
+            }
+        };
+        let field = &mut self.fields[at];
+        field.components = components;
+        field.values.clear();
+        &mut field.values
+    }
+}
+
+/// What a scene looks like: a description of its method, the static [`Context`] and a
+/// [`Frame`] per output time.
+pub trait View: Solver {
+    /// The method in a few words, for run summaries: integrator, linear solver, transfer.
+    fn method(&self) -> String;
+
+    /// The static context of the run, from the initial state.
+    fn context(&self, state: &Self::State) -> Context;
+
+    /// The frame of `state`, written into `out`'s buffers (see [`Frame::field_mut`]).
+    fn frame(&self, state: &Self::State, out: &mut Frame);
+
+    /// The run's error so far against the reference the scene carries (an exact solution, a
+    /// published table), where it has one.
+    fn reference_error(&self, state: &Self::State) -> Option<f64> {
+        let _ = state;
+        None
+    }
+}
