@@ -77,9 +77,15 @@ impl BuildContext<'_> {
 #[non_exhaustive]
 pub enum BuildError {
     /// The parameters do not fit the kind's schema: an unknown field, a missing one, a value of
-    /// the wrong type or an unknown name (serde's message, which names the field).
-    #[error("{0}")]
-    Schema(String),
+    /// the wrong type or an unknown name.
+    #[error("{}{message}", if field.is_empty() { String::new() } else { format!("field `{field}`: ") })]
+    Schema {
+        /// Where in the parameters (dotted path, empty for the table itself: an unknown or
+        /// missing field, whose name the message gives).
+        field: String,
+        /// serde's message.
+        message: String,
+    },
     /// A parameter is out of range, or the scene cannot be built with it.
     #[error("field `{field}`: {message}")]
     Invalid {
@@ -101,9 +107,14 @@ impl BuildError {
 /// The parameters of a kind, read from their scene-file form.
 ///
 /// # Errors
-/// [`BuildError::Schema`] with serde's message when `value` does not fit `T`.
+/// [`BuildError::Schema`] with serde's message and the path of the value it concerns when
+/// `value` does not fit `T`.
 pub fn params<T: DeserializeOwned>(value: &serde_json::Value) -> Result<T, BuildError> {
-    T::deserialize(value).map_err(|e| BuildError::Schema(e.to_string()))
+    serde_path_to_error::deserialize(value).map_err(|e| {
+        let field = e.path().to_string();
+        let field = if field == "." { String::new() } else { field };
+        BuildError::Schema { field, message: e.into_inner().to_string() }
+    })
 }
 
 /// A crate's scenes as the registry lists them: one `kind` of scene file, its presets and the

@@ -355,7 +355,10 @@ mod tests {
         assert_eq!(err.to_string(), "field `mass`: must be a positive finite number, got -1");
         p["mas"] = serde_json::json!(1.0);
         let err = (k.build)(&p, &BuildContext::default()).err().expect("refused");
-        assert!(err.to_string().contains("unknown field `mas`"), "{err}");
+        assert!(err.to_string().starts_with("field `mas`: unknown field `mas`, expected one of"), "{err}");
+        let p = serde_json::json!({ "eccentricity": 0.5, "integrator": "rk5" });
+        let err = (KINDS[1].build)(&p, &BuildContext::default()).err().expect("refused");
+        assert!(err.to_string().starts_with("field `integrator`: unknown variant `rk5`"), "{err}");
         let k = &KINDS[1];
         let p = serde_json::json!({ "eccentricity": 1.0, "integrator": "rk4" });
         let err = (k.build)(&p, &BuildContext::default()).err().expect("refused");
