@@ -64,6 +64,11 @@
 //! [`scenes`] has a swinging Panda, a 32-link pendulum chain and a spinning T-handle showing the
 //! Dzhanibekov flip, ready for the command line.
 //!
+//! [`KIND`] registers them as the `rigid` scene kind of anim-core's
+//! [`scene`](anim_core::scene) contracts, with the presets `panda`, `chain` and `t-handle` (see
+//! [`kind`]): built from the scene-file parameters [`kind::RigidParams`], stepped, checkpointed
+//! and drawn as the end points of their segments by [`kind::RigidSegments`].
+//!
 //! ## Accuracy, measured
 //!
 //! Kinematics, against Pinocchio 4.1 on the Franka Panda (7 DoF, fingers locked) and the UR5, 50
@@ -147,6 +152,7 @@ pub mod dense;
 pub mod dynamics;
 pub mod ik;
 pub mod jacobian;
+pub mod kind;
 pub mod kinematics;
 pub mod model;
 pub mod paden_kahan;
@@ -168,6 +174,7 @@ pub use jacobian::{
     Jacobian, ReferenceFrame, compute_joint_jacobians, compute_joint_jacobians_time_variation,
     frame_jacobian, frame_jacobian_time_variation, joint_jacobian,
 };
+pub use kind::KIND;
 pub use kinematics::{
     forward_kinematics, frame_point, frames_forward_kinematics, joint_world_placement,
     update_frame_placement, update_frame_placements,
