@@ -18,11 +18,19 @@
 //! | [`quadratic`] | 10-node tetrahedra (no locking in bending or near incompressibility): 4-point quadrature, closed-form consistent mass, HRZ lumping; in both time steppers and quasi-static solves | - |
 //! | [`ldlt`] | sparse `L D L^T` (faer) for symmetric indefinite Newton matrices | - |
 //! | [`scenes`] | cantilever beam, soft cube drop, twisted bar | - |
+//! | [`kind`] | the `fem` scene kind: presets, scene-file parameters, checkpoints and frames | - |
 //!
 //! **Element order.** [`FemModel::new`](model::FemModel::new) builds linear tetrahedra,
 //! [`FemModel::quadratic`](model::FemModel::quadratic) and
 //! [`FemModel::with_order`](model::FemModel::with_order) 10-node ones; the simulation, the
 //! scenes ([`scenes::by_name_with_order`]) and checkpoints do not care which.
+//!
+//! **Scene kind.** [`KIND`] registers the crate's scenes with the workspace
+//! ([`anim_core::scene::SceneKind`], scene files of `kind = "fem"`): the presets `beam`
+//! (`cantilever-beam`), `cube` (`soft-cube-drop`) and `twisted-bar`, built from
+//! [`kind::FemSceneParams`] (preset, resolution, integrator, linear solver, element);
+//! [`FemSimulation`](sim::FemSimulation) is their [`Checkpoint`](anim_core::scene::Checkpoint)
+//! and [`View`](anim_core::scene::View).
 //!
 //! **Model / data split.** A [`FemModel`](model::FemModel) is built once and never modified by an
 //! algorithm; a [`FemSimulation`](sim::FemSimulation) owns the settings and every scratch buffer
@@ -72,6 +80,7 @@ pub mod element;
 pub mod error;
 pub mod friction;
 pub mod generate;
+pub mod kind;
 pub mod ldlt;
 pub mod material;
 pub mod mesh;
@@ -82,9 +91,12 @@ pub mod scenes;
 pub mod sim;
 
 pub use error::FemError;
+pub use kind::KIND;
 
 #[cfg(test)]
 mod contact_tests;
+#[cfg(test)]
+mod kind_tests;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]

@@ -1,0 +1,233 @@
+//! The `fem` scene kind: anim-fem's presets and scene-file parameters, and the
+//! [`Checkpoint`] and [`View`] of a [`FemSimulation`], so that the command line, `cargo xtask`
+//! and the Python bindings run its scenes through [`anim_core::scene`] without knowing the crate.
+//!
+//! | preset | scene | run |
+//! | --- | --- | --- |
+//! | `beam` | `cantilever-beam`: a stable Neo-Hookean beam clamped at one end sags and swings, backward Euler | 120 frames of 1/60 s |
+//! | `cube` | `soft-cube-drop`: a soft cube dropped on the ground, backward Euler with penalty contact | 100 frames of 2 x 5 ms |
+//! | `twisted-bar` | `twisted-bar`: a bar twisted by a half turn at one end | 100 frames of 10 ms |
+//!
+//! A frame holds every node (for 10-node bodies, the corners then the edge nodes) and its
+//! velocity, in the scenes' own z-up frame; the [`Context`] gives the outward boundary
+//! triangles, the (corner) tetrahedra, the pinned and kinematic nodes as pins, the ground and the
+//! sphere obstacles.
+//!
+//! ```
+//! use anim_core::scene::{BuildContext, Frame};
+//!
+//! let beam = (anim_fem::KIND.presets)().into_iter().find(|p| p.name == "beam").expect("preset");
+//! let quick = beam.quick_params.as_ref().unwrap_or(&beam.params);
+//! let mut scene = (anim_fem::KIND.build)(quick, &BuildContext::default())?;
+//! scene.step(beam.run.dt)?;
+//! let mut frame = Frame::default();
+//! scene.frame(&mut frame);
+//! assert_eq!(frame.time, beam.run.dt);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use crate::boundary::Obstacle;
+use crate::model::ElementOrder;
+use crate::scenes;
+use crate::sim::{FemSimulation, LinearSolverChoice, TimeIntegrator};
+use anim_core::integrate::State;
+use anim_core::scene::{
+    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
+    RunDefaults, SceneKind, Simulated, View, params, saved_state,
+};
+use serde::{Deserialize, Serialize};
+
+/// The `fem` scene kind of anim-fem, for the workspace registry.
+pub const KIND: SceneKind = SceneKind {
+    kind: "fem",
+    crate_name: "anim-fem",
+    summary: "hyperelastic solids of linear or 10-node tetrahedra: a clamped beam, a dropped cube, a twisted bar",
+    presets,
+    build,
+};
+
+/// Scene-file parameters of an `fem` scene (the `[scene]` table without `kind`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FemSceneParams {
+    /// The scene: `"cantilever-beam"`, `"soft-cube-drop"` or `"twisted-bar"` (see
+    /// [`scenes`]).
+    pub preset: String,
+    /// Cells across the beam or bar (4 by default; the length gets 10 times as many), or along
+    /// the cube's side (6 by default); absent: the scene's default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resolution: Option<usize>,
+    /// Time integrator, `"backward-euler"` or `"symplectic-euler"`; absent: the scene's
+    /// (backward Euler).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub integrator: Option<TimeIntegrator>,
+    /// Linear solver inside Newton, `"cholesky"`, `"ldlt"` or `"jacobi-pcg"`; absent: the
+    /// scene's (Cholesky).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub linear_solver: Option<LinearSolverChoice>,
+    /// The element, `"tet4"` (linear tetrahedra) or `"tet10"` (10-node tetrahedra on the same
+    /// mesh: no locking in bending, 4 to 7 times the nodes); absent: `"tet4"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub element: Option<ElementOrder>,
+}
+
+fn presets() -> Vec<Preset> {
+    let preset = |name, description, run, scene: &str, quick: Option<usize>| Preset {
+        name,
+        description,
+        run,
+        params: serde_json::json!({ "preset": scene }),
+        quick_params: quick.map(|r| serde_json::json!({ "preset": scene, "resolution": r })),
+    };
+    vec![
+        preset(
+            "beam",
+            "a stable Neo-Hookean FEM beam clamped at one end sags and swings, backward Euler",
+            RunDefaults::new(0.016666666666666666, 120, 1),
+            "cantilever-beam",
+            Some(2),
+        ),
+        preset(
+            "cube",
+            "a soft FEM cube dropped on the ground, backward Euler with penalty contact",
+            RunDefaults::new(0.005, 100, 2),
+            "soft-cube-drop",
+            Some(3),
+        ),
+        preset(
+            "twisted-bar",
+            "an FEM bar twisted by a half turn at one end (large rotation)",
+            RunDefaults::new(0.01, 100, 1),
+            "twisted-bar",
+            Some(2),
+        ),
+    ]
+}
+
+fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
+    let p: FemSceneParams = params(value)?;
+    let found = scenes::by_name_with_order(&p.preset, p.resolution, p.element.unwrap_or_default())
+        .ok_or_else(|| {
+            BuildError::invalid(
+                "preset",
+                format!("unknown preset `{}` (one of {})", p.preset, scenes::NAMES.join(", ")),
+            )
+        })?;
+    let mut scene = found.map_err(|e| BuildError::invalid("resolution", e.to_string()))?;
+    if let Some(i) = p.integrator {
+        scene.params.integrator = i;
+    }
+    if let Some(l) = p.linear_solver {
+        scene.params.linear_solver = l;
+    }
+    let (sim, state) = scene.into_simulation().map_err(|e| BuildError::invalid("preset", e.to_string()))?;
+    Ok(Simulated::new(sim, state).boxed())
+}
+
+impl Checkpoint for FemSimulation {
+    const VERSION: u32 = 1;
+
+    fn time(&self, state: &State) -> f64 {
+        state.t
+    }
+
+    fn save(&self, state: &State) -> serde_json::Value {
+        serde_json::json!({ "state": state, "simulation": self.memory() })
+    }
+
+    fn restore(&mut self, state: &mut State, saved: &serde_json::Value) -> Result<(), CheckpointError> {
+        let restored = saved_state(saved, "state", state)?;
+        let memory =
+            saved.get("simulation").ok_or_else(|| CheckpointError::Missing { field: "simulation".into() })?;
+        // The memory is read whole (a step count) or refused: nothing is changed before this
+        // succeeds.
+        self.restore_memory(memory).map_err(|e| CheckpointError::invalid("simulation", e.to_string()))?;
+        *state = restored;
+        Ok(())
+    }
+
+    /// Moves the first free node to `f64::MAX` along x: the elements around it then have a
+    /// non-finite stress, which the step reports as [`FemError::NonFiniteElement`](crate::FemError).
+    fn provoke_overflow(&mut self, state: &mut State) -> Option<String> {
+        let fixed = self.model().fixed();
+        let node = (0..self.model().vertices()).find(|&i| !fixed[3 * i..3 * i + 3].iter().any(|&f| f))?;
+        state.x[3 * node] = f64::MAX;
+        Some(format!("x of node {node} set to f64::MAX"))
+    }
+}
+
+impl View for FemSimulation {
+    /// `integrator / linear solver`, then the element (`/ tet10`) for 10-node bodies.
+    fn method(&self) -> String {
+        let p = self.params();
+        let method = format!("{} / {}", p.integrator.name(), p.linear_solver.name());
+        match self.model().order() {
+            ElementOrder::Linear => method,
+            order => format!("{method} / {}", order.name()),
+        }
+    }
+
+    /// The boundary triangles, the (corner) tetrahedra, as pins the nodes whose three
+    /// coordinates are held (pinned or moved kinematically), the ground (the last obstacle plane
+    /// `z >= h`) and the sphere obstacles, and the region the body stays in: its bounding box at
+    /// `state`, widened sideways by a third of its size and extended down by its size or to
+    /// the ground.
+    fn context(&self, state: &State) -> Context {
+        let model = self.model();
+        let mut ground = None;
+        let mut spheres = Vec::new();
+        for o in model.obstacles() {
+            match *o {
+                Obstacle::Plane { normal: [0.0, 0.0, 1.0], offset } => ground = Some(offset),
+                Obstacle::Sphere { center, radius } => spheres.push(Prop::Sphere { center, radius }),
+                Obstacle::Plane { .. } => {}
+            }
+        }
+        let fixed = model.fixed();
+        // `Context` is non-exhaustive: filled field by field.
+        let mut context = Context::default();
+        context.point_dim = 3;
+        context.triangles = model.surface().to_vec();
+        context.tetrahedra.clone_from(&model.mesh().tets);
+        context.pins =
+            (0..model.vertices()).filter(|&i| fixed[3 * i..3 * i + 3].iter().all(|&f| f)).collect();
+        context.bounds = Some(frame_box(&state.x, ground, true));
+        context.props.extend(ground.map(|height| Prop::Ground { height }));
+        context.props.extend(spheres);
+        context
+    }
+
+    fn frame(&self, state: &State, out: &mut Frame) {
+        out.time = state.t;
+        out.points.clone_from(&state.x);
+        out.field_mut("velocity", 3).extend_from_slice(&state.v);
+    }
+}
+
+/// The bounding box of the points `x` (3 per point) widened sideways (x, y) by a third of its
+/// size and, when `falls`, extended down along -z by its size, or to the `ground`: where the
+/// motion of the scenes stays, for framing a picture.
+fn frame_box(x: &[f64], ground: Option<f64>, falls: bool) -> ([f64; 3], [f64; 3]) {
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in x.chunks_exact(3) {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if lo[0] > hi[0] {
+        return ([-1.0; 3], [1.0; 3]);
+    }
+    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-3);
+    for k in 0..2 {
+        lo[k] -= size / 3.0;
+        hi[k] += size / 3.0;
+    }
+    if falls {
+        lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
+    }
+    if let Some(z) = ground {
+        lo[2] = z;
+    }
+    (lo, hi)
+}
