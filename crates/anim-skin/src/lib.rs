@@ -24,6 +24,11 @@
 //! - [`scenes`]: the twisted cylinder (LBS's candy-wrapper collapse next to DQS) and
 //!   [`scenes::from_gltf`], both posable at any time into positions and triangles.
 //!
+//! [`KIND`] registers these as the `skinning` scene kind of anim-core's
+//! [`scene`](anim_core::scene) contracts, with the preset `twist` (the twisted cylinder, LBS
+//! beside DQS); a scene file may name any skinned glTF file instead ([`kind::SkinParams`]). The
+//! run loop plays it over time through [`kind::SkinPlayback`] (see [`kind`]).
+//!
 //! ## glTF conventions
 //!
 //! Right-handed, y-up, metres; quaternions `(x, y, z, w)`; node transforms `T * R * S`; a
@@ -66,6 +71,7 @@
 pub mod character;
 pub mod clip;
 pub mod gltf_io;
+pub mod kind;
 pub mod mesh;
 pub mod scenes;
 pub mod skeleton;
@@ -74,6 +80,7 @@ pub mod skinning;
 pub use character::{Character, CharacterData, CharacterMesh};
 pub use clip::{Channel, Clip, Interpolation, Property};
 pub use gltf_io::{LoadError, Loaded};
+pub use kind::KIND;
 pub use mesh::{MAX_INFLUENCES, SkinnedMesh, signed_volume};
 pub use skeleton::{Joint, Pose, Skeleton, Skin, Trs};
 pub use skinning::{Skinned, SkinningMethod, skin};
