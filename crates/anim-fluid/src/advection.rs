@@ -21,16 +21,21 @@
 //! sample and the wall (this is how the lid of a cavity drags the fluid); elsewhere outside the
 //! samples the nearest value is used.
 
-/// How advected quantities are carried.
+/// How advected quantities are carried. Serialised by its [`Advection::name`]
+/// (`"sl-linear"`, `"sl-monotone-cubic"`, `"bfecc"`, `"maccormack"`), as scene files name it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Advection {
     /// Semi-Lagrangian, linear interpolation (the seed's scheme).
+    #[serde(rename = "sl-linear")]
     Linear,
     /// Semi-Lagrangian, monotone cubic interpolation.
+    #[serde(rename = "sl-monotone-cubic")]
     MonotoneCubic,
     /// Back and forth error compensation and correction over linear semi-Lagrangian steps.
+    #[serde(rename = "bfecc")]
     Bfecc,
     /// MacCormack over linear semi-Lagrangian steps.
+    #[serde(rename = "maccormack")]
     MacCormack,
 }
 
@@ -63,12 +68,16 @@ impl Advection {
 ///   projecting halfway conserves the kinetic energy the first projection would remove, so the
 ///   splitting error is of second order, for two projections and two half-step advections per
 ///   step. Scalars (density, temperature) are advected once over `dt` by the midpoint field.
+///
+/// Serialised by its [`Splitting::name`] (`"advect-project"`, `"reflection"`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum Splitting {
     /// Advect over `dt`, then project (first order).
     #[default]
+    #[serde(rename = "advect-project")]
     AdvectProject,
     /// Advection-reflection (second order, two projections per step).
+    #[serde(rename = "reflection")]
     Reflection,
 }
 

@@ -28,6 +28,14 @@
 //! [`pressure`] works on cells labelled fluid / air / solid, so a particle fluid (PIC, FLIP,
 //! APIC) reuses it for its free-surface projection.
 //!
+//! ## Scenes
+//!
+//! [`KIND`] registers the crate's scenes with anim-core's scene contracts as the `fluid` kind
+//! ([`kind`]): the presets `smoke-box-2d` (the seed's solver), `smoke-plume-3d` and
+//! `lid-driven-cavity` (the MAC solver), built from their scene-file parameters
+//! ([`kind::FluidSceneParams`]: preset, resolution, pressure solver and tolerance, advection,
+//! splitting), checkpointed and drawn as density and velocity fields on an image grid.
+//!
 //! ## Which solver
 //!
 //! | choice | when |
@@ -146,9 +154,11 @@
 
 pub mod advection;
 pub mod error;
+pub mod kind;
 pub mod mac;
 pub mod pressure;
 pub mod scenes;
 pub mod seed;
 
 pub use error::FluidError;
+pub use kind::KIND;

@@ -1226,6 +1226,25 @@ impl MacFluid {
         if self.params.viscosity > 0.0 { self.viscosity(state, dt, step) } else { Ok(0) }
     }
 
+    /// [`Self::diffuse`]; a solve that fails on a non-finite residual (the velocity overflowed)
+    /// is kept in `deferred` and the step goes on, so that the non-finite guard at its end names
+    /// the value rather than the solve.
+    fn diffuse_or_defer(
+        &mut self,
+        state: &mut MacState,
+        dt: f64,
+        step: u64,
+        deferred: &mut Option<FluidError>,
+    ) -> Result<usize, FluidError> {
+        match self.diffuse(state, dt, step) {
+            Err(e @ FluidError::NotConverged { residual, .. }) if !residual.is_finite() => {
+                deferred.get_or_insert(e);
+                Ok(0)
+            }
+            other => other,
+        }
+    }
+
     fn advance_in_place(
         &mut self,
         next: &mut MacState,
@@ -1233,6 +1252,9 @@ impl MacFluid {
         dt: f64,
         step: u64,
     ) -> Result<MacStepInfo, FluidError> {
+        // A viscosity solve that failed on a non-finite residual, reported after the
+        // non-finite guard has had the chance to name the value that overflowed.
+        let mut deferred = None;
         let (pressure, viscosity_iterations) = match self.params.splitting {
             Splitting::AdvectProject => {
                 self.add_forces(next, dt);
@@ -1242,7 +1264,7 @@ impl MacFluid {
                 // scalars by the same field.
                 self.advect_velocity(next, None, dt);
                 self.advect_scalars(next, dt);
-                let viscosity = self.diffuse(next, dt, step)?;
+                let viscosity = self.diffuse_or_defer(next, dt, step, &mut deferred)?;
                 let pressure = self.project(next);
                 self.enforce_walls(&mut next.vel);
                 (pressure, viscosity)
@@ -1253,7 +1275,7 @@ impl MacFluid {
                 self.apply_sources(next);
                 self.enforce_walls(&mut next.vel);
                 self.advect_velocity(next, None, 0.5 * dt);
-                let mut viscosity = self.diffuse(next, 0.5 * dt, step)?;
+                let mut viscosity = self.diffuse_or_defer(next, 0.5 * dt, step, &mut deferred)?;
                 let mut reflect = std::mem::take(&mut self.reflect);
                 for a in 0..self.dim {
                     reflect[a].copy_from_slice(&next.vel[a]);
@@ -1273,7 +1295,7 @@ impl MacFluid {
                 self.advect_scalars(next, dt);
                 self.add_forces(next, 0.5 * dt);
                 self.enforce_walls(&mut next.vel);
-                viscosity += self.diffuse(next, 0.5 * dt, step)?;
+                viscosity += self.diffuse_or_defer(next, 0.5 * dt, step, &mut deferred)?;
                 let mut pressure = self.project(next);
                 self.enforce_walls(&mut next.vel);
                 pressure.iterations += first.iterations;
@@ -1283,6 +1305,9 @@ impl MacFluid {
             }
         };
         self.check_finite(next, before, step)?;
+        if let Some(e) = deferred {
+            return Err(e);
+        }
         if !pressure.converged && self.params.require_convergence {
             return Err(FluidError::NotConverged {
                 step,

@@ -52,16 +52,21 @@ pub enum CellLabel {
     Solid,
 }
 
-/// The pressure solve method.
+/// The pressure solve method. Serialised by its [`PressureMethod::name`] (`"jacobi"`,
+/// `"rb-gauss-seidel"`, `"cg"`, `"mgpcg"`), as scene files name it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum PressureMethod {
     /// Jacobi iteration.
+    #[serde(rename = "jacobi")]
     Jacobi,
     /// Red-black Gauss-Seidel.
+    #[serde(rename = "rb-gauss-seidel")]
     RedBlackGaussSeidel,
     /// Conjugate gradients.
+    #[serde(rename = "cg")]
     ConjugateGradient,
     /// Multigrid-preconditioned conjugate gradients.
+    #[serde(rename = "mgpcg")]
     Mgpcg,
 }
 

@@ -74,19 +74,21 @@ impl FluidScene {
     ///
     /// # Errors
     /// [`FluidError::BadParameter`] for a non-positive or non-finite `dt`; the solver's
-    /// [`FluidError`]. The fields, step count and time are then as before the step (the seed
-    /// scene's source arrays hold the failed step's source pattern, which the next step writes
-    /// again in full).
+    /// [`FluidError`]. The fields (the seed scene's sources included), step count and time are
+    /// then as before the step.
     pub fn step_by(&mut self, dt: f64) -> Result<StepReport, FluidError> {
         crate::error::positive("dt", dt)?;
         match &mut self.sim {
             FluidSim::Seed(f) => {
-                let dt32 = dt as f32;
-                if dt32 != f.params().dt {
+                let (dt32, before) = (dt as f32, f.params().dt);
+                if dt32 != before {
                     f.set_dt(dt32)?;
                 }
-                f.apply_source_pattern();
-                f.step()?;
+                if let Err(e) = f.step_with_source_pattern() {
+                    // The step the fluid kept before (positive, so accepted again).
+                    f.set_dt(before)?;
+                    return Err(e);
+                }
                 Ok(StepReport::at_time(f.time()))
             }
             FluidSim::Mac(f, s) => f.step(s, dt),
@@ -274,10 +276,16 @@ pub fn smoke_box_2d(n: usize) -> Result<FluidScene, FluidError> {
     })
 }
 
+/// Centre of the sphere of [`smoke_plume_3d`] (grid coordinates, y up), m.
+pub const PLUME_SPHERE_CENTRE: [f64; 3] = [0.5, 0.45, 0.5];
+/// Radius of the sphere of [`smoke_plume_3d`], m.
+pub const PLUME_SPHERE_RADIUS: f64 = 0.15;
+
 /// Hot smoke rising around a sphere: an `n x 3n/2 x n` box of height 1.5, open at the top,
 /// a vent (density 1, temperature 1, upward velocity 0.5) at the bottom centre, a sphere of
-/// radius 0.15 above it; buoyancy `alpha = 0.05`, `beta = 1`, vorticity confinement 2;
-/// MacCormack, MGPCG (tolerance 1e-5), dt = 1.5 h (CFL about 1 at the plume's speed).
+/// radius 0.15 above it ([`PLUME_SPHERE_CENTRE`], [`PLUME_SPHERE_RADIUS`]); buoyancy
+/// `alpha = 0.05`, `beta = 1`, vorticity confinement 2; MacCormack, MGPCG (tolerance 1e-5),
+/// dt = 1.5 h (CFL about 1 at the plume's speed).
 ///
 /// # Errors
 /// [`FluidError::BadGrid`] for `n < 2`.
@@ -304,7 +312,8 @@ pub fn smoke_plume_3d(n: usize) -> Result<FluidScene, FluidError> {
         ..MacParams::default()
     };
     let (mut fluid, state) = MacFluid::new([n, ny, n], 3, h, params)?;
-    fluid.set_solid(|p| (p[0] - 0.5).powi(2) + (p[1] - 0.45).powi(2) + (p[2] - 0.5).powi(2) < 0.15 * 0.15)?;
+    let ([cx, cy, cz], r) = (PLUME_SPHERE_CENTRE, PLUME_SPHERE_RADIUS);
+    fluid.set_solid(|p| (p[0] - cx).powi(2) + (p[1] - cy).powi(2) + (p[2] - cz).powi(2) < r * r)?;
     Ok(FluidScene {
         name: "smoke-plume-3d",
         description: "hot smoke rising from a vent around a sphere, open top",

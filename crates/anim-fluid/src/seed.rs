@@ -341,6 +341,12 @@ impl SeedFluid {
         (&self.u, &self.v)
     }
 
+    /// Density, `(N+2)^2` values indexed by [`ix`], to set an initial condition (the next step
+    /// checks what it produces from it).
+    pub fn density_mut(&mut self) -> &mut [f32] {
+        &mut self.dens
+    }
+
     /// The source arrays `(dens_prev, u_prev, v_prev)` the next step adds (times `dt`).
     pub fn sources_mut(&mut self) -> (&mut [f32], &mut [f32], &mut [f32]) {
         (&mut self.dens_prev, &mut self.u_prev, &mut self.v_prev)
@@ -360,7 +366,24 @@ impl SeedFluid {
     /// overflow `f32`). The six arrays, sources included, and the step count are then exactly as
     /// before the step (they are copied aside before each step; nothing is allocated).
     pub fn step(&mut self) -> Result<(), FluidError> {
-        let (n, p) = (self.n, self.params);
+        self.back_up();
+        self.step_backed_up()
+    }
+
+    /// [`SeedFluid::apply_source_pattern`], then [`SeedFluid::step`], as one step: on error
+    /// the six arrays are as before the call, the sources included (the ones the pattern
+    /// replaced).
+    ///
+    /// # Errors
+    /// As [`SeedFluid::step`].
+    pub fn step_with_source_pattern(&mut self) -> Result<(), FluidError> {
+        self.back_up();
+        self.apply_source_pattern();
+        self.step_backed_up()
+    }
+
+    /// Copies the six arrays aside.
+    fn back_up(&mut self) {
         for (b, a) in self.backup.iter_mut().zip([
             &self.dens,
             &self.dens_prev,
@@ -371,6 +394,11 @@ impl SeedFluid {
         ]) {
             b.copy_from_slice(a);
         }
+    }
+
+    /// The step after [`SeedFluid::back_up`]; on error the arrays are restored from the backup.
+    fn step_backed_up(&mut self) -> Result<(), FluidError> {
+        let (n, p) = (self.n, self.params);
         vel_step(n, &mut self.u, &mut self.v, &mut self.u_prev, &mut self.v_prev, p.visc, p.dt);
         dens_step(n, &mut self.dens, &mut self.dens_prev, &self.u, &self.v, p.diff, p.dt);
         let step = self.steps;

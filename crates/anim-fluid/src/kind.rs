@@ -1,0 +1,350 @@
+//! The `fluid` scene kind: the grid-fluid presets of [`scenes`] registered with anim-core's
+//! scene contracts ([`anim_core::scene`]), so the `anim` command line, `cargo xtask` and the
+//! Python bindings build, step, checkpoint and draw them without knowing this crate.
+//!
+//! | preset | what | solver |
+//! | --- | --- | --- |
+//! | `smoke-box-2d` | smoke rising from a source in a closed 128 x 128 box | the seed's stable fluids (`f32`, 20 Gauss-Seidel sweeps) |
+//! | `smoke-plume-3d` | hot smoke rising around a sphere, open top | 3D MAC grid, MacCormack + MGPCG |
+//! | `lid-driven-cavity` | the Re = 100 cavity stirring bands of dye | 2D MAC grid, MacCormack + MGPCG |
+//!
+//! A scene is the [`FluidScene`] itself stepped as a [`Solver`] whose state is the run's clock:
+//! the sum of the steps' `dt` in `f64` (the seed's solver keeps its own time in sums of the
+//! `f32` step). Its frames have no points: the fields `"density"` (1 per cell) and
+//! `"velocity"` (3 per cell, at the cell centres), x fastest, on the [`ImageGrid`] of the
+//! context, in the grid's own axes (y up, as the solvers and the image). The cavity's
+//! [`View::reference_error`] is the largest distance from Ghia, Ghia and Shin's (1982)
+//! centreline velocities.
+//!
+//! ```
+//! use anim_core::scene::Frame;
+//!
+//! let preset = (anim_fluid::KIND.presets)().remove(2);
+//! assert_eq!(preset.name, "lid-driven-cavity");
+//! let params = preset.quick_params.expect("a coarse version");
+//! let mut scene = (anim_fluid::KIND.build)(&params, &Default::default())?;
+//! scene.step(preset.run.dt)?;
+//! let mut frame = Frame::default();
+//! scene.frame(&mut frame);
+//! let cells = 16 * 16;
+//! assert_eq!(frame.field("density").map(|f| f.values.len()), Some(cells));
+//! assert_eq!(frame.field("velocity").map(|f| f.values.len()), Some(3 * cells));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use crate::advection::{Advection, Splitting};
+use crate::error::FluidError;
+use crate::mac::{MacFluid, MacState};
+use crate::pressure::PressureMethod;
+use crate::scenes::{self, FluidScene, FluidSim};
+use anim_core::scene::{
+    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, ImageGrid, Preset, Prop,
+    RunDefaults, SceneKind, Simulated, View, params, saved_field,
+};
+use anim_core::solver::{Solver, StepReport};
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+
+/// The `fluid` scene kind of anim-fluid, for the workspace registry.
+pub const KIND: SceneKind = SceneKind {
+    kind: "fluid",
+    crate_name: "anim-fluid",
+    summary: "grid fluids: the seed's stable fluids and the MAC solver in 2D and 3D, density and velocity per cell",
+    presets,
+    build,
+};
+
+/// The iteration cap of a pressure solve whose solver or tolerance a scene file sets (the
+/// report's pressure study's cap); the presets' own settings keep their cap.
+pub const PRESSURE_MAX_ITERATIONS: usize = 200_000;
+
+/// Scene-file parameters of a `fluid` scene: a preset of [`scenes::NAMES`] and what a file may
+/// change in it. Unset fields keep the preset's value.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FluidSceneParams {
+    /// The preset's name: `"smoke-box-2d"`, `"smoke-plume-3d"` or `"lid-driven-cavity"`.
+    pub preset: String,
+    /// Cells across the domain: 2 to 2048 in 2D, 2 to 128 for `smoke-plume-3d`. Default: the
+    /// preset's (128, 32, 64).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resolution: Option<usize>,
+    /// Pressure solver of the MAC presets (`"jacobi"`, `"rb-gauss-seidel"`, `"cg"`,
+    /// `"mgpcg"`). Default: the preset's (MGPCG). Setting it or the tolerance lets the solve
+    /// take up to [`PRESSURE_MAX_ITERATIONS`] iterations.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pressure_solver: Option<PressureMethod>,
+    /// Relative residual `max|b - A p| / max|b|` the pressure solve stops at, > 0 (MAC presets).
+    /// Default: the preset's (1e-5 for the plume, 1e-8 for the cavity).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pressure_tolerance: Option<f64>,
+    /// Advection scheme of the MAC presets (`"sl-linear"`, `"sl-monotone-cubic"`, `"bfecc"`,
+    /// `"maccormack"`). Default: the preset's (MacCormack).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub advection: Option<Advection>,
+    /// How a MAC step splits advection from projection (`"advect-project"`, the seed's order,
+    /// or `"reflection"`, advection-reflection). Default: the preset's (advect-project).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub splitting: Option<Splitting>,
+}
+
+impl FluidSceneParams {
+    /// The preset at `resolution` cells across (the preset's own when `None`).
+    #[must_use]
+    pub fn preset(name: &str, resolution: Option<usize>) -> Self {
+        Self {
+            preset: name.into(),
+            resolution,
+            pressure_solver: None,
+            pressure_tolerance: None,
+            advection: None,
+            splitting: None,
+        }
+    }
+
+    /// Checks the parameters and builds the scene.
+    ///
+    /// # Errors
+    /// [`BuildError::Invalid`] naming the field: an unknown preset, a resolution above the
+    /// preset's limit or one the solver refuses, a tolerance that is not positive and finite, a
+    /// MAC setting given to the seed's solver.
+    pub fn scene(&self) -> Result<FluidScene, BuildError> {
+        if let Some(tol) = self.pressure_tolerance
+            && !(tol > 0.0 && tol.is_finite())
+        {
+            return Err(BuildError::invalid(
+                "pressure_tolerance",
+                format!("must be a positive finite number, got {tol}"),
+            ));
+        }
+        let preset = self.preset.as_str();
+        let unknown = || {
+            BuildError::invalid(
+                "preset",
+                format!("unknown preset `{preset}` (one of {})", scenes::NAMES.join(", ")),
+            )
+        };
+        if !scenes::NAMES.contains(&preset) {
+            return Err(unknown());
+        }
+        let limit = if preset == "smoke-plume-3d" { 128 } else { 2048 };
+        if let Some(r) = self.resolution
+            && r > limit
+        {
+            return Err(BuildError::invalid(
+                "resolution",
+                format!("{preset} takes at most {limit} cells across, got {r}"),
+            ));
+        }
+        let mut scene = scenes::by_name(preset, self.resolution)
+            .ok_or_else(unknown)?
+            .map_err(|e| BuildError::invalid("resolution", e.to_string()))?;
+        let fields = [
+            ("pressure_solver", self.pressure_solver.is_some()),
+            ("pressure_tolerance", self.pressure_tolerance.is_some()),
+            ("advection", self.advection.is_some()),
+            ("splitting", self.splitting.is_some()),
+        ];
+        let Some(&(field, _)) = fields.iter().find(|(_, set)| *set) else { return Ok(scene) };
+        let FluidSim::Mac(fluid, _) = &mut scene.sim else {
+            return Err(BuildError::invalid(
+                field,
+                format!(
+                    "{preset} runs the seed's solver (20 Gauss-Seidel sweeps, linear advection), which has no pressure, advection or splitting settings"
+                ),
+            ));
+        };
+        if self.pressure_solver.is_some() || self.pressure_tolerance.is_some() {
+            let p = fluid.params();
+            let method = self.pressure_solver.unwrap_or(p.pressure);
+            let tol = self.pressure_tolerance.unwrap_or(p.pressure_tolerance);
+            let field = if self.pressure_solver.is_some() { "pressure_solver" } else { "pressure_tolerance" };
+            fluid
+                .set_pressure(method, tol, PRESSURE_MAX_ITERATIONS)
+                .map_err(|e| BuildError::invalid(field, e.to_string()))?;
+        }
+        if let Some(a) = self.advection {
+            fluid.set_advection(a);
+        }
+        if let Some(s) = self.splitting {
+            fluid.set_splitting(s);
+        }
+        Ok(scene)
+    }
+}
+
+fn presets() -> Vec<Preset> {
+    vec![
+        Preset {
+            name: "smoke-box-2d",
+            description: "the seed's stable fluids: smoke rising from a source in a closed 128x128 box",
+            run: RunDefaults::new(0.1, 100, 2),
+            params: json!({ "preset": "smoke-box-2d", "resolution": 128 }),
+            quick_params: Some(json!({ "preset": "smoke-box-2d", "resolution": 16 })),
+        },
+        Preset {
+            name: "smoke-plume-3d",
+            description: "hot smoke rising around a sphere, 3D MAC grid, MacCormack + MGPCG, open top",
+            run: RunDefaults::new(0.046875, 64, 1),
+            params: json!({ "preset": "smoke-plume-3d", "resolution": 32 }),
+            quick_params: Some(json!({ "preset": "smoke-plume-3d", "resolution": 8 })),
+        },
+        Preset {
+            name: "lid-driven-cavity",
+            description: "the Re = 100 lid-driven cavity (64x64 MAC grid) stirring bands of dye",
+            run: RunDefaults::new(0.015625, 128, 10),
+            params: json!({ "preset": "lid-driven-cavity", "resolution": 64 }),
+            quick_params: Some(json!({ "preset": "lid-driven-cavity", "resolution": 16 })),
+        },
+    ]
+}
+
+fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
+    let p: FluidSceneParams = params(value)?;
+    Ok(Simulated::new(p.scene()?, 0.0).boxed())
+}
+
+/// A [`FluidScene`] stepped by `dt` per step (the seed scene applies its source pattern first),
+/// with the run's clock as its state: the sum of the steps' `dt`.
+impl Solver for FluidScene {
+    type State = f64;
+    type Error = FluidError;
+
+    fn step(&mut self, time: &mut f64, dt: f64) -> Result<StepReport, FluidError> {
+        let mut report = self.step_by(dt)?;
+        *time += dt;
+        report.time = *time;
+        Ok(report)
+    }
+}
+
+/// Saved as `{"time": t, "fluid": memory}` with [`FluidScene::memory`]: the seed's six arrays,
+/// or the MAC state and its warm-start pressure.
+impl Checkpoint for FluidScene {
+    const VERSION: u32 = 1;
+
+    fn time(&self, time: &f64) -> f64 {
+        *time
+    }
+
+    fn save(&self, time: &f64) -> serde_json::Value {
+        json!({ "time": time, "fluid": self.memory() })
+    }
+
+    fn restore(&mut self, time: &mut f64, saved: &serde_json::Value) -> Result<(), CheckpointError> {
+        let t: f64 = saved_field(saved, "time")?;
+        if !t.is_finite() {
+            return Err(CheckpointError::invalid("time", format!("{t} is not finite")));
+        }
+        let memory = saved.get("fluid").ok_or_else(|| CheckpointError::Missing { field: "fluid".into() })?;
+        // Checks everything before it changes anything.
+        self.restore_memory(memory).map_err(|e| CheckpointError::invalid("fluid", e.to_string()))?;
+        *time = t;
+        Ok(())
+    }
+
+    fn provoke_overflow(&mut self, _: &mut f64) -> Option<String> {
+        match &mut self.sim {
+            FluidSim::Seed(f) => {
+                // The diffusion sums four neighbours: 2 f32::MAX is infinite.
+                f.density_mut().fill(f32::MAX);
+                Some("the density of every cell set to f32::MAX".into())
+            }
+            FluidSim::Mac(f, s) => {
+                // Neighbouring faces of opposite signs: the net outflow is infinite.
+                for values in s.vel.iter_mut().take(f.dim()) {
+                    for (k, u) in values.iter_mut().enumerate() {
+                        *u = if k % 2 == 0 { f64::MAX } else { -f64::MAX };
+                    }
+                }
+                Some("the face velocities set to +-f64::MAX, alternating".into())
+            }
+        }
+    }
+}
+
+impl View for FluidScene {
+    fn method(&self) -> String {
+        match &self.sim {
+            FluidSim::Seed(_) => "seed stable fluids (f32, 20 Gauss-Seidel sweeps)".to_string(),
+            FluidSim::Mac(f, _) => format!(
+                "{}D MAC, {} advection, {} splitting, {} pressure",
+                f.dim(),
+                f.params().advection.name(),
+                f.params().splitting.name(),
+                f.params().pressure.name()
+            ),
+        }
+    }
+
+    /// The image grid (origin at 0, the cell size as spacing, the density shown) and, for the
+    /// plume, its sphere in the grid's axes.
+    fn context(&self, _: &f64) -> Context {
+        // The seed's source adds 10 per step where it sits and the closed box keeps it all: in
+        // the 128^2 box after 200 steps the density's median is 17, its 99th percentile 50
+        // (measured on the scene's frames), so the scale ends at 50. The MAC scenes' densities
+        // lie in [0, 1] (sources and dye of 1, a limited advection).
+        let range = match &self.sim {
+            FluidSim::Seed(_) => (0.0, 50.0),
+            FluidSim::Mac(..) => (0.0, 1.0),
+        };
+        let mut context = Context::default();
+        context.image = Some(ImageGrid {
+            dims: self.dims(),
+            dim: self.dim(),
+            origin: [0.0; 3],
+            spacing: self.cell_size(),
+            shown: "density",
+            range,
+        });
+        if self.name == "smoke-plume-3d" {
+            context.props.push(Prop::Sphere {
+                center: scenes::PLUME_SPHERE_CENTRE,
+                radius: scenes::PLUME_SPHERE_RADIUS,
+            });
+        }
+        context
+    }
+
+    fn frame(&self, time: &f64, out: &mut Frame) {
+        out.time = *time;
+        out.points.clear();
+        self.density_into(out.field_mut("density", 1));
+        self.velocity_into(out.field_mut("velocity", 3));
+    }
+
+    fn reference_error(&self, _: &f64) -> Option<f64> {
+        match &self.sim {
+            FluidSim::Mac(fluid, state) if self.name == "lid-driven-cavity" => Some(ghia_error(fluid, state)),
+            _ => None,
+        }
+    }
+}
+
+/// Ghia, Ghia and Shin (1982), Re = 100: `u` along the vertical centreline, `(y, u)`.
+const GHIA_U: &str = include_str!("../testdata/ghia_re100_u.csv");
+/// The same for `v` along the horizontal centreline, `(x, v)`.
+const GHIA_V: &str = include_str!("../testdata/ghia_re100_v.csv");
+
+/// Ghia's points `(coordinate, value)` strictly inside the cavity.
+fn ghia_points(text: &str) -> impl Iterator<Item = (f64, f64)> + '_ {
+    text.lines()
+        .skip(1)
+        .filter_map(|l| {
+            let (a, b) = l.split_once(',')?;
+            Some((a.trim().parse().ok()?, b.trim().parse().ok()?))
+        })
+        .filter(|&(c, _)| c > 0.0 && c < 1.0)
+}
+
+/// The cavity's error on the Ghia study's measure: the largest `|u(0.5, y) - u_Ghia|` and
+/// `|v(x, 0.5) - v_Ghia|` over Ghia's interior points (the unit cavity, Re = 100).
+#[must_use]
+pub fn ghia_error(fluid: &MacFluid, state: &MacState) -> f64 {
+    let u = ghia_points(GHIA_U).map(|(y, u)| (fluid.velocity_at_point(state, [0.5, y, 0.0])[0] - u).abs());
+    let v = ghia_points(GHIA_V).map(|(x, v)| (fluid.velocity_at_point(state, [x, 0.5, 0.0])[1] - v).abs());
+    u.chain(v).fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests;
