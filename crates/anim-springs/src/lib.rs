@@ -24,6 +24,10 @@
 //!   reads OBJ files). Bad input is a [`BuildError`] naming the element, never a panic.
 //! - **Scenes** ([`scenes`]): a hanging cloth, a swinging rope, a jelly cube dropped on the
 //!   ground, and the benchmark cloth, each with its suggested integrator, solver and step.
+//! - **Scene kind** ([`KIND`], kind `springs`): the scenes behind anim-core's scene contracts
+//!   ([`anim_core::scene`]), with the presets `cloth` (the 32 x 32 hanging cloth), `rope` (the
+//!   swinging rope) and `jelly` (the jelly drop) that the `anim` command line runs;
+//!   [`SpringSimulation`] is a checkpointable, viewable solver ([`kind`]).
 //!
 //! [`SpringNetwork`] implements anim-core's [`SecondOrderSystem`](anim_core::integrate::SecondOrderSystem)
 //! (for the explicit methods) and [`MechanicalSystem`](anim_core::integrate::MechanicalSystem) (for
@@ -125,6 +129,7 @@
 pub mod analytic;
 mod build;
 pub mod contact;
+pub mod kind;
 mod mesh;
 pub mod network;
 pub mod scenes;
@@ -134,6 +139,7 @@ pub use build::{
     BuildError, Chain, Cloth, EARTH_GRAVITY, Lattice, MeshMass, MeshSprings, NetworkBuilder, SpringParams,
 };
 pub use contact::{Collider, Shape};
+pub use kind::KIND;
 pub use mesh::TriangleMesh;
 pub use network::{
     EnergyParts, JacobianMode, Particle, Spring, SpringKind, SpringModel, SpringNetwork, Stretch,
