@@ -133,6 +133,11 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
+//! [`KIND`] (kind `pbd`) puts the scenes behind anim-core's scene contracts
+//! ([`anim_core::scene`]) with the presets the `anim` command line runs: `drape` (cloth on a
+//! sphere), `flag`, `blob` (the soft tetrahedral blob), `pbd-rope` and `pbd-cloth` (the report's
+//! hanging cloth); [`PbdSimulation`] is a checkpointable, viewable solver ([`kind`]).
+//!
 //! `examples/cloth_drape.rs` runs any built-in scene ([`scenes`]: cloth draped over a sphere, a
 //! flag in the wind on a swaying pole, a rope of 100 links, a soft tetrahedral blob, a balloon)
 //! and prints energy, momentum, constraint violation and timings:
@@ -158,6 +163,7 @@
 mod build;
 pub mod collide;
 pub mod constraint;
+pub mod kind;
 mod model;
 mod project;
 pub mod scenes;
@@ -170,6 +176,7 @@ pub use build::{
 };
 pub use collide::{BodyMotion, Collider, KinematicBody, Pose, Shape};
 pub use constraint::{AttachTarget, Constraint, ConstraintFunction, ConstraintParams, ConstraintType};
+pub use kind::KIND;
 pub use model::{Particle, PbdModel, SparseGradient, VolumeMesh, Wind};
 pub use sim::{Method, PbdError, PbdParams, PbdSimulation, SolverKind, StepInfo};
 

@@ -1,0 +1,283 @@
+//! The `pbd` scene kind: the crate's scenes behind anim-core's scene contracts
+//! ([`anim_core::scene`]), so that the `anim` command line, `cargo xtask` and the Python bindings
+//! run them without knowing the crate.
+//!
+//! | preset | scene | run |
+//! | --- | --- | --- |
+//! | `drape` | [`cloth_drape`](crate::scenes::cloth_drape): cloth falling onto a sphere | 120 frames of 1/60 s |
+//! | `flag` | [`flag`](crate::scenes::flag): a flag on a swaying pole in gusty wind | 120 frames of 1/60 s |
+//! | `blob` | [`soft_blob`](crate::scenes::soft_blob): a tetrahedral blob dropped on the ground | 120 frames of 1/60 s |
+//! | `pbd-rope` | [`rope`](crate::scenes::rope): 100 links swinging over a capsule onto a box | 120 frames of 1/60 s |
+//! | `pbd-cloth` | [`hanging_cloth`](crate::scenes::hanging_cloth): the report's 14 x 14 cloth | 30 frames of 1/60 s |
+//!
+//! A scene file's `[scene]` table (`kind = "pbd"`) holds the fields of [`PbdSceneParams`]. The
+//! scene is a [`PbdSimulation`] with its [`State`]: it implements [`Checkpoint`] (the state and
+//! the simulation's memory: step count, external forces, pending body targets) and [`View`]
+//! (the particles and their velocities; the model's triangles, or the boundary of its
+//! tetrahedra, its edges and tetrahedra, the particles of zero inverse mass as pins, and the
+//! static colliders: ground, spheres, capsules and boxes).
+
+use crate::collide::Shape;
+use crate::scenes;
+use crate::sim::{Method, PbdSimulation};
+use anim_core::integrate::State;
+use anim_core::scene::{
+    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
+    RunDefaults, SceneKind, Simulated, View, params, saved_state,
+};
+use serde::{Deserialize, Serialize};
+
+/// The `pbd` scene kind of anim-pbd, for the workspace registry.
+pub const KIND: SceneKind = SceneKind {
+    kind: "pbd",
+    crate_name: "anim-pbd",
+    summary: "position based dynamics and XPBD: cloth, flags, ropes and soft bodies with collisions",
+    presets,
+    build,
+};
+
+/// The largest iteration or substep count a `pbd` scene takes.
+pub const MAX_PBD_COUNT: usize = 100_000;
+
+/// Scene-file parameters of a `pbd` scene: a preset of [`scenes`] with its own solver settings
+/// unless overridden.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PbdSceneParams {
+    /// The preset's name: `cloth-drape`, `flag`, `rope`, `soft-blob`, `balloon`,
+    /// `hanging-cloth` or `benchmark-cloth` ([`scenes::NAMES`]). Required.
+    pub preset: String,
+    /// Resolution (the preset's default when absent): the cloth's side (2 to 1024, default 32;
+    /// 14 for the hanging cloth; 50 for the benchmark cloth), the flag's width (3 to 512,
+    /// default 24), the rope's links (2 to 100,000, default 100), the blob's cells (2 to 40,
+    /// default 6), the balloon's subdivisions (0 to 6, default 3).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resolution: Option<usize>,
+    /// `"pbd"` (stiffness) or `"xpbd"` (compliance); the preset's when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub method: Option<Method>,
+    /// Solver iterations per substep, 1 to [`MAX_PBD_COUNT`] (the preset's when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub iterations: Option<usize>,
+    /// Substeps per step, 1 to [`MAX_PBD_COUNT`] (the preset's when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub substeps: Option<usize>,
+}
+
+/// The step of every preset: 1/60 s.
+const DT: f64 = 0.016666666666666666;
+
+fn presets() -> Vec<Preset> {
+    let preset = |name, description, frames, scene: &str, quick: Option<usize>| Preset {
+        name,
+        description,
+        run: RunDefaults::new(DT, frames, 1),
+        params: serde_json::json!({ "preset": scene }),
+        quick_params: quick.map(|n| serde_json::json!({ "preset": scene, "resolution": n })),
+    };
+    vec![
+        preset("drape", "XPBD cloth falling onto a sphere and draping over it", 120, "cloth-drape", Some(8)),
+        preset("flag", "an XPBD flag on a swaying pole in the wind", 120, "flag", Some(6)),
+        preset("blob", "a soft tetrahedral blob (XPBD) falling on the ground", 120, "soft-blob", Some(3)),
+        preset("pbd-rope", "a 100-link XPBD rope swinging against obstacles", 120, "rope", Some(20)),
+        preset(
+            "pbd-cloth",
+            "the report's 14x14 XPBD cloth pinned at two corners, hanging down for 0.5 s",
+            30,
+            "hanging-cloth",
+            None,
+        ),
+    ]
+}
+
+/// Builds a `pbd` scene from its parameters ([`PbdSceneParams`]).
+fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
+    let p: PbdSceneParams = params(value)?;
+    for (field, count) in [("iterations", p.iterations), ("substeps", p.substeps)] {
+        if let Some(k) = count
+            && !(1..=MAX_PBD_COUNT).contains(&k)
+        {
+            return Err(BuildError::invalid(field, format!("must lie in [1, {MAX_PBD_COUNT}], got {k}")));
+        }
+    }
+    let mut scene = match scenes::by_name(&p.preset, p.resolution) {
+        Some(Ok(scene)) => scene,
+        Some(Err(e)) => return Err(BuildError::invalid("resolution", e.to_string())),
+        None => {
+            return Err(BuildError::invalid(
+                "preset",
+                format!("unknown preset `{}` (one of {})", p.preset, scenes::NAMES.join(", ")),
+            ));
+        }
+    };
+    if let Some(method) = p.method {
+        scene.params.method = method;
+    }
+    if let Some(iterations) = p.iterations {
+        scene.params.iterations = iterations;
+    }
+    if let Some(substeps) = p.substeps {
+        scene.params.substeps = substeps;
+    }
+    let (sim, state) = scene.into_simulation().map_err(|e| BuildError::invalid("preset", e.to_string()))?;
+    Ok(Simulated::new(sim, state).boxed())
+}
+
+impl Checkpoint for PbdSimulation {
+    const VERSION: u32 = 1;
+
+    fn time(&self, state: &State) -> f64 {
+        state.t
+    }
+
+    fn save(&self, state: &State) -> serde_json::Value {
+        serde_json::json!({ "state": state, "simulation": self.memory() })
+    }
+
+    fn restore(&mut self, state: &mut State, saved: &serde_json::Value) -> Result<(), CheckpointError> {
+        let restored = saved_state(saved, "state", state)?;
+        let memory =
+            saved.get("simulation").ok_or_else(|| CheckpointError::Missing { field: "simulation".into() })?;
+        // The memory is checked and taken whole, or not at all.
+        self.restore_memory(memory).map_err(|e| CheckpointError::invalid("simulation", e.to_string()))?;
+        *state = restored;
+        Ok(())
+    }
+
+    fn provoke_overflow(&mut self, state: &mut State) -> Option<String> {
+        let i = self.model().inverse_masses().iter().position(|&w| w > 0.0)?;
+        // Both: the predicted position `x + h v` then overflows whatever the substep.
+        state.x[3 * i] = f64::MAX;
+        state.v[3 * i] = f64::MAX;
+        Some(format!("position and velocity x of particle {i} set to f64::MAX"))
+    }
+}
+
+impl View for PbdSimulation {
+    fn method(&self) -> String {
+        let p = self.params();
+        format!(
+            "{} / {}, {} iteration{} x {} substep{}",
+            format!("{:?}", p.method).to_lowercase(),
+            format!("{:?}", p.solver).to_lowercase(),
+            p.iterations,
+            if p.iterations == 1 { "" } else { "s" },
+            p.substeps,
+            if p.substeps == 1 { "" } else { "s" },
+        )
+    }
+
+    fn context(&self, state: &State) -> Context {
+        let model = self.model();
+        let mut triangles = model.triangles().to_vec();
+        if triangles.is_empty() && !model.tets().is_empty() {
+            triangles = boundary_triangles(model.tets(), state.x.len() / 3);
+        }
+        let (mut ground, mut spheres, mut others) = (None, Vec::new(), Vec::new());
+        for c in model.colliders().iter().filter(|c| c.body.is_none()) {
+            match c.shape {
+                Shape::Plane { point, normal: [0.0, 0.0, 1.0] } => ground = Some(point[2]),
+                Shape::Sphere { center, radius } => spheres.push(Prop::Sphere { center, radius }),
+                Shape::Capsule { a, b, radius } => others.push(Prop::Capsule { a, b, radius }),
+                Shape::Box { center, half_extents: h } => others.push(Prop::Cuboid {
+                    lo: [center[0] - h[0], center[1] - h[1], center[2] - h[2]],
+                    hi: [center[0] + h[0], center[1] + h[1], center[2] + h[2]],
+                }),
+                Shape::Plane { .. } => {}
+            }
+        }
+        let edges = model.edges().to_vec();
+        let mean = if edges.is_empty() {
+            0.01
+        } else {
+            edges
+                .iter()
+                .map(|[i, j]| {
+                    let (a, b) = (&state.x[3 * i..3 * i + 3], &state.x[3 * j..3 * j + 3]);
+                    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+                })
+                .sum::<f64>()
+                / edges.len() as f64
+        };
+        let mut context = Context::default();
+        context.point_dim = 3;
+        context.triangles = triangles;
+        context.lines = edges;
+        context.tetrahedra = model.tets().to_vec();
+        context.pins =
+            model.inverse_masses().iter().enumerate().filter(|&(_, &w)| w == 0.0).map(|(i, _)| i).collect();
+        context.point_radius = 0.2 * mean;
+        context.props.extend(ground.map(|height| Prop::Ground { height }));
+        context.props.extend(spheres);
+        context.props.extend(others);
+        context.bounds = Some(frame_box(&state.x, ground, true));
+        context
+    }
+
+    fn frame(&self, state: &State, out: &mut Frame) {
+        out.time = state.t;
+        out.points.clone_from(&state.x);
+        out.field_mut("velocity", 3).extend_from_slice(&state.v);
+    }
+}
+
+/// The boundary triangles of the tetrahedra `tets` over `n` points: the faces that belong to
+/// exactly one tetrahedron, oriented outward for positively oriented tetrahedra, in the order
+/// their first tetrahedron lists them. A tetrahedron with an index `>= n` is skipped.
+///
+/// The faces of a tetrahedron `(a, b, c, d)` are taken as `(a, c, b)`, `(a, b, d)`, `(a, d, c)`,
+/// `(b, c, d)` (outward when the tetrahedron is positive); a face is kept with the orientation
+/// of the tetrahedron that listed it, and the faces come out in the order in which their sorted
+/// vertex triples were first met.
+fn boundary_triangles(tets: &[[usize; 4]], n: usize) -> Vec<[usize; 3]> {
+    use std::collections::HashMap;
+    let mut count: HashMap<[usize; 3], (usize, [usize; 3])> = HashMap::new();
+    let mut order = Vec::new();
+    for t in tets {
+        if t.iter().any(|&i| i >= n) {
+            continue;
+        }
+        let [a, b, c, d] = *t;
+        for f in [[a, c, b], [a, b, d], [a, d, c], [b, c, d]] {
+            let mut key = f;
+            key.sort_unstable();
+            let entry = count.entry(key).or_insert_with(|| {
+                order.push(key);
+                (0, f)
+            });
+            entry.0 += 1;
+        }
+    }
+    order.iter().filter_map(|k| count.get(k)).filter(|(c, _)| *c == 1).map(|(_, f)| *f).collect()
+}
+
+/// The region a picture of the points `x` (flat, 3 per point) keeps in view: their bounding box
+/// widened by a third of its largest side in x and y, reaching down by 1.3 sides below the top
+/// for a scene that `falls`, and down to the `ground` when there is one.
+fn frame_box(x: &[f64], ground: Option<f64>, falls: bool) -> ([f64; 3], [f64; 3]) {
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in x.chunks_exact(3) {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if lo[0] > hi[0] {
+        return ([-1.0; 3], [1.0; 3]);
+    }
+    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-3);
+    for k in 0..2 {
+        lo[k] -= size / 3.0;
+        hi[k] += size / 3.0;
+    }
+    if falls {
+        lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
+    }
+    if let Some(z) = ground {
+        lo[2] = z;
+    }
+    (lo, hi)
+}
+
+#[cfg(test)]
+mod tests;
