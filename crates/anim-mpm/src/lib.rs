@@ -34,6 +34,12 @@
 //!   every step as a by-product of the double-buffered G2P;
 //! - [`scenes`]: the classic three-material 2D scene, a 3D dam break, a snowball hitting a wall,
 //!   and the two peer-benchmark scenes (Taichi's `mpm88` and `mpm3d`).
+//! - [`kind`]: the `mpm` scene kind, [`KIND`], which registers the scenes with the workspace
+//!   ([`anim_core::scene::SceneKind`], scene files of `kind = "mpm"`): the presets `mpm`
+//!   (`three-materials`), `dam-break-2d-mpm` (`dam-break-2d`, with its surge front against
+//!   Martin & Moyce as the reference error), `dam-break` (`dam-break-3d`) and `snowball`, built
+//!   from [`kind::MpmSceneParams`] (preset, resolution, transfer, kernel, particles per cell) and
+//!   run as a [`kind::MpmRun`] (checkpoints and frames).
 //!
 //! The seed's MLS-MPM listing prints the G2P affine update as `C_p = 1/dx^2 sum ...`; the factor
 //! is `D_p^-1 = 4/dx^2` for the quadratic kernel (its own APIC listing and Hu et al. 2018), and
@@ -109,6 +115,7 @@ mod avx2;
 pub mod boundary;
 mod grid;
 pub mod kernel;
+pub mod kind;
 pub mod material;
 mod particles;
 pub mod plasticity;
@@ -117,10 +124,13 @@ mod sim;
 mod transfer;
 
 #[cfg(test)]
+mod kind_tests;
+#[cfg(test)]
 mod tests;
 
 pub use boundary::{Boundary, Collider, Shape};
 pub use kernel::Kernel;
+pub use kind::KIND;
 pub use material::{Elastic, ElasticModel, Fluid, Material, Sand, Snow};
 pub use particles::Particles;
 pub use sim::{MpmParams, MpmSimulation, OutOfDomain, StepStats, Totals, Transfer};

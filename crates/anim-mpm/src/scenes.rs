@@ -451,10 +451,10 @@ pub const MARTIN_MOYCE: [(f64, f64); 15] = [
 ];
 
 /// The dam break's surge front `Z = (max x - x_wall) / a` of `particles` in a simulation with
-/// `params`.
+/// `params` (the dam break is 2D; the front of particles in `D` dimensions is along x).
 #[must_use]
-pub fn surge_front(params: &MpmParams, particles: &Particles<2>) -> f64 {
-    let right = particles.x.chunks_exact(2).map(|c| f64::from(c[0])).fold(f64::MIN, f64::max);
+pub fn surge_front<const D: usize>(params: &MpmParams, particles: &Particles<D>) -> f64 {
+    let right = particles.x.chunks_exact(D).map(|c| f64::from(c[0])).fold(f64::MIN, f64::max);
     (right - dam_break_wall(params)) / DAM_BREAK_COLUMN
 }
 
@@ -486,12 +486,29 @@ pub struct SurgeFront {
 impl SurgeFront {
     /// Starts at the run's initial particles (`T = 0`).
     #[must_use]
-    pub fn new(params: &MpmParams, particles: &Particles<2>) -> Self {
+    pub fn new<const D: usize>(params: &MpmParams, particles: &Particles<D>) -> Self {
         Self { last: (0.0, surge_front(params, particles)), z: Vec::with_capacity(MARTIN_MOYCE.len()) }
     }
 
+    /// Checks a tracker read from a checkpoint (at most one front per time of the table, every
+    /// value finite) and gives it the capacity of the whole table, so that observing does not
+    /// allocate.
+    ///
+    /// # Errors
+    /// What is wrong with it.
+    pub(crate) fn checked(mut self) -> Result<Self, String> {
+        if self.z.len() > MARTIN_MOYCE.len() {
+            return Err(format!("{} fronts; the table has {} times", self.z.len(), MARTIN_MOYCE.len()));
+        }
+        if let Some(bad) = [self.last.0, self.last.1].iter().chain(&self.z).find(|v| !v.is_finite()) {
+            return Err(format!("holds the non-finite value {bad}"));
+        }
+        self.z.reserve_exact(MARTIN_MOYCE.len() - self.z.len());
+        Ok(self)
+    }
+
     /// Records the front after a step ending at simulated time `time` (s).
-    pub fn observe(&mut self, time: f64, params: &MpmParams, particles: &Particles<2>) {
+    pub fn observe<const D: usize>(&mut self, time: f64, params: &MpmParams, particles: &Particles<D>) {
         let now = (time * dam_break_time_scale(), surge_front(params, particles));
         while let Some(&(t, _)) = MARTIN_MOYCE.get(self.z.len()) {
             if now.0 < t - 1e-9 {

@@ -12,13 +12,15 @@ use anim_core::solver::{Solver, StepReport};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// The transfer scheme.
+/// The transfer scheme; `"apic"` or `"mls-mpm"` in scene files and serialised parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum Transfer {
     /// APIC (seed 5.3.1): grid forces from `grad w_ip`, `F` updated with `sum v_i grad w_ip^T`.
+    #[serde(rename = "apic")]
     Apic,
     /// MLS-MPM (seed 5.3.2): stress fused into the affine momentum, `F` updated with `C_p`.
     #[default]
+    #[serde(rename = "mls-mpm")]
     Mls,
 }
 

@@ -1,0 +1,427 @@
+//! The `mpm` scene kind: anim-mpm's presets and scene-file parameters, and [`MpmRun`], the
+//! [`Checkpoint`] and [`View`] of a scene's simulation, so that the command line, `cargo xtask`
+//! and the Python bindings run its scenes through [`anim_core::scene`] without knowing the crate.
+//!
+//! | preset | scene | run |
+//! | --- | --- | --- |
+//! | `mpm` | `three-materials`: jelly, snow and water blocks falling together, 2D, 128^2 cells | 120 frames of 40 x 0.5 ms |
+//! | `dam-break-2d-mpm` | `dam-break-2d`: Martin & Moyce's dam break, 64^2 cells, with the surge front against the experiment | 35 frames of 64 x 0.156 ms |
+//! | `dam-break` | `dam-break-3d`: a water column collapsing in a tank, 48^3 cells | 100 frames of 16 x 1 ms |
+//! | `snowball` | `snowball`: a snowball hitting a wall and breaking up, 64^3 cells | 100 frames of 16 x 0.5 ms |
+//!
+//! **Frames.** One point per particle in the current (block-sorted) order of the particles,
+//! with its velocity, widened from `f32` to `f64`; 2D scenes lie in the `z = 0` plane. The
+//! scenes keep their own frame, the unit box with **y up** (gravity along `-y`). The
+//! [`Context`] draws particles as discs of half a cell, the domain's walls (their inner faces,
+//! [`MpmParams::wall_nodes`] cells in) as a [`Prop::Tank`], box colliders as
+//! [`Prop::Cuboid`]s and sphere colliders as [`Prop::Sphere`]s.
+//!
+//! **Reference.** The `dam-break-2d` scene carries a [`SurgeFront`]: its
+//! [`View::reference_error`] is the rms relative error of the surge front against Martin &
+//! Moyce at the table's times passed so far (`None` before the first, `T = 0.41`).
+//!
+//! ```
+//! use anim_core::scene::{BuildContext, Frame};
+//!
+//! let mpm = (anim_mpm::KIND.presets)().into_iter().find(|p| p.name == "mpm").expect("preset");
+//! let quick = mpm.quick_params.as_ref().expect("a quick version");
+//! let mut scene = (anim_mpm::KIND.build)(quick, &BuildContext::default())?;
+//! scene.step(mpm.run.dt)?;
+//! let mut frame = Frame::default();
+//! scene.frame(&mut frame);
+//! assert_eq!(scene.method(), "2D MLS-MPM, quadratic B-splines, CFL substeps");
+//! assert!(frame.points.chunks_exact(3).all(|p| p[2] == 0.0));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use crate::scenes::{self, MpmScene, SurgeFront};
+use crate::{Kernel, MpmError, MpmParams, MpmSimulation, OutOfDomain, Particles, Shape, Transfer};
+use anim_core::scene::{
+    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
+    RunDefaults, SceneKind, Simulated, View, params, saved_field,
+};
+use anim_core::solver::{Solver, StepClock, StepReport};
+use serde::{Deserialize, Serialize};
+
+/// The `mpm` scene kind of anim-mpm, for the workspace registry.
+pub const KIND: SceneKind = SceneKind {
+    kind: "mpm",
+    crate_name: "anim-mpm",
+    summary: "the material point method (APIC, MLS-MPM) in 2D and 3D: elastic, snow and fluid matter",
+    presets,
+    build,
+};
+
+/// Scene-file parameters of an `mpm` scene (the `[scene]` table without `kind`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MpmSceneParams {
+    /// The scene: `"three-materials"` or `"dam-break-2d"` in 2D, `"dam-break-3d"`,
+    /// `"snowball"`, or the peer benchmarks `"benchmark-2d"` and `"benchmark-3d"` (see
+    /// [`scenes`]).
+    pub preset: String,
+    /// Grid cells per axis, at least 8; absent: the scene's default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resolution: Option<usize>,
+    /// Particle-grid transfer, `"mls-mpm"` or `"apic"`; absent: the scene's (MLS-MPM).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transfer: Option<Transfer>,
+    /// Interpolation kernel, `"quadratic"` or `"cubic"` B-splines; absent: the scene's
+    /// (quadratic).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "kernel_name")]
+    pub kernel: Option<Kernel>,
+    /// Particles per cell and axis, 1 to 8 (`dam-break-2d` only; absent: 2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub particles_per_cell: Option<usize>,
+}
+
+/// The scene-file names of the [`Kernel`]s, `"quadratic"` and `"cubic"`, for an optional field.
+mod kernel_name {
+    use crate::Kernel;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    #[derive(Serialize, Deserialize)]
+    #[serde(rename_all = "lowercase")]
+    enum Name {
+        Quadratic,
+        Cubic,
+    }
+
+    #[allow(clippy::ref_option)]
+    pub fn serialize<S: Serializer>(kernel: &Option<Kernel>, s: S) -> Result<S::Ok, S::Error> {
+        kernel
+            .map(|k| match k {
+                Kernel::Quadratic => Name::Quadratic,
+                Kernel::Cubic => Name::Cubic,
+            })
+            .serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Kernel>, D::Error> {
+        Ok(Option::<Name>::deserialize(d)?.map(|n| match n {
+            Name::Quadratic => Kernel::Quadratic,
+            Name::Cubic => Kernel::Cubic,
+        }))
+    }
+}
+
+fn presets() -> Vec<Preset> {
+    let preset = |name, description, run, params: serde_json::Value, quick: usize| {
+        let mut quick_params = params.clone();
+        quick_params["resolution"] = serde_json::json!(quick);
+        Preset { name, description, run, params, quick_params: Some(quick_params) }
+    };
+    // Quick versions: the coarsest grids whose walls leave room for the scenes' matter (the
+    // three blocks reach 0.1 m from the sides, inside the walls below 18 cells; the 0.6 m column
+    // of the 3D dam break needs 12 cells or more; 16 gives the snowball 137 particles).
+    vec![
+        preset(
+            "mpm",
+            "MLS-MPM in 2D: a jelly block, a snow block and water falling together",
+            RunDefaults::new(0.0005, 120, 40),
+            serde_json::json!({ "preset": "three-materials" }),
+            32,
+        ),
+        preset(
+            "dam-break-2d-mpm",
+            "MLS-MPM in 2D: Martin & Moyce's dam break (0.2 x 0.4 m column), surge front vs the experiment",
+            RunDefaults::new(0.00015625, 35, 64),
+            serde_json::json!({ "preset": "dam-break-2d", "resolution": 64 }),
+            16,
+        ),
+        preset(
+            "dam-break",
+            "MLS-MPM in 3D: a water column collapsing in a tank",
+            RunDefaults::new(0.001, 100, 16),
+            serde_json::json!({ "preset": "dam-break-3d" }),
+            16,
+        ),
+        preset(
+            "snowball",
+            "MLS-MPM in 3D: a snowball hitting a wall and breaking up",
+            RunDefaults::new(0.0005, 100, 16),
+            serde_json::json!({ "preset": "snowball" }),
+            16,
+        ),
+    ]
+}
+
+fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
+    let p: MpmSceneParams = params(value)?;
+    if let Some(k) = p.particles_per_cell {
+        if !(1..=8).contains(&k) {
+            return Err(BuildError::invalid(
+                "particles_per_cell",
+                format!("must lie in [1, 8] (per axis), got {k}"),
+            ));
+        }
+        if p.preset != "dam-break-2d" && scenes::NAMES.contains(&p.preset.as_str()) {
+            return Err(BuildError::invalid(
+                "particles_per_cell",
+                format!("{} places its own particles; only dam-break-2d takes particles_per_cell", p.preset),
+            ));
+        }
+    }
+    let found = scenes::by_name_with(&p.preset, p.resolution, p.particles_per_cell).ok_or_else(|| {
+        BuildError::invalid(
+            "preset",
+            format!("unknown preset `{}` (one of {})", p.preset, scenes::NAMES.join(", ")),
+        )
+    })?;
+    let mut scene = found.map_err(|e| BuildError::invalid("resolution", e.to_string()))?;
+    if p.transfer.is_some() || p.kernel.is_some() {
+        let params = match &scene {
+            MpmScene::Two(s) => s.sim.params(),
+            MpmScene::Three(s) => s.sim.params(),
+        };
+        let transfer = p.transfer.unwrap_or(params.transfer);
+        let kernel = p.kernel.unwrap_or(params.kernel);
+        let field = if p.transfer.is_some() { "transfer" } else { "kernel" };
+        scene.set_method(transfer, kernel).map_err(|e| BuildError::invalid(field, e.to_string()))?;
+    }
+    Ok(match scene {
+        MpmScene::Two(s) => {
+            let front = (s.name == "dam-break-2d").then(|| SurgeFront::new(s.sim.params(), &s.state));
+            Simulated::new(MpmRun::new(s.sim, &s.state, front), s.state).boxed()
+        }
+        MpmScene::Three(s) => Simulated::new(MpmRun::new(s.sim, &s.state, None), s.state).boxed(),
+    })
+}
+
+/// A scene's simulation as the run loop steps, checkpoints and draws it: the
+/// [`MpmSimulation`] (which keeps the step count and the simulated time), and for the
+/// `dam-break-2d` scene the [`SurgeFront`] observed after every step.
+#[derive(Debug, Clone)]
+pub struct MpmRun<const D: usize> {
+    sim: MpmSimulation<D>,
+    /// The dam break's surge front at Martin & Moyce's times (`dam-break-2d` only).
+    front: Option<SurgeFront>,
+    /// Particles of the scene when built, for checking checkpoints.
+    particles: usize,
+}
+
+impl<const D: usize> MpmRun<D> {
+    /// `sim` stepping `particles` (the scene's initial ones), with the dam break's `front`
+    /// tracker where the scene has one.
+    #[must_use]
+    pub fn new(sim: MpmSimulation<D>, particles: &Particles<D>, front: Option<SurgeFront>) -> Self {
+        Self { sim, front, particles: particles.len() }
+    }
+
+    /// The simulation.
+    #[must_use]
+    pub fn simulation(&self) -> &MpmSimulation<D> {
+        &self.sim
+    }
+
+    /// The surge-front tracker, for the dam break.
+    #[must_use]
+    pub fn surge_front(&self) -> Option<&SurgeFront> {
+        self.front.as_ref()
+    }
+
+    /// The checks of a restored particle state beyond its array lengths: the scene's particle
+    /// count (or fewer, where particles leaving the domain are removed), known materials,
+    /// finite values.
+    fn check(&self, p: &Particles<D>) -> Result<(), String> {
+        p.check_lengths().map_err(|e| e.to_string())?;
+        let removing = self.sim.params().out_of_domain == OutOfDomain::Remove;
+        if p.len() > self.particles || (!removing && p.len() != self.particles) {
+            return Err(format!("{} particles; this scene has {}", p.len(), self.particles));
+        }
+        let materials = self.sim.materials().len();
+        if let Some(m) = p.material.iter().find(|&&m| usize::from(m) >= materials) {
+            return Err(format!("material {m}; this scene has {materials}"));
+        }
+        if let Some(id) = p.id.iter().find(|&&id| id as usize >= self.particles) {
+            return Err(format!("particle id {id}; this scene has {} particles", self.particles));
+        }
+        let values = p.x.iter().chain(&p.v).chain(&p.c).chain(&p.f).chain(&p.plastic);
+        if let Some(bad) = values.chain(&p.mass).chain(&p.volume).find(|v| !v.is_finite()) {
+            return Err(format!("holds the non-finite value {bad}"));
+        }
+        Ok(())
+    }
+}
+
+impl<const D: usize> Solver for MpmRun<D> {
+    type State = Particles<D>;
+    type Error = MpmError;
+
+    /// The simulation's step, then the surge front's observation.
+    fn step(&mut self, state: &mut Particles<D>, dt: f64) -> Result<StepReport, MpmError> {
+        let report = self.sim.step(state, dt)?;
+        if let Some(front) = &mut self.front {
+            front.observe(self.sim.time(), self.sim.params(), state);
+        }
+        Ok(report)
+    }
+}
+
+impl<const D: usize> Checkpoint for MpmRun<D> {
+    const VERSION: u32 = 1;
+
+    fn time(&self, _: &Particles<D>) -> f64 {
+        self.sim.time()
+    }
+
+    /// `{"dim", "particles", "simulation"}` and, in 2D, `"surge_front"` (`null` for the
+    /// scenes without one).
+    fn save(&self, state: &Particles<D>) -> serde_json::Value {
+        if D == 2 {
+            serde_json::json!({
+                "dim": D,
+                "particles": state,
+                "simulation": self.sim.memory(),
+                "surge_front": self.front,
+            })
+        } else {
+            serde_json::json!({ "dim": D, "particles": state, "simulation": self.sim.memory() })
+        }
+    }
+
+    fn restore(
+        &mut self,
+        state: &mut Particles<D>,
+        saved: &serde_json::Value,
+    ) -> Result<(), CheckpointError> {
+        let dim: usize = saved_field(saved, "dim")?;
+        if dim != D {
+            return Err(CheckpointError::invalid("dim", format!("a {dim}D checkpoint for a {D}D scene")));
+        }
+        let memory =
+            saved.get("simulation").ok_or_else(|| CheckpointError::Missing { field: "simulation".into() })?;
+        StepClock::from_memory(memory).map_err(|e| CheckpointError::invalid("simulation", e))?;
+        let particles: Particles<D> = saved_field(saved, "particles")?;
+        self.check(&particles).map_err(|e| CheckpointError::invalid("particles", e))?;
+        let front = match self.front {
+            Some(_) => Some(
+                saved_field::<SurgeFront>(saved, "surge_front")?
+                    .checked()
+                    .map_err(|e| CheckpointError::invalid("surge_front", e))?,
+            ),
+            None => None,
+        };
+        // Everything is checked: commit.
+        self.sim.restore_memory(memory).map_err(|e| CheckpointError::invalid("simulation", e.to_string()))?;
+        *state = particles;
+        self.front = front;
+        Ok(())
+    }
+
+    /// Sets the deformation gradient of the first particle to `1e30` in every entry: its stress
+    /// overflows in the next transfer, which the step reports as [`MpmError::NonFinite`].
+    fn provoke_overflow(&mut self, state: &mut Particles<D>) -> Option<String> {
+        let id = *state.id.first()?;
+        state.f[..D * D].fill(1e30);
+        Some(format!("deformation gradient of particle {id} set to 1e30 in every entry"))
+    }
+}
+
+/// The first three coordinates of a `D`-vector, widened to `f64` (0 beyond `D`).
+fn widen<const D: usize>(p: &[f32]) -> [f64; 3] {
+    std::array::from_fn(|k| p.get(k).map_or(0.0, |c| f64::from(*c)))
+}
+
+impl<const D: usize> View for MpmRun<D> {
+    /// `"{D}D {transfer}, {kernel} B-splines, CFL substeps"`.
+    fn method(&self) -> String {
+        let params = self.sim.params();
+        let transfer = match params.transfer {
+            Transfer::Apic => "APIC",
+            Transfer::Mls => "MLS-MPM",
+        };
+        let kernel = match params.kernel {
+            Kernel::Quadratic => "quadratic",
+            Kernel::Cubic => "cubic",
+        };
+        format!("{D}D {transfer}, {kernel} B-splines, CFL substeps")
+    }
+
+    /// Particles as discs of half a cell; the tank of the domain's walls, the colliders; the
+    /// region of the particles of `state`, widened sideways by a third of its size and extended
+    /// down along -z by its size.
+    fn context(&self, state: &Particles<D>) -> Context {
+        let params = self.sim.params();
+        let cell = params.size / params.resolution as f64;
+        let mut display = Frame::default();
+        self.frame(state, &mut display);
+        // `Context` is non-exhaustive: filled field by field.
+        let mut context = Context::default();
+        context.point_dim = 3;
+        context.point_radius = 0.5 * cell;
+        context.bounds = Some(frame_box(&display.points, None, true));
+        context.props.push(tank(params, D));
+        context.props.extend(params.colliders.iter().filter_map(|c| collider(c.shape, D)));
+        context
+    }
+
+    fn frame(&self, state: &Particles<D>, out: &mut Frame) {
+        out.time = self.sim.time();
+        out.points.clear();
+        for p in state.x.chunks_exact(D) {
+            out.points.extend_from_slice(&widen::<D>(p));
+        }
+        let v = out.field_mut("velocity", 3);
+        for u in state.v.chunks_exact(D) {
+            v.extend_from_slice(&widen::<D>(u));
+        }
+    }
+
+    fn reference_error(&self, _: &Particles<D>) -> Option<f64> {
+        self.front.as_ref().and_then(SurgeFront::errors).map(|(_, rms)| rms)
+    }
+}
+
+/// The domain's walls: the inner faces, [`MpmParams::wall_nodes`] cells in from the sides of
+/// `[0, size]^dim` (flat along z in 2D).
+fn tank(params: &MpmParams, dim: usize) -> Prop {
+    let inset = params.wall_nodes as f64 * params.h();
+    let (lo, hi) = (inset, params.size - inset);
+    let extent = |k: usize, v: f64| if k < dim { v } else { 0.0 };
+    Prop::Tank { lo: std::array::from_fn(|k| extent(k, lo)), hi: std::array::from_fn(|k| extent(k, hi)) }
+}
+
+/// A collider's shape at time 0 as a prop (z = 0 in 2D); `None` for planes.
+fn collider(shape: Shape, dim: usize) -> Option<Prop> {
+    let at = |v: [f32; 3], sign: f64, half: [f32; 3]| -> [f64; 3] {
+        std::array::from_fn(|k| if k < dim { f64::from(v[k]) + sign * f64::from(half[k]) } else { 0.0 })
+    };
+    match shape {
+        Shape::Box { center, half } => {
+            Some(Prop::Cuboid { lo: at(center, -1.0, half), hi: at(center, 1.0, half) })
+        }
+        Shape::Sphere { center, radius } => {
+            Some(Prop::Sphere { center: at(center, 0.0, [0.0; 3]), radius: f64::from(radius) })
+        }
+        Shape::Plane { .. } => None,
+    }
+}
+
+/// The bounding box of the points `x` (3 per point) widened sideways (x, y) by a third of its
+/// size and, when `falls`, extended down along -z by its size, or to the `ground`: where the
+/// motion of the scenes stays, for framing a picture.
+fn frame_box(x: &[f64], ground: Option<f64>, falls: bool) -> ([f64; 3], [f64; 3]) {
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in x.chunks_exact(3) {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if lo[0] > hi[0] {
+        return ([-1.0; 3], [1.0; 3]);
+    }
+    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-3);
+    for k in 0..2 {
+        lo[k] -= size / 3.0;
+        hi[k] += size / 3.0;
+    }
+    if falls {
+        lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
+    }
+    if let Some(z) = ground {
+        lo[2] = z;
+    }
+    (lo, hi)
+}
