@@ -149,8 +149,42 @@ impl Poisson {
         if labels.len() != cells {
             return Err(FluidError::BadLength { name: "labels", got: labels.len(), expected: cells });
         }
-        let mut diag = vec![0.0; cells];
-        let mut fluid_nbrs = vec![0u8; cells];
+        let mut op = Self {
+            dims,
+            dim,
+            labels,
+            diag: vec![0.0; cells],
+            fluid_nbrs: vec![0u8; cells],
+            singular: true,
+            open,
+        };
+        op.assemble();
+        Ok(op)
+    }
+
+    /// Replaces the labels by `labels` (one per cell of the same grid) and rebuilds the
+    /// operator in place, allocating nothing: the result equals [`Poisson::new`] for them.
+    ///
+    /// # Errors
+    /// [`FluidError::BadLength`] if `labels` does not have one entry per cell; the operator is
+    /// then unchanged.
+    pub fn relabel(&mut self, labels: &[CellLabel]) -> Result<(), FluidError> {
+        if labels.len() != self.labels.len() {
+            return Err(FluidError::BadLength {
+                name: "labels",
+                got: labels.len(),
+                expected: self.labels.len(),
+            });
+        }
+        self.labels.copy_from_slice(labels);
+        self.assemble();
+        Ok(())
+    }
+
+    /// The diagonal, the fluid-neighbour masks and the singularity flag from the labels.
+    fn assemble(&mut self) {
+        let Self { dims, dim, labels, diag, fluid_nbrs, open, .. } = self;
+        let (dims, dim, open) = (*dims, *dim, *open);
         let mut touches_air = false;
         let [nx, ny, nz] = dims;
         for k in 0..nz {
@@ -158,6 +192,8 @@ impl Poisson {
                 for i in 0..nx {
                     let c = i + nx * (j + ny * k);
                     if labels[c] != CellLabel::Fluid {
+                        diag[c] = 0.0;
+                        fluid_nbrs[c] = 0;
                         continue;
                     }
                     let mut count = 0u32;
@@ -192,7 +228,7 @@ impl Poisson {
                 }
             }
         }
-        Ok(Self { dims, dim, labels, diag, fluid_nbrs, singular: !touches_air, open })
+        self.singular = !touches_air;
     }
 
     /// Grid extents.
@@ -353,16 +389,23 @@ impl Poisson {
         });
     }
 
-    /// The coarse operator of the next multigrid level, or `None` when an extent would fall
-    /// below 2 cells.
-    fn coarsen(&self) -> Option<Poisson> {
+    /// The extents of the next multigrid level, or `None` when an extent would fall below 2
+    /// cells (they depend on the grid only, not on the labels).
+    fn coarse_dims(&self) -> Option<[usize; 3]> {
         let [nx, ny, nz] = self.dims;
         let coarse = |n: usize| n.div_ceil(2);
         let cd = [coarse(nx), coarse(ny), if self.dim == 3 { coarse(nz) } else { 1 }];
         if cd[0] < 2 || cd[1] < 2 || (self.dim == 3 && cd[2] < 2) || (nx <= 4 && ny <= 4) {
             return None;
         }
-        let mut labels = vec![CellLabel::Solid; cd[0] * cd[1] * cd[2]];
+        Some(cd)
+    }
+
+    /// The labels of the next level (extents `cd`) into `labels`: air where a child is air,
+    /// else fluid where a child is fluid, else solid.
+    fn coarse_labels(&self, cd: [usize; 3], labels: &mut [CellLabel]) {
+        let [nx, ny, nz] = self.dims;
+        labels.fill(CellLabel::Solid);
         for k in 0..nz {
             for j in 0..ny {
                 for i in 0..nx {
@@ -377,6 +420,14 @@ impl Poisson {
                 }
             }
         }
+    }
+
+    /// The coarse operator of the next multigrid level, or `None` when an extent would fall
+    /// below 2 cells.
+    fn coarsen(&self) -> Option<Poisson> {
+        let cd = self.coarse_dims()?;
+        let mut labels = vec![CellLabel::Solid; cd[0] * cd[1] * cd[2]];
+        self.coarse_labels(cd, &mut labels);
         Poisson::new(cd, self.dim, labels, self.open).ok()
     }
 }
@@ -493,6 +544,33 @@ impl PressureSolver {
             b: vec![0.0; n],
             partials: vec![0.0; n.div_ceil(CHUNK) + 1],
         })
+    }
+
+    /// Rebinds the solver to new cell labels of the same grid: the operator and its multigrid
+    /// hierarchy are rebuilt in their buffers, allocating nothing, and every buffer is cleared,
+    /// so the solver is then exactly what [`PressureSolver::new`] builds for the new labels
+    /// (the same solves, bit for bit).
+    ///
+    /// # Errors
+    /// [`FluidError::BadLength`] if `labels` does not have one entry per cell; the solver is
+    /// then unchanged.
+    pub fn relabel(&mut self, labels: &[CellLabel]) -> Result<(), FluidError> {
+        self.levels[0].op.relabel(labels)?;
+        for l in 1..self.levels.len() {
+            let (fine, coarse) = self.levels.split_at_mut(l);
+            let (fine, coarse) = (&fine[l - 1].op, &mut coarse[0].op);
+            fine.coarse_labels(coarse.dims, &mut coarse.labels);
+            coarse.assemble();
+        }
+        for lv in &mut self.levels {
+            for v in [&mut lv.x, &mut lv.b, &mut lv.r, &mut lv.tmp] {
+                v.fill(0.0);
+            }
+        }
+        for v in [&mut self.r, &mut self.z, &mut self.p, &mut self.q, &mut self.b, &mut self.partials] {
+            v.fill(0.0);
+        }
+        Ok(())
     }
 
     /// The operator.
@@ -759,6 +837,59 @@ mod tests {
 
     fn rhs(op: &Poisson) -> Vec<f64> {
         (0..op.len()).map(|c| ((c * 7919) % 97) as f64 / 97.0 - 0.5).collect()
+    }
+
+    /// Labels of a free-surface problem on `dims`: solid border, fluid below `level` cells
+    /// (shifted by `tilt` per column), air above.
+    fn pool(dims: [usize; 3], level: usize, tilt: usize) -> Vec<CellLabel> {
+        let mut labels = vec![CellLabel::Air; dims[0] * dims[1] * dims[2]];
+        for (c, l) in labels.iter_mut().enumerate() {
+            let (i, j, k) = (c % dims[0], (c / dims[0]) % dims[1], c / (dims[0] * dims[1]));
+            let border = |x: usize, n: usize| n > 1 && (x == 0 || x + 1 == n);
+            if border(i, dims[0]) || border(j, dims[1]) || border(k, dims[2]) {
+                *l = CellLabel::Solid;
+            } else if j < level + (i * tilt) / dims[0] {
+                *l = CellLabel::Fluid;
+            }
+        }
+        labels
+    }
+
+    /// A solver relabelled in place is the solver built for the new labels: every method gives
+    /// the same solution, bit for bit, and the operators are equal.
+    #[test]
+    fn relabelling_in_place_equals_building_anew() {
+        for dims in [[20, 17, 1], [9, 10, 8]] {
+            let dim = if dims[2] == 1 { 2 } else { 3 };
+            let (first, second) = (pool(dims, 6, 0), pool(dims, 4, 5));
+            for method in PressureMethod::ALL {
+                let op = Poisson::new(dims, dim, first.clone(), [[false; 2]; 3]).unwrap();
+                let mut reused = PressureSolver::new(op, method, 1e-9, 5000).unwrap();
+                let b = rhs(reused.operator());
+                let mut s = vec![0.0; b.len()];
+                reused.solve(&b, &mut s);
+                reused.relabel(&second).unwrap();
+                let op = Poisson::new(dims, dim, second.clone(), [[false; 2]; 3]).unwrap();
+                let mut fresh = PressureSolver::new(op, method, 1e-9, 5000).unwrap();
+                assert_eq!(reused.levels(), fresh.levels());
+                for (a, f) in reused.levels.iter().zip(&fresh.levels) {
+                    assert_eq!(
+                        (&a.op.labels, &a.op.diag, &a.op.fluid_nbrs),
+                        (&f.op.labels, &f.op.diag, &f.op.fluid_nbrs)
+                    );
+                    assert_eq!(a.op.singular, f.op.singular);
+                }
+                let (mut x, mut y) = (vec![0.0; b.len()], vec![0.0; b.len()]);
+                let (i, j) = (reused.solve(&b, &mut x), fresh.solve(&b, &mut y));
+                assert!(i.converged && i.iterations > 0, "{method:?} {dims:?}: {i:?}");
+                assert_eq!(i, j, "{method:?} {dims:?}");
+                assert!(x.iter().zip(&y).all(|(p, q)| p.to_bits() == q.to_bits()), "{method:?} {dims:?}");
+            }
+        }
+        let mut op = box_problem(8, 2, true);
+        let before = op.labels().to_vec();
+        assert!(matches!(op.relabel(&before[1..]), Err(FluidError::BadLength { got: 63, expected: 64, .. })));
+        assert_eq!(op.labels(), before);
     }
 
     /// Every method solves the same system: the residual it reports is the true one, and the

@@ -1,14 +1,15 @@
 //! The invariant "`step` allocates nothing": after one warm-up step, stepping the seed solver and
 //! the MAC solver (every pressure method and both splittings, 2D and 3D, with viscosity,
 //! buoyancy, vorticity confinement, an obstacle and an inflow) on a rayon pool of 2 threads
-//! performs no heap allocation. Counted by a wrapping global allocator, so this file is its own
-//! test binary. The pool's own bookkeeping can allocate now and then under load; a step that
-//! allocates does so every time, so three blocks of steps are run and one must be clean.
+//! performs no heap allocation; nor does rebinding a pressure solver to new cell labels. Counted
+//! by a wrapping global allocator, so this file is its own test binary. The pool's own
+//! bookkeeping can allocate now and then under load; a step that allocates does so every time,
+//! so three blocks of steps are run and one must be clean.
 
 use anim_core::alloc_count::CountingAllocator;
 use anim_fluid::advection::{Advection, Splitting};
 use anim_fluid::mac::{MacFluid, MacParams, Source};
-use anim_fluid::pressure::PressureMethod;
+use anim_fluid::pressure::{CellLabel, Poisson, PressureMethod, PressureSolver};
 use anim_fluid::scenes;
 
 #[global_allocator]
@@ -78,4 +79,24 @@ fn seed_and_mac_steps_do_not_allocate() {
             }
         }
     });
+    // Rebinding a pressure solver to new labels (what a particle fluid does when its fluid
+    // cells change) allocates nothing, for every method, in 2D and 3D.
+    for (dims, dim) in [([24, 20, 1], 2), ([10, 12, 9], 3)] {
+        let cells = dims[0] * dims[1] * dims[2];
+        let level = |h: usize| -> Vec<CellLabel> {
+            (0..cells)
+                .map(|c| if (c / dims[0]) % dims[1] < h { CellLabel::Fluid } else { CellLabel::Air })
+                .collect()
+        };
+        let (low, high) = (level(4), level(7));
+        for method in PressureMethod::ALL {
+            let op = Poisson::new(dims, dim, low.clone(), [[false; 2]; 3]).expect("operator");
+            let mut solver = PressureSolver::new(op, method, 1e-6, 100).expect("solver");
+            let made = ALLOC.count(|| {
+                solver.relabel(&high).expect("relabel");
+                solver.relabel(&low).expect("relabel");
+            });
+            assert_eq!(made, 0, "{method:?} {dim}D");
+        }
+    }
 }
