@@ -59,7 +59,13 @@
 //!   ([`scenes::sloshing_tank`], 2D and 3D), and the presets of the `anim` command
 //!   ([`scenes::by_name`]: `dam-break-2d`, `dam-break-3d`, `drop-2d`, `drop-3d`,
 //!   `sloshing-tank`);
+//! - [`kind`]: [`KIND`], the presets as the `flip` scene kind of anim-core's scene contracts;
 //! - [`error`]: the error type [`FlipError`].
+//!
+//! [`KIND`] registers the presets `dam-break-2d`, `dam-break-3d`, `drop-2d`, `drop-3d` and
+//! `sloshing-tank` as the `flip` scene kind ([`kind`]): built from their scene-file parameters
+//! ([`kind::FlipSceneParams`]: preset, resolution, transfer), checkpointed, and drawn as z-up
+//! particles in the world frame with the tank as a prop.
 //!
 //! The sloshing tank's first mode oscillates with the period of linear theory,
 //! `omega^2 = g k tanh(k d)`, to within 3.3% at 64 cells per metre (`tests/scenes.rs`; the
@@ -86,6 +92,7 @@
 
 pub mod classify;
 pub mod error;
+pub mod kind;
 pub mod mac;
 pub mod particles;
 pub mod project;
@@ -100,6 +107,7 @@ pub mod transfer;
 mod tests;
 
 pub use error::FlipError;
+pub use kind::KIND;
 pub use particles::Particles;
 pub use reseed::Reseed;
 pub use sim::{FlipParams, FlipSimulation, Sampling, StepInfo, StepTimes};

@@ -9,7 +9,7 @@ use crate::error::FlipError;
 
 /// The particles of a fluid in `D` dimensions.
 /// Serialised as flat arrays `{ "dim", "x", "v", "c" }` (row-major per particle).
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 pub struct Particles<const D: usize> {
     /// Positions, m.
     pub x: Vec<[f64; D]>,
@@ -17,6 +17,20 @@ pub struct Particles<const D: usize> {
     pub v: Vec<[f64; D]>,
     /// Affine velocity matrices (rows per velocity component), 1/s.
     pub c: Vec<[[f64; D]; D]>,
+}
+
+/// `clone_from` copies into the arrays' existing buffers (the step's backup of the particles
+/// allocates nothing once it has their size).
+impl<const D: usize> Clone for Particles<D> {
+    fn clone(&self) -> Self {
+        Self { x: self.x.clone(), v: self.v.clone(), c: self.c.clone() }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.x.clone_from(&source.x);
+        self.v.clone_from(&source.v);
+        self.c.clone_from(&source.c);
+    }
 }
 
 impl<const D: usize> Particles<D> {

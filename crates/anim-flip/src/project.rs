@@ -124,13 +124,16 @@ pub(crate) fn project<const D: usize>(
         return Ok(SolveInfo { iterations: 0, residual: 0.0, converged: true });
     }
     // The operator depends on the labels only: rebuild it (and its multigrid hierarchy) when
-    // they changed since the last projection.
-    let reuse = solver.as_ref().is_some_and(|sv| sv.operator().labels() == labels);
-    if !reuse {
-        let dims3 = [n[0], n[1], if D == 3 { n[D - 1] } else { 1 }];
-        let op = Poisson::new(dims3, D, labels.to_vec(), [[false; 2]; 3])?;
-        *solver =
-            Some(PressureSolver::new(op, settings.method, settings.tolerance, settings.max_iterations)?);
+    // they changed since the last projection, in the buffers of the first one built.
+    match solver.as_mut() {
+        Some(sv) if sv.operator().labels() == labels => {}
+        Some(sv) => sv.relabel(labels)?,
+        None => {
+            let dims3 = [n[0], n[1], if D == 3 { n[D - 1] } else { 1 }];
+            let op = Poisson::new(dims3, D, labels.to_vec(), [[false; 2]; 3])?;
+            *solver =
+                Some(PressureSolver::new(op, settings.method, settings.tolerance, settings.max_iterations)?);
+        }
     }
     let Some(solver) = solver.as_mut() else {
         return Ok(SolveInfo { iterations: 0, residual: 0.0, converged: true });

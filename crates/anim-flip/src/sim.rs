@@ -9,8 +9,9 @@
 //! 5. optionally, reseeding ([`crate::reseed`]): top up sparse interior cells, thin crowded ones.
 //!
 //! Every buffer is sized in [`FlipSimulation::new`] (particle buffers on the first step and when
-//! the particle count grows), except the pressure operator and its multigrid hierarchy, which
-//! are rebuilt (allocated) in a substep whose cell labels differ from the previous one's.
+//! the particle count grows; the pressure operator and its multigrid hierarchy in the first
+//! projection, then rebuilt in place when the cell labels change), so a step allocates nothing
+//! once the first is done (`tests/no_alloc_presets.rs`).
 
 use crate::classify::{Bins, classify};
 use crate::error::{FlipError, positive};

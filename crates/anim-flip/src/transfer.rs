@@ -28,8 +28,10 @@ use crate::particles::Particles;
 use anim_core::bspline::Kernel;
 use rayon::prelude::*;
 
-/// How grid velocities return to the particles.
+/// How grid velocities return to the particles. Serialised as scene files write it: `"pic"`,
+/// `"apic"`, or `{ "flip": 0.97 }` (TOML `{ flip = 0.97 }`).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Transfer {
     /// Particle-in-cell: particles take the interpolated grid velocity (dissipative).
     Pic,
