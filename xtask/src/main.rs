@@ -25,6 +25,12 @@ mod suites;
 
 use std::process::ExitCode;
 
+/// The system allocator with a counter: the scene-contract suite counts the allocations of a
+/// step (`cases/presets.rs`).
+#[global_allocator]
+pub static ALLOC: anim_core::alloc_count::CountingAllocator =
+    anim_core::alloc_count::CountingAllocator::new();
+
 const USAGE: &str = "usage: cargo xtask <conformance|stability|bench|report|ci> [--quick] [--long] [--filter TEXT] [--out DIR] [--threads 1,2,...]";
 
 #[derive(Debug, Default)]

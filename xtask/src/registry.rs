@@ -58,11 +58,15 @@ impl Check {
     }
 }
 
+/// How a conformance case runs: a plain function for a crate's reference problem, or a closure
+/// over the preset it checks for the suites that run on every registered preset.
+pub type CaseFn = Box<dyn Fn(&Ctx) -> Vec<Check> + Send + Sync>;
+
 /// A conformance case: one reference problem, several checks.
 pub struct ConformanceCase {
     pub crate_name: &'static str,
     pub name: &'static str,
-    pub run: fn(&Ctx) -> Vec<Check>,
+    pub run: CaseFn,
 }
 
 /// What a hard case did.
@@ -169,6 +173,7 @@ pub fn all() -> Registry {
     crate::cases::fluid::register(&mut r);
     crate::cases::flip::register(&mut r);
     crate::cases::determinism::register(&mut r);
+    crate::cases::presets::register(&mut r);
     r
 }
 

@@ -23,27 +23,27 @@ pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "oscillator convergence order",
-        run: oscillator_orders,
+        run: Box::new(oscillator_orders),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "kepler convergence order",
-        run: kepler_orders,
+        run: Box::new(kepler_orders),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "energy behaviour over 1e5 steps",
-        run: energy_behaviour,
+        run: Box::new(energy_behaviour),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "SO(3)/SE(3) exp-log identities",
-        run: lie_identities,
+        run: Box::new(lie_identities),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "3x3 SVD reconstruction",
-        run: svd_checks,
+        run: Box::new(svd_checks),
     });
 
     r.stability.push(StabilityCase {

@@ -14,37 +14,37 @@ pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
         crate_name: "anim-core",
         name: "determinism: 40k-dof chain on 1, 2, 4 threads",
-        run: core_chain,
+        run: Box::new(core_chain),
     });
     r.conformance.push(ConformanceCase {
         crate_name: "anim-springs",
         name: "determinism: 110 x 110 hanging cloth on 1, 2, 4 threads",
-        run: springs_cloth,
+        run: Box::new(springs_cloth),
     });
     r.conformance.push(ConformanceCase {
         crate_name: "anim-pbd",
         name: "determinism: cloth drape on 1, 2, 4 threads",
-        run: pbd_drape,
+        run: Box::new(pbd_drape),
     });
     r.conformance.push(ConformanceCase {
         crate_name: "anim-rigid",
         name: "determinism: Panda swing on 1, 2, 4 threads",
-        run: rigid_panda,
+        run: Box::new(rigid_panda),
     });
     r.conformance.push(ConformanceCase {
         crate_name: "anim-fem",
         name: "determinism: benchmark beam (backward Euler) on 1, 2, 4 threads",
-        run: fem_beam,
+        run: Box::new(fem_beam),
     });
     r.conformance.push(ConformanceCase {
         crate_name: "anim-skin",
         name: "determinism: twisted cylinder (LBS and DQS) on 1, 2, 4 threads",
-        run: skin_cylinder,
+        run: Box::new(skin_cylinder),
     });
     r.conformance.push(ConformanceCase {
         crate_name: "anim-flip",
         name: "determinism: 2D dam break (APIC) on 1, 2, 4 threads",
-        run: flip_dam_break,
+        run: Box::new(flip_dam_break),
     });
 }
 

@@ -23,22 +23,22 @@ pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "FLIP fluid volume over 10 s",
-        run: volume,
+        run: Box::new(volume),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "FLIP divergence after projection",
-        run: divergence,
+        run: Box::new(divergence),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "FLIP rotating disk angular momentum over transfers",
-        run: angular_momentum,
+        run: Box::new(angular_momentum),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "FLIP dam break vs Martin & Moyce (1952)",
-        run: dam_break_case,
+        run: Box::new(dam_break_case),
     });
     let stable = || Outcome::Stable(String::new());
     r.stability.push(StabilityCase {

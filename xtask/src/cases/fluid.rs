@@ -31,7 +31,7 @@ pub fn register(r: &mut Registry) {
         ("lid-driven cavity Re = 100 vs Ghia et al. 1982", ghia),
         ("MAC solver determinism across thread counts", determinism),
     ] {
-        r.conformance.push(ConformanceCase { crate_name: CRATE, name, run });
+        r.conformance.push(ConformanceCase { crate_name: CRATE, name, run: Box::new(run) });
     }
     let stable = || Outcome::Stable(String::new());
     let rejected = || Outcome::Rejected(String::new());

@@ -27,7 +27,7 @@ pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "VTK/PLY/OBJ written, read back by meshio",
-        run: meshio_round_trip,
+        run: Box::new(meshio_round_trip),
     });
 }
 

@@ -22,19 +22,23 @@ pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "P and dP/dF vs finite differences",
-        run: finite_differences,
+        run: Box::new(finite_differences),
     });
-    r.conformance.push(ConformanceCase { crate_name: CRATE, name: "rotation invariance", run: invariance });
+    r.conformance.push(ConformanceCase {
+        crate_name: CRATE,
+        name: "rotation invariance",
+        run: Box::new(invariance),
+    });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "rest state and small-strain agreement with linear elasticity",
-        run: small_strain,
+        run: Box::new(small_strain),
     });
-    r.conformance.push(ConformanceCase { crate_name: CRATE, name: "f32 vs f64", run: precision });
+    r.conformance.push(ConformanceCase { crate_name: CRATE, name: "f32 vs f64", run: Box::new(precision) });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "analytic PSD projection vs eigenvalue clamping",
-        run: psd_projection,
+        run: Box::new(psd_projection),
     });
     r.stability.push(StabilityCase {
         crate_name: CRATE,

@@ -9,6 +9,7 @@ pub mod io;
 pub mod material;
 pub mod mpm;
 pub mod pbd;
+pub mod presets;
 pub mod rigid;
 pub mod skin;
 pub mod soak;

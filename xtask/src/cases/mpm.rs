@@ -25,27 +25,27 @@ pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "MPM transfer conservation",
-        run: conservation,
+        run: Box::new(conservation),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "MPM determinism across thread counts",
-        run: determinism,
+        run: Box::new(determinism),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "MPM resting elastic block",
-        run: resting_block,
+        run: Box::new(resting_block),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "MPM colliding elastic disks",
-        run: colliding_disks,
+        run: Box::new(colliding_disks),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "MPM dam break vs Martin & Moyce (1952)",
-        run: dam_break_case,
+        run: Box::new(dam_break_case),
     });
 
     let stable = || Outcome::Stable(String::new());

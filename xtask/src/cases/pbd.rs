@@ -24,27 +24,27 @@ pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "XPBD hanging chain static stretch",
-        run: xpbd_chain,
+        run: Box::new(xpbd_chain),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "PBD effective stiffness vs iterations and dt",
-        run: pbd_stiffness,
+        run: Box::new(pbd_stiffness),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "PBD/XPBD momentum with unequal masses",
-        run: momentum,
+        run: Box::new(momentum),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "PBD constraint gradients vs finite differences",
-        run: gradients,
+        run: Box::new(gradients),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "PBD determinism across thread counts",
-        run: determinism,
+        run: Box::new(determinism),
     });
 
     let stable = || Outcome::Stable(String::new());

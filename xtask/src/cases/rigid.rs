@@ -36,27 +36,27 @@ pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "placements and Jacobians vs Pinocchio (Panda, UR5)",
-        run: pinocchio,
+        run: Box::new(pinocchio),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "Jacobians vs finite differences of FK",
-        run: jacobian_fd,
+        run: Box::new(jacobian_fd),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "FK three ways agree",
-        run: fk_three_ways,
+        run: Box::new(fk_three_ways),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "Paden-Kahan subproblems on random solvable instances",
-        run: paden_kahan,
+        run: Box::new(paden_kahan),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "analytic IK solutions reproduce targets",
-        run: analytic_ik,
+        run: Box::new(analytic_ik),
     });
 
     r.stability.push(StabilityCase {

@@ -20,22 +20,22 @@ pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "glTF posed vertices vs numpy reference",
-        run: |_| gltf_reference(),
+        run: Box::new(|_| gltf_reference()),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "DQS equals LBS on rigid single-influence vertices",
-        run: |_| dqs_vs_lbs(),
+        run: Box::new(|_| dqs_vs_lbs()),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "glTF interpolation step/linear/cubic by hand",
-        run: |_| interpolation(),
+        run: Box::new(|_| interpolation()),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "twisted cylinder volume, LBS vs DQS",
-        run: |_| candy_wrapper(),
+        run: Box::new(|_| candy_wrapper()),
     });
     r.studies.push(Study { crate_name: CRATE, name: "LBS vs DQS by twist-joint count", run: twist_study });
 }

@@ -24,22 +24,22 @@ pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "two-particle spring vs closed form",
-        run: two_particle,
+        run: Box::new(two_particle),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "two-particle spring convergence order",
-        run: two_particle_orders,
+        run: Box::new(two_particle_orders),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "hanging chain static stretch",
-        run: hanging_chain,
+        run: Box::new(hanging_chain),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "spring network Jacobians vs finite differences",
-        run: jacobian_fd,
+        run: Box::new(jacobian_fd),
     });
 
     for kind in EXPLICIT {

@@ -39,27 +39,27 @@ pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "RNEA, CRBA, C, g, ABA vs Pinocchio (Panda, UR5, chain32, floating Panda)",
-        run: pinocchio_dynamics,
+        run: Box::new(pinocchio_dynamics),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "dynamics cross-checks (closure, ABA/RNEA, CRBA/RNEA, Cholesky, H SPD)",
-        run: cross_checks,
+        run: Box::new(cross_checks),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "rigid steppers: measured orders of accuracy",
-        run: stepper_orders,
+        run: Box::new(stepper_orders),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "T-handle: Dzhanibekov flip and Euler-top period",
-        run: t_handle_period,
+        run: Box::new(t_handle_period),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "energy balance with torques, damping and limits (UR5)",
-        run: energy_balance,
+        run: Box::new(energy_balance),
     });
     for integrator in RigidIntegrator::ALL {
         r.stability.push(StabilityCase {
