@@ -19,10 +19,10 @@
 //! for, `preview.gif` (and `preview.png`, the last frame; fluids show their density), and
 //! `metrics.json`.
 
-use anim_cli::runner::{self, OutputFormat, Runner};
 use anim_cli::scene::{self, SceneFile};
 use anim_cli::tolerance;
-use anim_cli::view::{Snapshot, View};
+use anim_cli::view::{Geometry, OutputFormat, Snapshot, View};
+use anim_core::scene::{DynScene, Frame};
 use anim_io::FrameWriter;
 use anim_io::preview::{Canvas, GifWriter};
 use clap::{Parser, Subcommand};
@@ -51,9 +51,16 @@ enum Command {
     /// Continue a run from a checkpoint written with `--checkpoint-every`: the frames after it are
     /// bit for bit those of an uninterrupted run.
     Resume(ResumeArgs),
-    /// List the built-in scenes.
+    /// List the built-in scenes (`--kinds`: the scene kinds a scene file can name).
     #[command(visible_alias = "scenes")]
-    List,
+    List(ListArgs),
+}
+
+#[derive(clap::Args)]
+struct ListArgs {
+    /// List the registered scene kinds, with their crate and what they simulate.
+    #[arg(long)]
+    kinds: bool,
 }
 
 #[derive(clap::Args)]
@@ -94,9 +101,15 @@ struct RunArgs {
     /// Write every N-th frame to files.
     #[arg(long, default_value_t = 1)]
     stride: usize,
-    /// Skinning method for skinned-character scenes (default: the scene's).
-    #[arg(long, value_enum)]
-    skinning: Option<scene::SkinningChoice>,
+    /// Skinning method for skinned-character scenes (`lbs`, `dqs` or `both`; default: the
+    /// scene's): the same as `--set method=<choice>`.
+    #[arg(long, value_parser = ["lbs", "dqs", "both"])]
+    skinning: Option<String>,
+    /// Set a parameter of the scene's `[scene]` table, `KEY=VALUE` with a TOML value
+    /// (`--set resolution=48`, `--set integrator=rk4`, `--set 'transfer={flip=0.9}'`); repeatable.
+    /// The scene's kind checks it like a field of the file.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
     /// Skip the GIF/PNG preview.
     #[arg(long)]
     no_preview: bool,
@@ -123,7 +136,7 @@ struct RunArgs {
 /// The built-in scenes, one a line: name, description, and which one is the default.
 fn builtin_listing() -> String {
     let mut out = String::new();
-    for (name, description, _) in scene::BUILTIN {
+    for (name, description) in scene::builtins() {
         let default = if name == scene::DEFAULT_SCENE { " [default]" } else { "" };
         out.push_str(&format!("{name:<18} {description}{default}\n"));
     }
@@ -140,7 +153,13 @@ fn main() -> ExitCode {
         Err(e) => e.exit(),
     };
     match cli.command {
-        Command::List => {
+        Command::List(args) if args.kinds => {
+            for k in &anim::KINDS {
+                println!("{:<20} {:<13} {}", k.kind, k.crate_name, k.summary);
+            }
+            ExitCode::SUCCESS
+        }
+        Command::List(_) => {
             print!("{}", builtin_listing());
             ExitCode::SUCCESS
         }
@@ -160,24 +179,43 @@ fn finish(result: Result<(), String>) -> ExitCode {
 }
 
 /// Loads the scene named on the command line: a file if one exists at that path, else a
-/// built-in scene of that name. Returns the scene and the path errors should name.
-fn resolve(arg: Option<&str>) -> Result<(SceneFile, PathBuf), String> {
+/// built-in scene of that name. Returns the scene, the path errors should name and the file's
+/// text (none for a built-in scene).
+fn resolve(arg: Option<&str>) -> Result<(SceneFile, PathBuf, Option<String>), String> {
     let arg = arg.unwrap_or(scene::DEFAULT_SCENE);
     let path = Path::new(arg);
     // A folder of that name (such as a run's output) is not a scene file.
     if path.is_file() {
-        return scene::load(path).map(|s| (s, path.to_path_buf())).map_err(|e| e.to_string());
+        let text =
+            std::fs::read_to_string(path).map_err(|e| format!("{arg}: cannot read scene file: {e}"))?;
+        let file = scene::parse(&text, path).map_err(|e| e.to_string())?;
+        return Ok((file, path.to_path_buf(), Some(text)));
     }
     match scene::builtin(arg) {
-        Some(text) => {
-            let origin = PathBuf::from(format!("<built-in scene {arg}>"));
-            scene::parse(text, &origin).map(|s| (s, origin)).map_err(|e| e.to_string())
-        }
+        Some(file) => Ok((file, PathBuf::from(format!("<built-in scene {arg}>")), None)),
         None => Err(format!(
             "{arg}: no such scene file, and no built-in scene of that name (built-in: {})",
-            scene::BUILTIN.map(|b| b.0).join(", ")
+            scene::builtins().iter().map(|b| b.0).collect::<Vec<_>>().join(", ")
         )),
     }
+}
+
+/// `KEY=VALUE` of `--set` as a parameter: the value read as TOML, or as a string when it is
+/// not TOML (`--set method=dqs`).
+fn set_param(file: &mut SceneFile, arg: &str) -> Result<(), String> {
+    let (key, value) = arg.split_once('=').ok_or_else(|| format!("--set {arg}: expected KEY=VALUE"))?;
+    let key = key.trim();
+    if key.is_empty() || key == "kind" {
+        return Err(format!("--set {arg}: KEY must name a parameter of the scene (not `kind`)"));
+    }
+    let value = match toml::from_str::<toml::Table>(&format!("v = {value}")) {
+        Ok(mut t) => {
+            t.remove("v").map_or(serde_json::Value::Null, |v| serde_json::to_value(v).unwrap_or_default())
+        }
+        Err(_) => serde_json::Value::String(value.to_string()),
+    };
+    file.scene.params.insert(key.to_string(), value);
+    Ok(())
 }
 
 #[derive(Serialize)]
@@ -214,14 +252,14 @@ struct Metrics {
 }
 
 /// The checkpoint of a run: the scene and output settings it was started with, how far it got,
-/// and the runner's state. Written as `<out>/checkpoint.anim` (kind [`CHECKPOINT_KIND`]).
+/// and the scene's checkpoint ([`DynScene::save`]). Written as `<out>/checkpoint.anim` (kind
+/// [`CHECKPOINT_KIND`]).
 #[derive(Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RunCheckpoint {
     scene: SceneFile,
     /// The path scene errors and relative file names refer to.
     origin: PathBuf,
-    skinning: Option<scene::SkinningChoice>,
     out: PathBuf,
     format: OutputFormat,
     stride: usize,
@@ -238,21 +276,24 @@ struct RunCheckpoint {
     runner: serde_json::Value,
 }
 
-const CHECKPOINT_KIND: &str = "anim-run";
+/// Version 2: the scene is a registered kind with its parameters, the runner a [`DynScene`]
+/// checkpoint.
+const CHECKPOINT_KIND: &str = "anim-run-2";
 const CHECKPOINT_FILE: &str = "checkpoint.anim";
 
 /// A run ready to go: fresh from a scene, or resumed from a checkpoint.
 struct Session {
     file: SceneFile,
     origin: PathBuf,
-    skinning: Option<scene::SkinningChoice>,
     out: PathBuf,
     format: OutputFormat,
     stride: usize,
     preview_width: Option<u32>,
     checkpoint_every: Option<usize>,
     quiet: bool,
-    runner: Box<dyn Runner>,
+    runner: Box<dyn DynScene>,
+    /// How the scene is drawn and written.
+    geometry: Geometry,
     start_frame: usize,
     steps: u64,
     written_times: Vec<f64>,
@@ -275,6 +316,9 @@ struct Output {
     returned: std::sync::mpsc::Receiver<Snapshot>,
     worker: Option<std::thread::JoinHandle<WriterResult>>,
     spare: Vec<Snapshot>,
+    /// The scene's frame, scratch reused from frame to frame.
+    frame: Frame,
+    grid: bool,
 }
 
 /// The writer thread's state.
@@ -346,10 +390,11 @@ impl Output {
         format: OutputFormat,
         stride: usize,
         preview: Option<(u32, usize)>,
-        runner: &dyn Runner,
+        (geometry, dof): (&Geometry, usize),
         continuing: Option<&[f64]>,
     ) -> Result<Self, String> {
-        let view = View::new(runner.geometry());
+        let grid = matches!(geometry, Geometry::Grid { .. });
+        let view = View::new(geometry.clone());
         let mut writer = Writer { dir: dir.to_path_buf(), stride, view, frames: None, csv: None, gif: None };
         if let Some(f) = format.frame_format() {
             let frames = FrameWriter::continuing(dir.join("frames"), f, continuing.unwrap_or(&[]));
@@ -366,7 +411,7 @@ impl Output {
             let path = dir.join("frames.csv");
             let file = std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
             let mut csv = std::io::BufWriter::new(file);
-            let n = runner.state().dof();
+            let n = dof;
             let header: Vec<String> =
                 (0..n).map(|i| format!("x{i}")).chain((0..n).map(|i| format!("v{i}"))).collect();
             writeln!(csv, "frame,t,{},energy,error_vs_exact", header.join(","))
@@ -406,14 +451,21 @@ impl Output {
                 Ok((files, busy + start.elapsed().as_secs_f64()))
             })
             .map_err(|e| format!("cannot start the writer thread: {e}"))?;
-        Ok(Output { sender: Some(sender), returned, worker: Some(worker), spare: Vec::new() })
+        Ok(Output {
+            sender: Some(sender),
+            returned,
+            worker: Some(worker),
+            spare: Vec::new(),
+            frame: Frame::default(),
+            grid,
+        })
     }
 
-    /// Queues frame `index` of the runner's current state.
-    fn frame(&mut self, index: usize, runner: &dyn Runner, energy: Option<f64>) -> Result<(), String> {
+    /// Queues frame `index` of the scene's current state.
+    fn frame(&mut self, index: usize, runner: &dyn DynScene, energy: Option<f64>) -> Result<(), String> {
         self.spare.extend(self.returned.try_iter());
         let mut snapshot = self.spare.pop().unwrap_or_default();
-        runner.snapshot(energy, &mut snapshot);
+        snapshot.fill(runner, &mut self.frame, self.grid, energy);
         let sent = self.sender.as_ref().map(|s| s.send((index, snapshot)));
         match sent {
             Some(Ok(())) => Ok(()),
@@ -435,7 +487,7 @@ impl Output {
 
 /// A fresh run of the scene named on the command line.
 fn fresh(args: &RunArgs) -> Result<Session, String> {
-    let (mut file, origin) = resolve(args.scene.as_deref())?;
+    let (mut file, origin, text) = resolve(args.scene.as_deref())?;
     if let Some(f) = args.frames {
         if f == 0 {
             return Err("--frames must be at least 1".into());
@@ -458,7 +510,13 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
         return Err("--checkpoint-every must be at least 1".into());
     }
     if let Some(r) = args.resolution {
-        file.scene.set_resolution(r).map_err(|e| format!("--resolution {r}: {e}"))?;
+        file.scene.params.insert("resolution".into(), r.into());
+    }
+    if let Some(choice) = &args.skinning {
+        file.scene.params.insert("method".into(), choice.clone().into());
+    }
+    for arg in &args.set {
+        set_param(&mut file, arg)?;
     }
     if let Some(tol) = args.tolerance {
         if args.dt.is_some() {
@@ -469,7 +527,7 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
             // The scene had resolution r before the pick (set above); putting it back changes
             // the scene only if the pick chose another.
             let mut asked = file.scene.clone();
-            asked.set_resolution(r).map_err(|e| format!("--resolution {r}: {e}"))?;
+            asked.params.insert("resolution".into(), r.into());
             if asked != file.scene {
                 return Err(format!(
                     "give --resolution or --tolerance, not both: on {} the resolution is part of the method \
@@ -485,14 +543,24 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
             );
         }
     }
-    let runner = runner::build(&file.scene, &origin, args.skinning).map_err(|e| e.to_string())?;
-    let format = args.format.unwrap_or_else(|| runner.natural_format());
-    if !runner.geometry().accepts(format) {
+    let runner = scene::build(&file, &origin, text.as_deref()).map_err(|e| {
+        let e = e.to_string();
+        match args.resolution {
+            Some(r) if e.contains("unknown field `resolution`") => {
+                format!("--resolution {r}: a {} scene has no resolution", file.scene.kind)
+            }
+            Some(r) if e.contains("`scene.resolution`") => format!("--resolution {r}: {e}"),
+            _ => e,
+        }
+    })?;
+    let geometry = Geometry::from_context(&runner.context());
+    let format = args.format.unwrap_or_else(|| geometry.natural_format());
+    if !geometry.accepts(format) {
         return Err(if format == OutputFormat::Vti {
             format!(
                 "--format vti: {} is not a grid scene (vti frames hold grid fields); it writes {} frames",
                 file.name,
-                format_name(runner.natural_format())
+                format_name(geometry.natural_format())
             )
         } else {
             format!(
@@ -506,7 +574,6 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
     Ok(Session {
         file,
         origin,
-        skinning: args.skinning,
         out,
         format,
         stride: args.stride,
@@ -514,6 +581,7 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
         checkpoint_every: args.checkpoint_every,
         quiet: args.quiet,
         runner,
+        geometry,
         start_frame: 0,
         steps: 0,
         written_times: Vec::new(),
@@ -550,12 +618,12 @@ fn resumed(args: &ResumeArgs) -> Result<Session, String> {
         }
         file.run.frames = f;
     }
-    let mut runner = runner::build(&file.scene, &ckpt.origin, ckpt.skinning).map_err(|e| e.to_string())?;
+    let mut runner = scene::build(&file, &ckpt.origin, None).map_err(|e| e.to_string())?;
     runner.restore(&ckpt.runner).map_err(|e| format!("{}: {e}", args.checkpoint.display()))?;
+    let geometry = Geometry::from_context(&runner.context());
     Ok(Session {
         file,
         origin: ckpt.origin,
-        skinning: ckpt.skinning,
         out: args.out.clone().unwrap_or(ckpt.out),
         format: ckpt.format,
         stride: ckpt.stride,
@@ -563,6 +631,7 @@ fn resumed(args: &ResumeArgs) -> Result<Session, String> {
         checkpoint_every: ckpt.checkpoint_every,
         quiet: args.quiet,
         runner,
+        geometry,
         start_frame: ckpt.frame,
         steps: ckpt.steps,
         written_times: ckpt.written_times,
@@ -580,7 +649,6 @@ impl Session {
         let ckpt = RunCheckpoint {
             scene: self.file.clone(),
             origin: self.origin.clone(),
-            skinning: self.skinning,
             out: self.out.clone(),
             format: self.format,
             stride: self.stride,
@@ -604,11 +672,16 @@ fn execute(mut s: Session) -> Result<(), String> {
     let out = s.out.clone();
     std::fs::create_dir_all(&out)
         .map_err(|e| format!("{}: cannot create output folder: {e}", out.display()))?;
-    let run = s.file.run.clone();
+    let run = s.file.run;
     // At most about 100 preview frames, whatever the run's length.
     let preview = s.preview_width.map(|w| (w, run.frames.div_ceil(100)));
     let continuing = s.resumed.then_some(s.written_times.as_slice());
-    let mut output = Output::new(&out, s.format, s.stride, preview, s.runner.as_ref(), continuing)?;
+    let dof = {
+        let mut snap = Snapshot::default();
+        snap.fill(s.runner.as_ref(), &mut Frame::default(), false, None);
+        snap.x.len()
+    };
+    let mut output = Output::new(&out, s.format, s.stride, preview, (&s.geometry, dof), continuing)?;
     let writes_files = s.format.frame_format().is_some();
 
     let first_step = s.steps;
@@ -649,7 +722,7 @@ fn execute(mut s: Session) -> Result<(), String> {
             s.steps += 1;
         }
         step_seconds += t_step.elapsed().as_secs_f64();
-        if let Some(e) = s.runner.exact_error() {
+        if let Some(e) = s.runner.reference_error() {
             s.max_error = Some(s.max_error.map_or(e, |m: f64| m.max(e)));
         }
         if s.tolerance.is_some()
@@ -662,7 +735,7 @@ fn execute(mut s: Session) -> Result<(), String> {
             break;
         }
         if writes_files && frame.is_multiple_of(s.stride) {
-            s.written_times.push(s.runner.state().t);
+            s.written_times.push(s.runner.time());
         }
         if let Some(every) = s.checkpoint_every
             && (frame + 1).is_multiple_of(every)
@@ -687,14 +760,14 @@ fn execute(mut s: Session) -> Result<(), String> {
     let energy0 = s.energy_initial;
     let metrics = Metrics {
         scene: s.file.name.clone(),
-        system: s.runner.system(),
+        system: s.file.scene.system(),
         method: s.runner.method(),
         status: failure.clone().map_or_else(|| "completed".into(), |f| format!("diverged at {f}")),
         dt: run.dt,
         steps: s.steps,
         frames: run.frames,
         format: s.format,
-        simulated_seconds: s.runner.state().t,
+        simulated_seconds: s.runner.time(),
         wall_seconds: wall,
         step_seconds,
         output_seconds,

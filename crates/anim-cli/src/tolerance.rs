@@ -47,25 +47,21 @@
 //! study (the same cloth and methods as `pbd-cloth-position`, measured on the mean stretch; the
 //! picker reads the position study). Those scenes get an error naming the mapped ones.
 
-use crate::runner::Runner;
-use crate::scene::{MpmKernel, MpmTransfer, PressureSolver, Scene, SceneFile};
+use crate::scene::{SceneFile, SceneSpec};
 use anim_core::integrate::systems::{HarmonicOscillator, KeplerOrbit};
 use anim_core::integrate::{IntegratorKind, State};
+use anim_core::scene::{DynScene, Frame, RunDefaults};
 use anim_fem::material::MaterialModel;
 use anim_fem::sim::{LinearSolverChoice, TimeIntegrator};
 use anim_fluid::pressure::PressureMethod;
 use std::collections::BTreeMap;
+use typed::{MpmKernel, MpmTransfer, PressureSolver, Scene};
 
 /// The report's table, embedded at build time.
 pub const TABLE: &str = include_str!("../../../docs/report/cheapest.json");
 
 /// The version of `cheapest.json` this build reads.
 pub const FORMAT: u32 = 2;
-
-/// Ghia, Ghia and Shin (1982), Re = 100: `u` along the vertical centreline `(y, u)`.
-const GHIA_U: &str = include_str!("../../anim-fluid/testdata/ghia_re100_u.csv");
-/// The same for `v` along the horizontal centreline `(x, v)`.
-const GHIA_V: &str = include_str!("../../anim-fluid/testdata/ghia_re100_v.csv");
 
 /// The parts of `cheapest.json` the picker reads.
 #[derive(Debug, Clone, serde::Deserialize)]
@@ -324,12 +320,12 @@ fn horizon(family: &Family) -> Result<f64, String> {
 }
 
 impl Adapter {
-    fn new(file: &SceneFile, family: &Family) -> Result<Self, String> {
-        let duration = file.run.dt * (file.run.steps_per_frame * file.run.frames) as f64;
+    fn new(run: &RunDefaults, scene: &Scene, family: &Family) -> Result<Self, String> {
+        let duration = run.dt * (run.steps_per_frame * run.frames) as f64;
         let build = |e: String| format!("--tolerance: cannot build the scene to read its parameters: {e}");
-        Ok(match &file.scene {
+        Ok(match scene {
             Scene::HarmonicOscillator { .. } | Scene::KeplerOrbit { .. } => {
-                Adapter::Ode { unit: time_unit(&file.scene), horizon: horizon(family)?, duration }
+                Adapter::Ode { unit: time_unit(scene), horizon: horizon(family)?, duration }
             }
             Scene::Fem { preset, resolution, .. } => {
                 let scene = anim_fem::scenes::by_name(preset, *resolution)
@@ -498,7 +494,7 @@ impl Adapter {
                     let count = (k * scale * (1.0 - 1e-12)).ceil();
                     (count, 1.0, format!("{count} iterations: cloth side ratio {scale:.4}"))
                 };
-                if iterations.max(substeps) > crate::scene::MAX_PBD_COUNT as f64 {
+                if iterations.max(substeps) > anim_pbd::kind::MAX_PBD_COUNT as f64 {
                     return Err(format!("{} per step needed on this scene", iterations.max(substeps)));
                 }
                 Ok(Candidate {
@@ -565,8 +561,9 @@ pub fn choose(file: &mut SceneFile, tol: f64, table: &Table) -> Result<Choice, S
     if !(tol > 0.0 && tol.is_finite()) {
         return Err(format!("--tolerance must be a positive finite number, got {tol}"));
     }
-    let Some(family) = family_of(table, &file.scene) else {
-        let (kind, preset) = kind_of(&file.scene);
+    let mut scene = typed::typed(&file.scene).map_err(|e| format!("--tolerance: {}: {e}", file.name))?;
+    let Some(family) = family_of(table, &scene) else {
+        let (kind, preset) = kind_of(&scene);
         let names: Vec<String> = table
             .families
             .iter()
@@ -581,7 +578,7 @@ pub fn choose(file: &mut SceneFile, tol: f64, table: &Table) -> Result<Choice, S
             names.join(", ")
         ));
     };
-    if let Scene::Fluid { advection, splitting, .. } = &file.scene {
+    if let Scene::Fluid { advection, splitting, .. } = &scene {
         let set: Vec<&str> = [("advection", advection.is_some()), ("splitting", splitting.is_some())]
             .into_iter()
             .filter_map(|(name, on)| on.then_some(name))
@@ -595,7 +592,7 @@ pub fn choose(file: &mut SceneFile, tol: f64, table: &Table) -> Result<Choice, S
             ));
         }
     }
-    let adapter = Adapter::new(file, family)?;
+    let adapter = Adapter::new(&file.run, &scene, family)?;
     let mut best: Option<(f64, &str, Point, Candidate)> = None;
     let mut closest: Option<(&str, Point)> = None;
     // Methods the scene cannot run, grouped by the reason.
@@ -659,7 +656,8 @@ pub fn choose(file: &mut SceneFile, tol: f64, table: &Table) -> Result<Choice, S
         }
         None => (file.run.dt, file.run.steps_per_frame),
     };
-    let settings = apply(&mut file.scene, candidate.settings)?;
+    let settings = apply(&mut scene, candidate.settings)?;
+    file.scene = typed::untyped(&scene)?;
     file.run.dt = dt_run;
     file.run.steps_per_frame = steps_per_frame;
     let scaled = match candidate.dt {
@@ -790,45 +788,24 @@ fn wall(s: f64) -> String {
     }
 }
 
-/// Ghia's points `(coordinate, value)` strictly inside the cavity.
-fn ghia_points(text: &str) -> Vec<(f64, f64)> {
-    text.lines()
-        .skip(1)
-        .filter_map(|l| {
-            let (a, b) = l.split_once(',')?;
-            Some((a.trim().parse().ok()?, b.trim().parse().ok()?))
-        })
-        .filter(|&(c, _)| c > 0.0 && c < 1.0)
-        .collect()
-}
-
-/// The cavity's error on the Ghia study's measure: the largest `|u(0.5, y) - u_Ghia|` and
-/// `|v(x, 0.5) - v_Ghia|` over Ghia's interior points.
-#[must_use]
-pub fn ghia_error(fluid: &anim_fluid::mac::MacFluid, state: &anim_fluid::mac::MacState) -> f64 {
-    let u = ghia_points(GHIA_U)
-        .into_iter()
-        .map(|(y, u)| (fluid.velocity_at_point(state, [0.5, y, 0.0])[0] - u).abs());
-    let v = ghia_points(GHIA_V)
-        .into_iter()
-        .map(|(x, v)| (fluid.velocity_at_point(state, [x, 0.5, 0.0])[1] - v).abs());
-    u.chain(v).fold(0.0, f64::max)
-}
-
 /// The run's error on the measure of the study the scene was picked from (`None` for scenes
-/// without a reference in the run): the exact solution of the ODE scenes, Ghia's velocities for
-/// the cavity, for the other MAC fluid scenes `max_residual`, the largest relative pressure
-/// residual of the run's steps so far, and for the MPM dam break the rms relative surge-front
-/// error against Martin & Moyce at the table's times the run has passed
-/// ([`Runner::study_error`]).
+/// without a reference in the run): the exact solution of the ODE scenes, for the smoke plume
+/// `max_residual`, the largest relative pressure residual of the run's steps so far, and the
+/// scene's own reference error otherwise (Ghia's velocities for the cavity; for the MPM dam
+/// break the rms relative surge-front error against Martin & Moyce at the table's times the run
+/// has passed).
 #[must_use]
-pub fn table_error(scene: &Scene, runner: &dyn Runner, max_residual: Option<f64>) -> Option<f64> {
-    match scene {
-        Scene::Fluid { preset, .. } if preset.as_str() == "lid-driven-cavity" => {
-            runner.mac().map(|(fluid, state)| ghia_error(fluid, state))
-        }
+pub fn table_error(spec: &SceneSpec, runner: &dyn DynScene, max_residual: Option<f64>) -> Option<f64> {
+    let scene = typed::typed(spec).ok()?;
+    match &scene {
         Scene::Fluid { preset, .. } if preset.as_str() == "smoke-plume-3d" => max_residual,
-        _ => ode_error(scene, runner.state()).or_else(|| runner.study_error()),
+        Scene::HarmonicOscillator { .. } | Scene::KeplerOrbit { .. } => {
+            let mut frame = Frame::default();
+            runner.frame(&mut frame);
+            let v = frame.field("velocity").map(|f| f.values.clone()).unwrap_or_default();
+            ode_error(&scene, &State { t: frame.time, x: frame.points, v })
+        }
+        _ => runner.reference_error(),
     }
 }
 
@@ -853,3 +830,4 @@ pub fn ode_error(scene: &Scene, state: &State) -> Option<f64> {
 
 #[cfg(test)]
 mod tests;
+pub mod typed;

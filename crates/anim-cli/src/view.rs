@@ -2,9 +2,41 @@
 //! and per-frame [`Snapshot`]s. A [`View`] turns the two into frame files and preview images; it
 //! is `Send`, so the run loop hands snapshots to a writer thread and keeps stepping.
 
-use crate::runner::OutputFormat;
+use anim_core::scene::{Context, DynScene, Frame, Prop};
 use anim_io::preview::{Camera, Canvas, Colors, MeshStyle};
 use anim_io::{DataArray, FrameFormat, FrameWriter, ImageData, UnstructuredGrid};
+
+/// Frame formats the command line offers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum OutputFormat {
+    /// One CSV of the whole state per frame row (`frames.csv`): for systems of a few unknowns.
+    Csv,
+    /// VTK unstructured grids and a `.pvd` series (ParaView).
+    Vtu,
+    /// Binary PLY per frame (Blender, Houdini, MeshLab).
+    Ply,
+    /// OBJ per frame (any DCC tool).
+    Obj,
+    /// VTK image data per frame and a `.pvd` series (ParaView): the fields of grid scenes.
+    Vti,
+    /// No frame files (metrics and preview only).
+    None,
+}
+
+impl OutputFormat {
+    /// The anim-io format, for the mesh formats.
+    #[must_use]
+    pub fn frame_format(self) -> Option<FrameFormat> {
+        match self {
+            OutputFormat::Vtu => Some(FrameFormat::Vtu),
+            OutputFormat::Ply => Some(FrameFormat::Ply),
+            OutputFormat::Obj => Some(FrameFormat::Obj),
+            OutputFormat::Vti => Some(FrameFormat::Vti),
+            OutputFormat::Csv | OutputFormat::None => None,
+        }
+    }
+}
 
 /// The state at one frame, copied out of the simulation.
 #[derive(Debug, Clone, Default)]
@@ -19,6 +51,31 @@ pub struct Snapshot {
     pub energy: Option<f64>,
     /// Error against an exact solution, where one exists.
     pub error: Option<f64>,
+}
+
+impl Snapshot {
+    /// The scene's current frame: for a grid, its first field (the density) as `x` and its
+    /// velocity as `v`; otherwise the points as `x` and the velocity field as `v`. `frame` is
+    /// scratch reused from call to call.
+    pub fn fill(&mut self, scene: &dyn DynScene, frame: &mut Frame, grid: bool, energy: Option<f64>) {
+        scene.frame(frame);
+        self.t = frame.time;
+        self.x.clear();
+        self.v.clear();
+        let velocity = frame.fields.iter().find(|f| f.name == "velocity");
+        if grid {
+            if let Some(density) = frame.fields.iter().find(|f| f.name != "velocity") {
+                self.x.extend_from_slice(&density.values);
+            }
+        } else {
+            self.x.extend_from_slice(&frame.points);
+        }
+        if let Some(v) = velocity {
+            self.v.extend_from_slice(&v.values);
+        }
+        self.energy = energy;
+        self.error = scene.reference_error();
+    }
 }
 
 /// How a scene is drawn and written; fixed for the run.
@@ -65,6 +122,57 @@ pub enum Geometry {
 }
 
 impl Geometry {
+    /// How a scene with `context` is drawn and written: an image grid's fields, a system of a
+    /// few unknowns in the plane (with the attractor or anchor the context names), or points in
+    /// 3-D with their triangles or lines, the ground and the spheres of the context.
+    #[must_use]
+    pub fn from_context(context: &Context) -> Self {
+        if let Some(image) = &context.image {
+            return Geometry::Grid {
+                dims: image.dims,
+                dim: image.dim,
+                spacing: image.spacing,
+                range: image.range,
+            };
+        }
+        let bounds = context.bounds.unwrap_or(([-1.0; 3], [1.0; 3]));
+        if context.point_dim < 3 {
+            let sun = context.props.iter().any(|p| matches!(p, Prop::Attractor { .. }));
+            return Geometry::Planar {
+                extent: ([bounds.0[0], bounds.0[1]], [bounds.1[0], bounds.1[1]]),
+                sun,
+            };
+        }
+        let mut ground = None;
+        let mut spheres = Vec::new();
+        for prop in &context.props {
+            match *prop {
+                Prop::Ground { height } => ground = Some(height),
+                Prop::Sphere { center, radius } => spheres.push((center, radius)),
+                _ => {}
+            }
+        }
+        Geometry::Particles {
+            triangles: context.triangles.clone(),
+            edges: context.lines.clone(),
+            radius: context.point_radius,
+            ground,
+            spheres,
+            frame_box: bounds,
+        }
+    }
+
+    /// The frame format that suits the geometry: image data for grids, a CSV table for a few
+    /// unknowns, VTK unstructured grids otherwise.
+    #[must_use]
+    pub fn natural_format(&self) -> OutputFormat {
+        match self {
+            Geometry::Grid { .. } => OutputFormat::Vti,
+            Geometry::Planar { .. } => OutputFormat::Csv,
+            Geometry::Particles { .. } => OutputFormat::Vtu,
+        }
+    }
+
     /// Whether frames of this geometry can be written in `format`: grids as `vti` (or none),
     /// everything else in any format but `vti`.
     #[must_use]
@@ -273,32 +381,4 @@ impl View {
             }
         }
     }
-}
-
-/// The initial bounding box of 3-D particles widened sideways by a third of its size and, when
-/// `falls`, extended down along gravity (-z) by its size or to the ground: where the motion of
-/// the built-in scenes stays.
-pub fn frame_box(x: &[f64], ground: Option<f64>, falls: bool) -> ([f64; 3], [f64; 3]) {
-    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in x.chunks_exact(3) {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    if lo[0] > hi[0] {
-        return ([-1.0; 3], [1.0; 3]);
-    }
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-3);
-    for k in 0..2 {
-        lo[k] -= size / 3.0;
-        hi[k] += size / 3.0;
-    }
-    if falls {
-        lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
-    }
-    if let Some(z) = ground {
-        lo[2] = z;
-    }
-    (lo, hi)
 }

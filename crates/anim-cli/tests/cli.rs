@@ -253,3 +253,38 @@ fn a_tet10_fem_scene_runs_and_resumes_bit_for_bit() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn the_kinds_are_listed_and_any_parameter_can_be_set_from_the_command_line() {
+    let out = Command::new(env!("CARGO_BIN_EXE_anim")).args(["list", "--kinds"]).output().unwrap();
+    assert!(out.status.success());
+    let list = String::from_utf8_lossy(&out.stdout);
+    for kind in anim::KINDS {
+        assert!(list.lines().any(|l| l.starts_with(kind.kind) && l.contains(kind.crate_name)), "{list}");
+    }
+    let dir = temp("set");
+    let out = dir.to_str().unwrap();
+    let (ok, err) =
+        anim(&["run", "kepler", "--set", "integrator=rk4", "--frames", "2", "--no-preview", "--out", out]);
+    assert!(ok, "{err}");
+    let metrics = std::fs::read_to_string(dir.join("metrics.json")).unwrap();
+    assert!(metrics.contains("\"method\": \"rk4\""), "{metrics}");
+    // A table value, and an unknown parameter named with the kind's own list.
+    let (ok, err) = anim(&[
+        "run",
+        "kepler",
+        "--set",
+        "integrator={beta-blend={beta=0.5}}",
+        "--frames",
+        "1",
+        "--no-preview",
+        "--out",
+        out,
+    ]);
+    assert!(ok, "{err}");
+    let (ok, err) = anim(&["run", "kepler", "--set", "eccentricty=0.3", "--out", out]);
+    assert!(!ok && err.contains("field `scene.eccentricty`: unknown field `eccentricty`"), "{err}");
+    let (ok, err) = anim(&["run", "kepler", "--set", "kind=springs", "--out", out]);
+    assert!(!ok && err.contains("--set kind=springs: KEY must name a parameter"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,9 +1,13 @@
 use super::*;
 use crate::scene;
-use std::path::Path;
 
 fn builtin(name: &str) -> SceneFile {
-    scene::parse(scene::builtin(name).unwrap_or_default(), Path::new(name)).unwrap_or_else(|e| panic!("{e}"))
+    scene::builtin(name).unwrap_or_else(|| panic!("no built-in scene {name}"))
+}
+
+/// The picker's typed view of a scene file's `[scene]` table.
+fn typed_of(file: &SceneFile) -> Scene {
+    typed::typed(&file.scene).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn pt(param: f64, seconds: f64, error: f64) -> Point {
@@ -150,7 +154,7 @@ fn the_cheapest_on_the_scene_accounts_for_the_step_each_method_needs_there() {
     let c = choose(&mut file, 1e-2, &t).unwrap();
     assert_eq!(c.method, "rk4");
     assert_eq!(c.param, 0.1);
-    assert!(matches!(file.scene, Scene::KeplerOrbit { integrator: IntegratorKind::Rk4, .. }));
+    assert!(matches!(typed_of(&file), Scene::KeplerOrbit { integrator: IntegratorKind::Rk4, .. }));
     assert_fits(&c, &before, &file, 0.1 * 0.5);
     assert!(
         c.why.starts_with(
@@ -215,7 +219,7 @@ fn the_fem_beam_keeps_its_material_and_takes_the_studys_integrator_solver_and_sc
     let c = choose(&mut file, 1e-2, &t).unwrap();
     assert_eq!((c.method.as_str(), c.param), ("stable-neo-hookean backward-euler (ldlt)", 2.5e-3));
     assert!(matches!(
-        file.scene,
+        typed_of(&file),
         Scene::Fem {
             integrator: Some(TimeIntegrator::BackwardEuler),
             linear_solver: Some(LinearSolverChoice::Ldlt),
@@ -234,7 +238,7 @@ fn the_fem_beam_keeps_its_material_and_takes_the_studys_integrator_solver_and_sc
     let mut file = before.clone();
     let c = choose(&mut file, 6e-2, &t).unwrap();
     assert_eq!(c.method, "stable-neo-hookean symplectic-euler");
-    assert!(matches!(file.scene, Scene::Fem { integrator: Some(TimeIntegrator::SymplecticEuler), .. }));
+    assert!(matches!(typed_of(&file), Scene::Fem { integrator: Some(TimeIntegrator::SymplecticEuler), .. }));
     assert_eq!(c.settings, "integrator = symplectic-euler");
     // 1e-4: the most accurate of the scene's material is named, not the other material's 1e-6.
     let e = choose(&mut before.clone(), 1e-4, &t).unwrap_err();
@@ -264,7 +268,7 @@ fn the_hanging_cloth_takes_explicit_methods_only_at_the_stiffer_cloths_step() {
     let mut file = before.clone();
     let c = choose(&mut file, 1e-4, &t).unwrap();
     assert_eq!(c.method, "rk4");
-    assert!(matches!(file.scene, Scene::Springs { integrator: Some(IntegratorKind::Rk4), .. }));
+    assert!(matches!(typed_of(&file), Scene::Springs { integrator: Some(IntegratorKind::Rk4), .. }));
     // The preset (anim-springs scenes docs): 32 x 32 particles, 0.2 kg, structural 1000 N/m; the
     // study's 10 x 10, 0.1 kg, 100 N/m. The scene runs 120 x 2 x 0.01 = 2.4 s against 0.25 s.
     let omega = |k: f64, count: f64, mass: f64| (k * count / mass).sqrt();
@@ -294,7 +298,7 @@ fn the_cavity_takes_the_studys_resolution_and_pressure_solver() {
     let c = choose(&mut file, 0.03, &t).unwrap();
     assert_eq!((c.method.as_str(), c.param), ("mgpcg", 32.0));
     assert!(matches!(
-        file.scene,
+        typed_of(&file),
         Scene::Fluid {
             resolution: Some(32),
             pressure_solver: Some(PressureSolver(PressureMethod::Mgpcg)),
@@ -310,9 +314,7 @@ fn the_cavity_takes_the_studys_resolution_and_pressure_solver() {
     // The study measured the preset's advection and splitting: a scene that sets either is
     // refused rather than given a pick measured with another scheme.
     let mut changed = before.clone();
-    if let Scene::Fluid { splitting, .. } = &mut changed.scene {
-        *splitting = Some(crate::scene::FluidSplitting::Reflection);
-    }
+    changed.scene.params.insert("splitting".into(), "reflection".into());
     let e = choose(&mut changed, 0.03, &t).unwrap_err();
     assert!(e.contains("sets `splitting`, but the fluid_cavity_ghia study measured the preset's own"), "{e}");
     // The seed solver's smoke box is not a mapped preset.
@@ -339,7 +341,7 @@ fn the_smoke_plume_takes_the_pressure_solver_measured_at_the_nearest_grid() {
     let c = choose(&mut file, 1e-4, &t).unwrap();
     assert_eq!((c.method.as_str(), c.param), ("mgpcg N=64", 1e-5));
     assert!(matches!(
-        file.scene,
+        typed_of(&file),
         Scene::Fluid { resolution: Some(32), pressure_solver: Some(PressureSolver(PressureMethod::Mgpcg)), pressure_tolerance: Some(tol), .. }
             if tol == 1e-5
     ));
@@ -398,19 +400,19 @@ fn an_older_table_format_is_refused() {
 fn the_ode_error_is_zero_on_the_exact_solution() {
     // Independent of the runner: the exact state at t gives zero, a shifted one its shift.
     let osc = builtin("oscillator");
-    let Scene::HarmonicOscillator { mass, stiffness, damping, x0, v0, .. } = osc.scene else { panic!() };
+    let Scene::HarmonicOscillator { mass, stiffness, damping, x0, v0, .. } = typed_of(&osc) else { panic!() };
     let (xe, ve) = HarmonicOscillator::damped(mass, stiffness, damping).exact(x0, v0, 0.7);
     let mut s = State::new(vec![xe], vec![ve]);
     s.t = 0.7;
-    assert_eq!(ode_error(&osc.scene, &s), Some(0.0));
+    assert_eq!(ode_error(&typed_of(&osc), &s), Some(0.0));
     s.x[0] += 1e-3;
-    let e = ode_error(&osc.scene, &s).unwrap();
+    let e = ode_error(&typed_of(&osc), &s).unwrap();
     assert!((e - 1e-3 / x0.hypot(v0 / (stiffness / mass).sqrt())).abs() < 1e-15);
     let kep = builtin("kepler");
     let (xe, ve) = KeplerOrbit::ellipse(0.5).exact(1.3);
     let mut s = State::new(xe.to_vec(), ve.to_vec());
     s.t = 1.3;
-    assert_eq!(ode_error(&kep.scene, &s), Some(0.0));
+    assert_eq!(ode_error(&typed_of(&kep), &s), Some(0.0));
 }
 
 #[test]
@@ -422,7 +424,7 @@ fn the_ghia_error_of_a_cavity_at_rest_is_ghias_largest_interior_speed() {
         anim_fluid::scenes::lid_driven_cavity(128, 100.0, anim_fluid::advection::Advection::MacCormack)
             .unwrap();
     let anim_fluid::scenes::FluidSim::Mac(fluid, state) = &scene.sim else { panic!("a MAC scene") };
-    assert!((ghia_error(fluid, state) - 0.84123).abs() < 1e-12);
+    assert!((anim_fluid::kind::ghia_error(fluid, state) - 0.84123).abs() < 1e-12);
 }
 
 #[test]
@@ -470,7 +472,7 @@ fn the_pbd_cloth_takes_the_studys_method_and_counts_scaled_to_its_side_and_lengt
     // Iterations (1 ms x 7/4) beat substeps (2 ms x 7/4); PBD's cheap point misses 1e-2.
     assert_eq!((c.method.as_str(), c.param), ("Xpbd iterations (1 substep)", 4.0));
     assert!(matches!(
-        file.scene,
+        typed_of(&file),
         Scene::Pbd { method: Some(anim_pbd::Method::Xpbd), iterations: Some(7), substeps: Some(1), .. }
     ));
     assert_fits(&c, &before, &file, 1.0 / 60.0);
@@ -480,7 +482,7 @@ fn the_pbd_cloth_takes_the_studys_method_and_counts_scaled_to_its_side_and_lengt
     let c = choose(&mut file, 0.1, &t).unwrap();
     assert_eq!(c.method, "Pbd substeps (1 iteration)");
     assert!(matches!(
-        file.scene,
+        typed_of(&file),
         Scene::Pbd { method: Some(anim_pbd::Method::Pbd), iterations: Some(1), substeps: Some(28), .. }
     ));
     // Twice the study's length: the iteration series are left out, substeps grow by 2^2 = 4:
@@ -490,7 +492,7 @@ fn the_pbd_cloth_takes_the_studys_method_and_counts_scaled_to_its_side_and_lengt
     let mut file = long.clone();
     let c = choose(&mut file, 1e-2, &t).unwrap();
     assert_eq!((c.method.as_str(), c.param), ("Xpbd substeps (1 iteration)", 4.0));
-    assert!(matches!(file.scene, Scene::Pbd { iterations: Some(1), substeps: Some(28), .. }));
+    assert!(matches!(typed_of(&file), Scene::Pbd { iterations: Some(1), substeps: Some(28), .. }));
     assert!(
         c.why.contains("left out as not this scene's: Xpbd iterations (1 substep) (swept iterations"),
         "{}",
@@ -536,7 +538,7 @@ fn the_mpm_dam_break_takes_the_studys_resolution_transfer_kernel_and_particles_p
     let c = choose(&mut file, 0.1, &t).unwrap();
     assert_eq!((c.method.as_str(), c.param), ("APIC cubic, 2x2 ppc", 32.0));
     assert!(matches!(
-        file.scene,
+        typed_of(&file),
         Scene::Mpm {
             resolution: Some(32),
             transfer: Some(MpmTransfer::Apic),
@@ -552,7 +554,7 @@ fn the_mpm_dam_break_takes_the_studys_resolution_transfer_kernel_and_particles_p
     let c = choose(&mut file, 0.045, &t).unwrap();
     assert_eq!((c.method.as_str(), c.param), ("MLS-MPM quadratic, 3x3 ppc", 48.0));
     assert!(matches!(
-        file.scene,
+        typed_of(&file),
         Scene::Mpm {
             resolution: Some(48),
             transfer: Some(MpmTransfer::MlsMpm),

@@ -1,0 +1,139 @@
+use super::*;
+
+const KEPLER: &str = r#"name = "kepler"
+
+[run]
+dt = 0.005
+frames = 400
+steps_per_frame = 10
+
+[scene]
+kind = "kepler-orbit"
+eccentricity = 0.5
+integrator = "velocity-verlet"
+"#;
+
+const OSCILLATOR: &str = r#"name = "oscillator"
+
+[run]
+dt = 0.01
+frames = 500
+steps_per_frame = 2
+
+[scene]
+kind = "harmonic-oscillator"
+mass = 1.0
+stiffness = 40.0
+damping = 0.2
+x0 = 1.0
+v0 = 0.0
+integrator = "implicit-midpoint"
+"#;
+
+/// The error of parsing and building `text`.
+fn err(text: &str) -> String {
+    let path = Path::new("s.toml");
+    match parse(text, path) {
+        Err(e) => e.to_string(),
+        Ok(file) => build(&file, path, Some(text)).err().map(|e| e.to_string()).unwrap_or_default(),
+    }
+}
+
+fn line_of(text: &str, start: &str) -> usize {
+    text.lines().position(|l| l.starts_with(start)).unwrap() + 1
+}
+
+#[test]
+fn every_builtin_scene_is_a_scene_file_that_reads_back_and_builds() {
+    let names = builtins();
+    assert_eq!(names.len(), anim::presets().len());
+    assert!(builtin(DEFAULT_SCENE).is_some());
+    for (name, _) in names {
+        let file = builtin(name).unwrap();
+        assert_eq!(file.name, name);
+        let text = toml::to_string(&file).unwrap();
+        assert_eq!(parse(&text, Path::new(name)).unwrap(), file, "{name}");
+    }
+    // The small ones build as they are.
+    for name in ["kepler", "oscillator", "rope", "panda"] {
+        build(&builtin(name).unwrap(), Path::new(name), None).unwrap();
+    }
+}
+
+#[test]
+fn unknown_field_is_an_error_naming_file_line_and_field() {
+    let text = KEPLER.replace("eccentricity = 0.5", "eccentricity = 0.5\neccentrcity = 0.2");
+    let msg = err(&text);
+    let line = line_of(&text, "eccentrcity");
+    assert!(msg.starts_with(&format!("s.toml:{line}:")), "expected line {line}: {msg}");
+    assert!(msg.contains("unknown field `eccentrcity`"), "{msg}");
+    let text = KEPLER.replace("frames = 400", "frmes = 400");
+    let msg = err(&text);
+    assert!(
+        msg.starts_with(&format!("s.toml:{}:", line_of(&text, "frmes"))) && msg.contains("frmes"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn an_unknown_kind_is_refused_on_its_line_with_the_registered_ones() {
+    let text = KEPLER.replace("kepler-orbit", "warp-field");
+    let msg = err(&text);
+    assert!(msg.starts_with(&format!("s.toml:{}:", line_of(&text, "kind"))), "{msg}");
+    assert!(msg.contains("unknown scene kind `warp-field`") && msg.contains("springs"), "{msg}");
+}
+
+#[test]
+fn bad_values_name_their_field() {
+    let cases = [
+        (KEPLER.replace("dt = 0.005", "dt = -1.0"), "run.dt"),
+        (KEPLER.replace("frames = 400", "frames = 0"), "run.frames"),
+        (KEPLER.replace("eccentricity = 0.5", "eccentricity = 1.5"), "scene.eccentricity"),
+        (
+            KEPLER
+                .replace("integrator = \"velocity-verlet\"", "integrator = { beta-blend = { beta = 2.0 } }"),
+            "scene.integrator",
+        ),
+        (OSCILLATOR.replace("mass = 1.0", "mass = 0.0"), "scene.mass"),
+        (OSCILLATOR.replace("damping = 0.2", "damping = -0.2"), "scene.damping"),
+        (KEPLER.replace("name = \"kepler\"", "name = \"../x\""), "name"),
+    ];
+    for (text, field) in cases {
+        let msg = err(&text);
+        assert!(msg.contains(&format!("field `{field}`")), "{field}: {msg}");
+    }
+    // A parameter's error carries its line.
+    let text = OSCILLATOR.replace("mass = 1.0", "mass = 0.0");
+    assert!(err(&text).starts_with(&format!("s.toml:{}:", line_of(&text, "mass"))));
+}
+
+#[test]
+fn unknown_names_and_wrong_types_are_errors_on_their_line() {
+    let text = KEPLER.replace("velocity-verlet", "warp-drive");
+    let msg = err(&text);
+    assert!(msg.starts_with(&format!("s.toml:{}:", line_of(&text, "integrator"))), "{msg}");
+    assert!(msg.contains("warp-drive"), "{msg}");
+    let msg = err(&KEPLER.replace("frames = 400", "frames = \"many\""));
+    assert!(msg.starts_with("s.toml:"), "{msg}");
+}
+
+#[test]
+fn the_beta_blend_table_form_reaches_the_kind() {
+    let text =
+        KEPLER.replace("integrator = \"velocity-verlet\"", "integrator = { beta-blend = { beta = 0.5 } }");
+    let file = parse(&text, Path::new("s.toml")).unwrap();
+    let scene = build(&file, Path::new("s.toml"), Some(&text)).unwrap();
+    assert_eq!(scene.method(), "beta-blend(0.5)");
+}
+
+#[test]
+fn missing_file_names_the_path() {
+    let msg = load(Path::new("/no/such/scene.toml")).unwrap_err().to_string();
+    assert!(msg.contains("/no/such/scene.toml"), "{msg}");
+}
+
+#[test]
+fn system_names_kind_and_preset() {
+    assert_eq!(builtin("cloth").unwrap().scene.system(), "springs/hanging-cloth");
+    assert_eq!(builtin("kepler").unwrap().scene.system(), "kepler-orbit");
+}
