@@ -23,6 +23,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod output;
+pub mod run;
 pub mod scene;
 pub mod tolerance;
 pub mod view;

@@ -1,0 +1,195 @@
+//! The output of a run: frame files, CSV rows and the preview, written on a thread of their own
+//! so that the run loop keeps stepping while a frame is encoded.
+
+use crate::view::{Geometry, OutputFormat, Snapshot, View};
+use anim_core::scene::{DynScene, Frame};
+use anim_io::FrameWriter;
+use anim_io::preview::{Canvas, GifWriter};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What the writer thread produces: the files written and its own busy time.
+pub(crate) type WriterResult = Result<(Vec<String>, f64), String>;
+
+/// Frame files, CSV rows and the preview, written on a thread of their own so that the run
+/// loop keeps stepping while a frame is encoded. Snapshots travel through a bounded channel: a
+/// writer that falls behind slows the run instead of piling up memory.
+pub(crate) struct Output {
+    sender: Option<std::sync::mpsc::SyncSender<(usize, Snapshot)>>,
+    returned: std::sync::mpsc::Receiver<Snapshot>,
+    worker: Option<std::thread::JoinHandle<WriterResult>>,
+    spare: Vec<Snapshot>,
+    /// The scene's frame, scratch reused from frame to frame.
+    frame: Frame,
+    grid: bool,
+}
+
+/// The writer thread's state.
+struct Writer {
+    dir: PathBuf,
+    stride: usize,
+    view: View,
+    frames: Option<FrameWriter>,
+    csv: Option<std::io::BufWriter<std::fs::File>>,
+    gif: Option<(GifWriter, Canvas, anim_io::preview::Camera, usize)>,
+}
+
+impl Writer {
+    fn frame(&mut self, index: usize, s: &Snapshot) -> Result<(), String> {
+        if index.is_multiple_of(self.stride) {
+            if let Some(frames) = &mut self.frames {
+                self.view.write_frame(frames, s)?;
+            }
+            if let Some(csv) = &mut self.csv {
+                let values: Vec<String> = s.x.iter().chain(&s.v).map(|v| format!("{v:e}")).collect();
+                let opt = |v: Option<f64>| v.map(|v| format!("{v:e}")).unwrap_or_default();
+                writeln!(csv, "{index},{:e},{},{},{}", s.t, values.join(","), opt(s.energy), opt(s.error))
+                    .map_err(|e| e.to_string())?;
+            }
+        }
+        if let Some((gif, canvas, camera, every)) = &mut self.gif
+            && index.is_multiple_of(*every)
+        {
+            canvas.clear();
+            self.view.draw(canvas, camera, s)?;
+            gif.push(canvas).map_err(|e| e.to_string())?;
+        }
+        Ok(())
+    }
+
+    fn finish(self) -> Result<Vec<String>, String> {
+        let mut files = Vec::new();
+        if let Some(frames) = &self.frames {
+            let n = frames.sequence().frames().len();
+            match frames.finish().map_err(|e| e.to_string())? {
+                Some(pvd) => files.push(format!("{} ({n} frames)", pvd.display())),
+                None => files.push(format!(
+                    "{} ({n} .{} frames)",
+                    self.dir.join("frames").display(),
+                    frames.format().extension()
+                )),
+            }
+        }
+        if let Some(mut csv) = self.csv {
+            csv.flush().map_err(|e| e.to_string())?;
+            files.push(self.dir.join("frames.csv").display().to_string());
+        }
+        if let Some((gif, canvas, _, _)) = self.gif {
+            let png = self.dir.join("preview.png");
+            canvas.save_png(&png).map_err(|e| e.to_string())?;
+            let path = gif.finish().map_err(|e| e.to_string())?;
+            files.push(path.display().to_string());
+            files.push(png.display().to_string());
+        }
+        Ok(files)
+    }
+}
+
+impl Output {
+    /// The writer of a run; `continuing` holds the times of the frame files an earlier part of
+    /// the run wrote (resumed runs continue the numbering and append to `frames.csv`).
+    pub(crate) fn new(
+        dir: &Path,
+        format: OutputFormat,
+        stride: usize,
+        preview: Option<(u32, usize)>,
+        (geometry, dof): (&Geometry, usize),
+        continuing: Option<&[f64]>,
+    ) -> Result<Self, String> {
+        let grid = matches!(geometry, Geometry::Grid { .. });
+        let view = View::new(geometry.clone());
+        let mut writer = Writer { dir: dir.to_path_buf(), stride, view, frames: None, csv: None, gif: None };
+        if let Some(f) = format.frame_format() {
+            let frames = FrameWriter::continuing(dir.join("frames"), f, continuing.unwrap_or(&[]));
+            writer.frames = Some(frames.map_err(|e| e.to_string())?);
+        }
+        if format == OutputFormat::Csv && continuing.is_some() {
+            let path = dir.join("frames.csv");
+            let file = std::fs::OpenOptions::new()
+                .append(true)
+                .open(&path)
+                .map_err(|e| format!("{}: cannot append to the run's frames: {e}", path.display()))?;
+            writer.csv = Some(std::io::BufWriter::new(file));
+        } else if format == OutputFormat::Csv {
+            let path = dir.join("frames.csv");
+            let file = std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let mut csv = std::io::BufWriter::new(file);
+            let n = dof;
+            let header: Vec<String> =
+                (0..n).map(|i| format!("x{i}")).chain((0..n).map(|i| format!("v{i}"))).collect();
+            writeln!(csv, "frame,t,{},energy,error_vs_exact", header.join(","))
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            writer.csv = Some(csv);
+        }
+        if let Some((width, every)) = preview {
+            // A grid is shown at its own proportions; everything else at 4:3.
+            let height = match writer.view.aspect() {
+                Some(a) => (f64::from(width) / a).round().clamp(16.0, 4096.0) as u32,
+                None => (width * 3 / 4).max(1),
+            };
+            let path = dir.join("preview.gif");
+            let gif = GifWriter::create(&path, width, height, 4, true).map_err(|e| e.to_string())?;
+            let camera = writer.view.camera(f64::from(width) / f64::from(height));
+            writer.gif = Some((gif, Canvas::new(width, height, [248, 248, 250]), camera, every));
+        }
+        let (sender, receiver) = std::sync::mpsc::sync_channel::<(usize, Snapshot)>(4);
+        let (give_back, returned) = std::sync::mpsc::channel::<Snapshot>();
+        let worker = std::thread::Builder::new()
+            .name("anim-writer".into())
+            .spawn(move || {
+                let mut busy = 0.0;
+                let mut result = Ok(());
+                for (index, snapshot) in receiver {
+                    let start = Instant::now();
+                    if result.is_ok() {
+                        result = writer.frame(index, &snapshot);
+                    }
+                    busy += start.elapsed().as_secs_f64();
+                    // Hand the buffers back for reuse; the run may already have ended.
+                    let _ = give_back.send(snapshot);
+                }
+                result?;
+                let start = Instant::now();
+                let files = writer.finish()?;
+                Ok((files, busy + start.elapsed().as_secs_f64()))
+            })
+            .map_err(|e| format!("cannot start the writer thread: {e}"))?;
+        Ok(Output {
+            sender: Some(sender),
+            returned,
+            worker: Some(worker),
+            spare: Vec::new(),
+            frame: Frame::default(),
+            grid,
+        })
+    }
+
+    /// Queues frame `index` of the scene's current state.
+    pub(crate) fn frame(
+        &mut self,
+        index: usize,
+        runner: &dyn DynScene,
+        energy: Option<f64>,
+    ) -> Result<(), String> {
+        self.spare.extend(self.returned.try_iter());
+        let mut snapshot = self.spare.pop().unwrap_or_default();
+        snapshot.fill(runner, &mut self.frame, self.grid, energy);
+        let sent = self.sender.as_ref().map(|s| s.send((index, snapshot)));
+        match sent {
+            Some(Ok(())) => Ok(()),
+            // The writer stopped early: its error is reported by `finish`.
+            _ => Err("the frame writer stopped".into()),
+        }
+    }
+
+    /// Waits for the writer and returns the files written and the writer's busy time.
+    pub(crate) fn finish(mut self) -> WriterResult {
+        drop(self.sender.take());
+        match self.worker.take().map(std::thread::JoinHandle::join) {
+            Some(Ok(result)) => result,
+            Some(Err(_)) => Err("the frame writer panicked".into()),
+            None => Err("the frame writer was not started".into()),
+        }
+    }
+}

@@ -1,0 +1,573 @@
+//! A run of a scene: from the command line's arguments or a checkpoint to frames, a preview,
+//! `metrics.json` and checkpoints. Every scene is a [`DynScene`] built through the registry.
+
+use crate::output::Output;
+use crate::scene::{self, SceneFile};
+use crate::tolerance;
+use crate::view::{Geometry, OutputFormat, Snapshot};
+use anim_core::scene::{DynScene, Frame};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// `anim resume`: continue a checkpointed run.
+#[derive(clap::Args)]
+pub struct ResumeArgs {
+    /// The checkpoint file (`<out>/checkpoint.anim`).
+    pub checkpoint: PathBuf,
+    /// Output folder (default: the one the checkpointed run wrote to).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Total number of frames of the run (default: the checkpointed run's).
+    #[arg(long)]
+    pub frames: Option<usize>,
+    /// No progress bar or summary on the terminal.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// `anim run`: run a scene file, a built-in scene or the default scene.
+#[derive(clap::Args)]
+pub struct RunArgs {
+    /// A scene file (TOML) or the name of a built-in scene (see `anim list`).
+    pub scene: Option<String>,
+    /// Output folder (default: `anim-out/<scene name>`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Override the number of frames.
+    #[arg(long)]
+    pub frames: Option<usize>,
+    /// Override the time step in seconds.
+    #[arg(long, allow_hyphen_values = true)]
+    pub dt: Option<f64>,
+    /// Frame file format (default: the scene's natural one; fluid grids: vti or none).
+    #[arg(long, value_enum)]
+    pub format: Option<OutputFormat>,
+    /// Override the resolution of a preset scene that has one (cloth, MPM, FEM, particle fluids
+    /// and fluid grids: cells or particles across).
+    #[arg(long)]
+    pub resolution: Option<usize>,
+    /// Write every N-th frame to files.
+    #[arg(long, default_value_t = 1)]
+    pub stride: usize,
+    /// Skinning method for skinned-character scenes (`lbs`, `dqs` or `both`; default: the
+    /// scene's): the same as `--set method=<choice>`.
+    #[arg(long, value_parser = ["lbs", "dqs", "both"])]
+    pub skinning: Option<String>,
+    /// Set a parameter of the scene's `[scene]` table, `KEY=VALUE` with a TOML value
+    /// (`--set resolution=48`, `--set integrator=rk4`, `--set 'transfer={flip=0.9}'`); repeatable.
+    /// The scene's kind checks it like a field of the file.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Skip the GIF/PNG preview.
+    #[arg(long)]
+    pub no_preview: bool,
+    /// Preview width in pixels (height is 3/4 of it).
+    #[arg(long, default_value_t = 320)]
+    pub preview_width: u32,
+    /// No progress bar or summary on the terminal.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Every N frames, replace `<out>/checkpoint.anim` (atomically) with the run's state;
+    /// `anim resume` continues from it.
+    #[arg(long)]
+    pub checkpoint_every: Option<usize>,
+    /// The accuracy the run needs instead of a method: the method (integrator, solver, time
+    /// step, resolution, pressure tolerance, PBD iterations and substeps, MPM transfer and kernel)
+    /// comes from the report's measured work-precision studies (oscillator, Kepler, FEM beam,
+    /// hanging cloth, lid-driven cavity, smoke plume, PBD cloth, MPM dam break), and
+    /// the run's error on the study's measure is printed at the end where the scene has a
+    /// reference.
+    #[arg(long, allow_hyphen_values = true)]
+    pub tolerance: Option<f64>,
+}
+
+/// Loads the scene named on the command line: a file if one exists at that path, else a
+/// built-in scene of that name. Returns the scene, the path errors should name and the file's
+/// text (none for a built-in scene).
+fn resolve(arg: Option<&str>) -> Result<(SceneFile, PathBuf, Option<String>), String> {
+    let arg = arg.unwrap_or(scene::DEFAULT_SCENE);
+    let path = Path::new(arg);
+    // A folder of that name (such as a run's output) is not a scene file.
+    if path.is_file() {
+        let text =
+            std::fs::read_to_string(path).map_err(|e| format!("{arg}: cannot read scene file: {e}"))?;
+        let file = scene::parse(&text, path).map_err(|e| e.to_string())?;
+        return Ok((file, path.to_path_buf(), Some(text)));
+    }
+    match scene::builtin(arg) {
+        Some(file) => Ok((file, PathBuf::from(format!("<built-in scene {arg}>")), None)),
+        None => Err(format!(
+            "{arg}: no such scene file, and no built-in scene of that name (built-in: {})",
+            scene::builtins().iter().map(|b| b.0).collect::<Vec<_>>().join(", ")
+        )),
+    }
+}
+
+/// `KEY=VALUE` of `--set` as a parameter: the value read as TOML, or as a string when it is
+/// not TOML (`--set method=dqs`).
+fn set_param(file: &mut SceneFile, arg: &str) -> Result<(), String> {
+    let (key, value) = arg.split_once('=').ok_or_else(|| format!("--set {arg}: expected KEY=VALUE"))?;
+    let key = key.trim();
+    if key.is_empty() || key == "kind" {
+        return Err(format!("--set {arg}: KEY must name a parameter of the scene (not `kind`)"));
+    }
+    let value = match toml::from_str::<toml::Table>(&format!("v = {value}")) {
+        Ok(mut t) => {
+            t.remove("v").map_or(serde_json::Value::Null, |v| serde_json::to_value(v).unwrap_or_default())
+        }
+        Err(_) => serde_json::Value::String(value.to_string()),
+    };
+    file.scene.params.insert(key.to_string(), value);
+    Ok(())
+}
+
+#[derive(Serialize)]
+struct Metrics {
+    scene: String,
+    system: String,
+    method: String,
+    status: String,
+    dt: f64,
+    steps: u64,
+    frames: usize,
+    format: OutputFormat,
+    simulated_seconds: f64,
+    wall_seconds: f64,
+    step_seconds: f64,
+    output_seconds: f64,
+    output_fraction: f64,
+    writer_busy_seconds: f64,
+    steps_per_second: f64,
+    energy_initial: Option<f64>,
+    energy_final: Option<f64>,
+    relative_energy_change: Option<f64>,
+    max_error_vs_exact: Option<f64>,
+    /// `--tolerance` asked for.
+    tolerance: Option<f64>,
+    /// The run's final error on the measure of the cheapest-method table (relative).
+    tolerance_error_final: Option<f64>,
+    /// Its largest value over the frames.
+    tolerance_error_max: Option<f64>,
+    newton_iterations: usize,
+    resumed_from_frame: Option<usize>,
+    checkpoints_written: usize,
+    files: Vec<String>,
+}
+
+/// The checkpoint of a run: the scene and output settings it was started with, how far it got,
+/// and the scene's checkpoint ([`DynScene::save`]). Written as `<out>/checkpoint.anim` (kind
+/// [`CHECKPOINT_KIND`]).
+#[derive(Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RunCheckpoint {
+    scene: SceneFile,
+    /// The path scene errors and relative file names refer to.
+    origin: PathBuf,
+    out: PathBuf,
+    format: OutputFormat,
+    stride: usize,
+    preview_width: Option<u32>,
+    checkpoint_every: Option<usize>,
+    /// Frames completed.
+    frame: usize,
+    steps: u64,
+    /// Times of the frame files written so far.
+    written_times: Vec<f64>,
+    energy_initial: Option<f64>,
+    max_error: Option<f64>,
+    newton_iterations: usize,
+    runner: serde_json::Value,
+}
+
+/// Version 2: the scene is a registered kind with its parameters, the runner a [`DynScene`]
+/// checkpoint.
+const CHECKPOINT_KIND: &str = "anim-run-2";
+const CHECKPOINT_FILE: &str = "checkpoint.anim";
+
+/// A run ready to go: fresh from a scene, or resumed from a checkpoint.
+struct Session {
+    file: SceneFile,
+    origin: PathBuf,
+    out: PathBuf,
+    format: OutputFormat,
+    stride: usize,
+    preview_width: Option<u32>,
+    checkpoint_every: Option<usize>,
+    quiet: bool,
+    runner: Box<dyn DynScene>,
+    /// How the scene is drawn and written.
+    geometry: Geometry,
+    start_frame: usize,
+    steps: u64,
+    written_times: Vec<f64>,
+    energy_initial: Option<f64>,
+    max_error: Option<f64>,
+    newton_iterations: usize,
+    resumed: bool,
+    /// The `--tolerance` asked for, if any.
+    tolerance: Option<f64>,
+}
+
+/// A fresh run of the scene named on the command line.
+fn fresh(args: &RunArgs) -> Result<Session, String> {
+    let (mut file, origin, text) = resolve(args.scene.as_deref())?;
+    if let Some(f) = args.frames {
+        if f == 0 {
+            return Err("--frames must be at least 1".into());
+        }
+        file.run.frames = f;
+    }
+    if let Some(dt) = args.dt {
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(format!("--dt must be a positive finite number, got {dt}"));
+        }
+        file.run.dt = dt;
+    }
+    if args.stride == 0 {
+        return Err("--stride must be at least 1".into());
+    }
+    if args.preview_width < 16 || args.preview_width > 4096 {
+        return Err(format!("--preview-width must lie in [16, 4096], got {}", args.preview_width));
+    }
+    if args.checkpoint_every == Some(0) {
+        return Err("--checkpoint-every must be at least 1".into());
+    }
+    if let Some(r) = args.resolution {
+        file.scene.params.insert("resolution".into(), r.into());
+    }
+    if let Some(choice) = &args.skinning {
+        file.scene.params.insert("method".into(), choice.clone().into());
+    }
+    for arg in &args.set {
+        set_param(&mut file, arg)?;
+    }
+    if let Some(tol) = args.tolerance {
+        if args.dt.is_some() {
+            return Err("give --dt or --tolerance, not both (--tolerance picks the step)".into());
+        }
+        let choice = tolerance::choose(&mut file, tol, &tolerance::table()?)?;
+        if let Some(r) = args.resolution {
+            // The scene had resolution r before the pick (set above); putting it back changes
+            // the scene only if the pick chose another.
+            let mut asked = file.scene.clone();
+            asked.params.insert("resolution".into(), r.into());
+            if asked != file.scene {
+                return Err(format!(
+                    "give --resolution or --tolerance, not both: on {} the resolution is part of the method \
+                     --tolerance picks ({})",
+                    file.name, choice.settings
+                ));
+            }
+        }
+        if !args.quiet {
+            println!(
+                "--tolerance {tol:e}: picked {} ({}) because {}",
+                choice.method, choice.settings, choice.why
+            );
+        }
+    }
+    let runner = scene::build(&file, &origin, text.as_deref()).map_err(|e| {
+        let e = e.to_string();
+        match args.resolution {
+            Some(r) if e.contains("unknown field `resolution`") => {
+                format!("--resolution {r}: a {} scene has no resolution", file.scene.kind)
+            }
+            Some(r) if e.contains("`scene.resolution`") => format!("--resolution {r}: {e}"),
+            _ => e,
+        }
+    })?;
+    let geometry = Geometry::from_context(&runner.context());
+    let format = args.format.unwrap_or_else(|| geometry.natural_format());
+    if !geometry.accepts(format) {
+        return Err(if format == OutputFormat::Vti {
+            format!(
+                "--format vti: {} is not a grid scene (vti frames hold grid fields); it writes {} frames",
+                file.name,
+                format_name(geometry.natural_format())
+            )
+        } else {
+            format!(
+                "--format {}: {} is a grid scene: its frames are vti (or none)",
+                format_name(format),
+                file.name
+            )
+        });
+    }
+    let out = args.out.clone().unwrap_or_else(|| Path::new("anim-out").join(&file.name));
+    Ok(Session {
+        file,
+        origin,
+        out,
+        format,
+        stride: args.stride,
+        preview_width: (!args.no_preview).then_some(args.preview_width),
+        checkpoint_every: args.checkpoint_every,
+        quiet: args.quiet,
+        runner,
+        geometry,
+        start_frame: 0,
+        steps: 0,
+        written_times: Vec::new(),
+        energy_initial: None,
+        max_error: None,
+        newton_iterations: 0,
+        resumed: false,
+        tolerance: args.tolerance,
+    })
+}
+
+/// The command-line spelling of a frame format.
+fn format_name(format: OutputFormat) -> String {
+    use clap::ValueEnum;
+    format.to_possible_value().map_or_else(|| format!("{format:?}"), |v| v.get_name().to_string())
+}
+
+/// A run continued from a checkpoint: the scene is rebuilt from the checkpoint's copy and the
+/// runner's state restored.
+fn resumed(args: &ResumeArgs) -> Result<Session, String> {
+    let (header, ckpt): (_, RunCheckpoint) =
+        anim_io::read_checkpoint(&args.checkpoint).map_err(|e| e.to_string())?;
+    if header.kind != CHECKPOINT_KIND {
+        return Err(format!(
+            "{}: a checkpoint of kind `{}`, not of an `anim run` (`{CHECKPOINT_KIND}`)",
+            args.checkpoint.display(),
+            header.kind
+        ));
+    }
+    let mut file = ckpt.scene;
+    if let Some(f) = args.frames {
+        if f <= ckpt.frame {
+            return Err(format!("--frames {f}: the checkpoint is already at frame {}", ckpt.frame));
+        }
+        file.run.frames = f;
+    }
+    let mut runner = scene::build(&file, &ckpt.origin, None).map_err(|e| e.to_string())?;
+    runner.restore(&ckpt.runner).map_err(|e| format!("{}: {e}", args.checkpoint.display()))?;
+    let geometry = Geometry::from_context(&runner.context());
+    Ok(Session {
+        file,
+        origin: ckpt.origin,
+        out: args.out.clone().unwrap_or(ckpt.out),
+        format: ckpt.format,
+        stride: ckpt.stride,
+        preview_width: ckpt.preview_width,
+        checkpoint_every: ckpt.checkpoint_every,
+        quiet: args.quiet,
+        runner,
+        geometry,
+        start_frame: ckpt.frame,
+        steps: ckpt.steps,
+        written_times: ckpt.written_times,
+        energy_initial: ckpt.energy_initial,
+        max_error: ckpt.max_error,
+        newton_iterations: ckpt.newton_iterations,
+        resumed: true,
+        tolerance: None,
+    })
+}
+
+impl Session {
+    /// Writes `<out>/checkpoint.anim` for the frames completed so far (`frame` of them).
+    fn checkpoint(&self, frame: usize) -> Result<PathBuf, String> {
+        let ckpt = RunCheckpoint {
+            scene: self.file.clone(),
+            origin: self.origin.clone(),
+            out: self.out.clone(),
+            format: self.format,
+            stride: self.stride,
+            preview_width: self.preview_width,
+            checkpoint_every: self.checkpoint_every,
+            frame,
+            steps: self.steps,
+            written_times: self.written_times.clone(),
+            energy_initial: self.energy_initial,
+            max_error: self.max_error,
+            newton_iterations: self.newton_iterations,
+            runner: self.runner.save(),
+        };
+        let path = self.out.join(CHECKPOINT_FILE);
+        anim_io::write_checkpoint(&path, CHECKPOINT_KIND, &ckpt).map_err(|e| e.to_string())?;
+        Ok(path)
+    }
+}
+
+fn execute(mut s: Session) -> Result<(), String> {
+    let out = s.out.clone();
+    std::fs::create_dir_all(&out)
+        .map_err(|e| format!("{}: cannot create output folder: {e}", out.display()))?;
+    let run = s.file.run;
+    // At most about 100 preview frames, whatever the run's length.
+    let preview = s.preview_width.map(|w| (w, run.frames.div_ceil(100)));
+    let continuing = s.resumed.then_some(s.written_times.as_slice());
+    let dof = {
+        let mut snap = Snapshot::default();
+        snap.fill(s.runner.as_ref(), &mut Frame::default(), false, None);
+        snap.x.len()
+    };
+    let mut output = Output::new(&out, s.format, s.stride, preview, (&s.geometry, dof), continuing)?;
+    let writes_files = s.format.frame_format().is_some();
+
+    let first_step = s.steps;
+    let total_steps = (run.frames * run.steps_per_frame) as u64;
+    let bar = ProgressBar::with_draw_target(Some(total_steps), ProgressDrawTarget::hidden());
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {elapsed} elapsed, eta {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_position(s.steps);
+    let start = Instant::now();
+    let mut bar_shown = false;
+    let mut energy = None;
+    let mut step_seconds = 0.0;
+    let mut failure = None;
+    let mut checkpoints = 0usize;
+    let mut table_error: Option<(f64, f64)> = None;
+    let mut max_residual: Option<f64> = None;
+    'frames: for frame in s.start_frame..run.frames {
+        let t_step = Instant::now();
+        for _ in 0..run.steps_per_frame {
+            match s.runner.step(run.dt) {
+                Ok(report) => {
+                    s.newton_iterations += report.iterations;
+                    if let Some(r) = report.residual {
+                        max_residual = Some(max_residual.map_or(r, |m: f64| m.max(r)));
+                    }
+                    energy = report.energy;
+                    if s.energy_initial.is_none() {
+                        s.energy_initial = energy;
+                    }
+                }
+                Err(e) => {
+                    failure = Some(format!("step {}: {e}", s.steps));
+                    break 'frames;
+                }
+            }
+            s.steps += 1;
+        }
+        step_seconds += t_step.elapsed().as_secs_f64();
+        if let Some(e) = s.runner.reference_error() {
+            s.max_error = Some(s.max_error.map_or(e, |m: f64| m.max(e)));
+        }
+        if s.tolerance.is_some()
+            && let Some(e) = tolerance::table_error(&s.file.scene, s.runner.as_ref(), max_residual)
+        {
+            table_error = Some((e, table_error.map_or(e, |(_, m)| m.max(e))));
+        }
+        if let Err(e) = output.frame(frame, s.runner.as_ref(), energy) {
+            failure = Some(format!("frame {frame}: {e}"));
+            break;
+        }
+        if writes_files && frame.is_multiple_of(s.stride) {
+            s.written_times.push(s.runner.time());
+        }
+        if let Some(every) = s.checkpoint_every
+            && (frame + 1).is_multiple_of(every)
+            && frame + 1 < run.frames
+        {
+            s.checkpoint(frame + 1)?;
+            checkpoints += 1;
+        }
+        if !s.quiet && !bar_shown && start.elapsed() > Duration::from_secs(1) {
+            bar.set_draw_target(ProgressDrawTarget::stderr());
+            bar_shown = true;
+        }
+        bar.set_position(s.steps);
+    }
+    bar.finish_and_clear();
+    let (files, writer_seconds) = output.finish()?;
+    let wall = start.elapsed().as_secs_f64();
+    // What output added to the run: everything that was not stepping (the writer overlaps
+    // with stepping; what it could not hide shows here).
+    let output_seconds = (wall - step_seconds).max(0.0);
+    let steps_here = s.steps - first_step;
+    let energy0 = s.energy_initial;
+    let metrics = Metrics {
+        scene: s.file.name.clone(),
+        system: s.file.scene.system(),
+        method: s.runner.method(),
+        status: failure.clone().map_or_else(|| "completed".into(), |f| format!("diverged at {f}")),
+        dt: run.dt,
+        steps: s.steps,
+        frames: run.frames,
+        format: s.format,
+        simulated_seconds: s.runner.time(),
+        wall_seconds: wall,
+        step_seconds,
+        output_seconds,
+        output_fraction: output_seconds / wall.max(1e-12),
+        writer_busy_seconds: writer_seconds,
+        steps_per_second: steps_here as f64 / step_seconds.max(1e-12),
+        energy_initial: energy0,
+        energy_final: energy,
+        relative_energy_change: energy0.zip(energy).map(|(e0, e)| (e - e0) / e0.abs().max(f64::MIN_POSITIVE)),
+        max_error_vs_exact: s.max_error,
+        tolerance: s.tolerance,
+        tolerance_error_final: table_error.map(|e| e.0),
+        tolerance_error_max: table_error.map(|e| e.1),
+        newton_iterations: s.newton_iterations,
+        resumed_from_frame: s.resumed.then_some(s.start_frame),
+        checkpoints_written: checkpoints,
+        files,
+    };
+    let metrics_path = out.join("metrics.json");
+    anim_io::metrics::write_json(&metrics_path, &metrics).map_err(|e| e.to_string())?;
+    if !s.quiet {
+        if let Some(f) = metrics.resumed_from_frame {
+            println!("resumed at frame {f} (step {first_step})");
+        }
+        println!(
+            "{}: {} steps of {} s with {} in {:.2} s ({:.0} steps/s); output {:.0}% of the time",
+            metrics.scene,
+            steps_here,
+            metrics.dt,
+            metrics.method,
+            wall,
+            metrics.steps_per_second,
+            100.0 * metrics.output_fraction
+        );
+        if let Some(d) = metrics.relative_energy_change {
+            println!("  relative energy change {d:.3e}");
+        }
+        if let Some(e) = metrics.max_error_vs_exact {
+            println!("  max error against the exact solution {e:.3e}");
+        }
+        if let (Some(tol), Some((last, max))) = (s.tolerance, table_error) {
+            println!(
+                "  error on the table's measure: final {last:.3e}, max over the frames {max:.3e}; tolerance {tol:e} {}",
+                if last <= tol { "met" } else { "NOT met" }
+            );
+        }
+        for f in &metrics.files {
+            println!("  wrote {f}");
+        }
+        if checkpoints > 0 {
+            println!("  wrote {} ({checkpoints} times)", out.join(CHECKPOINT_FILE).display());
+        }
+        println!("  wrote {}", metrics_path.display());
+    }
+    match failure {
+        Some(f) => {
+            Err(format!("simulation diverged at {f} (frames up to the failure and metrics were written)"))
+        }
+        None => Ok(()),
+    }
+}
+
+/// Runs the scene `args` names and writes its output.
+///
+/// # Errors
+/// A message naming the flag, file, field or step that failed; a run that diverges writes its
+/// frames up to the failure and its metrics first.
+pub fn run(args: &RunArgs) -> Result<(), String> {
+    fresh(args).and_then(execute)
+}
+
+/// Continues the run checkpointed in `args.checkpoint`.
+///
+/// # Errors
+/// As [`run`], and for a checkpoint that cannot be read or restored.
+pub fn resume(args: &ResumeArgs) -> Result<(), String> {
+    resumed(args).and_then(execute)
+}
