@@ -14,7 +14,7 @@ mod bench;
 mod cases;
 mod ci;
 mod machine;
-mod peers_file;
+mod peers;
 mod python;
 mod registry;
 mod report;

@@ -3,7 +3,7 @@
 //! cheapest-method table also as `docs/report/cheapest.json` (read by `anim run --tolerance`).
 
 use crate::machine::Machine;
-use crate::peers_file::{self, PeerRow};
+use crate::peers::ratios::{self, PeerRow};
 use crate::registry::{self, Ctx, StudyResult, fmt_num};
 use crate::report_data::{self, Data, Kind, Part};
 use crate::scaling;
@@ -215,8 +215,7 @@ pub fn run(ctx: &Ctx, out: &str, threads: &[usize], filter: Option<&str>) -> boo
         );
     }
     let data = Data::new(ctx.quick, Machine::this(), parts);
-    let report =
-        Report::from_data(&data, peers_file::read(&dir.join("peers.csv")), dir.join("soak.md").exists());
+    let report = Report::from_data(&data, ratios::read(&dir.join("peers.csv")), dir.join("soak.md").exists());
     let mut ok = match write(dir, &report).and_then(|()| data.write(&data_path)) {
         Ok(()) => true,
         Err(e) => {
@@ -548,7 +547,7 @@ pub fn index_markdown(r: &Report) -> String {
                  row with the date and machine it was measured on; a filtered run replaces only its crate's \
                  rows). Ratio = our time per step over theirs: below 1 means faster.\n"
             );
-            md.push_str(&peers_file::markdown(rows));
+            md.push_str(&ratios::markdown(rows));
             md.push('\n');
         }
         Err(e) => {

@@ -69,7 +69,7 @@ pub fn run() -> bool {
                 t_y
             );
             rows.push((dim, n, ours.particles, threads, ours.per_step_s, t_step, ratio));
-            crate::peers_file::record(
+            super::ratios::record(
                 "anim-mpm",
                 &format!("MLS-MPM fluid {dim}D {n}^{dim}, {} particles", ours.particles),
                 "Taichi",

@@ -159,8 +159,8 @@ pub fn run() -> bool {
         )
     };
     let peer_name = format!("Taichi {version} mpm3d");
-    crate::peers_file::record("anim-flip", &case("per step"), &peer_name, threads, ours.per_substep, t_step);
-    crate::peers_file::record(
+    super::ratios::record("anim-flip", &case("per step"), &peer_name, threads, ours.per_substep, t_step);
+    super::ratios::record(
         "anim-flip",
         &case("per simulated second"),
         &peer_name,

@@ -93,7 +93,7 @@ pub fn run() -> bool {
         "| pbatoolkit (Python Newton loop, SuperLU) | 1 | {peer_elements} | {peer_s:.4} | [{peer_iters}] | {peer_tip} |"
     );
     println!("\nspeed-up per implicit step: {:.1}x (pbatoolkit / anim-fem)", peer_s / ours_s);
-    crate::peers_file::record(
+    super::ratios::record(
         "anim-fem",
         &format!("benchmark beam, {elements} elements, one backward Euler step (pbatoolkit: one thread)"),
         "pbatoolkit",

@@ -143,7 +143,7 @@ pub fn run() -> bool {
                 && o.threads == 1
                 && o.code.starts_with("anim-pbd")
         }) {
-            crate::peers_file::record(
+            super::ratios::record(
                 "anim-pbd",
                 &format!("XPBD cloth {n}x{n}, {} iterations, {}", theirs.iterations, ours.code, n = theirs.n),
                 &theirs.code,

@@ -120,7 +120,7 @@ pub fn run() -> bool {
                 match c {
                     Some(c) => {
                         println!("| {n} | {:.2} ms | {:.2} ms | {:.2}x |", c * 1e3, ours * 1e3, c / ours);
-                        crate::peers_file::record(
+                        super::ratios::record(
                             "anim-fluid",
                             &format!("seed stable fluids N = {n}, 20 Gauss-Seidel sweeps"),
                             "the seed's C (cc -O3 -march=native)",
@@ -190,7 +190,7 @@ pub fn run() -> bool {
                     Ok(s) => {
                         println!("| taichi stable_fluid (500 Jacobi) | {t} | {:.1} ms |", s * 1e3);
                         if t == 1 {
-                            crate::peers_file::record(
+                            super::ratios::record(
                                 "anim-fluid",
                                 "stable fluids 512 x 512: our seed mode (20 GS sweeps) vs Taichi (500 Jacobi)",
                                 "Taichi 1.7.4 stable_fluid",

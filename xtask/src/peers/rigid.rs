@@ -317,7 +317,7 @@ pub fn run() -> bool {
     );
     for (robot, kernel, ours, theirs, detail) in &rows {
         println!("| {robot} | {kernel} | {ours:.1} ns | {theirs:.1} ns | {:.3} | {detail} |", ours / theirs);
-        crate::peers_file::record(
+        super::ratios::record(
             "anim-rigid",
             &format!("{robot} {kernel}"),
             "Pinocchio",
