@@ -20,6 +20,9 @@
 //! velocity is interpolated toward the wall's velocity over the half cell between the last
 //! sample and the wall (this is how the lid of a cavity drags the fluid); elsewhere outside the
 //! samples the nearest value is used.
+//!
+//! This module holds the choice of scheme and the interpolation on one lattice; the MAC solver
+//! runs the passes over its faces and cells (`mac/advect.rs`).
 
 /// How advected quantities are carried. Serialised by its [`Advection::name`]
 /// (`"sl-linear"`, `"sl-monotone-cubic"`, `"bfecc"`, `"maccormack"`), as scene files name it.
