@@ -1,5 +1,5 @@
-//! The scene contracts, checked on every registered preset through
-//! [`DynScene`](anim_core::scene::DynScene) alone, so that a newly registered preset gets them
+//! The scene contracts, checked on every registered preset through anim-core's `DynScene`
+//! alone, so that a newly registered preset gets them
 //! without any edit here:
 //!
 //! - **determinism**: the same steps on rayon pools of 1, 2 and 4 threads end in the same
