@@ -1,7 +1,8 @@
 //! The case registry: conformance checks, stability cases and work-precision studies.
 //!
 //! Each crate's cases live in a module of `cases/` with a `register` function; adding a crate
-//! means adding that module and one line to [`all`]. Nothing else in xtask changes.
+//! means adding that module and one line to `cases::all`. Nothing else in xtask changes. This
+//! module holds only the types and helpers the cases share: it uses none of them.
 
 use std::time::Instant;
 
@@ -158,25 +159,6 @@ pub struct Registry {
     pub studies: Vec<Study>,
 }
 
-/// The registry of every crate's cases.
-pub fn all() -> Registry {
-    let mut r = Registry::default();
-    crate::cases::core::register(&mut r);
-    crate::cases::io::register(&mut r);
-    crate::cases::springs::register(&mut r);
-    crate::cases::rigid::register(&mut r);
-    crate::cases::pbd::register(&mut r);
-    crate::cases::skin::register(&mut r);
-    crate::cases::material::register(&mut r);
-    crate::cases::fem::register(&mut r);
-    crate::cases::mpm::register(&mut r);
-    crate::cases::fluid::register(&mut r);
-    crate::cases::flip::register(&mut r);
-    crate::cases::determinism::register(&mut r);
-    crate::cases::presets::register(&mut r);
-    r
-}
-
 /// Median wall time of `f`, in seconds: repeats `f` in batches until each batch lasts at least
 /// `min_batch` seconds, over `batches` batches.
 pub fn median_seconds(batches: usize, min_batch: f64, mut f: impl FnMut()) -> f64 {
@@ -196,6 +178,20 @@ pub fn median_seconds(batches: usize, min_batch: f64, mut f: impl FnMut()) -> f6
         .collect();
     times.sort_by(f64::total_cmp);
     times[times.len() / 2]
+}
+
+/// A duration for tables: `us`, `ms` or `s` with two decimals; `-` when not finite.
+pub fn seconds(s: f64) -> String {
+    if !s.is_finite() {
+        return "-".into();
+    }
+    if s < 1e-3 {
+        format!("{:.2} us", s * 1e6)
+    } else if s < 1.0 {
+        format!("{:.2} ms", s * 1e3)
+    } else {
+        format!("{s:.2} s")
+    }
 }
 
 /// Formats a number compactly for tables.

@@ -4,7 +4,7 @@
 
 use crate::machine::Machine;
 use crate::peers::ratios::{self, PeerRow};
-use crate::registry::{self, Ctx, StudyResult, fmt_num};
+use crate::registry::{Ctx, StudyResult, fmt_num};
 use crate::report_data::{self, Data, Kind, Part};
 use crate::scaling;
 use crate::suites::{self, ConformanceRun, StabilityRun};
@@ -153,7 +153,7 @@ pub fn run(ctx: &Ctx, out: &str, threads: &[usize], filter: Option<&str>) -> boo
         Some(p) => parts.push(p),
         None => missing.push(format!("{krate}: {name}")),
     };
-    let reg = registry::all();
+    let reg = crate::cases::all();
     for case in &reg.conformance {
         if !suites::selected(filter, case.crate_name, case.name) {
             keep(&mut stored, &mut parts, Kind::Conformance, case.crate_name, case.name);
@@ -629,19 +629,7 @@ fn study_markdown(crate_name: &str, r: &StudyResult) -> String {
     md
 }
 
-/// A duration for tables: us, ms or s.
-pub fn seconds(s: f64) -> String {
-    if !s.is_finite() {
-        return "-".into();
-    }
-    if s < 1e-3 {
-        format!("{:.2} us", s * 1e6)
-    } else if s < 1.0 {
-        format!("{:.2} ms", s * 1e3)
-    } else {
-        format!("{s:.2} s")
-    }
-}
+pub use crate::registry::seconds;
 
 const PALETTE: [RGBColor; 10] = [
     RGBColor(31, 119, 180),

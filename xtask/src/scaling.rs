@@ -300,7 +300,7 @@ pub fn markdown(rows: &[Row]) -> String {
             r.krate,
             r.scene,
             r.threads,
-            crate::report::seconds(r.seconds),
+            crate::registry::seconds(r.seconds),
             r.speedup
         );
     }

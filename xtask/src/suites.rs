@@ -1,6 +1,6 @@
 //! Running the conformance and stability suites and printing their tables.
 
-use crate::registry::{self, Check, Ctx, Outcome, fmt_num};
+use crate::registry::{Check, Ctx, Outcome, fmt_num};
 use std::time::Instant;
 
 /// Results of a conformance run.
@@ -26,7 +26,7 @@ pub fn selected(filter: Option<&str>, crate_name: &str, name: &str) -> bool {
 pub fn conformance(ctx: &Ctx, filter: Option<&str>) -> ConformanceRun {
     let start = Instant::now();
     let mut checks = Vec::new();
-    for case in registry::all().conformance {
+    for case in crate::cases::all().conformance {
         if !selected(filter, case.crate_name, case.name) {
             continue;
         }
@@ -78,7 +78,7 @@ impl StabilityRun {
 
 pub fn stability(ctx: &Ctx, filter: Option<&str>) -> StabilityRun {
     let mut rows = Vec::new();
-    for case in registry::all().stability {
+    for case in crate::cases::all().stability {
         if !selected(filter, case.crate_name, case.name) {
             continue;
         }

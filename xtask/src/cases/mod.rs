@@ -14,3 +14,22 @@ pub mod rigid;
 pub mod skin;
 pub mod soak;
 pub mod springs;
+
+/// The registry of every crate's cases.
+pub fn all() -> crate::registry::Registry {
+    let mut r = crate::registry::Registry::default();
+    self::core::register(&mut r);
+    io::register(&mut r);
+    springs::register(&mut r);
+    rigid::register(&mut r);
+    pbd::register(&mut r);
+    skin::register(&mut r);
+    material::register(&mut r);
+    fem::register(&mut r);
+    mpm::register(&mut r);
+    fluid::register(&mut r);
+    flip::register(&mut r);
+    determinism::register(&mut r);
+    presets::register(&mut r);
+    r
+}

@@ -118,8 +118,8 @@ pub fn markdown(rows: &[PeerRow]) -> String {
             r.case.replace('|', "/"),
             r.peer.replace('|', "/"),
             r.threads,
-            crate::report::seconds(r.ours_s),
-            crate::report::seconds(r.theirs_s),
+            crate::registry::seconds(r.ours_s),
+            crate::registry::seconds(r.theirs_s),
             r.ratio
         ));
     }
