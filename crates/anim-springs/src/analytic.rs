@@ -1,7 +1,8 @@
 //! Reference problems with closed-form answers: the two-particle spring and the static hanging
 //! chain. The tests, the conformance suite and the examples share them.
 
-use crate::build::{BuildError, Chain, NetworkBuilder, SpringParams};
+use crate::build::{Chain, NetworkBuilder, SpringParams};
+use crate::error::BuildError;
 use crate::network::SpringNetwork;
 use anim_core::glam::DVec3;
 use anim_core::integrate::State;

@@ -58,6 +58,7 @@
 //! implicit methods do not. `delta` of a millimetre or so (well below the spring lengths) makes
 //! implicit steps robust.
 
+use crate::geom::{MIN_LENGTH, outer};
 use anim_core::glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 
@@ -205,7 +206,7 @@ impl Collider {
                     return None;
                 }
                 // At the exact centre the normal is undefined: push out along +z.
-                if r > crate::network::MIN_LENGTH {
+                if r > MIN_LENGTH {
                     Some((radius - r, d / r, 1.0 / r))
                 } else {
                     Some((radius - r, DVec3::Z, 0.0))
@@ -273,10 +274,4 @@ impl Collider {
             *k += (phi * curvature) * (dg_dn * proj);
         }
     }
-}
-
-/// `a b^T`.
-#[inline]
-pub(crate) fn outer(a: DVec3, b: DVec3) -> DMat3 {
-    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
 }

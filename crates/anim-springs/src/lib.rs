@@ -129,16 +129,17 @@
 pub mod analytic;
 mod build;
 pub mod contact;
+mod error;
+mod geom;
 pub mod kind;
 mod mesh;
 pub mod network;
 pub mod scenes;
 mod sim;
 
-pub use build::{
-    BuildError, Chain, Cloth, EARTH_GRAVITY, Lattice, MeshMass, MeshSprings, NetworkBuilder, SpringParams,
-};
+pub use build::{Chain, Cloth, EARTH_GRAVITY, Lattice, MeshMass, MeshSprings, NetworkBuilder, SpringParams};
 pub use contact::{Collider, Shape};
+pub use error::BuildError;
 pub use kind::KIND;
 pub use mesh::TriangleMesh;
 pub use network::{

@@ -6,7 +6,7 @@
 //! (normals, texture coordinates, groups, materials, comments) is skipped. Problems are
 //! [`BuildError::Obj`] naming the line.
 
-use crate::BuildError;
+use crate::error::BuildError;
 
 /// Vertex positions and triangles read from an OBJ file.
 #[derive(Debug, Clone, PartialEq, Default)]

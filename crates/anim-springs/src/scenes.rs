@@ -23,8 +23,9 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-use crate::build::{BuildError, Chain, Cloth, EARTH_GRAVITY, Lattice, NetworkBuilder, SpringParams};
+use crate::build::{Chain, Cloth, EARTH_GRAVITY, Lattice, NetworkBuilder, SpringParams};
 use crate::contact::Collider;
+use crate::error::BuildError;
 use crate::network::SpringNetwork;
 use crate::sim::{SpringError, SpringSimulation};
 use anim_core::glam::{DQuat, DVec3};

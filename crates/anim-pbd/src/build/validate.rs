@@ -1,0 +1,378 @@
+//! Checking and building: [`PbdBuilder::build`] validates every input (sizes, masses, positions,
+//! pins, bodies, colliders, wind, triangles, edges, every constraint's indices, parameters and
+//! rest shape, every balloon's mesh) and reports the first problem as a [`BuildError`] naming the
+//! element; only then does a [`PbdModel`] exist. The rest values are computed from the positions
+//! here, and the model's incidence lists (the constraints at each particle, in increasing
+//! constraint order, and the triangles at each particle) are built for the solvers' fixed-order
+//! sums. A balloon's mesh must be closed and consistently oriented with a positive volume: every
+//! directed edge appears once and has its opposite.
+
+use super::builder::{PbdBuilder, Pending, bad};
+use super::error::BuildError;
+use crate::constraint::{
+    AttachTarget, Constraint, ConstraintFunction, ConstraintParams, IsometricBending, dihedral,
+    isometric_weights, tet_volume,
+};
+use crate::model::{Particle, PbdModel, VolumeMesh};
+use anim_core::glam::DVec3;
+use std::collections::HashMap;
+
+impl PbdBuilder {
+    /// Checks everything and builds the model.
+    ///
+    /// # Errors
+    /// The first problem found, as a [`BuildError`] naming the element.
+    pub fn build(&self) -> Result<PbdModel, BuildError> {
+        let n = self.positions.len();
+        if n == 0 {
+            return Err(BuildError::NoParticles);
+        }
+        if n >= u32::MAX as usize {
+            return Err(BuildError::TooLarge { what: "particles", count: n, max: u32::MAX as usize - 1 });
+        }
+        if self.pending.len() >= u32::MAX as usize {
+            return Err(BuildError::TooLarge {
+                what: "constraints",
+                count: self.pending.len(),
+                max: u32::MAX as usize - 1,
+            });
+        }
+        if !self.gravity.iter().all(|g| g.is_finite()) {
+            return Err(BuildError::NonFiniteGravity { gravity: self.gravity });
+        }
+        let mut particles = Vec::with_capacity(n);
+        for (i, (&m, p)) in self.masses.iter().zip(&self.positions).enumerate() {
+            if !(m > 0.0 && m.is_finite()) {
+                return Err(BuildError::BadMass { particle: i, mass: m });
+            }
+            if !p.iter().all(|c| c.is_finite()) {
+                return Err(BuildError::NonFinitePosition { particle: i, position: *p });
+            }
+            particles.push(Particle { mass: m, pinned: false });
+        }
+        for (k, &p) in self.pins.iter().enumerate() {
+            if p >= n {
+                return Err(BuildError::PinIndex { pin: k, index: p, particles: n });
+            }
+            particles[p].pinned = true;
+        }
+        let inv_mass: Vec<f64> =
+            particles.iter().map(|p| if p.pinned { 0.0 } else { 1.0 / p.mass }).collect();
+        for (b, body) in self.bodies.iter().enumerate() {
+            let pose = body.pose;
+            let ok = pose.position.is_finite()
+                && pose.rotation.is_finite()
+                && (pose.rotation.length() - 1.0).abs() < 1e-6
+                && match body.motion {
+                    crate::collide::BodyMotion::Fixed => true,
+                    crate::collide::BodyMotion::Constant { velocity, angular_velocity } => {
+                        velocity.iter().chain(&angular_velocity).all(|v| v.is_finite())
+                    }
+                    crate::collide::BodyMotion::Oscillate { amplitude, frequency } => {
+                        amplitude.iter().all(|v| v.is_finite()) && frequency.is_finite()
+                    }
+                };
+            if !ok {
+                return Err(BuildError::BadBody {
+                    body: b,
+                    reason: "pose must be finite with a unit quaternion, motion finite".into(),
+                });
+            }
+        }
+        let colliders = self
+            .colliders
+            .iter()
+            .enumerate()
+            .map(|(k, c)| {
+                c.validate(self.bodies.len())
+                    .map_err(|reason| BuildError::BadCollider { collider: k, reason })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        if let Some(w) = self.wind
+            && !(w.velocity.iter().all(|v| v.is_finite())
+                && w.drag >= 0.0
+                && w.drag.is_finite()
+                && w.gust.is_finite())
+        {
+            return Err(bad(
+                "wind",
+                "velocity, drag, gust",
+                "must be finite with drag >= 0",
+                format!("{w:?}"),
+            ));
+        }
+        for (t, tri) in self.triangles.iter().enumerate() {
+            if let Some(&i) = tri.iter().find(|&&i| i >= n) {
+                return Err(BuildError::TriangleIndex { triangle: t, index: i, vertices: n });
+            }
+        }
+        for e in &self.edges {
+            if let Some(&i) = e.iter().find(|&&i| i >= n) {
+                return Err(bad("edge", "vertex", "must be a particle index", i));
+            }
+        }
+        let pos: Vec<DVec3> = self.positions.iter().map(|&p| DVec3::from_array(p)).collect();
+        let mut volume_meshes = Vec::with_capacity(self.volume_meshes.len());
+        for (tris, c) in &self.volume_meshes {
+            volume_meshes.push(volume_mesh(tris, &pos, *c)?);
+        }
+        let mut constraints = Vec::with_capacity(self.pending.len());
+        for (j, (p, params)) in self.pending.iter().enumerate() {
+            constraints.push(self.constraint(j, p, params, &pos, &volume_meshes)?);
+        }
+        // Incidence: constraints per particle, in increasing constraint order.
+        let mut count = vec![0usize; n + 1];
+        let parts = |c: &Constraint| -> Vec<usize> {
+            match &c.function {
+                ConstraintFunction::GlobalVolume { mesh, .. } => volume_meshes[*mesh].vertices.clone(),
+                _ => c.particles().to_vec(),
+            }
+        };
+        let all_parts: Vec<Vec<usize>> = constraints.iter().map(parts).collect();
+        for ps in &all_parts {
+            for &p in ps {
+                count[p + 1] += 1;
+            }
+        }
+        for p in 0..n {
+            count[p + 1] += count[p];
+        }
+        let inc_ptr = count.clone();
+        let mut fill = count;
+        let mut inc = vec![(0u32, 0u32); inc_ptr[n]];
+        for (j, ps) in all_parts.iter().enumerate() {
+            for (slot, &p) in ps.iter().enumerate() {
+                inc[fill[p]] = (j as u32, slot as u32);
+                fill[p] += 1;
+            }
+        }
+        let mut tcount = vec![0usize; n + 1];
+        for t in &self.triangles {
+            for &p in t {
+                tcount[p + 1] += 1;
+            }
+        }
+        for p in 0..n {
+            tcount[p + 1] += tcount[p];
+        }
+        let tri_ptr = tcount.clone();
+        let mut tfill = tcount;
+        let mut tri_inc = vec![0u32; tri_ptr[n]];
+        for (k, t) in self.triangles.iter().enumerate() {
+            for &p in t {
+                tri_inc[tfill[p]] = k as u32;
+                tfill[p] += 1;
+            }
+        }
+        Ok(PbdModel {
+            particles,
+            inv_mass,
+            positions: self.positions.clone(),
+            constraints,
+            volume_meshes,
+            colliders,
+            bodies: self.bodies.clone(),
+            gravity: DVec3::from_array(self.gravity),
+            wind: self.wind,
+            triangles: self.triangles.clone(),
+            edges: self.edges.clone(),
+            tets: self.tets.clone(),
+            inc_ptr,
+            inc,
+            tri_ptr,
+            tri_inc,
+        })
+    }
+
+    fn constraint(
+        &self,
+        j: usize,
+        p: &Pending,
+        params: &ConstraintParams,
+        pos: &[DVec3],
+        meshes: &[VolumeMesh],
+    ) -> Result<Constraint, BuildError> {
+        let n = pos.len();
+        let kind = match p {
+            Pending::Distance { .. } => "distance",
+            Pending::Dihedral(_) => "dihedral bending",
+            Pending::Isometric(_) => "isometric bending",
+            Pending::Tet(_) => "tetrahedral volume",
+            Pending::Volume { .. } => "global volume",
+            Pending::Attach { .. } => "attachment",
+        };
+        if !(0.0..=1.0).contains(&params.stiffness) {
+            return Err(BuildError::BadStiffness { constraint: j, kind, value: params.stiffness });
+        }
+        if !(params.compliance >= 0.0 && params.compliance.is_finite()) {
+            return Err(BuildError::BadCompliance { constraint: j, kind, value: params.compliance });
+        }
+        if !(params.damping >= 0.0 && params.damping.is_finite()) {
+            return Err(BuildError::BadDamping { constraint: j, kind, value: params.damping });
+        }
+        let indices: Vec<usize> = match p {
+            Pending::Distance { i, j, .. } => vec![*i, *j],
+            Pending::Dihedral(s) | Pending::Isometric(s) | Pending::Tet(s) => s.to_vec(),
+            Pending::Volume { .. } => vec![],
+            Pending::Attach { particle, .. } => vec![*particle],
+        };
+        for (a, &i) in indices.iter().enumerate() {
+            if i >= n {
+                return Err(BuildError::ConstraintIndex { constraint: j, kind, index: i, particles: n });
+            }
+            if indices[..a].contains(&i) {
+                return Err(BuildError::RepeatedIndex { constraint: j, kind, particle: i });
+            }
+        }
+        let degenerate =
+            |reason| BuildError::DegenerateRest { constraint: j, kind, particles: indices.clone(), reason };
+        let function = match p {
+            Pending::Distance { i, j: k, rest } => {
+                let l = rest.unwrap_or_else(|| (pos[*i] - pos[*k]).length());
+                if !(l >= 0.0 && l.is_finite()) {
+                    return Err(BuildError::BadRestValue {
+                        constraint: j,
+                        kind,
+                        name: "rest length",
+                        requirement: "non-negative and finite",
+                        value: l,
+                    });
+                }
+                ConstraintFunction::Distance { particles: [*i, *k], rest_length: l }
+            }
+            Pending::Dihedral(s) => {
+                let (theta, _) =
+                    dihedral(s.map(|i| pos[i])).ok_or_else(|| degenerate("a triangle has zero area"))?;
+                ConstraintFunction::DihedralBending { particles: *s, rest_angle: theta }
+            }
+            Pending::Isometric(s) => {
+                let (weights, rest) = isometric_weights(s.map(|i| pos[i].to_array()))
+                    .ok_or_else(|| degenerate("a triangle has zero area"))?;
+                ConstraintFunction::IsometricBending(IsometricBending { particles: *s, weights, rest })
+            }
+            Pending::Tet(s) => {
+                let p4 = s.map(|i| pos[i]);
+                let v = tet_volume(p4).0;
+                let mut l2 = 0.0f64;
+                for a in 0..4 {
+                    for b in a + 1..4 {
+                        l2 = l2.max((p4[a] - p4[b]).length_squared());
+                    }
+                }
+                if !(v.abs() > 1e-12 * l2 * l2.sqrt()) {
+                    return Err(degenerate("zero volume"));
+                }
+                ConstraintFunction::TetVolume { particles: *s, rest_volume: v }
+            }
+            Pending::Volume { mesh, pressure } => {
+                if !(*pressure > 0.0 && pressure.is_finite()) {
+                    return Err(BuildError::BadRestValue {
+                        constraint: j,
+                        kind,
+                        name: "pressure",
+                        requirement: "positive and finite",
+                        value: *pressure,
+                    });
+                }
+                let m = &meshes[*mesh];
+                let x: Vec<f64> = pos.iter().flat_map(|p| p.to_array()).collect();
+                ConstraintFunction::GlobalVolume {
+                    mesh: *mesh,
+                    rest_volume: m.volume(&x),
+                    pressure: *pressure,
+                }
+            }
+            Pending::Attach { particle, target, distance } => {
+                if !(*distance >= 0.0 && distance.is_finite()) {
+                    return Err(BuildError::BadRestValue {
+                        constraint: j,
+                        kind,
+                        name: "distance",
+                        requirement: "non-negative and finite",
+                        value: *distance,
+                    });
+                }
+                match target {
+                    AttachTarget::Point(t) if !t.iter().all(|c| c.is_finite()) => {
+                        return Err(BuildError::BadRestValue {
+                            constraint: j,
+                            kind,
+                            name: "target",
+                            requirement: "finite",
+                            value: f64::NAN,
+                        });
+                    }
+                    AttachTarget::Body { body, local } => {
+                        if *body >= self.bodies.len() {
+                            return Err(BuildError::BodyIndex {
+                                constraint: j,
+                                body: *body,
+                                bodies: self.bodies.len(),
+                            });
+                        }
+                        if !local.iter().all(|c| c.is_finite()) {
+                            return Err(BuildError::BadRestValue {
+                                constraint: j,
+                                kind,
+                                name: "local point",
+                                requirement: "finite",
+                                value: f64::NAN,
+                            });
+                        }
+                    }
+                    AttachTarget::Point(_) => {}
+                }
+                ConstraintFunction::Attachment { particle: *particle, target: *target, distance: *distance }
+            }
+        };
+        Ok(Constraint { function, params: *params })
+    }
+}
+
+/// Validates a closed mesh and converts it to local indices.
+fn volume_mesh(tris: &[[usize; 3]], pos: &[DVec3], constraint: usize) -> Result<VolumeMesh, BuildError> {
+    let n = pos.len();
+    let fail =
+        |reason: String| BuildError::BadVolumeMesh { reason: format!("constraint {constraint}: {reason}") };
+    if tris.len() < 4 {
+        return Err(fail(format!("a closed mesh needs at least 4 triangles, got {}", tris.len())));
+    }
+    let mut directed: HashMap<(usize, usize), usize> = HashMap::new();
+    for (t, tri) in tris.iter().enumerate() {
+        if let Some(&i) = tri.iter().find(|&&i| i >= n) {
+            return Err(fail(format!("triangle {t} names particle {i}, which does not exist")));
+        }
+        if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
+            return Err(fail(format!("triangle {t} {tri:?} repeats a vertex")));
+        }
+        for k in 0..3 {
+            let e = (tri[k], tri[(k + 1) % 3]);
+            if directed.insert(e, t).is_some() {
+                return Err(fail(format!(
+                    "directed edge {e:?} appears twice (triangle {t}): the mesh is not consistently oriented or not manifold"
+                )));
+            }
+        }
+    }
+    for (&(a, b), &t) in &directed {
+        if !directed.contains_key(&(b, a)) {
+            return Err(fail(format!(
+                "edge ({a}, {b}) of triangle {t} has no opposite: the mesh is not closed"
+            )));
+        }
+    }
+    let mut vertices: Vec<usize> = tris.iter().flatten().copied().collect();
+    vertices.sort_unstable();
+    vertices.dedup();
+    let local: HashMap<usize, u32> = vertices.iter().enumerate().map(|(k, &v)| (v, k as u32)).collect();
+    let triangles = tris.iter().map(|t| t.map(|i| local[&i])).collect();
+    let m = VolumeMesh { vertices, triangles };
+    let x: Vec<f64> = pos.iter().flat_map(|p| p.to_array()).collect();
+    let v = m.volume(&x);
+    if !(v > 0.0) {
+        return Err(fail(format!(
+            "enclosed volume {v:e} is not positive (are the normals pointing inward?)"
+        )));
+    }
+    Ok(m)
+}

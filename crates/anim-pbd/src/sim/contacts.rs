@@ -1,0 +1,60 @@
+//! Line (8) of the loop, `generateCollisionConstraints(x_i -> p_i)`: every free particle is
+//! tested against every collider at the collider's pose for the end of the substep, and a
+//! particle whose predicted position `p` lies within `thickness + margin + |p - x|` of the
+//! surface gets a contact constraint `n . (p - q) - thickness >= 0`, with `q` the closest surface
+//! point and `n` the outward normal there, frozen for the substep ([`crate::collide`] has the
+//! contact model, its friction and restitution). The contact also records how far the obstacle's
+//! surface point moved over the substep (friction acts relative to it) and the normal velocity
+//! before the solve (for restitution at line 16).
+//!
+//! Contacts are generated collider by collider, particles in increasing order, so each particle
+//! appears at most once per collider: each collider's contacts form one group that the coloured
+//! and Jacobi sweeps project in parallel.
+
+use super::scratch::Data;
+use crate::collide::{Contact, Pose};
+use crate::model::PbdModel;
+use anim_core::glam::DVec3;
+
+/// Line (8): fills `d.contacts` and their per-collider groups `d.contact_groups` for predicted
+/// positions `d.p`, with speculative margin `margin`, over a substep of length `h`.
+pub(super) fn generate_contacts(model: &PbdModel, d: &mut Data, margin: f64, h: f64) {
+    let n = model.num_particles();
+    let w = &model.inv_mass;
+    d.contacts.clear();
+    d.contact_groups.clear();
+    for (ci, col) in model.colliders.iter().enumerate() {
+        let start = d.contacts.len();
+        let (pose, prev) = match col.body {
+            Some(b) => (d.pose_sub[b], d.pose_sub_prev[b]),
+            None => (Pose::IDENTITY, Pose::IDENTITY),
+        };
+        for i in 0..n {
+            if w[i] == 0.0 {
+                continue;
+            }
+            let p = d.p[i];
+            let local = pose.inverse_apply(p);
+            let (phi, nl) = col.shape.signed_distance(local);
+            if !(phi < col.thickness + margin + (p - d.x[i]).length()) {
+                continue;
+            }
+            let normal = pose.rotation * nl;
+            let q = p - normal * phi;
+            let ql = pose.inverse_apply(q);
+            let obstacle_dx = q - prev.apply(ql);
+            let vn_pre = normal.dot(d.v[i] - obstacle_dx / h);
+            d.contacts.push(Contact {
+                particle: i as u32,
+                collider: ci as u32,
+                normal,
+                offset: normal.dot(q) + col.thickness,
+                obstacle_dx,
+                vn_pre,
+                lambda: 0.0,
+                dx: DVec3::ZERO,
+            });
+        }
+        d.contact_groups.push(start..d.contacts.len());
+    }
+}
