@@ -15,7 +15,8 @@
 //! | [`friction`] | Coulomb friction at obstacle contacts: velocity-level in explicit steps, IPC's lagged smoothed potential (Li et al. 2020, section 5) in backward Euler | - |
 //! | [`newton`] | Newton on the incremental potential with a backtracking line search, Rayleigh damping `gamma` | 5.2 |
 //! | [`sim`] | symplectic Euler and backward Euler steps, quasi-static solves, the `Solver` implementation | 2, 5.2 |
-//! | [`quadratic`] | 10-node tetrahedra (no locking in bending or near incompressibility): 4-point quadrature, closed-form consistent mass, HRZ lumping; in both time steppers and quasi-static solves | - |
+//! | [`tet10`] | the 10-node tetrahedron (no locking in bending or near incompressibility): shape functions, 4-point quadrature, closed-form consistent mass, HRZ lumping | - |
+//! | [`quadratic`] | bodies of 10-node tetrahedra in both time steppers, and the quasi-static front end [`QuadraticModel`](quadratic::QuadraticModel) | - |
 //! | [`ldlt`] | sparse `L D L^T` (faer) for symmetric indefinite Newton matrices | - |
 //! | [`scenes`] | cantilever beam, soft cube drop, twisted bar | - |
 //! | [`kind`] | the `fem` scene kind: presets, scene-file parameters, checkpoints and frames | - |
@@ -89,6 +90,7 @@ pub mod newton;
 pub mod quadratic;
 pub mod scenes;
 pub mod sim;
+pub mod tet10;
 
 pub use error::FemError;
 pub use kind::KIND;

@@ -3,7 +3,7 @@
 //! algorithms read and never modify.
 //!
 //! A body is made of linear (4-node, [`FemModel::new`]) or quadratic (10-node,
-//! [`FemModel::quadratic`], [`quadratic`](crate::quadratic)) tetrahedra ([`ElementOrder`]).
+//! [`FemModel::quadratic`], [`tet10`](crate::tet10)) tetrahedra ([`ElementOrder`]).
 //! Everything else (masses, gravity, loads, pinned and kinematic nodes, obstacles, both time
 //! integrators) works the same for both; the nodes of a 10-node body are its corner vertices
 //! followed by its edge nodes, and [`FemModel::mesh`] holds all of them as positions with the
@@ -20,7 +20,7 @@ use crate::generate::{TET10_EDGES, Tet10Mesh};
 use crate::material::Material;
 use crate::mesh::{TetMesh, validate};
 use crate::newton::ElasticBody;
-use crate::quadratic::{Tet10Elements, consistent_mass_coefficient, lumped_mass_coefficient};
+use crate::tet10::{Tet10Elements, consistent_mass_coefficient, lumped_mass_coefficient};
 use anim_core::linalg::CsrMatrix;
 use anim_material::nalgebra::Matrix3;
 use serde::{Deserialize, Serialize};
@@ -35,11 +35,11 @@ pub const EARTH_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
 pub enum MassKind {
     /// Diagonal: each linear element gives a quarter of its mass `rho W` to each vertex; a
     /// 10-node element gives `rho W / 36` to each corner and `4 rho W / 27` to each edge node
-    /// (HRZ lumping, see [`quadratic`](crate::quadratic)).
+    /// (HRZ lumping, see [`tet10`](crate::tet10)).
     Lumped,
     /// The consistent mass matrix of the shape functions, `M_ab = rho int N_a N_b dV I_3`:
     /// `rho W (1 + delta_ab) / 20 I_3` per linear element, the table of
-    /// [`quadratic`](crate::quadratic) for 10-node elements.
+    /// [`tet10`](crate::tet10) for 10-node elements.
     Consistent,
 }
 

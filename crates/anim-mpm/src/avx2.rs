@@ -1,5 +1,5 @@
 //! AVX2 variants of the P2G and G2P kernels, chosen at run time when the CPU has AVX2 (see
-//! [`Avx2::detect`]).
+//! [`Avx2::detect`](crate::simd::Avx2::detect)).
 //!
 //! The whole per-block P2G and per-chunk G2P loops are compiled with AVX2 enabled (VEX
 //! encoding, wider registers for the scalar parts). In 2D the stencil rows use 256-bit
@@ -12,28 +12,18 @@
 
 use crate::grid::SparseGrid;
 use crate::kernel::Spline;
-use crate::particles::Particles;
-use crate::transfer::{
+use crate::particle_transfer::{
     ChunkOut, Ctx, G2pOutcome, Gathered, Stencil, g2p_gather, gathered, p2g_particle, p2g_prepare, span,
     splat, wstride,
 };
+use crate::particles::Particles;
+use crate::simd::Avx2;
 use std::arch::x86_64::{
     __m128, __m256, _mm_add_ps, _mm_mul_ps, _mm_set1_ps, _mm_setzero_ps, _mm256_add_ps,
     _mm256_castps256_ps128, _mm256_extractf128_ps, _mm256_mul_ps, _mm256_set_m128, _mm256_set1_ps,
     _mm256_setzero_ps,
 };
 use wide::f32x4;
-
-/// Proof that the running CPU has AVX2: only [`Avx2::detect`] makes one.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Avx2(());
-
-impl Avx2 {
-    /// `Some` when the CPU supports AVX2 (detected once and cached by `std`).
-    pub(crate) fn detect() -> Option<Self> {
-        std::is_x86_feature_detected!("avx2").then_some(Self(()))
-    }
-}
 
 #[inline(always)]
 fn m128(v: f32x4) -> __m128 {
@@ -45,7 +35,7 @@ fn v4(m: __m128) -> f32x4 {
     bytemuck::cast(m)
 }
 
-/// P2G of one particle block, as [`crate::transfer::p2g_block`].
+/// P2G of one particle block, as [`crate::particle_transfer::p2g_block`].
 #[allow(unsafe_code)]
 pub(crate) fn p2g_block<const D: usize, K: Spline, const APIC: bool>(
     _cpu: Avx2,
@@ -164,7 +154,7 @@ fn g2p_chunk_k<const D: usize, K: Spline, const APIC: bool>(
     o: ChunkOut<'_>,
 ) -> G2pOutcome {
     let inv_h = ctx.inv_h;
-    crate::transfer::g2p_chunk::<D, K, APIC>(grid, st, ctx, chunk, o, |win, s| {
+    crate::particle_transfer::g2p_chunk::<D, K, APIC>(grid, st, ctx, chunk, o, |win, s| {
         if D == 2 { gather_2d::<D, K, APIC>(win, s, inv_h) } else { g2p_gather::<D, K, APIC>(win, s, inv_h) }
     })
 }
@@ -216,18 +206,4 @@ fn gather_2d<const D: usize, K: Spline, const APIC: bool>(
     let bcol: [f32x4; D] = std::array::from_fn(|a| if a == 0 { b0 } else { b1 });
     let gcol: [f32x4; D] = std::array::from_fn(|a| if a == 0 { g0 } else { g1 });
     gathered::<D, APIC>(vel, bcol, gcol, inv_h)
-}
-
-/// Runs `f` compiled with AVX2 enabled (`f` is inlined into an AVX2 function; its arithmetic
-/// is unchanged, only the instruction selection and vector width differ).
-#[allow(unsafe_code)]
-#[inline(always)]
-pub(crate) fn run<R>(_cpu: Avx2, f: impl FnOnce() -> R) -> R {
-    // SAFETY: `run_k` only needs AVX2, whose presence `_cpu` proves (see `p2g_block`).
-    unsafe { run_k(f) }
-}
-
-#[target_feature(enable = "avx2")]
-fn run_k<R>(f: impl FnOnce() -> R) -> R {
-    f()
 }

@@ -24,7 +24,7 @@
 //! contiguous in memory and their grid window stays in cache.
 
 use crate::kernel::Kernel;
-use crate::transfer::{Avx2, with_simd};
+use crate::simd::{Avx2, with_simd};
 use rayon::prelude::*;
 use wide::f32x4;
 

@@ -25,7 +25,8 @@
 //!   snow exactly as the seed (`F = F_E F_P`, singular values of `F_E` clamped to
 //!   `[1 - theta_c, 1 + theta_s]`, Lamé parameters hardened by `exp(xi (1 - J_P))`, `xi = 10`,
 //!   `E = 1e4`, `nu = 0.2`), a weakly compressible fluid with the `J`-based equation of state,
-//!   and Drucker-Prager sand; the return maps live in [`plasticity`];
+//!   and Drucker-Prager sand; the return maps live in [`plasticity`], sand's log-strain
+//!   elasticity in [`hencky`];
 //! - [`boundary`]: sticky / slip / separating conditions on the domain walls and on analytic
 //!   planes, boxes and spheres, fixed or moving;
 //! - the grid is sparse: blocks of `4^D` nodes are allocated only where particles are (a dense
@@ -114,13 +115,16 @@
 mod avx2;
 pub mod boundary;
 mod grid;
+pub mod hencky;
 pub mod kernel;
 pub mod kind;
 pub mod material;
+mod particle_transfer;
 mod particles;
 pub mod plasticity;
 pub mod scenes;
 mod sim;
+mod simd;
 mod transfer;
 
 #[cfg(test)]

@@ -1,17 +1,17 @@
 //! Materials: what a particle is made of and the Kirchhoff stress `tau = P F^T` it exerts.
 //!
-//! | material | elastic part | plasticity ([`plasticity`]) |
+//! | material | elastic part | plasticity ([`plasticity`](crate::plasticity)) |
 //! | --- | --- | --- |
 //! | [`Material::Elastic`] | shared [`FixedCorotated`] or [`NeoHookean`] (`anim-material`) | none |
 //! | [`Material::Snow`] | shared [`FixedCorotated`] on `F_E`, Lamé parameters hardened by `exp(xi (1 - J_P))` | singular values of `F_E` clamped to `[1 - theta_c, 1 + theta_s]` (seed 5.3.2) |
 //! | [`Material::Fluid`] | weakly compressible: `p(J) = K/gamma (J^-gamma - 1)`, `tau = -p J I` | `F` reset to `J^(1/d) I` (no shear memory) |
-//! | [`Material::Sand`] | Hencky (St. Venant-Kirchhoff in log strain): `tau = U (2 mu eps + lambda tr(eps) I) U^T` | Drucker-Prager return map with hardening (Klár et al. 2016) |
+//! | [`Material::Sand`] | Hencky (St. Venant-Kirchhoff in log strain, [`hencky`]): `tau = U (2 mu eps + lambda tr(eps) I) U^T` | Drucker-Prager return map with hardening (Klár et al. 2016) |
 //!
 //! The MLS-MPM momentum of seed 5.3.2 needs `V_p^0 P(F_p) F_p^T`, the Kirchhoff stress times
 //! the rest volume, and APIC's grid force `f_i = -sum_p V_p^0 P F_p^T grad w_ip` needs the same
 //! product, so this module computes exactly that (`kirchhoff`).
 
-use crate::plasticity;
+use crate::hencky;
 use crate::{Mat, MpmError};
 use anim_material::{FixedCorotated, Hyperelastic, Lame, NeoHookean};
 use serde::{Deserialize, Serialize};
@@ -280,7 +280,7 @@ pub(crate) fn kirchhoff<const D: usize>(m: &Compiled, f: &Mat<D>, plastic: f32) 
             let j = anim_material::decomposition::determinant(f);
             Mat::<D>::identity() * (-m.pressure(j) * j)
         }
-        Kind::Sand => plasticity::hencky_kirchhoff(&m.lame, f),
+        Kind::Sand => hencky::hencky_kirchhoff(&m.lame, f),
     }
 }
 
@@ -300,6 +300,6 @@ pub(crate) fn energy<const D: usize>(m: &Compiled, f: &Mat<D>, plastic: f32) -> 
                 k / g * ((j - 1.0) - (j.powf(1.0 - g) - 1.0) / (1.0 - g))
             }
         }
-        Kind::Sand => plasticity::hencky_energy(&m.lame, f),
+        Kind::Sand => hencky::hencky_energy(&m.lame, f),
     }
 }

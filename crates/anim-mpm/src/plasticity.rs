@@ -1,5 +1,5 @@
 //! Plasticity: the return maps applied to a particle's deformation gradient after its update
-//! `F <- (I + dt grad v) F`, and the Hencky stress of sand.
+//! `F <- (I + dt grad v) F`.
 //!
 //! **Snow** (seed 5.3.2; Stomakhin, Schroeder, Chai, Teran & Selle, *A material point method
 //! for snow simulation*, SIGGRAPH 2013). With `F = F_E F_P`, the trial elastic part
@@ -24,7 +24,9 @@
 //! ```
 //!
 //! and the hardening state `q += dq` raises the friction angle `phi_F = h0 + (h1 q - h3) e^{-h2 q}`.
+//! The elastic part of sand, in the same log strain, is [`hencky`](crate::hencky).
 
+use crate::hencky::{SIGMA_MIN, scale_columns};
 use crate::material::{Compiled, Kind};
 use crate::{Mat, Vector};
 use anim_material::{Lame, svd};
@@ -61,12 +63,6 @@ pub(crate) fn snow<const D: usize>(theta_c: f32, theta_s: f32, f: &mut Mat<D>, j
     *f = scale_columns(&s.u, &sigma) * s.v.transpose();
 }
 
-/// `U diag(s)`.
-#[inline]
-fn scale_columns<const D: usize>(u: &Mat<D>, s: &Vector<D>) -> Mat<D> {
-    Mat::<D>::from_fn(|i, j| u[(i, j)] * s[j])
-}
-
 /// The Drucker-Prager friction coefficient for the hardening state `q`.
 #[inline]
 fn friction_alpha(h: &[f32; 4], q: f32) -> f32 {
@@ -74,9 +70,6 @@ fn friction_alpha(h: &[f32; 4], q: f32) -> f32 {
     let s = phi.sin();
     (2.0f32 / 3.0).sqrt() * 2.0 * s / (3.0 - s)
 }
-
-/// Smallest singular value treated as positive in the log strain.
-const SIGMA_MIN: f32 = 1e-4;
 
 /// Sand: the Drucker-Prager return map in log-strain space with hardening.
 pub(crate) fn sand<const D: usize>(lame: &Lame<f32>, h: &[f32; 4], f: &mut Mat<D>, q: &mut f32) {
@@ -98,29 +91,6 @@ pub(crate) fn sand<const D: usize>(lame: &Lame<f32>, h: &[f32; 4], f: &mut Mat<D
     *q += dq;
     let sigma = new_eps.map(f32::exp);
     *f = scale_columns(&s.u, &sigma) * s.v.transpose();
-}
-
-/// Hencky Kirchhoff stress `tau = U diag(2 mu eps + lambda tr(eps)) U^T`, `eps = log sigma`.
-pub(crate) fn hencky_kirchhoff<const D: usize>(lame: &Lame<f32>, f: &Mat<D>) -> Mat<D> {
-    let s = svd(f);
-    let mut eps = Vector::<D>::zeros();
-    for i in 0..D {
-        eps[i] = s.sigma[i].max(SIGMA_MIN).ln();
-    }
-    let tr = eps.sum();
-    let t = eps.map(|e| 2.0 * lame.mu * e + lame.lambda * tr);
-    scale_columns(&s.u, &t) * s.u.transpose()
-}
-
-/// Hencky energy density `mu |eps|^2 + lambda/2 tr(eps)^2`.
-pub(crate) fn hencky_energy<const D: usize>(lame: &Lame<f32>, f: &Mat<D>) -> f32 {
-    let s = svd(f);
-    let mut eps = Vector::<D>::zeros();
-    for i in 0..D {
-        eps[i] = s.sigma[i].max(SIGMA_MIN).ln();
-    }
-    let tr = eps.sum();
-    lame.mu * eps.norm_squared() + 0.5 * lame.lambda * tr * tr
 }
 
 #[cfg(test)]
@@ -181,26 +151,5 @@ mod tests {
         let tr0 = 1.25f32.ln() + 0.95f32.ln() + 0.8f32.ln();
         assert!(q > 0.0, "the trial state was outside the cone");
         assert!((tr - tr0).abs() < 1e-5);
-    }
-
-    #[test]
-    fn hencky_stress_is_energy_derivative() {
-        // tau = P F^T with P = dpsi/dF; check P by central differences of psi.
-        let lame = Lame { mu: 3.0f32, lambda: 2.0 };
-        let f = Mat::<2>::new(1.1, 0.2, -0.1, 0.9);
-        let tau = hencky_kirchhoff(&lame, &f);
-        let mut p = Mat::<2>::zeros();
-        let h = 1e-3f32;
-        for i in 0..2 {
-            for j in 0..2 {
-                let mut a = f;
-                let mut b = f;
-                a[(i, j)] += h;
-                b[(i, j)] -= h;
-                p[(i, j)] = (hencky_energy(&lame, &a) - hencky_energy(&lame, &b)) / (2.0 * h);
-            }
-        }
-        let tau_fd = p * f.transpose();
-        assert!((tau - tau_fd).norm() < 2e-3 * tau.norm().max(1.0), "{tau} vs {tau_fd}");
     }
 }

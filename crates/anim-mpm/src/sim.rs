@@ -5,8 +5,10 @@ use crate::boundary::{Boundary, Collider};
 use crate::grid::SparseGrid;
 use crate::kernel::{Cubic, Kernel, Quadratic, Spline};
 use crate::material::{Compiled, Kind, Material, energy};
+use crate::particle_transfer::Ctx;
 use crate::particles::Particles;
-use crate::transfer::{self, Ctx};
+use crate::simd::{self, Avx2};
+use crate::transfer;
 use crate::{Mat, MpmError, Vector};
 use anim_core::solver::{Solver, StepReport};
 use rayon::prelude::*;
@@ -157,7 +159,7 @@ pub struct MpmSimulation<const D: usize> {
     remove: Vec<bool>,
     partials: Vec<[f64; 12]>,
     /// The AVX2 transfer kernels, when the CPU has them (`None`: the portable kernels).
-    pub(crate) simd: Option<transfer::Avx2>,
+    pub(crate) simd: Option<Avx2>,
     steps: u64,
     time: f64,
     stats: StepStats,
@@ -216,7 +218,7 @@ impl<const D: usize> MpmSimulation<D> {
             backup: Particles::new(),
             remove: Vec::new(),
             partials: Vec::new(),
-            simd: transfer::Avx2::detect(),
+            simd: Avx2::detect(),
             steps: 0,
             time: 0.0,
             stats: StepStats::default(),
@@ -380,7 +382,7 @@ impl<const D: usize> MpmSimulation<D> {
         let (v2, c2, bad) = (0..n.div_ceil(CHUNK))
             .into_par_iter()
             .map(|chunk| {
-                transfer::with_simd(
+                simd::with_simd(
                     self.simd,
                     #[inline(always)]
                     || {

@@ -131,7 +131,7 @@ fn avx2_kernels_match_the_portable_kernels_bit_for_bit() {
     // The AVX2 kernels do the portable kernels' operations in the same order per lane (no
     // fused multiply-adds): the states must agree in every bit, in 2D (the explicit 256-bit
     // rows) and 3D, for both transfers and kernels, with elastic, snow and fluid particles.
-    let Some(cpu) = transfer::Avx2::detect() else {
+    let Some(cpu) = simd::Avx2::detect() else {
         eprintln!("no AVX2 on this CPU: only the portable kernels exist here");
         return;
     };
@@ -141,7 +141,7 @@ fn avx2_kernels_match_the_portable_kernels_bit_for_bit() {
         (Transfer::Apic, Kernel::Quadratic),
         (Transfer::Apic, Kernel::Cubic),
     ] {
-        let run2 = |simd: Option<transfer::Avx2>| {
+        let run2 = |simd: Option<simd::Avx2>| {
             let mut scene = scenes::three_materials(32).expect("scene");
             let mut params = scene.sim.params().clone();
             params.transfer = transfer;
@@ -155,7 +155,7 @@ fn avx2_kernels_match_the_portable_kernels_bit_for_bit() {
         };
         let (fast, portable) = (run2(Some(cpu)), run2(None));
         assert!(same_bits(&fast, &portable), "2D {transfer:?} {kernel:?}");
-        let run3 = |simd: Option<transfer::Avx2>| {
+        let run3 = |simd: Option<simd::Avx2>| {
             let mut sim = MpmSimulation::<3>::new(
                 free_space(transfer, kernel),
                 vec![Material::Elastic(Elastic::default())],

@@ -3,7 +3,7 @@
 use anim_core::lie::{Se3, Twist};
 
 use crate::dense::SquareMatrix;
-use crate::jacobian::Jacobian;
+use crate::matrix6x::Jacobian;
 use crate::model::Model;
 use crate::spatial::{ArticulatedInertia, Force, Motion, SpatialInertia};
 

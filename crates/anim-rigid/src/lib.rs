@@ -154,6 +154,7 @@ pub mod ik;
 pub mod jacobian;
 pub mod kind;
 pub mod kinematics;
+pub mod matrix6x;
 pub mod model;
 pub mod paden_kahan;
 pub mod poe;

@@ -21,6 +21,8 @@ use crate::skeleton::{Pose, Skeleton};
 use anim_core::glam::{DQuat, DVec3, DVec4};
 use serde::{Deserialize, Serialize};
 
+pub use crate::rotation::slerp;
+
 /// How values between keys are computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Interpolation {
@@ -186,26 +188,6 @@ impl Channel {
 
 fn to_quat(v: DVec4) -> DQuat {
     DQuat::from_xyzw(v.x, v.y, v.z, v.w)
-}
-
-/// Spherical linear interpolation along the shorter arc: `b` is negated when `a . b < 0`, and
-/// `t = 0` returns `a`, `t = 1` returns `b` (or `-b`). The angle is computed as
-/// `2 atan2(|a - b|, |a + b|)`, accurate at small angles; below `1e-9` rad it falls back to a
-/// normalised lerp.
-#[must_use]
-pub fn slerp(a: DQuat, b: DQuat, t: f64) -> DQuat {
-    let (a4, mut b4) = (DVec4::from(a), DVec4::from(b));
-    if a4.dot(b4) < 0.0 {
-        b4 = -b4;
-    }
-    let theta = 2.0 * (a4 - b4).length().atan2((a4 + b4).length());
-    let r = if theta < 1e-9 {
-        a4.lerp(b4, t).normalize()
-    } else {
-        let s = theta.sin();
-        (((1.0 - t) * theta).sin() / s) * a4 + ((t * theta).sin() / s) * b4
-    };
-    DQuat::from_vec4(r)
 }
 
 /// A named set of channels.

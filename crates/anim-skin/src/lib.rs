@@ -73,6 +73,7 @@ pub mod clip;
 pub mod gltf_io;
 pub mod kind;
 pub mod mesh;
+pub mod rotation;
 pub mod scenes;
 pub mod skeleton;
 pub mod skinning;

@@ -173,7 +173,7 @@ impl Pose {
     }
 
     /// Blends two poses: `out = (1 - w) a + w b`, translations and scales lerped, rotations
-    /// slerped along the shorter arc ([`crate::clip::slerp`]). `w = 0` gives `a` exactly and
+    /// slerped along the shorter arc ([`crate::rotation::slerp`]). `w = 0` gives `a` exactly and
     /// `w = 1` gives `b` exactly.
     ///
     /// # Panics
@@ -184,7 +184,7 @@ impl Pose {
         out.local.clear();
         out.local.extend(a.local.iter().zip(&b.local).map(|(x, y)| Trs {
             translation: x.translation.lerp(y.translation, w),
-            rotation: crate::clip::slerp(x.rotation, y.rotation, w),
+            rotation: crate::rotation::slerp(x.rotation, y.rotation, w),
             scale: x.scale.lerp(y.scale, w),
         }));
     }

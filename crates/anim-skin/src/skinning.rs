@@ -63,6 +63,9 @@ use wide::f64x2;
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+mod outputs;
+
+use outputs::Outputs;
 
 /// Vertices per parallel task.
 pub const CHUNK: usize = 2048;
@@ -296,16 +299,6 @@ fn skin_with(
 /// a chunk runs in both lanes. Results therefore do not depend on how vertices are paired.
 type P = f64x2;
 type P3 = [P; 3];
-
-/// One chunk's output slices.
-struct Outputs<'a> {
-    x: &'a mut [f64],
-    y: &'a mut [f64],
-    z: &'a mut [f64],
-    nx: &'a mut [f64],
-    ny: &'a mut [f64],
-    nz: &'a mut [f64],
-}
 
 /// A skinning method as a kernel over a pair of vertices with `K` influences each: `js[l]` and
 /// `ws[l]` are lane `l`'s joint indices and weights, `p` and `n` the rest positions and normals;

@@ -4,8 +4,8 @@
 use anim_core::glam::DVec3;
 use anim_core::lie::{Se3, Twist};
 
-use super::{check_q, check_v};
 use crate::data::Data;
+use crate::dynamics::check::{check_q, check_v};
 use crate::jacobian::world_columns;
 use crate::kinematics::joint_placement;
 use crate::model::Model;

@@ -10,8 +10,10 @@
 
 use thiserror::Error;
 
-use super::{check_q, check_v, crba, nonlinear_effects};
 use crate::data::{Data, NO_PARENT};
+use crate::dynamics::check::{check_q, check_v};
+use crate::dynamics::crba::crba;
+use crate::dynamics::rnea::nonlinear_effects;
 use crate::model::Model;
 
 /// A numerical failure of the dynamics.
@@ -102,7 +104,7 @@ pub fn solve_mass_matrix(model: &Model, data: &Data, b: &mut [f64]) {
 
 /// Forward dynamics by the mass matrix: `v̇ = H(q)⁻¹ (τ - C(q, v))` with [`crba`],
 /// [`nonlinear_effects`] and the `LᵀDL` factorisation; written into `data.ddq` and returned.
-/// Slower than [`aba`](super::aba) for long chains (`O(n²)` to `O(n³)` against `O(n)`), and
+/// Slower than [`aba`](crate::aba) for long chains (`O(n²)` to `O(n³)` against `O(n)`), and
 /// independent of it: the two are tested against each other.
 ///
 /// # Errors

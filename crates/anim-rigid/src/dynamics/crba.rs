@@ -17,9 +17,10 @@
 use anim_core::glam::DVec3;
 use anim_core::lie::Se3;
 
-use super::{axis_dot, check_q};
 use crate::data::{Data, NO_PARENT};
 use crate::dense::SquareMatrix;
+use crate::dynamics::check::check_q;
+use crate::dynamics::subspace::axis_dot;
 use crate::jacobian::world_columns;
 use crate::kinematics::joint_placement;
 use crate::model::{Axis, JointType, Model};

@@ -12,8 +12,9 @@
 
 use anim_core::glam::DVec3;
 
-use super::{check_q, check_v, joint_motion};
 use crate::data::Data;
+use crate::dynamics::check::{check_q, check_v};
+use crate::dynamics::subspace::joint_motion;
 use crate::kinematics::{forward_kinematics, joint_placement};
 use crate::model::Model;
 use crate::spatial::{Force, Motion};

@@ -29,7 +29,7 @@
 //! | [`kinetic_energy`], [`potential_energy`], [`spatial_momentum`], [`center_of_mass`] | `½ vᵀ H v`, `-Σ mᵢ g·cᵢ`, `Σ Iᵢ vᵢ`, `Σ mᵢ cᵢ / M` | `O(n)` | 2.13 |
 //!
 //! (`n` bodies, `d` the depth of the tree.) Every function is `algorithm(&model, &mut data, ...)`
-//! and writes its result into [`Data`]; none allocates.
+//! and writes its result into [`Data`](crate::Data); none allocates.
 //!
 //! # RNEA: recursive Newton-Euler
 //!
@@ -99,68 +99,15 @@
 //! bodies and contact are not modelled here.
 
 mod aba;
+mod check;
 mod cholesky;
 mod crba;
 mod energy;
 mod rnea;
+mod subspace;
 
 pub use aba::aba;
 pub use cholesky::{DynamicsError, factor_mass_matrix, forward_dynamics_cholesky, solve_mass_matrix};
 pub use crba::{LOCAL_DEPTH, crba, crba_local, crba_world};
 pub use energy::{center_of_mass, kinetic_energy, potential_energy, spatial_momentum};
 pub use rnea::{gravity_torques, nonlinear_effects, rnea};
-
-use anim_core::glam::DVec3;
-
-use crate::data::Data;
-use crate::model::{Axis, JointType, Model};
-use crate::spatial::{Force, Motion};
-
-/// `a · v` for an axis, reading one component when the axis is a coordinate axis.
-#[inline(always)]
-pub(crate) fn axis_dot(axis: &Axis, v: DVec3) -> f64 {
-    match axis {
-        Axis::X => v.x,
-        Axis::Y => v.y,
-        Axis::Z => v.z,
-        Axis::Unaligned(u) => u.dot(v),
-    }
-}
-
-/// The joint velocity `S q̇` in the joint (child) frame; `qd` is the joint's slice of `v`.
-#[inline(always)]
-pub(crate) fn joint_motion(kind: &JointType, qd: &[f64]) -> Motion {
-    match kind {
-        JointType::Revolute(axis) => Motion::new(DVec3::ZERO, axis.vector() * qd[0]),
-        JointType::Prismatic(axis) => Motion::new(axis.vector() * qd[0], DVec3::ZERO),
-        JointType::Fixed => Motion::ZERO,
-        JointType::Spherical => Motion::new(DVec3::ZERO, DVec3::new(qd[0], qd[1], qd[2])),
-        JointType::Free => Motion::new(DVec3::new(qd[0], qd[1], qd[2]), DVec3::new(qd[3], qd[4], qd[5])),
-    }
-}
-
-/// `Sᵀ f` written into the joint's slice `out`.
-#[inline(always)]
-pub(crate) fn joint_project(kind: &JointType, f: &Force, out: &mut [f64]) {
-    match kind {
-        JointType::Revolute(axis) => out[0] = axis_dot(axis, f.angular),
-        JointType::Prismatic(axis) => out[0] = axis_dot(axis, f.linear),
-        JointType::Fixed => {}
-        JointType::Spherical => out.copy_from_slice(&f.angular.to_array()),
-        JointType::Free => {
-            out[..3].copy_from_slice(&f.linear.to_array());
-            out[3..].copy_from_slice(&f.angular.to_array());
-        }
-    }
-}
-
-#[track_caller]
-pub(crate) fn check_q(model: &Model, data: &Data, q: &[f64]) {
-    assert_eq!(q.len(), model.nq(), "q has length {}, the model nq = {}", q.len(), model.nq());
-    assert!(data.fits(model), "this Data was not made for this Model (Data::new(&model))");
-}
-
-#[track_caller]
-pub(crate) fn check_v(model: &Model, name: &str, v: &[f64]) {
-    assert_eq!(v.len(), model.nv(), "{name} has length {}, the model nv = {}", v.len(), model.nv());
-}

@@ -4,8 +4,9 @@
 
 use anim_core::glam::DVec3;
 
-use super::{check_q, check_v, joint_motion, joint_project};
 use crate::data::Data;
+use crate::dynamics::check::{check_q, check_v};
+use crate::dynamics::subspace::{joint_motion, joint_project};
 use crate::kinematics::joint_placement;
 use crate::model::Model;
 use crate::spatial::Motion;

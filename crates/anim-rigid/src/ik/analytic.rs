@@ -44,7 +44,7 @@ use thiserror::Error;
 
 use crate::config::neutral;
 use crate::data::Data;
-use crate::ik::pose_error;
+use crate::ik::pose::pose_error;
 use crate::kinematics::frames_forward_kinematics;
 use crate::model::{FrameIndex, JointType, Model};
 use crate::paden_kahan::{

@@ -10,14 +10,8 @@
 
 pub mod analytic;
 pub mod numerical;
+mod pose;
 
 pub use analytic::{AnalyticIk, AnalyticIkKind, IkError, IkSolution};
 pub use numerical::{IkParams, IkReport, NumericalIk};
-
-use anim_core::lie::{Se3, so3};
-
-/// The pose error between `a` and `b`: `(‖t_a - t_b‖, rotation angle of R_aᵀ R_b)`.
-#[must_use]
-pub fn pose_error(a: &Se3, b: &Se3) -> (f64, f64) {
-    ((a.translation - b.translation).length(), so3::angle(a.rotation.transpose() * b.rotation))
-}
+pub use pose::pose_error;

@@ -25,7 +25,7 @@ use anim_core::lie::{Se3, Twist};
 
 use crate::config::{clamp_to_limits, integrate_into, neutral};
 use crate::data::Data;
-use crate::ik::pose_error;
+use crate::ik::pose::pose_error;
 use crate::jacobian::{Jacobian, ReferenceFrame, compute_joint_jacobians, frame_jacobian};
 use crate::kinematics::{forward_kinematics, update_frame_placement};
 use crate::model::{FrameIndex, Model};

@@ -5,8 +5,9 @@
 use anim_core::glam::{DMat3, DQuat, DVec3};
 use anim_core::lie::{Se3, so3};
 
-use super::{SimError, SimParams};
 use crate::model::{JointType, Model};
+use crate::sim::error::SimError;
+use crate::sim::params::SimParams;
 
 const NAME: &str = "free-body-midpoint";
 const MAX_ITERATIONS: usize = 30;

@@ -5,12 +5,14 @@ use anim_core::diagnostics::{Component, Element, Field, NonFinite, check_finite}
 use anim_core::solver::{Solver, StepReport};
 use serde::{Deserialize, Serialize};
 
-use super::free_body::FreeBody;
-use super::system::ArticulatedSystem;
-use super::{RigidState, SimError, SimParams};
 use crate::config;
 use crate::dense::SquareMatrix;
 use crate::model::Model;
+use crate::sim::error::SimError;
+use crate::sim::free_body::FreeBody;
+use crate::sim::params::SimParams;
+use crate::sim::state::RigidState;
+use crate::sim::system::ArticulatedSystem;
 
 /// The time steppers of [`RigidSimulation`] (see the table in [`crate::sim`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -299,7 +301,7 @@ impl RigidSimulation {
         Ok(RigidState::new(q, v))
     }
 
-    /// The total energy of `state` ([`Energy::total`](super::Energy::total)).
+    /// The total energy of `state` ([`Energy::total`](crate::sim::Energy::total)).
     ///
     /// # Panics
     /// When the state does not match the model.

@@ -3,10 +3,11 @@
 
 use anim_core::integrate::SecondOrderSystem;
 
-use super::{SimError, SimParams};
 use crate::data::Data;
 use crate::dynamics::{aba, kinetic_energy, potential_energy, spatial_momentum};
 use crate::model::{JointType, Model};
+use crate::sim::error::SimError;
+use crate::sim::params::SimParams;
 use crate::spatial::Force;
 
 /// The energy of a state, by part (J).
@@ -33,7 +34,7 @@ impl Energy {
 ///
 /// Implements anim-core's [`SecondOrderSystem`] (state `x = q`, `dof = nv`), meaningful when the
 /// model is Euclidean ([`Model::is_euclidean`]); for spherical and free joints step it with
-/// [`RigidSimulation`](super::RigidSimulation).
+/// [`RigidSimulation`](crate::sim::RigidSimulation).
 ///
 /// ```
 /// use anim_core::integrate::{Integrator, IntegratorKind, State};

@@ -10,8 +10,8 @@
 //! vertex, so a vertex's result does not depend on its neighbours or on the chunking. Results
 //! differ from the portable kernels' by rounding only (fused multiply-adds round once).
 
-use super::Outputs;
 use crate::mesh::{MAX_INFLUENCES, SkinnedMesh};
+use crate::skinning::outputs::Outputs;
 use std::arch::x86_64::{
     __m256d, _CMP_GT_OQ, _mm256_add_pd, _mm256_and_pd, _mm256_blendv_pd, _mm256_cmp_pd, _mm256_div_pd,
     _mm256_fmadd_pd, _mm256_fmsub_pd, _mm256_mul_pd, _mm256_or_pd, _mm256_permute2f128_pd, _mm256_set1_pd,
