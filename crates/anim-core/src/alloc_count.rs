@@ -87,3 +87,60 @@ unsafe impl GlobalAlloc for CountingAllocator {
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 }
+
+/// What [`preset_step_allocations`] counted for one preset.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PresetAllocations {
+    /// The preset's name.
+    pub preset: &'static str,
+    /// Allocations per block of four steps, at most three blocks, stopping at a clean one.
+    pub blocks: Vec<usize>,
+}
+
+/// The allocations of every preset of `kind` (at its quick parameters) once its first step is
+/// done: blocks of four steps inside a 2-thread rayon pool (as a worker: a parallel call from a
+/// thread outside every pool goes through rayon's global injector, which allocates now and
+/// then), up to three blocks, stopping at the first clean one. The pool's own bookkeeping can
+/// allocate now and then under load; a step that allocates does so in every block, so the last
+/// block is 0 exactly when the steps allocate nothing. `alloc` must be the process's global
+/// allocator.
+///
+/// # Errors
+/// The preset's name and the message when one cannot be built or a step fails.
+pub fn preset_step_allocations(
+    alloc: &CountingAllocator,
+    kind: &crate::scene::SceneKind,
+) -> Result<Vec<PresetAllocations>, String> {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().map_err(|e| e.to_string())?;
+    pool.install(|| {
+        let mut out = Vec::new();
+        for preset in (kind.presets)() {
+            let name = preset.name;
+            let params = preset.quick_params.as_ref().unwrap_or(&preset.params);
+            let mut scene = (kind.build)(params, &crate::scene::BuildContext::default())
+                .map_err(|e| format!("{name}: {e}"))?;
+            let dt = preset.run.dt;
+            scene.step(dt).map_err(|e| format!("{name}: step 1: {e}"))?;
+            let mut blocks = Vec::new();
+            for _ in 0..3 {
+                let mut failed = None;
+                blocks.push(alloc.count(|| {
+                    for _ in 0..4 {
+                        if let Err(e) = scene.step(dt) {
+                            failed = Some(e.to_string());
+                            return;
+                        }
+                    }
+                }));
+                if let Some(e) = failed {
+                    return Err(format!("{name}: {e}"));
+                }
+                if blocks.last() == Some(&0) {
+                    break;
+                }
+            }
+            out.push(PresetAllocations { preset: name, blocks });
+        }
+        Ok(out)
+    })
+}

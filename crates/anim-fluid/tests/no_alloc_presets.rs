@@ -1,44 +1,24 @@
-//! The invariant "`step` allocates nothing", through the scene registry: every preset of
-//! [`anim_fluid::KIND`] at its quick parameters, built by the kind's builder and stepped as a
-//! `Box<dyn DynScene>`, makes no heap allocation in steps 2 to 5 (on a rayon pool of 2
-//! threads). Counted by a wrapping global allocator, so this file is its own test binary. The
-//! pool's own bookkeeping can allocate now and then under load; a step that allocates does so
-//! every time, so up to three blocks of four steps are run and one must be clean.
+//! The presets of `anim_fluid::KIND` step without allocating once their first step is done
+//! (`anim_core::alloc_count::preset_step_allocations`: blocks of four steps of every preset's
+//! quick parameters on a rayon pool of 2 threads). Counted by a wrapping global allocator, so
+//! this file is its own test binary.
 
-use anim_core::alloc_count::CountingAllocator;
-use anim_core::scene::DynScene;
+use anim_core::alloc_count::{CountingAllocator, preset_step_allocations};
 
 #[global_allocator]
 static ALLOC: CountingAllocator = CountingAllocator::new();
 
-/// Allocations in up to three blocks of four steps, stopping at a clean one.
-fn blocks(scene: &mut dyn DynScene, dt: f64) -> Vec<usize> {
-    let mut out = Vec::with_capacity(3);
-    for _ in 0..3 {
-        let mut ok = true;
-        out.push(ALLOC.count(|| {
-            for _ in 0..4 {
-                ok &= scene.step(dt).is_ok();
-            }
-        }));
-        assert!(ok, "a step failed");
-        if out.last() == Some(&0) {
-            break;
-        }
-    }
-    out
-}
-
 #[test]
 fn preset_steps_do_not_allocate() {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("pool");
-    pool.install(|| {
-        for preset in (anim_fluid::KIND.presets)() {
-            let params = preset.quick_params.as_ref().unwrap_or(&preset.params);
-            let mut scene = (anim_fluid::KIND.build)(params, &Default::default()).expect("builds");
-            scene.step(preset.run.dt).expect("the first step");
-            let counts = blocks(scene.as_mut(), preset.run.dt);
-            assert_eq!(counts.last(), Some(&0), "{}: allocations per block {counts:?}", preset.name);
-        }
-    });
+    let counted = preset_step_allocations(&ALLOC, &anim_fluid::KIND).unwrap_or_else(|e| panic!("{e}"));
+    assert!(!counted.is_empty());
+    for c in counted {
+        assert_eq!(
+            c.blocks.last(),
+            Some(&0),
+            "{}: allocations per block of four steps {:?}",
+            c.preset,
+            c.blocks
+        );
+    }
 }

@@ -350,7 +350,7 @@ impl<const D: usize> View for MpmRun<D> {
         let mut context = Context::default();
         context.point_dim = 3;
         context.point_radius = 0.5 * cell;
-        context.bounds = Some(frame_box(&display.points, None, true));
+        context.bounds = Some(anim_core::scene::frame_box(&display.points, None, true));
         context.props.push(tank(params, D));
         context.props.extend(params.colliders.iter().filter_map(|c| collider(c.shape, D)));
         context
@@ -396,32 +396,4 @@ fn collider(shape: Shape, dim: usize) -> Option<Prop> {
         }
         Shape::Plane { .. } => None,
     }
-}
-
-/// The bounding box of the points `x` (3 per point) widened sideways (x, y) by a third of its
-/// size and, when `falls`, extended down along -z by its size, or to the `ground`: where the
-/// motion of the scenes stays, for framing a picture.
-fn frame_box(x: &[f64], ground: Option<f64>, falls: bool) -> ([f64; 3], [f64; 3]) {
-    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in x.chunks_exact(3) {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    if lo[0] > hi[0] {
-        return ([-1.0; 3], [1.0; 3]);
-    }
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-3);
-    for k in 0..2 {
-        lo[k] -= size / 3.0;
-        hi[k] += size / 3.0;
-    }
-    if falls {
-        lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
-    }
-    if let Some(z) = ground {
-        lo[2] = z;
-    }
-    (lo, hi)
 }

@@ -210,7 +210,7 @@ impl View for PbdSimulation {
         context.props.extend(ground.map(|height| Prop::Ground { height }));
         context.props.extend(spheres);
         context.props.extend(others);
-        context.bounds = Some(frame_box(&state.x, ground, true));
+        context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
         context
     }
 
@@ -249,34 +249,6 @@ fn boundary_triangles(tets: &[[usize; 4]], n: usize) -> Vec<[usize; 3]> {
         }
     }
     order.iter().filter_map(|k| count.get(k)).filter(|(c, _)| *c == 1).map(|(_, f)| *f).collect()
-}
-
-/// The region a picture of the points `x` (flat, 3 per point) keeps in view: their bounding box
-/// widened by a third of its largest side in x and y, reaching down by 1.3 sides below the top
-/// for a scene that `falls`, and down to the `ground` when there is one.
-fn frame_box(x: &[f64], ground: Option<f64>, falls: bool) -> ([f64; 3], [f64; 3]) {
-    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in x.chunks_exact(3) {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    if lo[0] > hi[0] {
-        return ([-1.0; 3], [1.0; 3]);
-    }
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-3);
-    for k in 0..2 {
-        lo[k] -= size / 3.0;
-        hi[k] += size / 3.0;
-    }
-    if falls {
-        lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
-    }
-    if let Some(z) = ground {
-        lo[2] = z;
-    }
-    (lo, hi)
 }
 
 #[cfg(test)]

@@ -1,42 +1,24 @@
-//! The architecture invariant "no solver allocates inside `step`", for the `pbd` presets run
-//! as the command line runs them: built through [`anim_pbd::KIND`] from their quick
-//! parameters and stepped behind `Box<dyn DynScene>` on a rayon pool of 2 threads. After the
-//! first step, steps 2 to 5 perform no heap allocation. Counted by a wrapping global allocator,
-//! so this file is its own test binary. (`no_alloc.rs` checks the same scenes at their default
-//! resolutions with every solver, through the simulation itself.)
+//! The presets of `anim_pbd::KIND` step without allocating once their first step is done
+//! (`anim_core::alloc_count::preset_step_allocations`: blocks of four steps of every preset's
+//! quick parameters on a rayon pool of 2 threads). Counted by a wrapping global allocator, so
+//! this file is its own test binary.
 
-use anim_core::alloc_count::CountingAllocator;
-use anim_core::scene::BuildContext;
+use anim_core::alloc_count::{CountingAllocator, preset_step_allocations};
 
 #[global_allocator]
 static ALLOC: CountingAllocator = CountingAllocator::new();
 
 #[test]
 fn preset_steps_do_not_allocate() {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("pool");
-    for preset in (anim_pbd::KIND.presets)() {
-        let params = preset.quick_params.as_ref().unwrap_or(&preset.params);
-        let dt = preset.run.dt;
-        // The counter sees every thread of the process: the test harness's own thread records
-        // the running test in a map while the first test starts (seen: 2 to 6 allocations in
-        // about one run in five), and the pool's deques can allocate under load. A step that
-        // allocates does so in every attempt; three fresh scenes are tried and one must be clean.
-        let mut attempts = Vec::new();
-        for _ in 0..3 {
-            let mut scene = (anim_pbd::KIND.build)(params, &BuildContext::default()).expect("builds");
-            let counted = pool.install(|| {
-                scene.step(dt).expect("first step");
-                ALLOC.count(|| {
-                    for _ in 2..=5 {
-                        scene.step(dt).expect("step");
-                    }
-                })
-            });
-            attempts.push(counted);
-            if counted == 0 {
-                break;
-            }
-        }
-        assert_eq!(attempts.last(), Some(&0), "{}: allocations in steps 2 to 5: {attempts:?}", preset.name);
+    let counted = preset_step_allocations(&ALLOC, &anim_pbd::KIND).unwrap_or_else(|e| panic!("{e}"));
+    assert!(!counted.is_empty());
+    for c in counted {
+        assert_eq!(
+            c.blocks.last(),
+            Some(&0),
+            "{}: allocations per block of four steps {:?}",
+            c.preset,
+            c.blocks
+        );
     }
 }

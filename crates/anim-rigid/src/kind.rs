@@ -205,29 +205,6 @@ fn fixed_in_world(model: &Model, f: FrameIndex) -> bool {
     true
 }
 
-/// The initial bounding box of the points `x` (flat, 3 per point) widened sideways by a third
-/// of its size and extended down along gravity (`-z`) by its size: the region the motion of the
-/// built-in scenes stays in.
-fn frame_box(x: &[f64]) -> ([f64; 3], [f64; 3]) {
-    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in x.chunks_exact(3) {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    if lo[0] > hi[0] {
-        return ([-1.0; 3], [1.0; 3]);
-    }
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-3);
-    for k in 0..2 {
-        lo[k] -= size / 3.0;
-        hi[k] += size / 3.0;
-    }
-    lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
-    (lo, hi)
-}
-
 impl Solver for RigidSegments {
     type State = RigidState;
     type Error = SimError;
@@ -312,7 +289,7 @@ impl View for RigidSegments {
         context.lines = lines;
         context.pins = self.pins();
         context.point_radius = 0.06 * longest.max(1e-3);
-        context.bounds = Some(frame_box(&self.display.x));
+        context.bounds = Some(anim_core::scene::frame_box(&self.display.x, None, true));
         context
     }
 

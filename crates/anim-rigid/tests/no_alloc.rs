@@ -22,13 +22,24 @@ use anim_rigid::{
 #[global_allocator]
 static ALLOC: CountingAllocator = CountingAllocator::new();
 
+/// Allocations in five calls of `f` after a first one. The counter sees every thread of the
+/// process, the test harness's included, which can allocate at any time under load; code that
+/// allocates does so in every block, so up to three blocks of five calls are counted and the
+/// first clean one ends the count (0), else the last block's count is returned.
 fn counted(mut f: impl FnMut()) -> usize {
     f();
-    ALLOC.count(|| {
-        for _ in 0..5 {
-            f();
+    let mut n = 0;
+    for _ in 0..3 {
+        n = ALLOC.count(|| {
+            for _ in 0..5 {
+                f();
+            }
+        });
+        if n == 0 {
+            break;
         }
-    })
+    }
+    n
 }
 
 #[test]

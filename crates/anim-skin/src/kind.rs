@@ -260,27 +260,6 @@ impl SkinPlayback {
     }
 }
 
-/// The bounding box of the points `x` (flat, 3 per point) widened sideways (`x`, `y`) by a third
-/// of its size: the region a picture keeps in view.
-fn frame_box(x: &[f64]) -> ([f64; 3], [f64; 3]) {
-    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in x.chunks_exact(3) {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    if lo[0] > hi[0] {
-        return ([-1.0; 3], [1.0; 3]);
-    }
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-3);
-    for k in 0..2 {
-        lo[k] -= size / 3.0;
-        hi[k] += size / 3.0;
-    }
-    (lo, hi)
-}
-
 impl Solver for SkinPlayback {
     type State = State;
     type Error = PlaybackError;
@@ -336,7 +315,7 @@ impl View for SkinPlayback {
         let mut context = Context::default();
         context.point_dim = 3;
         context.triangles.clone_from(&self.triangles);
-        context.bounds = Some(frame_box(&state.x));
+        context.bounds = Some(anim_core::scene::frame_box(&state.x, None, false));
         context
     }
 

@@ -172,7 +172,7 @@ impl View for SpringSimulation {
             Shape::Sphere { center, radius } => Some(Prop::Sphere { center, radius }),
             Shape::Plane { .. } => None,
         }));
-        context.bounds = Some(frame_box(&state.x, ground, true));
+        context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
         context
     }
 
@@ -181,34 +181,6 @@ impl View for SpringSimulation {
         out.points.clone_from(&state.x);
         out.field_mut("velocity", 3).extend_from_slice(&state.v);
     }
-}
-
-/// The region a picture of the points `x` (flat, 3 per point) keeps in view: their bounding box
-/// widened by a third of its largest side in x and y, reaching down by 1.3 sides below the top
-/// for a scene that `falls`, and down to the `ground` when there is one.
-fn frame_box(x: &[f64], ground: Option<f64>, falls: bool) -> ([f64; 3], [f64; 3]) {
-    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-    for p in x.chunks_exact(3) {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    if lo[0] > hi[0] {
-        return ([-1.0; 3], [1.0; 3]);
-    }
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-3);
-    for k in 0..2 {
-        lo[k] -= size / 3.0;
-        hi[k] += size / 3.0;
-    }
-    if falls {
-        lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
-    }
-    if let Some(z) = ground {
-        lo[2] = z;
-    }
-    (lo, hi)
 }
 
 #[cfg(test)]
@@ -431,14 +403,5 @@ mod tests {
         assert!(msg.contains("warp-drive"), "{msg}");
         let msg = build_err(&serde_json::json!({ "preset": "hanging-cloth", "linear_solver": "lu" }));
         assert!(msg.contains("lu"), "{msg}");
-    }
-
-    #[test]
-    fn the_frame_box_frames_the_points_and_reaches_the_ground() {
-        assert_eq!(frame_box(&[], None, true), ([-1.0; 3], [1.0; 3]));
-        let x = [0.0, 0.0, 1.0, 3.0, 0.0, 1.0];
-        assert_eq!(frame_box(&x, None, false), ([-1.0, -1.0, 1.0], [4.0, 1.0, 1.0]));
-        assert_eq!(frame_box(&x, None, true).0[2], 1.0 - 1.3 * 3.0);
-        assert_eq!(frame_box(&x, Some(0.25), true).0[2], 0.25);
     }
 }

@@ -48,4 +48,4 @@ mod view;
 pub use checkpoint::{Checkpoint, CheckpointError, saved_field, saved_state};
 pub use dynamic::{DynScene, Simulated, StepError};
 pub use preset::{BuildContext, BuildError, BuildFn, Preset, RunDefaults, SceneKind, params};
-pub use view::{Context, Field, Frame, ImageGrid, Prop, View};
+pub use view::{Context, Field, Frame, ImageGrid, Prop, View, frame_box};

@@ -167,6 +167,36 @@ impl Frame {
     }
 }
 
+/// The region the motion of a scene starting at `points` (flat, 3 per point, z up) stays in,
+/// for [`Context::bounds`]: their bounding box widened sideways (x, y) by a third of its size,
+/// when `falls` extended down along gravity (-z) to 1.3 times its size below its top, and down
+/// to the ground when there is one. `([-1; 3], [1; 3])` for no points.
+#[must_use]
+pub fn frame_box(points: &[f64], ground: Option<f64>, falls: bool) -> ([f64; 3], [f64; 3]) {
+    let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+    for p in points.chunks_exact(3) {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if lo[0] > hi[0] {
+        return ([-1.0; 3], [1.0; 3]);
+    }
+    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-3);
+    for k in 0..2 {
+        lo[k] -= size / 3.0;
+        hi[k] += size / 3.0;
+    }
+    if falls {
+        lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
+    }
+    if let Some(z) = ground {
+        lo[2] = z;
+    }
+    (lo, hi)
+}
+
 /// What a scene looks like: a description of its method, the static [`Context`] and a
 /// [`Frame`] per output time.
 pub trait View: Solver {
@@ -184,5 +214,20 @@ pub trait View: Solver {
     fn reference_error(&self, state: &Self::State) -> Option<f64> {
         let _ = state;
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::frame_box;
+
+    #[test]
+    fn the_frame_box_frames_the_points_and_reaches_the_ground() {
+        assert_eq!(frame_box(&[], None, true), ([-1.0; 3], [1.0; 3]));
+        // Points from (0, 0, 1) to (3, 0, 1): size 3, widened by 1 on each side in x and y.
+        let x = [0.0, 0.0, 1.0, 3.0, 0.0, 1.0];
+        assert_eq!(frame_box(&x, None, false), ([-1.0, -1.0, 1.0], [4.0, 1.0, 1.0]));
+        assert_eq!(frame_box(&x, None, true).0[2], 1.0 - 1.3 * 3.0);
+        assert_eq!(frame_box(&x, Some(0.25), true).0[2], 0.25);
     }
 }
