@@ -144,3 +144,34 @@ pub fn preset_step_allocations(
         Ok(out)
     })
 }
+
+/// The test that every preset of a scene kind steps without allocating once its first step is
+/// done ([`preset_step_allocations`]), for a crate's integration test file of its own (the macro
+/// installs the counting global allocator):
+///
+/// ```ignore
+/// anim_core::preset_allocation_test!(anim_springs::KIND);
+/// ```
+#[macro_export]
+macro_rules! preset_allocation_test {
+    ($kind:expr) => {
+        #[global_allocator]
+        static ALLOC: $crate::alloc_count::CountingAllocator = $crate::alloc_count::CountingAllocator::new();
+
+        #[test]
+        fn preset_steps_do_not_allocate() {
+            let counted = $crate::alloc_count::preset_step_allocations(&ALLOC, &$kind)
+                .unwrap_or_else(|e| panic!("{e}"));
+            assert!(!counted.is_empty(), "the kind has no preset");
+            for c in counted {
+                assert_eq!(
+                    c.blocks.last(),
+                    Some(&0),
+                    "{}: allocations per block of four steps {:?}",
+                    c.preset,
+                    c.blocks
+                );
+            }
+        }
+    };
+}
