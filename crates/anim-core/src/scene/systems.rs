@@ -468,4 +468,43 @@ mod tests {
         let err = (k.build)(&p, &BuildContext::default()).err().expect("refused");
         assert_eq!(err.to_string(), "field `eccentricity`: must lie in [0, 1), got 1");
     }
+    #[test]
+    fn the_ode_error_is_zero_on_the_exact_solution() {
+        // Independent of the runner: the exact state at t gives zero, a shifted one its shift.
+        let p: OscillatorParams = params(&oscillator_presets()[0].params).expect("params");
+        let (xe, ve) = HarmonicOscillator::damped(p.mass, p.stiffness, p.damping).exact(p.x0, p.v0, 0.7);
+        let mut s = State::new(vec![xe], vec![ve]);
+        s.t = 0.7;
+        assert_eq!(oscillator_error(&p, &s), Some(0.0));
+        s.x[0] += 1e-3;
+        let e = oscillator_error(&p, &s).expect("an error");
+        assert!((e - 1e-3 / p.x0.hypot(p.v0 / (p.stiffness / p.mass).sqrt())).abs() < 1e-15);
+        let k: KeplerParams = params(&kepler_presets()[0].params).expect("params");
+        let (xe, ve) = KeplerOrbit::ellipse(0.5).exact(1.3);
+        let mut s = State::new(xe.to_vec(), ve.to_vec());
+        s.t = 1.3;
+        assert_eq!(kepler_error(&k, &s), Some(0.0));
+    }
+
+    #[test]
+    fn the_oscillator_step_is_in_units_of_one_over_omega_and_shrinks_over_long_runs() {
+        let f = study::family("o", "harmonic-oscillator", Some(100.0), &[], &[]);
+        let p = oscillator_presets().remove(0);
+        let adapter = (KINDS[0].tolerance.expect("mapped").adapter)(&p.params, &p.run, &f).expect("adapter");
+        let pt = Point { param: 0.5, seconds: 1e-5, error: 1e-3 };
+        // k = 40, m = 1: omega = sqrt(40); 1000 steps of 0.01 s = 63 time units, inside 100.
+        let c = adapter.candidate("rk4", &pt).expect("runs");
+        assert_eq!(c.dt, Some(0.5 / 40f64.sqrt()));
+        assert_eq!(c.summary, "integrator = rk4");
+        assert_eq!(c.note, format!("1/omega = {:.4}", 1.0 / 40f64.sqrt()));
+        // Kepler: a 20 s run against a horizon of 5 shrinks RK4's step by (1/4)^(1/2).
+        let f = study::family("k", "kepler-orbit", Some(5.0), &[], &[]);
+        let p = kepler_presets().remove(0);
+        let adapter = (KINDS[1].tolerance.expect("mapped").adapter)(&p.params, &p.run, &f).expect("adapter");
+        let c = adapter.candidate("rk4", &Point { param: 0.1, ..pt }).expect("runs");
+        assert!((c.dt.expect("a step") - 0.05).abs() < 1e-15);
+        assert!((c.cost - 2.0).abs() < 1e-12);
+        assert_eq!(adapter.candidate("rk5", &pt).unwrap_err(), "`rk5` is not a method this build knows");
+        assert_eq!(integrator("velocity-verlet"), Some(IntegratorKind::VelocityVerlet));
+    }
 }
