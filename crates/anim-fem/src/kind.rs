@@ -27,10 +27,12 @@
 //! ```
 
 use crate::boundary::Obstacle;
+use crate::material::MaterialModel;
 use crate::model::ElementOrder;
 use crate::scenes;
 use crate::sim::{FemSimulation, LinearSolverChoice, TimeIntegrator};
 use anim_core::integrate::State;
+use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
     RunDefaults, SceneKind, Simulated, View, params, saved_state,
@@ -44,6 +46,7 @@ pub const KIND: SceneKind = SceneKind {
     summary: "hyperelastic solids of linear or 10-node tetrahedra: a clamped beam, a dropped cube, a twisted bar",
     presets,
     build,
+    tolerance: Some(Tolerance { adapter: tolerance_adapter, error: study::reference_error }),
 };
 
 /// Scene-file parameters of an `fem` scene (the `[scene]` table without `kind`).
@@ -202,4 +205,99 @@ impl View for FemSimulation {
         out.points.clone_from(&state.x);
         out.field_mut("velocity", 3).extend_from_slice(&state.v);
     }
+}
+
+/// A label of the FEM beam study: `"<model> symplectic-euler"` or
+/// `"<model> backward-euler (<solver>)"` (names of [`MaterialModel::name`],
+/// [`TimeIntegrator::name`], [`LinearSolverChoice::name`]); reports from before the solver sweep
+/// wrote `"<model> backward-euler"`, the default solver (`None` here; Cholesky).
+#[must_use]
+pub fn fem_label(label: &str) -> Option<(MaterialModel, TimeIntegrator, Option<LinearSolverChoice>)> {
+    let (model, rest) = label.split_once(' ')?;
+    let model = MaterialModel::ALL.into_iter().find(|m| m.name() == model)?;
+    let explicit = TimeIntegrator::SymplecticEuler;
+    if rest == explicit.name() {
+        return Some((model, explicit, None));
+    }
+    let implicit = TimeIntegrator::BackwardEuler;
+    let rest = rest.strip_prefix(implicit.name())?;
+    if rest.is_empty() {
+        return Some((model, implicit, None));
+    }
+    let solver = rest.strip_prefix(" (")?.strip_suffix(')')?;
+    let solver = LinearSolverChoice::ALL.into_iter().find(|s| s.name() == solver)?;
+    Some((model, implicit, Some(solver)))
+}
+
+/// The `fem-beam` study on a `cantilever-beam` scene: only the series of the scene's material
+/// model; the study's step scaled by the ratio of wave speeds `sqrt(E/rho)` (study over scene),
+/// by the ratio of cell sizes when the scene's cells are smaller, and by `(H / T)^2` when the
+/// run is longer than the study's horizon (the integrators are first order).
+struct BeamAdapter {
+    model: MaterialModel,
+    scale: f64,
+    horizon: f64,
+    duration: f64,
+}
+
+impl StudyAdapter for BeamAdapter {
+    fn candidate(&self, method: &str, point: &Point) -> Result<Candidate, String> {
+        let Self { model, scale, horizon, duration } = *self;
+        let (m, integrator, solver) = fem_label(method).ok_or_else(|| study::unknown_method(method))?;
+        if m != model {
+            return Err(format!("{} material (the scene's is {})", m.name(), model.name()));
+        }
+        let length = study::horizon_factor(horizon, duration, 1);
+        let factor = scale * length;
+        let solver = solver.unwrap_or(LinearSolverChoice::Cholesky);
+        let mut settings = serde_json::Map::new();
+        settings.insert("integrator".into(), serde_json::json!(integrator));
+        settings.insert("linear_solver".into(), serde_json::json!(solver));
+        let summary = match integrator {
+            TimeIntegrator::SymplecticEuler => format!("integrator = {}", integrator.name()),
+            TimeIntegrator::BackwardEuler => {
+                format!("integrator = {}, linear_solver = {}", integrator.name(), solver.name())
+            }
+        };
+        Ok(Candidate {
+            settings,
+            summary,
+            dt: Some(point.param * factor),
+            cost: 1.0 / factor,
+            dt_swept: true,
+            note: format!("wave speed and cell ratios {scale:.4} x run length (H/T)^2 = {length:.4}"),
+        })
+    }
+}
+
+/// The adapter of an `fem` scene to its study (the registry maps `fem/cantilever-beam`).
+fn tolerance_adapter(
+    value: &serde_json::Value,
+    run: &RunDefaults,
+    family: &Family,
+) -> Result<Box<dyn StudyAdapter>, String> {
+    let p: FemSceneParams = params(value).map_err(study::unreadable)?;
+    let scene = scenes::by_name(&p.preset, p.resolution)
+        .ok_or_else(|| format!("--tolerance: unknown fem preset `{}`", p.preset))?
+        .map_err(study::unreadable)?;
+    let material = *scene.model.material();
+    let mesh = scene.model.mesh();
+    let cell = mesh
+        .tets
+        .iter()
+        .flat_map(|t| {
+            let p = |i: usize| anim_core::glam::DVec3::from_array(mesh.positions[t[i]]);
+            [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)].map(|(a, b)| p(a).distance(p(b)))
+        })
+        .fold(f64::INFINITY, f64::min);
+    let speed = |young: f64, density: f64| (young / density).sqrt();
+    let ratio = speed(study::problem(family, "young")?, study::problem(family, "density")?)
+        / speed(material.lame.young(), material.density);
+    let scale = ratio * (cell / study::problem(family, "cell")?).min(1.0);
+    Ok(Box::new(BeamAdapter {
+        model: material.model,
+        scale,
+        horizon: study::horizon(family)?,
+        duration: study::duration(run),
+    }))
 }

@@ -248,3 +248,69 @@ fn bad_parameters_name_their_field() {
     let msg = refused(&json!({ "resolution": 2 }));
     assert!(msg.contains("missing field `preset`"), "{msg}");
 }
+
+mod tolerance {
+    use crate::kind::{KIND, fem_label};
+    use crate::material::MaterialModel;
+    use crate::sim::{LinearSolverChoice, TimeIntegrator};
+    use anim_core::scene::study::{Point, family};
+
+    #[test]
+    fn labels_of_the_fem_study_parse_back() {
+        // The beam study's labels, spelled as its brief gives them.
+        for model in MaterialModel::ALL {
+            assert_eq!(
+                fem_label(&format!("{} symplectic-euler", model.name())),
+                Some((model, TimeIntegrator::SymplecticEuler, None))
+            );
+            for solver in LinearSolverChoice::ALL {
+                assert_eq!(
+                    fem_label(&format!("{} backward-euler ({})", model.name(), solver.name())),
+                    Some((model, TimeIntegrator::BackwardEuler, Some(solver)))
+                );
+            }
+        }
+        assert_eq!(
+            fem_label("linear backward-euler"),
+            Some((MaterialModel::Linear, TimeIntegrator::BackwardEuler, None))
+        );
+        for bad in [
+            "stable-neo-hookean",
+            "rubber symplectic-euler",
+            "linear backward-euler (lu)",
+            "linear backward-eulerx",
+        ] {
+            assert_eq!(fem_label(bad), None, "{bad}");
+        }
+    }
+
+    #[test]
+    fn the_beam_keeps_its_material_and_scales_the_studys_step() {
+        let f = family(
+            "fem-beam",
+            "fem/cantilever-beam",
+            Some(0.5),
+            &[("young", 1e6), ("density", 1000.0), ("cell", 0.05)],
+            &[],
+        );
+        let preset = (KIND.presets)().into_iter().find(|p| p.name == "beam").expect("preset");
+        let adapter =
+            (KIND.tolerance.expect("mapped").adapter)(&preset.params, &preset.run, &f).expect("adapter");
+        let pt = Point { param: 2.5e-3, seconds: 0.2, error: 8e-3 };
+        let e = adapter.candidate("neo-hookean symplectic-euler", &pt).unwrap_err();
+        assert_eq!(e, "neo-hookean material (the scene's is stable-neo-hookean)");
+        let c =
+            adapter.candidate("stable-neo-hookean backward-euler (ldlt)", &pt).expect("the scene's material");
+        assert_eq!(c.summary, "integrator = backward-euler, linear_solver = ldlt");
+        assert_eq!(c.settings.get("linear_solver"), Some(&serde_json::json!("ldlt")));
+        // The preset: E = 10 MPa, rho = 1000, 4 cells across 0.1 m; the study's beam E = 1 MPa,
+        // 2 cells: wave speeds sqrt(1e6 / 1e7), cells 0.025 / 0.05; the scene runs 120 frames of
+        // 1/60 s = 2 s, four times the 0.5 s horizon, a first-order method: (1/4)^2.
+        let dt = 2.5e-3 * (0.1f64).sqrt() * 0.5 / 16.0;
+        let got = c.dt.expect("a step");
+        assert!((got - dt).abs() < 1e-9 * dt, "{got} != {dt}");
+        assert_eq!(c.note, "wave speed and cell ratios 0.1581 x run length (H/T)^2 = 0.0625");
+        let c = adapter.candidate("stable-neo-hookean symplectic-euler", &pt).expect("explicit");
+        assert_eq!(c.summary, "integrator = symplectic-euler");
+    }
+}

@@ -51,6 +51,7 @@ pub const KIND: SceneKind = SceneKind {
     summary: "an incompressible particle fluid (PIC, FLIP, APIC on a MAC grid) in 2D and 3D: dam breaks, drops, a sloshing tank",
     presets,
     build,
+    tolerance: None,
 };
 
 /// Scene-file parameters of a `flip` scene: a preset of [`scenes::NAMES`] and what a file may

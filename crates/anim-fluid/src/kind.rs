@@ -37,6 +37,7 @@ use crate::error::FluidError;
 use crate::mac::{MacFluid, MacState};
 use crate::pressure::PressureMethod;
 use crate::scenes::{self, FluidScene, FluidSim};
+use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, ImageGrid, Preset, Prop,
     RunDefaults, SceneKind, Simulated, View, params, saved_field,
@@ -52,6 +53,7 @@ pub const KIND: SceneKind = SceneKind {
     summary: "grid fluids: the seed's stable fluids and the MAC solver in 2D and 3D, density and velocity per cell",
     presets,
     build,
+    tolerance: Some(Tolerance { adapter: tolerance_adapter, error: tolerance_error }),
 };
 
 /// The iteration cap of a pressure solve whose solver or tolerance a scene file sets (the
@@ -344,6 +346,136 @@ pub fn ghia_error(fluid: &MacFluid, state: &MacState) -> f64 {
     let u = ghia_points(GHIA_U).map(|(y, u)| (fluid.velocity_at_point(state, [0.5, y, 0.0])[0] - u).abs());
     let v = ghia_points(GHIA_V).map(|(x, v)| (fluid.velocity_at_point(state, [x, 0.5, 0.0])[1] - v).abs());
     u.chain(v).fold(0.0, f64::max)
+}
+
+/// A label of the pressure study: `"<solver> N=<n>"`.
+#[must_use]
+pub fn pressure_label(label: &str) -> Option<(PressureMethod, usize)> {
+    let (name, n) = label.split_once(" N=")?;
+    Some((pressure_method(name)?, n.parse().ok()?))
+}
+
+/// The pressure solver of [`PressureMethod::name`] `name`.
+#[must_use]
+pub fn pressure_method(name: &str) -> Option<PressureMethod> {
+    PressureMethod::ALL.into_iter().find(|m| m.name() == name)
+}
+
+/// The settings of a picked pressure solve: the resolution (if picked), the solver and its
+/// tolerance, as scene-file parameters and in scene-file terms.
+fn pressure_candidate(n: Option<usize>, solver: PressureMethod, tol: f64, dt: Option<f64>) -> Candidate {
+    let mut settings = serde_json::Map::new();
+    if let Some(n) = n {
+        settings.insert("resolution".into(), json!(n));
+    }
+    settings.insert("pressure_solver".into(), json!(solver));
+    settings.insert("pressure_tolerance".into(), json!(tol));
+    Candidate {
+        settings,
+        summary: format!(
+            "{}pressure_solver = {}, pressure_tolerance = {tol:e}",
+            n.map(|n| format!("resolution = {n}, ")).unwrap_or_default(),
+            solver.name()
+        ),
+        dt,
+        cost: 1.0,
+        dt_swept: false,
+        note: String::new(),
+    }
+}
+
+/// The `fluid_cavity_ghia` study on the `lid-driven-cavity` scene: the resolution `N` and the
+/// pressure solver at the study's pressure tolerance, `dt = 1/N`.
+struct CavityAdapter {
+    pressure_tolerance: f64,
+}
+
+impl StudyAdapter for CavityAdapter {
+    fn candidate(&self, method: &str, point: &Point) -> Result<Candidate, String> {
+        let solver = pressure_method(method).ok_or_else(|| study::unknown_method(method))?;
+        let n = point.param.round();
+        if !(2.0..=2048.0).contains(&n) {
+            return Err(format!("resolution {n} out of range"));
+        }
+        let n = n as usize;
+        Ok(pressure_candidate(Some(n), solver, self.pressure_tolerance, Some(1.0 / n as f64)))
+    }
+}
+
+/// The `fluid_pressure_divergence` study on the `smoke-plume-3d` scene: the pressure solver and
+/// its tolerance, from the series measured at the grid size (`nearest`) nearest the scene's
+/// largest side (`n`).
+struct PressureAdapter {
+    n: usize,
+    nearest: usize,
+}
+
+impl StudyAdapter for PressureAdapter {
+    fn candidate(&self, method: &str, point: &Point) -> Result<Candidate, String> {
+        let Self { n, nearest } = *self;
+        let (solver, measured) = pressure_label(method).ok_or_else(|| study::unknown_method(method))?;
+        if measured != nearest {
+            return Err(format!(
+                "measured at N = {measured}; the scene's grid ({n} cells) is nearest N = {nearest}"
+            ));
+        }
+        Ok(pressure_candidate(None, solver, point.param, None))
+    }
+}
+
+/// The adapter of a `fluid` scene to its study (the registry maps `fluid/lid-driven-cavity` and
+/// `fluid/smoke-plume-3d`). The studies measured the presets' own advection and splitting: a
+/// scene that sets either is refused (the message, without the `--tolerance: FILE` the picker
+/// puts before it, names the fields).
+fn tolerance_adapter(
+    value: &serde_json::Value,
+    _: &RunDefaults,
+    family: &Family,
+) -> Result<Box<dyn StudyAdapter>, String> {
+    let p: FluidSceneParams = params(value).map_err(study::unreadable)?;
+    let set: Vec<&str> = [("advection", p.advection.is_some()), ("splitting", p.splitting.is_some())]
+        .into_iter()
+        .filter_map(|(name, on)| on.then_some(name))
+        .collect();
+    if !set.is_empty() {
+        return Err(format!(
+            "sets `{}`, but the {} study measured the preset's own; remove the field or --tolerance",
+            set.join("` and `"),
+            family.study
+        ));
+    }
+    if p.preset == "lid-driven-cavity" {
+        return Ok(Box::new(CavityAdapter {
+            pressure_tolerance: study::problem(family, "pressure_tolerance")?,
+        }));
+    }
+    let scene = scenes::by_name(&p.preset, p.resolution)
+        .ok_or_else(|| format!("--tolerance: unknown fluid preset `{}`", p.preset))?
+        .map_err(study::unreadable)?;
+    let n = scene.dims().into_iter().max().unwrap_or(1);
+    let sizes: Vec<usize> =
+        family.series.iter().filter_map(|s| pressure_label(&s.method).map(|(_, n)| n)).collect();
+    let nearest = sizes
+        .iter()
+        .copied()
+        .min_by(|a, b| {
+            let d = |m: usize| (m as f64 / n as f64).ln().abs();
+            d(*a).total_cmp(&d(*b)).then(a.cmp(b))
+        })
+        .ok_or_else(|| format!("--tolerance: the {} study measured no grid size", family.study))?;
+    Ok(Box::new(PressureAdapter { n, nearest }))
+}
+
+/// The run's error on its study's measure: for the smoke plume the largest relative pressure
+/// residual of the run's projections (`max_residual`), else the scene's own reference error
+/// (Ghia's velocities for the cavity).
+fn tolerance_error(
+    value: &serde_json::Value,
+    scene: &dyn DynScene,
+    max_residual: Option<f64>,
+) -> Option<f64> {
+    let p: FluidSceneParams = params(value).ok()?;
+    if p.preset == "smoke-plume-3d" { max_residual } else { scene.reference_error() }
 }
 
 #[cfg(test)]

@@ -36,6 +36,7 @@
 
 use crate::scenes::{self, MpmScene, SurgeFront};
 use crate::{Kernel, MpmError, MpmParams, MpmSimulation, OutOfDomain, Particles, Shape, Transfer};
+use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
     RunDefaults, SceneKind, Simulated, View, params, saved_field,
@@ -50,6 +51,7 @@ pub const KIND: SceneKind = SceneKind {
     summary: "the material point method (APIC, MLS-MPM) in 2D and 3D: elastic, snow and fluid matter",
     presets,
     build,
+    tolerance: Some(Tolerance { adapter: tolerance_adapter, error: study::reference_error }),
 };
 
 /// Scene-file parameters of an `mpm` scene (the `[scene]` table without `kind`).
@@ -396,4 +398,75 @@ fn collider(shape: Shape, dim: usize) -> Option<Prop> {
         }
         Shape::Plane { .. } => None,
     }
+}
+
+/// The scene-file name of a transfer (`"apic"`, `"mls-mpm"`).
+fn transfer_name(transfer: Transfer) -> &'static str {
+    match transfer {
+        Transfer::Apic => "apic",
+        Transfer::Mls => "mls-mpm",
+    }
+}
+
+/// The scene-file name of a kernel (`"quadratic"`, `"cubic"`).
+fn kernel_name_of(kernel: Kernel) -> &'static str {
+    match kernel {
+        Kernel::Quadratic => "quadratic",
+        Kernel::Cubic => "cubic",
+    }
+}
+
+/// A label of the MPM dam-break study: `"<MLS-MPM|APIC> <quadratic|cubic>, <k>x<k> ppc"`.
+#[must_use]
+pub fn mpm_label(label: &str) -> Option<(Transfer, Kernel, usize)> {
+    let (method, ppc) = label.split_once(", ")?;
+    let (transfer, kernel) = method.split_once(' ')?;
+    let transfer = match transfer {
+        "MLS-MPM" => Transfer::Mls,
+        "APIC" => Transfer::Apic,
+        _ => return None,
+    };
+    let kernel = [Kernel::Quadratic, Kernel::Cubic].into_iter().find(|k| kernel_name_of(*k) == kernel)?;
+    let (a, b) = ppc.strip_suffix(" ppc")?.split_once('x')?;
+    let k: usize = a.parse().ok()?;
+    (b.parse::<usize>().ok()? == k).then_some((transfer, kernel, k))
+}
+
+/// The `mpm_dam_break` study on the `dam-break-2d` scene: resolution, transfer, kernel and
+/// particles per cell, at the study's step `dt = h / 100`.
+struct DamBreakAdapter;
+
+impl StudyAdapter for DamBreakAdapter {
+    fn candidate(&self, method: &str, point: &Point) -> Result<Candidate, String> {
+        let (transfer, kernel, ppc) = mpm_label(method).ok_or_else(|| study::unknown_method(method))?;
+        let n = point.param.round();
+        if !(8.0..=4096.0).contains(&n) {
+            return Err(format!("resolution {n} out of range"));
+        }
+        let n = n as usize;
+        let (t, k) = (transfer_name(transfer), kernel_name_of(kernel));
+        let mut settings = serde_json::Map::new();
+        settings.insert("resolution".into(), serde_json::json!(n));
+        settings.insert("transfer".into(), serde_json::json!(t));
+        settings.insert("kernel".into(), serde_json::json!(k));
+        settings.insert("particles_per_cell".into(), serde_json::json!(ppc));
+        Ok(Candidate {
+            settings,
+            summary: format!("resolution = {n}, transfer = {t}, kernel = {k}, particles_per_cell = {ppc}"),
+            dt: Some(scenes::dam_break_2d_dt(n)),
+            cost: 1.0,
+            dt_swept: false,
+            note: String::new(),
+        })
+    }
+}
+
+/// The adapter of an `mpm` scene to its study (the registry maps `mpm/dam-break-2d`).
+fn tolerance_adapter(
+    value: &serde_json::Value,
+    _: &RunDefaults,
+    family: &Family,
+) -> Result<Box<dyn StudyAdapter>, String> {
+    let p: MpmSceneParams = params(value).map_err(study::unreadable)?;
+    if p.preset == "dam-break-2d" { Ok(Box::new(DamBreakAdapter)) } else { Err(study::unmapped(family)) }
 }

@@ -318,3 +318,47 @@ fn bad_parameters_name_their_field() {
     let msg = refused(&json!({ "preset": "dam-break-2d", "transfer": "Mls" }));
     assert!(msg.contains("unknown variant `Mls`"), "{msg}");
 }
+
+mod tolerance {
+    use crate::kind::{KIND, mpm_label};
+    use crate::{Kernel, Transfer};
+    use anim_core::scene::study::{Point, family};
+
+    #[test]
+    fn labels_of_the_mpm_study_parse_back() {
+        assert_eq!(mpm_label("MLS-MPM quadratic, 2x2 ppc"), Some((Transfer::Mls, Kernel::Quadratic, 2)));
+        assert_eq!(mpm_label("APIC cubic, 2x2 ppc"), Some((Transfer::Apic, Kernel::Cubic, 2)));
+        assert_eq!(mpm_label("MLS-MPM quadratic, 3x3 ppc"), Some((Transfer::Mls, Kernel::Quadratic, 3)));
+        for bad in
+            ["MLS-MPM quadratic", "FLIP quadratic, 2x2 ppc", "APIC quartic, 2x2 ppc", "APIC cubic, 2x3 ppc"]
+        {
+            assert_eq!(mpm_label(bad), None, "{bad}");
+        }
+    }
+
+    #[test]
+    fn the_dam_break_takes_the_studys_settings_and_step() {
+        let f = family("mpm_dam_break", "mpm/dam-break-2d", None, &[], &[]);
+        let tolerance = KIND.tolerance.expect("mapped");
+        let p = (KIND.presets)().into_iter().find(|p| p.name == "dam-break-2d-mpm").expect("preset");
+        let adapter = (tolerance.adapter)(&p.params, &p.run, &f).expect("adapter");
+        let c = adapter
+            .candidate("APIC cubic, 2x2 ppc", &Point { param: 32.0, seconds: 0.8, error: 0.08 })
+            .expect("runs");
+        assert_eq!(c.summary, "resolution = 32, transfer = apic, kernel = cubic, particles_per_cell = 2");
+        // Half a cell per sound crossing at c = 50 m/s, h = 1/32 m.
+        let dt = c.dt.expect("a step");
+        assert!((dt - 0.5 / 32.0 / 50.0).abs() < 1e-15, "{dt}");
+        // The settings are the scene's own parameters: they build.
+        let mut params = p.params.clone();
+        for (k, v) in c.settings {
+            params[k] = v;
+        }
+        params["resolution"] = serde_json::json!(16);
+        assert!((KIND.build)(&params, &Default::default()).is_ok());
+        // The other presets are not the study's.
+        let other = (KIND.presets)().into_iter().find(|p| p.name == "mpm").expect("preset");
+        let e = (tolerance.adapter)(&other.params, &other.run, &f).err().expect("unmapped");
+        assert_eq!(e, "--tolerance: the mpm_dam_break study has no mapping to this scene");
+    }
+}

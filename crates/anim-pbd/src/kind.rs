@@ -21,6 +21,7 @@ use crate::collide::Shape;
 use crate::scenes;
 use crate::sim::{Method, PbdSimulation};
 use anim_core::integrate::State;
+use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
     RunDefaults, SceneKind, Simulated, View, params, saved_state,
@@ -34,6 +35,7 @@ pub const KIND: SceneKind = SceneKind {
     summary: "position based dynamics and XPBD: cloth, flags, ropes and soft bodies with collisions",
     presets,
     build,
+    tolerance: Some(Tolerance { adapter: tolerance_adapter, error: study::reference_error }),
 };
 
 /// The largest iteration or substep count a `pbd` scene takes.
@@ -249,6 +251,96 @@ fn boundary_triangles(tets: &[[usize; 4]], n: usize) -> Vec<[usize; 3]> {
         }
     }
     order.iter().filter_map(|k| count.get(k)).filter(|(c, _)| *c == 1).map(|(_, f)| *f).collect()
+}
+
+/// A label of the PBD cloth studies: `"<Pbd|Xpbd> substeps (1 iteration)"` (`true`: substeps
+/// swept) or `"<Pbd|Xpbd> iterations (1 substep)"` (`false`).
+#[must_use]
+pub fn pbd_label(label: &str) -> Option<(Method, bool)> {
+    let (method, rest) = label.split_once(' ')?;
+    let method = [Method::Pbd, Method::Xpbd].into_iter().find(|m| format!("{m:?}") == method)?;
+    match rest {
+        "substeps (1 iteration)" => Some((method, true)),
+        "iterations (1 substep)" => Some((method, false)),
+        _ => None,
+    }
+}
+
+/// The `pbd-cloth-position` study on a `hanging-cloth` scene: the method, and the iteration or
+/// substep count scaled by the ratio of cloth sides (scene over study) when the scene's cloth is
+/// finer and, for substeps, by `(T/H)^2` when the run is longer than the study's horizon (the
+/// series sweeping iterations at one substep are then left out); the study's step.
+struct ClothAdapter {
+    scale: f64,
+    study_dt: f64,
+    horizon: f64,
+    duration: f64,
+}
+
+impl StudyAdapter for ClothAdapter {
+    fn candidate(&self, method: &str, point: &Point) -> Result<Candidate, String> {
+        let Self { scale, study_dt, horizon, duration } = *self;
+        let (m, substeps) = pbd_label(method).ok_or_else(|| study::unknown_method(method))?;
+        let k = point.param.round();
+        if !(1.0..=1e4).contains(&k) {
+            return Err(format!("count {k} out of range"));
+        }
+        let length = study::horizon_factor(horizon, duration, 1);
+        let (iterations, substeps, note) = if substeps {
+            let count = (k * scale / length * (1.0 - 1e-12)).ceil();
+            let note =
+                format!("{count} substeps: cloth side ratio {scale:.4} x run length (H/T)^2 = {length:.4}");
+            (1.0, count, note)
+        } else {
+            if length < 1.0 {
+                return Err(format!(
+                    "swept iterations at one substep: the error was measured over the study's {horizon} s and \
+                     iterations do not shrink the step, so it does not bound a {duration:.4} s run"
+                ));
+            }
+            let count = (k * scale * (1.0 - 1e-12)).ceil();
+            (count, 1.0, format!("{count} iterations: cloth side ratio {scale:.4}"))
+        };
+        if iterations.max(substeps) > MAX_PBD_COUNT as f64 {
+            return Err(format!("{} per step needed on this scene", iterations.max(substeps)));
+        }
+        let (i, s) = (iterations as usize, substeps as usize);
+        let mut settings = serde_json::Map::new();
+        settings.insert("method".into(), serde_json::json!(m));
+        settings.insert("iterations".into(), serde_json::json!(i));
+        settings.insert("substeps".into(), serde_json::json!(s));
+        Ok(Candidate {
+            settings,
+            summary: format!(
+                "method = {}, iterations = {i}, substeps = {s}",
+                format!("{m:?}").to_lowercase()
+            ),
+            dt: Some(study_dt),
+            cost: iterations * substeps / k,
+            dt_swept: false,
+            note,
+        })
+    }
+}
+
+/// The adapter of a `pbd` scene to its study (the registry maps `pbd/hanging-cloth`).
+fn tolerance_adapter(
+    value: &serde_json::Value,
+    run: &RunDefaults,
+    family: &Family,
+) -> Result<Box<dyn StudyAdapter>, String> {
+    let p: PbdSceneParams = params(value).map_err(study::unreadable)?;
+    let scene = scenes::by_name(&p.preset, p.resolution)
+        .ok_or_else(|| format!("--tolerance: unknown pbd preset `{}`", p.preset))?
+        .map_err(study::unreadable)?;
+    // The cloth's side in particles (the scene and the study's cloths are square).
+    let side = ((scene.state.x.len() / 3) as f64).sqrt();
+    Ok(Box::new(ClothAdapter {
+        scale: (side / study::problem(family, "n")?).max(1.0),
+        study_dt: study::problem(family, "dt")?,
+        horizon: study::horizon(family)?,
+        duration: study::duration(run),
+    }))
 }
 
 #[cfg(test)]

@@ -45,6 +45,7 @@ pub const KIND: SceneKind = SceneKind {
     summary: "articulated and free rigid bodies without contact, drawn as line segments",
     presets,
     build,
+    tolerance: None,
 };
 
 /// Scene-file parameters of a `rigid` scene (the `[scene]` table without `kind`).

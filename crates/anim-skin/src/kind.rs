@@ -47,6 +47,7 @@ pub const KIND: SceneKind = SceneKind {
     summary: "a skinned character posed over time by linear blend or dual-quaternion skinning",
     presets,
     build,
+    tolerance: None,
 };
 
 /// Which skinning a scene shows.

@@ -19,6 +19,8 @@ use crate::scenes;
 use crate::sim::SpringSimulation;
 use anim_core::integrate::{IntegratorKind, State};
 use anim_core::linalg::LinearSolverKind;
+use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
+use anim_core::scene::systems::integrator;
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
     RunDefaults, SceneKind, Simulated, View, params, saved_state,
@@ -32,6 +34,7 @@ pub const KIND: SceneKind = SceneKind {
     summary: "mass-spring networks (cloth, ropes, jelly) under any integrator of anim-core",
     presets,
     build,
+    tolerance: Some(Tolerance { adapter: tolerance_adapter, error: study::reference_error }),
 };
 
 /// Scene-file parameters of a `springs` scene: a preset of [`scenes`] with its own integrator
@@ -180,6 +183,103 @@ impl View for SpringSimulation {
         out.time = state.t;
         out.points.clone_from(&state.x);
         out.field_mut("velocity", 3).extend_from_slice(&state.v);
+    }
+}
+
+/// The `springs-cloth` study on a `hanging-cloth` scene: explicit integrators only (the scene
+/// takes one linearised Newton iteration per step, the study converged Newton to 1e-10), the
+/// study's step scaled by the ratio of the highest spring frequencies estimated as
+/// `sqrt(k_max N / M)` (stiffest spring, particle count, total mass) when the scene's is higher,
+/// and by `(H / T)^(2/p)` when the run is longer than the study's horizon.
+struct ClothAdapter {
+    scale: f64,
+    horizon: f64,
+    duration: f64,
+}
+
+impl StudyAdapter for ClothAdapter {
+    fn candidate(&self, method: &str, point: &Point) -> Result<Candidate, String> {
+        let Self { scale, horizon, duration } = *self;
+        if method.contains(" / ") {
+            return Err("implicit (the scene takes one linearised Newton iteration per step, the study converged Newton)".into());
+        }
+        let kind = integrator(method).ok_or_else(|| study::unknown_method(method))?;
+        let length = study::horizon_factor(horizon, duration, kind.order());
+        let factor = scale * length;
+        let mut settings = serde_json::Map::new();
+        settings.insert("integrator".into(), serde_json::json!(kind));
+        Ok(Candidate {
+            settings,
+            summary: format!("integrator = {}", kind.label()),
+            dt: Some(point.param * factor),
+            cost: 1.0 / factor,
+            dt_swept: true,
+            note: format!("spring frequency ratio {scale:.4} x run length (H/T)^(2/p) = {length:.4}"),
+        })
+    }
+}
+
+/// The adapter of a `springs` scene to its study (the registry maps `springs/hanging-cloth`).
+fn tolerance_adapter(
+    value: &serde_json::Value,
+    run: &RunDefaults,
+    family: &Family,
+) -> Result<Box<dyn StudyAdapter>, String> {
+    let p: SpringsParams = params(value).map_err(study::unreadable)?;
+    let scene = scenes::by_name(&p.preset, p.resolution)
+        .ok_or_else(|| format!("--tolerance: unknown springs preset `{}`", p.preset))?
+        .map_err(study::unreadable)?;
+    let net = &scene.network;
+    let k = net.springs().iter().map(|s| s.stiffness).fold(0.0, f64::max);
+    let count = (scene.state.x.len() / 3) as f64;
+    let omega_scene = (k * count / net.total_mass()).sqrt();
+    let n = study::problem(family, "n")?;
+    let omega_study = (study::problem(family, "stiffness")? * n * n / study::problem(family, "mass")?).sqrt();
+    Ok(Box::new(ClothAdapter {
+        scale: (omega_study / omega_scene).min(1.0),
+        horizon: study::horizon(family)?,
+        duration: study::duration(run),
+    }))
+}
+
+#[cfg(test)]
+mod tolerance_tests {
+    use super::*;
+    use anim_core::scene::study::family;
+
+    fn pt(param: f64, seconds: f64, error: f64) -> Point {
+        Point { param, seconds, error }
+    }
+
+    #[test]
+    fn the_hanging_cloth_takes_explicit_methods_only_at_the_stiffer_cloths_step() {
+        let f = family(
+            "springs-cloth",
+            "springs/hanging-cloth",
+            Some(0.25),
+            &[("n", 10.0), ("size", 0.5), ("mass", 0.1), ("stiffness", 100.0)],
+            &[],
+        );
+        let preset = (KIND.presets)().into_iter().find(|p| p.name == "cloth").expect("preset");
+        let tolerance = KIND.tolerance.expect("mapped");
+        let adapter = (tolerance.adapter)(&preset.params, &preset.run, &f).expect("adapter");
+        let e = adapter.candidate("backward-euler / cholesky", &pt(0.01, 1e-4, 1e-4)).unwrap_err();
+        assert!(e.starts_with("implicit ("), "{e}");
+        assert_eq!(
+            adapter.candidate("leapfrog-x", &pt(0.01, 1e-4, 1e-4)).unwrap_err(),
+            "`leapfrog-x` is not a method this build knows"
+        );
+        let c = adapter.candidate("rk4", &pt(6.25e-4, 2e-3, 1e-6)).expect("explicit");
+        assert_eq!(c.summary, "integrator = rk4");
+        assert_eq!(c.settings.get("integrator"), Some(&serde_json::json!(IntegratorKind::Rk4)));
+        // The preset: 32 x 32 particles, 0.2 kg, structural 1000 N/m; the study's 10 x 10, 0.1 kg,
+        // 100 N/m. The scene runs 120 x 2 x 0.01 = 2.4 s against 0.25 s.
+        let omega = |k: f64, count: f64, mass: f64| (k * count / mass).sqrt();
+        let dt = 6.25e-4 * omega(100.0, 100.0, 0.1) / omega(1000.0, 1024.0, 0.2) * (0.25f64 / 2.4).sqrt();
+        let got = c.dt.expect("a step");
+        assert!((got - dt).abs() < 1e-9 * dt, "{got} != {dt}");
+        assert!((c.cost - 6.25e-4 / dt).abs() < 1e-9 * c.cost);
+        assert!(c.dt_swept);
     }
 }
 

@@ -16,7 +16,9 @@
 //! `Box<dyn DynScene>`. A crate registers its scenes as one [`SceneKind`]: the `kind` a scene
 //! file names, the crate's [`Preset`]s (name, description, default step and frame counts, the
 //! scene-file parameters), and a builder from those parameters, which are the crate's own serde
-//! types read with `deny_unknown_fields`.
+//! types read with `deny_unknown_fields`. A kind whose scenes a study of the report measured
+//! also gives a [`study::Tolerance`]: what each measured method means on its scenes, for
+//! `anim run SCENE --tolerance TOL`.
 //!
 //! ```
 //! use anim_core::scene::{DynScene, Frame};
@@ -42,6 +44,7 @@
 mod checkpoint;
 mod dynamic;
 mod preset;
+pub mod study;
 pub mod systems;
 mod view;
 

@@ -1,6 +1,7 @@
 //! [`SceneKind`] and [`Preset`]: how a crate registers its scenes.
 
 use super::dynamic::DynScene;
+use super::study::Tolerance;
 use serde::de::DeserializeOwned;
 use std::path::Path;
 
@@ -132,6 +133,9 @@ pub struct SceneKind {
     pub presets: fn() -> Vec<Preset>,
     /// Builds a scene from its parameters (the `[scene]` table without `kind`).
     pub build: BuildFn,
+    /// How the report's studies map to this kind's scenes for `--tolerance` (`None`: no study
+    /// measured them).
+    pub tolerance: Option<Tolerance>,
 }
 
 /// The builder of a [`SceneKind`]: parameters in, a scene out.

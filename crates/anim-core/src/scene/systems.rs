@@ -7,10 +7,17 @@
 //! | `kepler-orbit` | `kepler` | a planet on an `e = 0.5` ellipse, velocity Verlet, about 3 orbits | Kepler's equation |
 //!
 //! [`View::reference_error`] is the Euclidean distance of `(x, v)` from the exact solution.
+//!
+//! For `--tolerance` both kinds map the report's ODE studies ([`Tolerance`]): `core-oscillator`
+//! (`m = k = 1`, times in units of `1/omega`) and `core-kepler` (`e = 0.5`, `a = mu = 1`) give
+//! the integrator and `dt`, the step scaled by `(H / T)^(2/p)` when the run is longer than the
+//! study's horizon; the run's error on the studies' measures is [`oscillator_error`] and
+//! [`kepler_error`].
 
 use super::checkpoint::{Checkpoint, CheckpointError, saved_state};
 use super::dynamic::{DynScene, Simulated};
 use super::preset::{BuildContext, BuildError, Preset, RunDefaults, SceneKind, params};
+use super::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use super::view::{Context, Frame, Prop, View};
 use crate::integrate::systems::{HarmonicOscillator, KeplerOrbit};
 use crate::integrate::{IntegrateError, IntegratorKind, MechanicalSystem, Simulation, State};
@@ -25,6 +32,7 @@ pub const KINDS: [SceneKind; 2] = [
         summary: "a damped harmonic oscillator m x'' = -k x - c x' with its exact solution",
         presets: oscillator_presets,
         build: build_oscillator,
+        tolerance: Some(Tolerance { adapter: oscillator_adapter, error: oscillator_table_error }),
     },
     SceneKind {
         kind: "kepler-orbit",
@@ -32,6 +40,7 @@ pub const KINDS: [SceneKind; 2] = [
         summary: "a planet on an ellipse around a fixed sun (a = mu = 1), exact by Kepler's equation",
         presets: kepler_presets,
         build: build_kepler,
+        tolerance: Some(Tolerance { adapter: kepler_adapter, error: kepler_table_error }),
     },
 ];
 
@@ -253,6 +262,101 @@ impl View for ExactSystem {
     }
 }
 
+/// The integrator a table label names.
+#[must_use]
+pub fn integrator(label: &str) -> Option<IntegratorKind> {
+    IntegratorKind::ALL.into_iter().find(|k| k.label() == label)
+}
+
+/// The ODE studies on a scene: times in units of `1/omega` (`unit` is the scene's `omega` over
+/// the study's), the study's horizon and the run's length.
+struct OdeAdapter {
+    unit: f64,
+    horizon: f64,
+    duration: f64,
+}
+
+impl StudyAdapter for OdeAdapter {
+    fn candidate(&self, method: &str, point: &Point) -> Result<Candidate, String> {
+        let Self { unit, horizon, duration } = *self;
+        let kind = integrator(method).ok_or_else(|| study::unknown_method(method))?;
+        let factor = study::horizon_factor(horizon / unit, duration, kind.order());
+        let mut note = Vec::new();
+        if unit != 1.0 {
+            note.push(format!("1/omega = {:.4}", 1.0 / unit));
+        }
+        if factor != 1.0 {
+            note.push(format!("run length (H/T)^(2/p) = {factor:.4}"));
+        }
+        let mut settings = serde_json::Map::new();
+        settings.insert("integrator".into(), serde_json::to_value(kind).map_err(|e| e.to_string())?);
+        Ok(Candidate {
+            settings,
+            summary: format!("integrator = {}", kind.label()),
+            dt: Some(point.param / unit * factor),
+            cost: 1.0 / factor,
+            dt_swept: true,
+            note: note.join(" x "),
+        })
+    }
+}
+
+/// The oscillator study on an oscillator scene: its times are scene times times `omega`.
+fn oscillator_adapter(
+    value: &serde_json::Value,
+    run: &RunDefaults,
+    family: &Family,
+) -> Result<Box<dyn StudyAdapter>, String> {
+    let p: OscillatorParams = params(value).map_err(study::unreadable)?;
+    let unit = (p.stiffness / p.mass).sqrt();
+    Ok(Box::new(OdeAdapter { unit, horizon: study::horizon(family)?, duration: study::duration(run) }))
+}
+
+/// The Kepler study on a Kepler scene: the study and scene share `a = mu = 1`.
+fn kepler_adapter(
+    value: &serde_json::Value,
+    run: &RunDefaults,
+    family: &Family,
+) -> Result<Box<dyn StudyAdapter>, String> {
+    let _: KeplerParams = params(value).map_err(study::unreadable)?;
+    Ok(Box::new(OdeAdapter { unit: 1.0, horizon: study::horizon(family)?, duration: study::duration(run) }))
+}
+
+/// The state a scene's frame shows.
+fn state_of(scene: &dyn DynScene) -> State {
+    let mut frame = Frame::default();
+    scene.frame(&mut frame);
+    let v = frame.field("velocity").map(|f| f.values.clone()).unwrap_or_default();
+    State { t: frame.time, x: frame.points, v }
+}
+
+fn oscillator_table_error(value: &serde_json::Value, scene: &dyn DynScene, _: Option<f64>) -> Option<f64> {
+    oscillator_error(&params(value).ok()?, &state_of(scene))
+}
+
+fn kepler_table_error(value: &serde_json::Value, scene: &dyn DynScene, _: Option<f64>) -> Option<f64> {
+    kepler_error(&params(value).ok()?, &state_of(scene))
+}
+
+/// The oscillator study's error of `state`: `|(x - x_e, (v - v_e)/omega)| / |(x0, v0/omega)|`
+/// against the exact solution (`None` for an empty state).
+#[must_use]
+pub fn oscillator_error(p: &OscillatorParams, state: &State) -> Option<f64> {
+    let omega = (p.stiffness / p.mass).sqrt();
+    let (xe, ve) = HarmonicOscillator::damped(p.mass, p.stiffness, p.damping).exact(p.x0, p.v0, state.t);
+    let scale = p.x0.hypot(p.v0 / omega);
+    let (dx, dv) = (state.x.first()? - xe, (state.v.first()? - ve) / omega);
+    Some(dx.hypot(dv) / scale.max(f64::MIN_POSITIVE))
+}
+
+/// The Kepler study's error of `state`: `|x - x_e|` against Kepler's equation (`None` for a
+/// state of fewer than two coordinates).
+#[must_use]
+pub fn kepler_error(p: &KeplerParams, state: &State) -> Option<f64> {
+    let (xe, _) = KeplerOrbit::ellipse(p.eccentricity).exact(state.t);
+    Some((state.x.first()? - xe[0]).hypot(state.x.get(1)? - xe[1]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -363,5 +467,44 @@ mod tests {
         let p = serde_json::json!({ "eccentricity": 1.0, "integrator": "rk4" });
         let err = (k.build)(&p, &BuildContext::default()).err().expect("refused");
         assert_eq!(err.to_string(), "field `eccentricity`: must lie in [0, 1), got 1");
+    }
+    #[test]
+    fn the_ode_error_is_zero_on_the_exact_solution() {
+        // Independent of the runner: the exact state at t gives zero, a shifted one its shift.
+        let p: OscillatorParams = params(&oscillator_presets()[0].params).expect("params");
+        let (xe, ve) = HarmonicOscillator::damped(p.mass, p.stiffness, p.damping).exact(p.x0, p.v0, 0.7);
+        let mut s = State::new(vec![xe], vec![ve]);
+        s.t = 0.7;
+        assert_eq!(oscillator_error(&p, &s), Some(0.0));
+        s.x[0] += 1e-3;
+        let e = oscillator_error(&p, &s).expect("an error");
+        assert!((e - 1e-3 / p.x0.hypot(p.v0 / (p.stiffness / p.mass).sqrt())).abs() < 1e-15);
+        let k: KeplerParams = params(&kepler_presets()[0].params).expect("params");
+        let (xe, ve) = KeplerOrbit::ellipse(0.5).exact(1.3);
+        let mut s = State::new(xe.to_vec(), ve.to_vec());
+        s.t = 1.3;
+        assert_eq!(kepler_error(&k, &s), Some(0.0));
+    }
+
+    #[test]
+    fn the_oscillator_step_is_in_units_of_one_over_omega_and_shrinks_over_long_runs() {
+        let f = study::family("o", "harmonic-oscillator", Some(100.0), &[], &[]);
+        let p = oscillator_presets().remove(0);
+        let adapter = (KINDS[0].tolerance.expect("mapped").adapter)(&p.params, &p.run, &f).expect("adapter");
+        let pt = Point { param: 0.5, seconds: 1e-5, error: 1e-3 };
+        // k = 40, m = 1: omega = sqrt(40); 1000 steps of 0.01 s = 63 time units, inside 100.
+        let c = adapter.candidate("rk4", &pt).expect("runs");
+        assert_eq!(c.dt, Some(0.5 / 40f64.sqrt()));
+        assert_eq!(c.summary, "integrator = rk4");
+        assert_eq!(c.note, format!("1/omega = {:.4}", 1.0 / 40f64.sqrt()));
+        // Kepler: a 20 s run against a horizon of 5 shrinks RK4's step by (1/4)^(1/2).
+        let f = study::family("k", "kepler-orbit", Some(5.0), &[], &[]);
+        let p = kepler_presets().remove(0);
+        let adapter = (KINDS[1].tolerance.expect("mapped").adapter)(&p.params, &p.run, &f).expect("adapter");
+        let c = adapter.candidate("rk4", &Point { param: 0.1, ..pt }).expect("runs");
+        assert!((c.dt.expect("a step") - 0.05).abs() < 1e-15);
+        assert!((c.cost - 2.0).abs() < 1e-12);
+        assert_eq!(adapter.candidate("rk5", &pt).unwrap_err(), "`rk5` is not a method this build knows");
+        assert_eq!(integrator("velocity-verlet"), Some(IntegratorKind::VelocityVerlet));
     }
 }

@@ -342,3 +342,77 @@ fn mac_settings_reach_the_solver() {
         (PressureMethod::Mgpcg, 1e-8, 1000, Advection::Bfecc)
     );
 }
+
+#[test]
+fn labels_of_the_pressure_study_parse_back() {
+    assert_eq!(pressure_label("rb-gauss-seidel N=256"), Some((PressureMethod::RedBlackGaussSeidel, 256)));
+    assert_eq!(pressure_label("mgpcg N=64"), Some((PressureMethod::Mgpcg, 64)));
+    assert_eq!(pressure_label("sor N=64"), None);
+}
+
+#[test]
+fn the_ghia_error_of_a_cavity_at_rest_is_ghias_largest_interior_speed() {
+    // At rest every sampled velocity is 0 (Ghia's points lie more than half a cell from the lid
+    // at N = 128), so the error is the largest |u| or |v| of Ghia et al. (1982), Table I/II at
+    // Re = 100: u = 0.84123 at y = 0.9766.
+    let scene = scenes::lid_driven_cavity(128, 100.0, Advection::MacCormack).unwrap();
+    let FluidSim::Mac(fluid, state) = &scene.sim else { panic!("a MAC scene") };
+    assert!((ghia_error(fluid, state) - 0.84123).abs() < 1e-12);
+}
+
+fn tolerance_family(
+    study: &str,
+    scene: &str,
+    problem: &[(&str, f64)],
+    series: &[&str],
+) -> anim_core::scene::study::Family {
+    let series: Vec<(&str, Vec<Point>)> = series.iter().map(|m| (*m, Vec::new())).collect();
+    anim_core::scene::study::family(study, scene, None, problem, &series)
+}
+
+#[test]
+fn the_cavity_takes_the_studys_resolution_and_pressure_solver_at_a_step_of_one_cell() {
+    let f = tolerance_family(
+        "fluid_cavity_ghia",
+        "fluid/lid-driven-cavity",
+        &[("pressure_tolerance", 1e-5)],
+        &[],
+    );
+    let p = preset("lid-driven-cavity");
+    let adapter = (KIND.tolerance.expect("mapped").adapter)(&p.params, &p.run, &f).expect("adapter");
+    let c = adapter.candidate("mgpcg", &Point { param: 32.0, seconds: 0.3, error: 0.02 }).expect("runs");
+    assert_eq!(c.summary, "resolution = 32, pressure_solver = mgpcg, pressure_tolerance = 1e-5");
+    assert_eq!(c.settings.get("resolution"), Some(&json!(32)));
+    assert_eq!(c.settings.get("pressure_solver"), Some(&json!("mgpcg")));
+    assert_eq!(c.dt, Some(1.0 / 32.0));
+    assert_eq!(
+        adapter.candidate("sor", &Point { param: 32.0, seconds: 0.3, error: 0.02 }).unwrap_err(),
+        "`sor` is not a method this build knows"
+    );
+    // A scene that sets the advection or the splitting is refused.
+    let mut changed = p.params.clone();
+    changed["splitting"] = json!("reflection");
+    let e = (KIND.tolerance.expect("mapped").adapter)(&changed, &p.run, &f).err().expect("refused");
+    assert_eq!(
+        e,
+        "sets `splitting`, but the fluid_cavity_ghia study measured the preset's own; remove the field or --tolerance"
+    );
+}
+
+#[test]
+fn the_smoke_plume_takes_the_series_measured_at_the_nearest_grid() {
+    let f =
+        tolerance_family("fluid_pressure_divergence", "fluid/smoke-plume-3d", &[], &["cg N=64", "cg N=256"]);
+    let p = preset("smoke-plume-3d");
+    let adapter = (KIND.tolerance.expect("mapped").adapter)(&p.params, &p.run, &f).expect("adapter");
+    let pt = Point { param: 1e-5, seconds: 1e-4, error: 9e-6 };
+    // 32 x 48 x 32 cells: the largest side, 48, is nearest N = 64 (log scale).
+    assert_eq!(
+        adapter.candidate("cg N=256", &pt).unwrap_err(),
+        "measured at N = 256; the scene's grid (48 cells) is nearest N = 64"
+    );
+    let c = adapter.candidate("cg N=64", &pt).expect("runs");
+    assert_eq!(c.summary, "pressure_solver = cg, pressure_tolerance = 1e-5");
+    assert_eq!(c.dt, None);
+    assert!(!c.settings.contains_key("resolution"));
+}

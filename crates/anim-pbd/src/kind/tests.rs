@@ -286,3 +286,43 @@ fn bad_parameters_name_their_field() {
     let msg = build_err(&serde_json::json!({ "preset": "flag", "iterations": -1 }));
     assert!(msg.contains("-1"), "{msg}");
 }
+
+#[test]
+fn labels_of_the_pbd_studies_parse_back() {
+    // The PBD studies write `format!("{method:?} ...")`.
+    for m in [Method::Pbd, Method::Xpbd] {
+        assert_eq!(pbd_label(&format!("{m:?} substeps (1 iteration)")), Some((m, true)));
+        assert_eq!(pbd_label(&format!("{m:?} iterations (1 substep)")), Some((m, false)));
+    }
+    for bad in ["Xpbd", "Xpbd substeps", "Jacobi substeps (1 iteration)", "xpbd substeps (1 iteration)"] {
+        assert_eq!(pbd_label(bad), None, "{bad}");
+    }
+}
+
+#[test]
+fn the_hanging_cloth_scales_the_studys_counts_by_its_side_and_length() {
+    use anim_core::scene::study::{Point, family};
+    let f =
+        family("pbd-cloth-position", "pbd/hanging-cloth", Some(0.5), &[("n", 8.0), ("dt", 1.0 / 60.0)], &[]);
+    let p = (KIND.presets)().into_iter().find(|p| p.name == "pbd-cloth").expect("preset");
+    let adapter = (KIND.tolerance.expect("mapped").adapter)(&p.params, &p.run, &f).expect("adapter");
+    let pt = Point { param: 4.0, seconds: 1e-3, error: 1e-3 };
+    // The preset's cloth is 14 x 14 against the study's 8 x 8: counts scale by 14 / 8 = 1.75.
+    let c = adapter.candidate("Xpbd iterations (1 substep)", &pt).expect("runs");
+    assert_eq!(c.summary, "method = xpbd, iterations = 7, substeps = 1");
+    assert_eq!(c.settings.get("method"), Some(&serde_json::json!("xpbd")));
+    assert_eq!(c.dt, Some(1.0 / 60.0));
+    assert!((c.cost - 7.0 / 4.0).abs() < 1e-12);
+    // Twice the study's length: iterations are left out, substeps grow by 2^2 = 4.
+    let mut long = p.run;
+    long.frames = 60;
+    let adapter = (KIND.tolerance.expect("mapped").adapter)(&p.params, &long, &f).expect("adapter");
+    assert!(
+        adapter
+            .candidate("Xpbd iterations (1 substep)", &pt)
+            .unwrap_err()
+            .starts_with("swept iterations at one substep")
+    );
+    let c = adapter.candidate("Xpbd substeps (1 iteration)", &pt).expect("runs");
+    assert_eq!(c.summary, "method = xpbd, iterations = 1, substeps = 28");
+}
