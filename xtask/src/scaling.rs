@@ -196,10 +196,10 @@ pub struct Row {
     pub scene: String,
     pub threads: usize,
     /// Seconds per step (NaN when the run failed).
-    #[serde(with = "crate::report_data::float")]
+    #[serde(with = "anim_core::cases::float")]
     pub seconds: f64,
     /// Speed-up over the one-thread run of the same scene.
-    #[serde(with = "crate::report_data::float")]
+    #[serde(with = "anim_core::cases::float")]
     pub speedup: f64,
     /// Whether the state after the first steps equals the one-thread state bit for bit.
     pub identical: Option<bool>,

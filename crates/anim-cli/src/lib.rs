@@ -2,7 +2,7 @@
 //!
 //! The library behind the `anim` command: scene files ([`scene`]: TOML naming a registered scene
 //! kind and its parameters, checked by the crate that implements it; the built-in scenes are the
-//! registered presets of `anim::KINDS`), the method picked for a stated accuracy ([`tolerance`]:
+//! registered presets of `anim::CRATES`), the method picked for a stated accuracy ([`tolerance`]:
 //! the report's measured cheapest-method table, embedded), and how a run is drawn and written
 //! ([`view`]: frame files and previews from a scene's `Context` and `Frame`s). The binary adds
 //! the command line, the run loop, the writer thread and the checkpoint files. No crate is named

@@ -75,7 +75,7 @@ fn main() -> ExitCode {
     };
     match cli.command {
         Command::List(args) if args.kinds => {
-            for k in &anim::KINDS {
+            for k in anim::kinds() {
                 println!("{:<20} {:<13} {}", k.kind, k.crate_name, k.summary);
             }
             ExitCode::SUCCESS

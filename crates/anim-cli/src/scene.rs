@@ -157,7 +157,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
     })?;
     validate(&scene).map_err(|(field, message)| SceneError::invalid(path, field, message))?;
     if scene.scene.registered().is_none() {
-        let kinds: Vec<&str> = anim::KINDS.iter().map(|k| k.kind).collect();
+        let kinds: Vec<&str> = anim::kinds().map(|k| k.kind).collect();
         let at = scene_table(text).and_then(|s| field_offset(text, s, "kind")).unwrap_or(0);
         let (line, column) = line_col(text, at);
         return Err(SceneError::Parse {

@@ -259,7 +259,7 @@ fn the_kinds_are_listed_and_any_parameter_can_be_set_from_the_command_line() {
     let out = Command::new(env!("CARGO_BIN_EXE_anim")).args(["list", "--kinds"]).output().unwrap();
     assert!(out.status.success());
     let list = String::from_utf8_lossy(&out.stdout);
-    for kind in anim::KINDS {
+    for kind in anim::kinds() {
         assert!(list.lines().any(|l| l.starts_with(kind.kind) && l.contains(kind.crate_name)), "{list}");
     }
     let dir = temp("set");

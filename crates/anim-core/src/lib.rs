@@ -33,6 +33,8 @@
 
 pub mod alloc_count;
 pub mod bspline;
+#[cfg(feature = "cases")]
+pub mod cases;
 pub mod diagnostics;
 pub mod integrate;
 pub mod lie;

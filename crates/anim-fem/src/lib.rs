@@ -77,6 +77,8 @@
 
 pub mod assembly;
 pub mod boundary;
+#[cfg(feature = "cases")]
+pub mod cases;
 pub mod element;
 pub mod error;
 pub mod friction;

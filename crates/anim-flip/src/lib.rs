@@ -90,6 +90,8 @@
 //! # Ok::<(), anim_flip::FlipError>(())
 //! ```
 
+#[cfg(feature = "cases")]
+pub mod cases;
 pub mod classify;
 pub mod error;
 pub mod kind;

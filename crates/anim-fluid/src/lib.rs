@@ -153,6 +153,8 @@
 //! ```
 
 pub mod advection;
+#[cfg(feature = "cases")]
+pub mod cases;
 pub mod error;
 pub mod kind;
 pub mod mac;

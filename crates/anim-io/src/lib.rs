@@ -59,6 +59,8 @@
 //! # }
 //! ```
 
+#[cfg(feature = "cases")]
+pub mod cases;
 pub mod checkpoint;
 mod data;
 mod error;

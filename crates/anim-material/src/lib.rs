@@ -79,6 +79,8 @@
 
 pub use nalgebra;
 
+#[cfg(feature = "cases")]
+pub mod cases;
 pub mod decomposition;
 mod lame;
 pub mod models;

@@ -114,6 +114,8 @@
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 pub mod boundary;
+#[cfg(feature = "cases")]
+pub mod cases;
 mod grid;
 pub mod hencky;
 pub mod kernel;

@@ -161,6 +161,8 @@
 //! Fedkiw, "Simulation of clothing with folds and wrinkles", 2003 (dihedral gradients).
 
 mod build;
+#[cfg(feature = "cases")]
+pub mod cases;
 pub mod collide;
 pub mod constraint;
 pub mod kind;

@@ -146,6 +146,8 @@
 //! `examples/panda_fk_ik.rs` does the same on the Franka Panda and the UR5 (analytic IK, all
 //! eight solutions).
 
+#[cfg(feature = "cases")]
+pub mod cases;
 pub mod config;
 pub mod data;
 pub mod dense;

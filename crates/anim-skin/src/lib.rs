@@ -68,6 +68,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+#[cfg(feature = "cases")]
+pub mod cases;
 pub mod character;
 pub mod clip;
 pub mod gltf_io;

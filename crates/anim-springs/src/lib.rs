@@ -128,6 +128,8 @@
 
 pub mod analytic;
 mod build;
+#[cfg(feature = "cases")]
+pub mod cases;
 pub mod contact;
 mod error;
 mod geom;

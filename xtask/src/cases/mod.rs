@@ -15,9 +15,10 @@ pub mod skin;
 pub mod soak;
 pub mod springs;
 
-/// The registry of every crate's cases.
+/// The registry of every crate's cases: what each crate registers itself (`anim::cases()`), then
+/// the cases still kept here, then the suites that run on every registered preset.
 pub fn all() -> crate::registry::Registry {
-    let mut r = crate::registry::Registry::default();
+    let mut r = anim::cases();
     self::core::register(&mut r);
     io::register(&mut r);
     springs::register(&mut r);
@@ -30,6 +31,7 @@ pub fn all() -> crate::registry::Registry {
     fluid::register(&mut r);
     flip::register(&mut r);
     determinism::register(&mut r);
+    soak::register(&mut r);
     presets::register(&mut r);
     r
 }

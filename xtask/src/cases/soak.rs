@@ -3,11 +3,11 @@
 //! time stepping of its own (its models run inside the FEM and MPM soaks); anim-io has none.
 
 use crate::registry::fmt_num;
-use crate::soak::{Budget, Soak, SoakCase, drive, finish, rejected};
+use crate::registry::{Budget, Soak, SoakCase, drive, finish, rejected};
 
-/// Every soak case, in crate order.
-pub fn cases() -> Vec<SoakCase> {
-    vec![
+/// Registers the soak cases, in crate order.
+pub fn register(r: &mut crate::registry::Registry) {
+    r.soak.extend([
         SoakCase {
             crate_name: "anim-core",
             name: "Kepler orbit e = 0.9, velocity Verlet, 2000 steps per orbit",
@@ -56,7 +56,7 @@ pub fn cases() -> Vec<SoakCase> {
             bound: "every pose identical to its first cycle, bit for bit; volume within 2% of rest",
             run: skin_loop,
         },
-    ]
+    ]);
 }
 
 /// Energy-stride shared by the cases.

@@ -1,0 +1,248 @@
+//! Conformance checks, hard cases, soak runs and work-precision studies: the types every crate's
+//! `cases` feature registers and `cargo xtask` runs (feature `cases`).
+//!
+//! A crate exports `pub fn register(r: &mut Registry)` from its own `cases` module; its tests run
+//! the cases in quick mode and `cargo xtask conformance`, `stability` and `report` run them from
+//! the workspace registry, so a check lives in one place and is run by both.
+
+pub mod float;
+mod soak;
+
+pub use soak::{Budget, Clock, Soak, SoakCase, drive, finish, rejected};
+
+use std::time::Instant;
+
+/// Options every case receives.
+#[derive(Debug, Clone, Copy)]
+pub struct Ctx {
+    /// Smaller sweeps for CI (`--quick`).
+    pub quick: bool,
+}
+
+/// How a measured value is judged against its reference.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum Judge {
+    /// Pass when `|measured - reference| <= tolerance`.
+    Near,
+    /// Pass when `measured <= tolerance` (an error that must be small; reference is informative).
+    AtMost,
+    /// Pass when `measured >= tolerance`.
+    AtLeast,
+}
+
+/// One conformance measurement with its verdict.
+#[derive(Debug, Clone)]
+pub struct Check {
+    /// The crate the check belongs to (`anim-fem`).
+    pub crate_name: &'static str,
+    /// The reference problem.
+    pub case: String,
+    /// What is measured.
+    pub metric: String,
+    /// The measured value.
+    pub measured: f64,
+    /// The reference value.
+    pub reference: f64,
+    /// The tolerance, read according to `judge`.
+    pub tolerance: f64,
+    /// How `measured` is judged.
+    pub judge: Judge,
+    /// Where the reference comes from.
+    pub source: &'static str,
+}
+
+impl Check {
+    /// Whether the measurement is finite and meets its rule.
+    pub fn passed(&self) -> bool {
+        if !self.measured.is_finite() {
+            return false;
+        }
+        match self.judge {
+            Judge::Near => (self.measured - self.reference).abs() <= self.tolerance,
+            Judge::AtMost => self.measured <= self.tolerance,
+            Judge::AtLeast => self.measured >= self.tolerance,
+        }
+    }
+
+    /// The rule in words, for tables.
+    pub fn rule(&self) -> String {
+        match self.judge {
+            Judge::Near => format!("|m - {}| <= {}", fmt_num(self.reference), fmt_num(self.tolerance)),
+            Judge::AtMost => format!("<= {}", fmt_num(self.tolerance)),
+            Judge::AtLeast => format!(">= {}", fmt_num(self.tolerance)),
+        }
+    }
+}
+
+/// How a conformance case runs: a plain function for a crate's reference problem, or a closure
+/// over the preset it checks for the suites that run on every registered preset.
+pub type CaseFn = Box<dyn Fn(&Ctx) -> Vec<Check> + Send + Sync>;
+
+/// A conformance case: one reference problem, several checks.
+pub struct ConformanceCase {
+    /// The crate.
+    pub crate_name: &'static str,
+    /// The case's name.
+    pub name: &'static str,
+    /// Runs the case.
+    pub run: CaseFn,
+}
+
+/// What a hard case did.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum Outcome {
+    /// Ran to the end within its bounds.
+    Stable(String),
+    /// Diverged and the divergence was detected and reported (never a silent NaN).
+    Diverged(String),
+    /// Refused up front with a clear error.
+    Rejected(String),
+}
+
+impl Outcome {
+    /// The outcome's kind in words.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Outcome::Stable(_) => "stable",
+            Outcome::Diverged(_) => "diverged (detected)",
+            Outcome::Rejected(_) => "rejected",
+        }
+    }
+
+    /// The detail text.
+    pub fn detail(&self) -> &str {
+        match self {
+            Outcome::Stable(s) | Outcome::Diverged(s) | Outcome::Rejected(s) => s,
+        }
+    }
+
+    /// Whether this outcome is of the same kind as `other`.
+    pub fn same_kind(&self, other: &Outcome) -> bool {
+        std::mem::discriminant(self) == std::mem::discriminant(other)
+    }
+}
+
+/// A named hard case with the outcome it is expected to have.
+pub struct StabilityCase {
+    /// The crate.
+    pub crate_name: &'static str,
+    /// The case's name.
+    pub name: &'static str,
+    /// Expected outcome kind (the detail text is ignored).
+    pub expected: fn() -> Outcome,
+    /// Runs the case.
+    pub run: fn(&Ctx) -> Outcome,
+}
+
+/// One point of a work-precision curve.
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
+pub struct Point {
+    /// The swept parameter (time step, resolution, iterations).
+    #[serde(with = "crate::cases::float")]
+    pub param: f64,
+    /// Median wall time of one run, seconds.
+    #[serde(with = "crate::cases::float")]
+    pub seconds: f64,
+    /// Error against the reference.
+    #[serde(with = "crate::cases::float")]
+    pub error: f64,
+}
+
+/// One method's curve.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct Series {
+    /// The method.
+    pub label: String,
+    /// The curve, in sweep order.
+    pub points: Vec<Point>,
+}
+
+/// A work-precision study: error against wall time for several methods on one problem.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct StudyResult {
+    /// Title.
+    pub title: String,
+    /// File stem for the SVG and table.
+    pub slug: String,
+    /// What the error measures.
+    pub error_label: String,
+    /// What the swept parameter is.
+    pub param_label: String,
+    /// One curve per method.
+    pub series: Vec<Series>,
+}
+
+/// A registered work-precision study.
+pub struct Study {
+    /// The crate.
+    pub crate_name: &'static str,
+    /// The study's name.
+    pub name: &'static str,
+    /// Runs the study.
+    pub run: fn(&Ctx) -> StudyResult,
+}
+
+/// Everything registered.
+#[derive(Default)]
+pub struct Registry {
+    /// Conformance cases.
+    pub conformance: Vec<ConformanceCase>,
+    /// Hard cases.
+    pub stability: Vec<StabilityCase>,
+    /// Work-precision studies.
+    pub studies: Vec<Study>,
+    /// Soak runs.
+    pub soak: Vec<SoakCase>,
+}
+
+/// Median wall time of `f`, in seconds: repeats `f` in batches until each batch lasts at least
+/// `min_batch` seconds, over `batches` batches.
+pub fn median_seconds(batches: usize, min_batch: f64, mut f: impl FnMut()) -> f64 {
+    // Calibrate the repeat count on one call.
+    let start = Instant::now();
+    f();
+    let once = start.elapsed().as_secs_f64().max(1e-9);
+    let reps = ((min_batch / once).ceil() as usize).clamp(1, 1_000_000);
+    let mut times: Vec<f64> = (0..batches)
+        .map(|_| {
+            let start = Instant::now();
+            for _ in 0..reps {
+                f();
+            }
+            start.elapsed().as_secs_f64() / reps as f64
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
+}
+
+/// A duration for tables: `us`, `ms` or `s` with two decimals; `-` when not finite.
+pub fn seconds(s: f64) -> String {
+    if !s.is_finite() {
+        return "-".into();
+    }
+    if s < 1e-3 {
+        format!("{:.2} us", s * 1e6)
+    } else if s < 1.0 {
+        format!("{:.2} ms", s * 1e3)
+    } else {
+        format!("{s:.2} s")
+    }
+}
+
+/// Formats a number compactly for tables.
+pub fn fmt_num(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else if !x.is_finite() {
+        format!("{x}")
+    } else if x.abs() >= 1e-3 && x.abs() < 1e4 {
+        let s = format!("{x:.4}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
+/// Registers anim-core's own cases (its integrators, Lie groups and linear algebra).
+pub fn register(_r: &mut Registry) {}
