@@ -131,7 +131,7 @@ mod tests {
             assert!(p.params.is_object() && p.params.get("kind").is_none(), "{}", p.name);
             assert!(!p.description.is_empty(), "{}", p.name);
         }
-        for k in kinds() {
+        for k in super::kinds() {
             assert!(k.crate_name.starts_with("anim-"), "{}", k.kind);
             assert!(!(k.presets)().is_empty(), "{} has no preset", k.kind);
         }
