@@ -246,3 +246,69 @@ pub fn fmt_num(x: f64) -> String {
 
 /// Registers anim-core's own cases (its integrators, Lie groups and linear algebra).
 pub fn register(_r: &mut Registry) {}
+
+/// Runs every conformance and stability case that `register` registers, in quick mode, and
+/// returns one line per failed check or unexpected outcome (empty when everything passes): what
+/// a crate's `tests/cases.rs` asserts.
+///
+/// ```
+/// use anim_core::cases::{Check, ConformanceCase, Judge, Registry, quick_failures};
+///
+/// fn register(r: &mut Registry) {
+///     r.conformance.push(ConformanceCase {
+///         crate_name: "anim-core",
+///         name: "one plus one",
+///         run: Box::new(|_| {
+///             vec![Check {
+///                 crate_name: "anim-core",
+///                 case: "one plus one".into(),
+///                 metric: "sum".into(),
+///                 measured: 1.0 + 1.0,
+///                 reference: 2.0,
+///                 tolerance: 0.0,
+///                 judge: Judge::Near,
+///                 source: "arithmetic",
+///             }]
+///         }),
+///     });
+/// }
+/// assert!(quick_failures(register).is_empty());
+/// ```
+#[must_use]
+pub fn quick_failures(register: fn(&mut Registry)) -> Vec<String> {
+    let mut r = Registry::default();
+    register(&mut r);
+    let ctx = Ctx { quick: true };
+    let mut failures = Vec::new();
+    for case in &r.conformance {
+        let checks = (case.run)(&ctx);
+        if checks.is_empty() {
+            failures.push(format!("{} / {}: no checks", case.crate_name, case.name));
+        }
+        for c in checks.iter().filter(|c| !c.passed()) {
+            failures.push(format!(
+                "{} / {} / {}: measured {} against {} ({})",
+                c.crate_name,
+                c.case,
+                c.metric,
+                fmt_num(c.measured),
+                c.rule(),
+                c.source
+            ));
+        }
+    }
+    for case in &r.stability {
+        let (expected, got) = ((case.expected)(), (case.run)(&ctx));
+        if !got.same_kind(&expected) {
+            failures.push(format!(
+                "{} / {}: expected {}, got {}: {}",
+                case.crate_name,
+                case.name,
+                expected.kind(),
+                got.kind(),
+                got.detail()
+            ));
+        }
+    }
+    failures
+}
