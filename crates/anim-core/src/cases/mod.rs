@@ -7,8 +7,10 @@
 
 pub mod float;
 mod soak;
+mod threads;
 
 pub use soak::{Budget, Clock, Soak, SoakCase, drive, finish, rejected};
+pub use threads::{across_threads, differing_bits};
 
 use std::time::Instant;
 
