@@ -6,7 +6,6 @@ pub mod fem;
 pub mod flip;
 pub mod fluid;
 pub mod io;
-pub mod material;
 pub mod mpm;
 pub mod pbd;
 pub mod presets;
@@ -25,7 +24,6 @@ pub fn all() -> crate::registry::Registry {
     rigid::register(&mut r);
     pbd::register(&mut r);
     skin::register(&mut r);
-    material::register(&mut r);
     fem::register(&mut r);
     mpm::register(&mut r);
     fluid::register(&mut r);
