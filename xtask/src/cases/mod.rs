@@ -5,7 +5,6 @@ pub mod determinism;
 pub mod fem;
 pub mod flip;
 pub mod fluid;
-pub mod io;
 pub mod mpm;
 pub mod pbd;
 pub mod presets;
@@ -19,7 +18,6 @@ pub mod springs;
 pub fn all() -> crate::registry::Registry {
     let mut r = anim::cases();
     self::core::register(&mut r);
-    io::register(&mut r);
     springs::register(&mut r);
     rigid::register(&mut r);
     pbd::register(&mut r);
