@@ -2,7 +2,6 @@
 
 pub mod core;
 pub mod determinism;
-pub mod fem;
 pub mod flip;
 pub mod fluid;
 pub mod mpm;
@@ -22,7 +21,6 @@ pub fn all() -> crate::registry::Registry {
     rigid::register(&mut r);
     pbd::register(&mut r);
     skin::register(&mut r);
-    fem::register(&mut r);
     mpm::register(&mut r);
     fluid::register(&mut r);
     flip::register(&mut r);
