@@ -4,7 +4,6 @@ pub mod core;
 pub mod determinism;
 pub mod flip;
 pub mod fluid;
-pub mod mpm;
 pub mod pbd;
 pub mod presets;
 pub mod rigid;
@@ -21,7 +20,6 @@ pub fn all() -> crate::registry::Registry {
     rigid::register(&mut r);
     pbd::register(&mut r);
     skin::register(&mut r);
-    mpm::register(&mut r);
     fluid::register(&mut r);
     flip::register(&mut r);
     determinism::register(&mut r);
