@@ -77,7 +77,7 @@ pub const SCENE_FAMILIES: [SceneFamily; 8] = [
         study: "fem-beam",
         scene: "fem/cantilever-beam",
         horizon: Some(0.5),
-        problem: crate::cases::fem::study_problem,
+        problem: anim_fem::cases::study_problem,
     },
     SceneFamily {
         study: "fluid_cavity_ghia",

@@ -29,11 +29,6 @@ pub fn register(r: &mut Registry) {
         run: Box::new(rigid_panda),
     });
     r.conformance.push(ConformanceCase {
-        crate_name: "anim-fem",
-        name: "determinism: benchmark beam (backward Euler) on 1, 2, 4 threads",
-        run: Box::new(fem_beam),
-    });
-    r.conformance.push(ConformanceCase {
         crate_name: "anim-skin",
         name: "determinism: twisted cylinder (LBS and DQS) on 1, 2, 4 threads",
         run: Box::new(skin_cylinder),
@@ -108,21 +103,6 @@ fn rigid_panda(ctx: &Ctx) -> Vec<Check> {
             sim.step(&mut state, dt).map_err(|e| e.to_string())?;
         }
         Ok(state.q.iter().chain(&state.v).copied().collect())
-    })
-}
-
-fn fem_beam(ctx: &Ctx) -> Vec<Check> {
-    // CI: 14 x 2 x 2 cells (336 tetrahedra), element loops split into parallel chunks; the full
-    // suite: 50 x 8 x 8 (19,200), where the gather into nodes runs in parallel too.
-    let (cells, steps) = if ctx.quick { (14, 3) } else { (50, 5) };
-    across_threads("anim-fem", &format!("benchmark beam, {cells} cells along"), || {
-        let scene = anim_fem::scenes::benchmark_beam(cells).map_err(|e| e.to_string())?;
-        let dt = scene.dt;
-        let (mut sim, mut state) = scene.into_simulation().map_err(|e| e.to_string())?;
-        for _ in 0..steps {
-            sim.step(&mut state, dt).map_err(|e| e.to_string())?;
-        }
-        Ok(flat(&state))
     })
 }
 

@@ -2,12 +2,11 @@
 //! fluid volume over 10 s of sloshing, divergence after every projection against the solver
 //! tolerance, angular momentum of a rotating disk over the transfers (APIC keeps it, PIC does
 //! not), and the 2D dam-break surge front against Martin & Moyce (1952) (the table of
-//! [`super::mpm`]). Hard cases: CFL 10 (large steps split into adaptive substeps) and particles
+//! [`anim_mpm::cases`]). Hard cases: CFL 10 (large steps split into adaptive substeps) and particles
 //! driven into an obstacle (pushed out, counted). Study: the dam break's surge-front error
 //! against wall time for PIC, FLIP and APIC and for anim-mpm's weakly compressible fluid, each at
 //! several resolutions.
 
-use super::mpm::{MARTIN_MOYCE, front_errors, shifted_errors};
 use crate::registry::{
     Check, ConformanceCase, Ctx, Judge, Outcome, Point, Registry, Series, StabilityCase, Study, StudyResult,
     fmt_num,
@@ -16,6 +15,7 @@ use anim_flip::{
     Contour, FlipError, FlipParams, FlipSimulation, ParticleSurface, Particles, Reseed, SurfaceParams,
     Transfer, scenes,
 };
+use anim_mpm::cases::{MARTIN_MOYCE, front_errors, shifted_errors};
 
 const CRATE: &str = "anim-flip";
 
@@ -348,7 +348,7 @@ fn dam_break(n: usize, transfer: Transfer, no_slip: bool) -> Result<SurgeFront, 
 /// experiment's 1.34 over `T = 2.83..3.33`). No-slip walls slow the front by a drag of one cell's
 /// width, which shrinks with the cell: FLIP 0.97 has 6.0% at 80 cells per metre but 12.8% at 160.
 /// anim-mpm's weakly compressible fluid (sticky walls) converges to the same lead (rms 5.6% at 128,
-/// 8.5% at 192 cells per axis, [`super::mpm`]). What slows the experiment's front (the gate,
+/// 8.5% at 192 cells per axis, [`anim_mpm::cases`]). What slows the experiment's front (the gate,
 /// friction on the floor and the side walls of a narrow tank, an aerated tip) is not modelled,
 /// and the table's readings come in steps of 0.11 in `Z` (a quarter inch), 10% of the first
 /// reading. `examples/dam_break.rs` in anim-flip prints these runs.
@@ -432,7 +432,7 @@ pub(crate) const DAM_BREAK_TOLERANCES: &[f64] = &[5e-2];
 
 /// The 2D dam break of [`dam_break_case`] (a = 0.2 m, no-slip walls, 2x2 particles per cell,
 /// steps of 2 ms split into CFL-1 substeps) with PIC, FLIP 0.97 and APIC, and the same column
-/// in anim-mpm's weakly compressible fluid (the scene of [`super::mpm`]'s study: sticky walls,
+/// in anim-mpm's weakly compressible fluid (the scene of [`anim_mpm::cases`]'s study: sticky walls,
 /// 2x2 particles per cell, c = 50 m/s), at several grid resolutions. Error: the rms relative
 /// surge-front error against Martin & Moyce (1952), the gated measure of both conformance cases;
 /// time: one run to T = 3.33 (t = 0.34 s).
@@ -458,7 +458,7 @@ fn dam_break_study(ctx: &Ctx) -> StudyResult {
     ] {
         let points = mpm_cells
             .iter()
-            .map(|&n| match super::mpm::dam_break(n, 2, transfer, anim_mpm::Kernel::Quadratic) {
+            .map(|&n| match anim_mpm::cases::dam_break(n, 2, transfer, anim_mpm::Kernel::Quadratic) {
                 Ok(r) => Point { param: n as f64, seconds: r.seconds, error: front_errors(&r.z).1 },
                 Err(_) => failed(n),
             })

@@ -2,12 +2,8 @@
 
 pub mod core;
 pub mod determinism;
-pub mod fem;
 pub mod flip;
 pub mod fluid;
-pub mod io;
-pub mod material;
-pub mod mpm;
 pub mod pbd;
 pub mod presets;
 pub mod rigid;
@@ -20,14 +16,10 @@ pub mod springs;
 pub fn all() -> crate::registry::Registry {
     let mut r = anim::cases();
     self::core::register(&mut r);
-    io::register(&mut r);
     springs::register(&mut r);
     rigid::register(&mut r);
     pbd::register(&mut r);
     skin::register(&mut r);
-    material::register(&mut r);
-    fem::register(&mut r);
-    mpm::register(&mut r);
     fluid::register(&mut r);
     flip::register(&mut r);
     determinism::register(&mut r);

@@ -3,33 +3,26 @@
 //! One case writes `.vtu` (base64 and ASCII, f64 and f32), `.vti` (2-D and 3-D, point and cell
 //! fields), a `.pvd` series, `.ply` (point attributes; triangles) and `.obj` files with anim-io's
 //! writers into a temporary folder, together with a JSON manifest of what was written, and runs
-//! `xtask/scripts/check_meshio.py`, which reads every file back with the Python `meshio` package
-//! (the `.vti` and `.pvd` XML with its own ElementTree/base64 decoder: meshio reads neither) and
-//! reports the largest difference per file. It also reads the committed Gmsh and TetGen test
+//! the crate's `scripts/check_meshio.py`, which reads every file back with the Python `meshio`
+//! package (the `.vti` and `.pvd` XML with its own ElementTree/base64 decoder: meshio reads
+//! neither) and reports the largest difference per file. It also reads the committed Gmsh and TetGen test
 //! files with meshio and compares them with what anim-io's readers return. Every comparison must
 //! be exact: the writers store f64 and f32 bit for bit.
 //!
 //! Without `python3` or `meshio` the case passes with a visible SKIPPED note in its metric; it
 //! never makes the suite fail for a missing tool (`pip install meshio` to run it).
 
-use crate::registry::{Check, ConformanceCase, Ctx, Judge, Registry};
-use anim_io::gmsh::read_gmsh;
-use anim_io::tetgen::read_tetgen;
-use anim_io::{DataArray, FrameFormat, FrameWriter, ImageData, UnstructuredGrid, VtkEncoding};
+use crate::gmsh::read_gmsh;
+use crate::tetgen::read_tetgen;
+use crate::{DataArray, FrameFormat, FrameWriter, ImageData, UnstructuredGrid, VtkEncoding};
+use anim_core::cases::{Check, Ctx, Judge};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const CRATE: &str = "anim-io";
-const SOURCE: &str = "meshio (Python) reading our files; meshio's readers on testdata/";
+use super::CRATE;
 
-pub fn register(r: &mut Registry) {
-    r.conformance.push(ConformanceCase {
-        crate_name: CRATE,
-        name: "VTK/PLY/OBJ written, read back by meshio",
-        run: Box::new(meshio_round_trip),
-    });
-}
+const SOURCE: &str = "meshio (Python) reading our files; meshio's readers on testdata/";
 
 /// A small tetrahedral block: `n^3` grid points, 6 tetrahedra per cube, slightly sheared so no
 /// coordinate is a round number.
@@ -69,12 +62,12 @@ fn flat3<T: Copy + Into<f64>>(v: &[[T; 3]]) -> Vec<f64> {
 }
 
 /// Writes every file and returns the manifest entries.
-fn write_all(dir: &Path) -> Result<Vec<Value>, anim_io::IoError> {
+fn write_all(dir: &Path) -> Result<Vec<Value>, crate::IoError> {
     let mut entries = Vec::new();
     let (pts, tets) = block(3);
     let n = pts.len();
     let tris: Vec<[usize; 3]> = {
-        let m = anim_io::TetMesh { positions: pts.clone(), tets: tets.clone() };
+        let m = crate::TetMesh { positions: pts.clone(), tets: tets.clone() };
         m.boundary_triangles()
     };
     let lines: Vec<[usize; 2]> = (0..n - 1).step_by(5).map(|i| [i, i + 1]).collect();
@@ -197,7 +190,7 @@ fn write_all(dir: &Path) -> Result<Vec<Value>, anim_io::IoError> {
     let ppos: Vec<[f32; 3]> = pts.iter().map(|p| p.map(|c| c as f32)).collect();
     let radius: Vec<f32> = (0..n).map(|i| 0.01 + i as f32 * 1e-4).collect();
     let ids: Vec<i32> = (0..n as i32).map(|i| i * 7 - 20).collect();
-    anim_io::ply::Ply::new(&ppos)
+    crate::ply::Ply::new(&ppos)
         .attribute("radius", &radius)
         .vector_attribute(["vx", "vy", "vz"], &vel)
         .attribute("id", &ids)
@@ -231,7 +224,7 @@ fn write_all(dir: &Path) -> Result<Vec<Value>, anim_io::IoError> {
     }));
 
     // OBJ: triangles and polylines (meshio reads the triangles; the script reads `l` itself).
-    anim_io::obj::write_obj(dir.join("surface.obj"), &pts, &tris, &lines)?;
+    crate::obj::write_obj(dir.join("surface.obj"), &pts, &tris, &lines)?;
     entries.push(json!({
         "name": "surface.obj", "kind": "mesh", "points": pts, "cells": [{ "type": "triangle", "data": tris }],
         "lines": lines, "point_data": {}, "cell_data": {},
@@ -240,7 +233,7 @@ fn write_all(dir: &Path) -> Result<Vec<Value>, anim_io::IoError> {
 }
 
 /// What anim-io's readers return for the committed Gmsh and TetGen files, for meshio to match.
-fn reader_entries(testdata: &Path) -> Result<Vec<Value>, anim_io::IoError> {
+fn reader_entries(testdata: &Path) -> Result<Vec<Value>, crate::IoError> {
     let mut out = Vec::new();
     for file in ["cube_v22.msh", "cube_v41.msh", "cube_meshio_v22.msh", "cube_meshio_v41.msh"] {
         let m = read_gmsh(testdata.join(file))?;
@@ -276,7 +269,7 @@ fn failure(why: String) -> Vec<Check> {
     vec![check("meshio round trip", format!("FAILED: {why}"), f64::INFINITY)]
 }
 
-fn meshio_round_trip(_ctx: &Ctx) -> Vec<Check> {
+pub(super) fn meshio_round_trip(_ctx: &Ctx) -> Vec<Check> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let dir = std::env::temp_dir().join(format!("anim-io-meshio-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -293,7 +286,7 @@ fn run_in(dir: &Path, root: &Path) -> Vec<Check> {
         Ok(e) => e,
         Err(e) => return failure(format!("writing: {e}")),
     };
-    match reader_entries(&root.join("../crates/anim-io/testdata")) {
+    match reader_entries(&root.join("testdata")) {
         Ok(e) => entries.extend(e),
         Err(e) => return failure(format!("reading testdata: {e}")),
     }

@@ -3,7 +3,7 @@
 
 Usage: check_meshio.py MANIFEST.json
 
-The manifest (written by `cargo xtask conformance`, case "VTK/PLY/OBJ written, read back by
+The manifest (written by anim-io's conformance case "VTK/PLY/OBJ written, read back by
 meshio") lists every file with its points, cells and fields. This script reads each file with
 meshio (an independent implementation of the formats), or, for .vti image data and .pvd
 collections which meshio does not read, with its own ElementTree + base64 decoder, and prints
