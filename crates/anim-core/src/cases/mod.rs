@@ -314,3 +314,23 @@ pub fn quick_failures(register: fn(&mut Registry)) -> Vec<String> {
     }
     failures
 }
+
+/// The test a crate's `cases` module declares with one line: every conformance and stability
+/// case of `register` passes in quick mode (see [`quick_failures`]).
+///
+/// `cargo xtask ci` skips this test in the debug test run (`--skip
+/// conformance_and_hard_cases_pass_in_quick_mode`) because its conformance and stability steps
+/// run the same cases right after, in release; `cargo test -p <crate> --features cases` runs it.
+#[macro_export]
+macro_rules! quick_cases_test {
+    ($register:path) => {
+        #[cfg(test)]
+        mod quick_cases {
+            #[test]
+            fn conformance_and_hard_cases_pass_in_quick_mode() {
+                let failures = $crate::cases::quick_failures($register);
+                assert!(failures.is_empty(), "{}", failures.join("\n"));
+            }
+        }
+    };
+}

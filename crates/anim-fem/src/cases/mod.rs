@@ -139,3 +139,5 @@ fn cantilever_dynamic(
     m.pin_vertices(&clamp)?;
     FemSimulation::new(m, FemParams::default())
 }
+
+anim_core::quick_cases_test!(crate::cases::register);

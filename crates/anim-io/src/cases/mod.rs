@@ -17,3 +17,5 @@ pub fn register(r: &mut Registry) {
         run: Box::new(meshio_round_trip),
     });
 }
+
+anim_core::quick_cases_test!(crate::cases::register);

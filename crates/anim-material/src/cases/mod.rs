@@ -208,3 +208,5 @@ impl<T: crate::Scalar, const D: usize> FlatVec for Tangent<T, D> {
         self.d.iter().flatten().flat_map(|m| m.iter().map(|x| x.to_f64_lossless())).collect()
     }
 }
+
+anim_core::quick_cases_test!(crate::cases::register);

@@ -111,3 +111,5 @@ pub fn register(r: &mut Registry) {
         run: soak::mpm_three_materials,
     });
 }
+
+anim_core::quick_cases_test!(crate::cases::register);
