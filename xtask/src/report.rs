@@ -58,13 +58,13 @@ pub const SCENE_FAMILIES: [SceneFamily; 8] = [
     SceneFamily {
         study: "core-oscillator",
         scene: "harmonic-oscillator",
-        horizon: Some(crate::cases::core::OSCILLATOR_HORIZON),
+        horizon: Some(anim_core::cases::core::OSCILLATOR_HORIZON),
         problem: no_problem,
     },
     SceneFamily {
         study: "core-kepler",
         scene: "kepler-orbit",
-        horizon: Some(crate::cases::core::KEPLER_HORIZON),
+        horizon: Some(anim_core::cases::core::KEPLER_HORIZON),
         problem: no_problem,
     },
     SceneFamily {
@@ -981,7 +981,7 @@ mod tests {
         assert_eq!(osc["study"], "core-oscillator");
         assert_eq!(osc["crate"], "anim-core");
         assert_eq!(osc["scene"], "harmonic-oscillator");
-        assert_eq!(osc["horizon"], crate::cases::core::OSCILLATOR_HORIZON);
+        assert_eq!(osc["horizon"], anim_core::cases::core::OSCILLATOR_HORIZON);
         assert_eq!(osc["param"], "dt");
         assert_eq!(families[1]["scene"], serde_json::Value::Null);
         let picks = osc["picks"].as_array().unwrap();

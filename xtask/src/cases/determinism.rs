@@ -3,16 +3,10 @@
 //! whose bits differ from the 1-thread run (must be 0).
 
 use crate::registry::{Check, ConformanceCase, Ctx, Registry, across_threads};
-use anim_core::integrate::systems::LinearChain;
-use anim_core::integrate::{IntegratorKind, State, study::advance};
+use anim_core::integrate::State;
 use anim_core::solver::Solver;
 
 pub fn register(r: &mut Registry) {
-    r.conformance.push(ConformanceCase {
-        crate_name: "anim-core",
-        name: "determinism: 40k-dof chain on 1, 2, 4 threads",
-        run: Box::new(core_chain),
-    });
     r.conformance.push(ConformanceCase {
         crate_name: "anim-springs",
         name: "determinism: 110 x 110 hanging cloth on 1, 2, 4 threads",
@@ -47,27 +41,6 @@ pub fn register(r: &mut Registry) {
 
 fn flat(state: &State) -> Vec<f64> {
     state.x.iter().chain(&state.v).copied().collect()
-}
-
-fn core_chain(ctx: &Ctx) -> Vec<Check> {
-    let steps = if ctx.quick { 20 } else { 200 };
-    let mut out = Vec::new();
-    for kind in
-        [IntegratorKind::SymplecticEuler, IntegratorKind::VelocityVerlet, IntegratorKind::ImplicitMidpoint]
-    {
-        out.extend(across_threads("anim-core", &format!("chain, {}", kind.label()), || {
-            // 40,000 unknowns: above the threshold of the chunked parallel update loops.
-            let mut sys = LinearChain::new(40_000, 0.01, 100.0, 0.01, 9.81);
-            let mut state = sys.rest_state();
-            for (i, v) in state.v.iter_mut().enumerate() {
-                *v = ((i % 13) as f64 - 6.0) * 1e-3;
-            }
-            let mut integ = kind.build(40_000);
-            advance(integ.as_mut(), &mut sys, &mut state, 1e-3, steps).map_err(|e| e.to_string())?;
-            Ok(flat(&state))
-        }));
-    }
-    out
 }
 
 fn springs_cloth(ctx: &Ctx) -> Vec<Check> {

@@ -1,6 +1,5 @@
 //! Cases per crate. Each module registers its conformance checks, hard cases and studies.
 
-pub mod core;
 pub mod determinism;
 pub mod fem;
 pub mod flip;
@@ -19,7 +18,6 @@ pub mod springs;
 /// the cases still kept here, then the suites that run on every registered preset.
 pub fn all() -> crate::registry::Registry {
     let mut r = anim::cases();
-    self::core::register(&mut r);
     io::register(&mut r);
     springs::register(&mut r);
     rigid::register(&mut r);
