@@ -71,7 +71,7 @@ pub const SCENE_FAMILIES: [SceneFamily; 8] = [
         study: "springs-cloth",
         scene: "springs/hanging-cloth",
         horizon: Some(0.25),
-        problem: crate::cases::springs::study_problem,
+        problem: anim_springs::cases::study_problem,
     },
     SceneFamily {
         study: "fem-beam",

@@ -8,11 +8,6 @@ use anim_core::solver::Solver;
 
 pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
-        crate_name: "anim-springs",
-        name: "determinism: 110 x 110 hanging cloth on 1, 2, 4 threads",
-        run: Box::new(springs_cloth),
-    });
-    r.conformance.push(ConformanceCase {
         crate_name: "anim-pbd",
         name: "determinism: cloth drape on 1, 2, 4 threads",
         run: Box::new(pbd_drape),
@@ -41,20 +36,6 @@ pub fn register(r: &mut Registry) {
 
 fn flat(state: &State) -> Vec<f64> {
     state.x.iter().chain(&state.v).copied().collect()
-}
-
-fn springs_cloth(ctx: &Ctx) -> Vec<Check> {
-    let steps = if ctx.quick { 5 } else { 50 };
-    across_threads("anim-springs", "hanging cloth 110 x 110", || {
-        // 36,300 unknowns: above the threshold of anim-core's parallel update loops.
-        let scene = anim_springs::scenes::hanging_cloth(Some(110)).map_err(|e| e.to_string())?;
-        let dt = scene.dt;
-        let (mut sim, mut state) = scene.into_simulation().map_err(|e| e.to_string())?;
-        for _ in 0..steps {
-            sim.step(&mut state, dt).map_err(|e| e.to_string())?;
-        }
-        Ok(flat(&state))
-    })
 }
 
 fn pbd_drape(ctx: &Ctx) -> Vec<Check> {

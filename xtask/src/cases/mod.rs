@@ -12,14 +12,12 @@ pub mod presets;
 pub mod rigid;
 pub mod skin;
 pub mod soak;
-pub mod springs;
 
 /// The registry of every crate's cases: what each crate registers itself (`anim::cases()`), then
 /// the cases still kept here, then the suites that run on every registered preset.
 pub fn all() -> crate::registry::Registry {
     let mut r = anim::cases();
     io::register(&mut r);
-    springs::register(&mut r);
     rigid::register(&mut r);
     pbd::register(&mut r);
     skin::register(&mut r);
