@@ -94,8 +94,8 @@ pub const SCENE_FAMILIES: [SceneFamily; 8] = [
     SceneFamily {
         study: "pbd-cloth-position",
         scene: "pbd/hanging-cloth",
-        horizon: Some(crate::cases::pbd::STUDY_T),
-        problem: crate::cases::pbd::study_problem,
+        horizon: Some(anim_pbd::cases::STUDY_T),
+        problem: anim_pbd::cases::study_problem,
     },
     SceneFamily { study: "mpm_dam_break", scene: "mpm/dam-break-2d", horizon: None, problem: no_problem },
 ];

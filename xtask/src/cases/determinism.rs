@@ -8,11 +8,6 @@ use anim_core::solver::Solver;
 
 pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
-        crate_name: "anim-pbd",
-        name: "determinism: cloth drape on 1, 2, 4 threads",
-        run: Box::new(pbd_drape),
-    });
-    r.conformance.push(ConformanceCase {
         crate_name: "anim-rigid",
         name: "determinism: Panda swing on 1, 2, 4 threads",
         run: Box::new(rigid_panda),
@@ -36,19 +31,6 @@ pub fn register(r: &mut Registry) {
 
 fn flat(state: &State) -> Vec<f64> {
     state.x.iter().chain(&state.v).copied().collect()
-}
-
-fn pbd_drape(ctx: &Ctx) -> Vec<Check> {
-    let steps = if ctx.quick { 30 } else { 300 };
-    across_threads("anim-pbd", "cloth drape", || {
-        let scene = anim_pbd::scenes::cloth_drape(None).map_err(|e| e.to_string())?;
-        let dt = scene.dt;
-        let (mut sim, mut state) = scene.into_simulation().map_err(|e| e.to_string())?;
-        for _ in 0..steps {
-            sim.step(&mut state, dt).map_err(|e| e.to_string())?;
-        }
-        Ok(flat(&state))
-    })
 }
 
 fn rigid_panda(ctx: &Ctx) -> Vec<Check> {

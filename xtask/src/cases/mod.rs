@@ -7,7 +7,6 @@ pub mod fluid;
 pub mod io;
 pub mod material;
 pub mod mpm;
-pub mod pbd;
 pub mod presets;
 pub mod rigid;
 pub mod skin;
@@ -19,7 +18,6 @@ pub fn all() -> crate::registry::Registry {
     let mut r = anim::cases();
     io::register(&mut r);
     rigid::register(&mut r);
-    pbd::register(&mut r);
     skin::register(&mut r);
     material::register(&mut r);
     fem::register(&mut r);
