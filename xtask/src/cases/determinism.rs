@@ -8,11 +8,6 @@ use anim_core::solver::Solver;
 
 pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
-        crate_name: "anim-rigid",
-        name: "determinism: Panda swing on 1, 2, 4 threads",
-        run: Box::new(rigid_panda),
-    });
-    r.conformance.push(ConformanceCase {
         crate_name: "anim-fem",
         name: "determinism: benchmark beam (backward Euler) on 1, 2, 4 threads",
         run: Box::new(fem_beam),
@@ -31,20 +26,6 @@ pub fn register(r: &mut Registry) {
 
 fn flat(state: &State) -> Vec<f64> {
     state.x.iter().chain(&state.v).copied().collect()
-}
-
-fn rigid_panda(ctx: &Ctx) -> Vec<Check> {
-    // The rigid steppers are serial; the case guards against a parallel path changing that.
-    let steps = if ctx.quick { 100 } else { 1000 };
-    across_threads("anim-rigid", "Panda swing", || {
-        let scene = anim_rigid::scenes::panda_swing().map_err(|e| e.to_string())?;
-        let dt = scene.dt;
-        let (mut sim, mut state) = scene.into_simulation().map_err(|e| e.to_string())?;
-        for _ in 0..steps {
-            sim.step(&mut state, dt).map_err(|e| e.to_string())?;
-        }
-        Ok(state.q.iter().chain(&state.v).copied().collect())
-    })
 }
 
 fn fem_beam(ctx: &Ctx) -> Vec<Check> {

@@ -8,7 +8,6 @@ pub mod io;
 pub mod material;
 pub mod mpm;
 pub mod presets;
-pub mod rigid;
 pub mod skin;
 pub mod soak;
 
@@ -17,7 +16,6 @@ pub mod soak;
 pub fn all() -> crate::registry::Registry {
     let mut r = anim::cases();
     io::register(&mut r);
-    rigid::register(&mut r);
     skin::register(&mut r);
     material::register(&mut r);
     fem::register(&mut r);

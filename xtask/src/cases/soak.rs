@@ -9,12 +9,6 @@ use crate::registry::{Budget, Soak, SoakCase, drive, finish, rejected};
 pub fn register(r: &mut crate::registry::Registry) {
     r.soak.extend([
         SoakCase {
-            crate_name: "anim-rigid",
-            name: "32-link pendulum chain falling from horizontal, RK4 at dt = 5e-4 s",
-            bound: "energy never gains 1% of the chain's potential drop m g L (loss reported)",
-            run: rigid_chain,
-        },
-        SoakCase {
             crate_name: "anim-fem",
             name: "E = 1e8 Pa stable Neo-Hookean cantilever, backward Euler at dt = 1/24 s",
             bound: "total energy never above its initial value",
@@ -52,47 +46,6 @@ fn exceeds(e: f64, e0: f64) -> bool {
 /// The error text of a bound broken at step `k`.
 fn above(k: u64, e: f64, e0: f64) -> String {
     format!("step {k}: energy {e} J above its initial value {e0} J")
-}
-
-fn rigid_chain(budget: Budget) -> Soak {
-    use anim_core::solver::Solver;
-    let scene = match anim_rigid::scenes::pendulum_chain(None) {
-        Ok(s) => s,
-        Err(e) => return rejected(budget, e),
-    };
-    let dt = scene.dt;
-    let (mut sim, mut state) = match scene.into_simulation() {
-        Ok(s) => s,
-        Err(e) => return rejected(budget, e),
-    };
-    // 32 links of 0.1 kg and 0.1 m: total mass 3.2 kg, the centre of mass can fall 1.6 m at most.
-    let scale = 3.2 * 9.81 * 1.6;
-    let e0 = sim.energy(&state);
-    let (mut gain, mut loss) = (0.0f64, 0.0f64);
-    let clock = match drive(budget, dt, |k| {
-        sim.step(&mut state, dt).map_err(|e| e.to_string())?;
-        if k.is_multiple_of(STRIDE) {
-            let de = sim.energy(&state) - e0;
-            gain = gain.max(de);
-            loss = loss.max(-de);
-            if !(de < 0.01 * scale) {
-                return Err(format!("step {k}: energy gain {de} J against m g L = {scale} J"));
-            }
-        }
-        Ok(())
-    }) {
-        Ok(c) => c,
-        Err(s) => return s,
-    };
-    let d = format!(
-        "largest energy gain {} J ({} of m g L = {} J), largest loss {} J ({}; RK4 is not symplectic and dissipates slowly), checked every {STRIDE} steps",
-        fmt_num(gain),
-        fmt_num(gain / scale),
-        fmt_num(scale),
-        fmt_num(loss),
-        fmt_num(loss / scale)
-    );
-    finish(&clock, dt, true, d)
 }
 
 fn fem_stiff_beam(budget: Budget) -> Soak {
