@@ -58,20 +58,20 @@ pub const SCENE_FAMILIES: [SceneFamily; 8] = [
     SceneFamily {
         study: "core-oscillator",
         scene: "harmonic-oscillator",
-        horizon: Some(crate::cases::core::OSCILLATOR_HORIZON),
+        horizon: Some(anim_core::cases::core::OSCILLATOR_HORIZON),
         problem: no_problem,
     },
     SceneFamily {
         study: "core-kepler",
         scene: "kepler-orbit",
-        horizon: Some(crate::cases::core::KEPLER_HORIZON),
+        horizon: Some(anim_core::cases::core::KEPLER_HORIZON),
         problem: no_problem,
     },
     SceneFamily {
         study: "springs-cloth",
         scene: "springs/hanging-cloth",
         horizon: Some(0.25),
-        problem: crate::cases::springs::study_problem,
+        problem: anim_springs::cases::study_problem,
     },
     SceneFamily {
         study: "fem-beam",
@@ -94,8 +94,8 @@ pub const SCENE_FAMILIES: [SceneFamily; 8] = [
     SceneFamily {
         study: "pbd-cloth-position",
         scene: "pbd/hanging-cloth",
-        horizon: Some(crate::cases::pbd::STUDY_T),
-        problem: crate::cases::pbd::study_problem,
+        horizon: Some(anim_pbd::cases::STUDY_T),
+        problem: anim_pbd::cases::study_problem,
     },
     SceneFamily { study: "mpm_dam_break", scene: "mpm/dam-break-2d", horizon: None, problem: no_problem },
 ];
@@ -981,7 +981,7 @@ mod tests {
         assert_eq!(osc["study"], "core-oscillator");
         assert_eq!(osc["crate"], "anim-core");
         assert_eq!(osc["scene"], "harmonic-oscillator");
-        assert_eq!(osc["horizon"], crate::cases::core::OSCILLATOR_HORIZON);
+        assert_eq!(osc["horizon"], anim_core::cases::core::OSCILLATOR_HORIZON);
         assert_eq!(osc["param"], "dt");
         assert_eq!(families[1]["scene"], serde_json::Value::Null);
         let picks = osc["picks"].as_array().unwrap();

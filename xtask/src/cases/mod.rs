@@ -1,24 +1,16 @@
 //! Cases per crate. Each module registers its conformance checks, hard cases and studies.
 
-pub mod core;
 pub mod determinism;
 pub mod flip;
 pub mod fluid;
-pub mod pbd;
 pub mod presets;
-pub mod rigid;
 pub mod skin;
 pub mod soak;
-pub mod springs;
 
 /// The registry of every crate's cases: what each crate registers itself (`anim::cases()`), then
 /// the cases still kept here, then the suites that run on every registered preset.
 pub fn all() -> crate::registry::Registry {
     let mut r = anim::cases();
-    self::core::register(&mut r);
-    springs::register(&mut r);
-    rigid::register(&mut r);
-    pbd::register(&mut r);
     skin::register(&mut r);
     fluid::register(&mut r);
     flip::register(&mut r);

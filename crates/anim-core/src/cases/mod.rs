@@ -5,6 +5,7 @@
 //! the cases in quick mode and `cargo xtask conformance`, `stability` and `report` run them from
 //! the workspace registry, so a check lives in one place and is run by both.
 
+pub mod core;
 pub mod float;
 mod soak;
 mod threads;
@@ -247,7 +248,9 @@ pub fn fmt_num(x: f64) -> String {
 }
 
 /// Registers anim-core's own cases (its integrators, Lie groups and linear algebra).
-pub fn register(_r: &mut Registry) {}
+pub fn register(r: &mut Registry) {
+    self::core::register(r);
+}
 
 /// Runs every conformance and stability case that `register` registers, in quick mode, and
 /// returns one line per failed check or unexpected outcome (empty when everything passes): what

@@ -4,17 +4,18 @@
 //! stretch errors measured against a converged XPBD run. XPBD converges to the material its
 //! compliances define; PBD's stiffness depends on the iteration count, so it converges elsewhere.
 
-use crate::registry::{Ctx, Point, Series, StudyResult, median_seconds};
-use anim_pbd::{ConstraintFunction, Method, PbdModel, PbdParams, PbdSimulation, SolverKind};
+use crate::{ConstraintFunction, Method, PbdModel, PbdParams, PbdSimulation, SolverKind};
+use anim_core::cases::{Ctx, Point, Series, StudyResult, median_seconds};
 
-pub(crate) const STUDY_T: f64 = 0.5;
+/// Simulated time of the study (s), the horizon its cheapest-method table holds for.
+pub const STUDY_T: f64 = 0.5;
 const STUDY_DT: f64 = 1.0 / 60.0;
 
 /// The study cloth: anim-pbd's `hanging-cloth` preset (`n x n`, 0.5 m, 0.1 kg, pinned at two
 /// corners, stiff distances (`alpha = 1e-7` m/N; PBD `k = 1`), soft isometric bending
 /// (`alpha = 5`; PBD `k = 0.1`)), which `anim run --tolerance` maps to this study.
 fn study_model(n: usize) -> Option<PbdModel> {
-    anim_pbd::scenes::hanging_cloth(Some(n)).ok().map(|s| s.model)
+    crate::scenes::hanging_cloth(Some(n)).ok().map(|s| s.model)
 }
 
 /// The study cloth's side in particles.

@@ -5,8 +5,8 @@
 //! `C_j / alpha = T_j`: link `j` stretches by `alpha T_j` whatever the iteration count or time
 //! step, which the conformance checks measure; the hard cases start lighter chains far from rest.
 
+use crate::{BuildError, Chain, ConstraintParams, PbdBuilder, PbdModel, PbdParams, PbdSimulation};
 use anim_core::integrate::State;
-use anim_pbd::{BuildError, Chain, ConstraintParams, PbdBuilder, PbdModel, PbdParams, PbdSimulation};
 
 /// A vertical chain of `n` free particles of mass `m` below a pin, links of rest length `l`.
 pub(super) struct HangingChain {

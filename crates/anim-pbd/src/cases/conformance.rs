@@ -7,11 +7,11 @@
 //! determinism across thread counts.
 
 use super::chain::CHAIN;
-use crate::registry::{Check, Ctx, Judge, fmt_num};
-use anim_pbd::{
+use crate::{
     AttachTarget, Bending, BuildError, Cloth, Collider, ConstraintFunction, ConstraintParams, EARTH_GRAVITY,
     Method, PbdBuilder, PbdModel, PbdParams, PbdSimulation, SolverKind,
 };
+use anim_core::cases::{Check, Ctx, Judge, fmt_num};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

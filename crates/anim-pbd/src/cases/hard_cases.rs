@@ -5,12 +5,12 @@
 //! the state kept).
 
 use super::chain::HangingChain;
-use crate::registry::{Ctx, Outcome, fmt_num};
-use anim_core::integrate::State;
-use anim_pbd::{
+use crate::{
     Bending, Cloth, ConstraintFunction, ConstraintParams, EARTH_GRAVITY, Method, PbdBuilder, PbdError,
     PbdModel, PbdParams, PbdSimulation, SolverKind,
 };
+use anim_core::cases::{Ctx, Outcome, fmt_num};
+use anim_core::integrate::State;
 
 fn finite(s: &State) -> bool {
     s.x.iter().chain(&s.v).all(|v| v.is_finite())
@@ -171,7 +171,7 @@ pub(super) fn pins_next_to_free(_ctx: &Ctx) -> Outcome {
 }
 
 pub(super) fn zero_compliance(_ctx: &Ctx) -> Outcome {
-    let scene = match anim_pbd::scenes::cloth_drape(Some(24)) {
+    let scene = match crate::scenes::cloth_drape(Some(24)) {
         Ok(s) => s,
         Err(e) => return Outcome::Rejected(e.to_string()),
     };

@@ -1,8 +1,8 @@
 //! The timed runs of `cargo xtask bench --peers` for anim-pbd: the benchmark cloth of
-//! `anim_pbd::scenes::benchmark` stepped by XPBD on a pool of a given thread count, as the peer
+//! `crate::scenes::benchmark` stepped by XPBD on a pool of a given thread count, as the peer
 //! codes step the same cloth.
 
-use anim_pbd::{
+use crate::{
     Bending, Cloth, ConstraintParams, EARTH_GRAVITY, Method, PbdBuilder, PbdParams, PbdSimulation, SolverKind,
 };
 
@@ -29,7 +29,7 @@ pub fn peer_cloth(
     steps: usize,
     repeats: usize,
 ) -> Result<PeerRun, String> {
-    use anim_pbd::scenes::benchmark::*;
+    use crate::scenes::benchmark::*;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
     pool.install(|| {
         let mut b = PbdBuilder::new();
