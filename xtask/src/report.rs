@@ -83,7 +83,7 @@ pub const SCENE_FAMILIES: [SceneFamily; 8] = [
         study: "fluid_cavity_ghia",
         scene: "fluid/lid-driven-cavity",
         horizon: None,
-        problem: crate::cases::fluid::ghia_study_problem,
+        problem: anim_fluid::cases::ghia_study_problem,
     },
     SceneFamily {
         study: "fluid_pressure_divergence",

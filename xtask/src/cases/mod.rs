@@ -4,7 +4,6 @@ pub mod core;
 pub mod determinism;
 pub mod fem;
 pub mod flip;
-pub mod fluid;
 pub mod io;
 pub mod material;
 pub mod mpm;
@@ -28,7 +27,6 @@ pub fn all() -> crate::registry::Registry {
     material::register(&mut r);
     fem::register(&mut r);
     mpm::register(&mut r);
-    fluid::register(&mut r);
     flip::register(&mut r);
     determinism::register(&mut r);
     soak::register(&mut r);
