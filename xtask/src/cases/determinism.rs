@@ -34,11 +34,6 @@ pub fn register(r: &mut Registry) {
         run: Box::new(fem_beam),
     });
     r.conformance.push(ConformanceCase {
-        crate_name: "anim-skin",
-        name: "determinism: twisted cylinder (LBS and DQS) on 1, 2, 4 threads",
-        run: Box::new(skin_cylinder),
-    });
-    r.conformance.push(ConformanceCase {
         crate_name: "anim-flip",
         name: "determinism: 2D dam break (APIC) on 1, 2, 4 threads",
         run: Box::new(flip_dam_break),
@@ -123,25 +118,6 @@ fn fem_beam(ctx: &Ctx) -> Vec<Check> {
             sim.step(&mut state, dt).map_err(|e| e.to_string())?;
         }
         Ok(flat(&state))
-    })
-}
-
-fn skin_cylinder(ctx: &Ctx) -> Vec<Check> {
-    // 96 segments around: about 11,000 vertices, several parallel chunks.
-    let segments = if ctx.quick { 96 } else { 192 };
-    across_threads("anim-skin", &format!("twisted cylinder, {segments} segments"), || {
-        let scene = anim_skin::scenes::twisted_cylinder(Some(segments)).map_err(|e| e.to_string())?;
-        let mut data = scene.data();
-        let mut out = Vec::new();
-        for method in [anim_skin::SkinningMethod::Lbs, anim_skin::SkinningMethod::Dqs] {
-            for t in [0.5, 1.3, 2.0] {
-                scene.pose(&mut data, t, method).map_err(|e| e.to_string())?;
-                for m in &data.skinned {
-                    out.extend(m.x.iter().chain(&m.y).chain(&m.z));
-                }
-            }
-        }
-        Ok(out)
     })
 }
 

@@ -10,7 +10,6 @@ pub mod mpm;
 pub mod pbd;
 pub mod presets;
 pub mod rigid;
-pub mod skin;
 pub mod soak;
 pub mod springs;
 
@@ -23,7 +22,6 @@ pub fn all() -> crate::registry::Registry {
     springs::register(&mut r);
     rigid::register(&mut r);
     pbd::register(&mut r);
-    skin::register(&mut r);
     material::register(&mut r);
     fem::register(&mut r);
     mpm::register(&mut r);

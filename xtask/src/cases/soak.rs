@@ -44,12 +44,6 @@ pub fn register(r: &mut crate::registry::Registry) {
             bound: "kinetic + gravitational energy never above its initial value",
             run: mpm_three_materials,
         },
-        SoakCase {
-            crate_name: "anim-skin",
-            name: "twisted cylinder, DQS, clip looped 500 times",
-            bound: "every pose identical to its first cycle, bit for bit; volume within 2% of rest",
-            run: skin_loop,
-        },
     ]);
 }
 
@@ -324,46 +318,4 @@ fn mpm_three_materials(budget: Budget) -> Soak {
         fmt_num(last)
     );
     finish(&clock, dt, true, d)
-}
-
-fn skin_loop(budget: Budget) -> Soak {
-    use anim_skin::SkinningMethod;
-    use anim_skin::scenes::{twisted_cylinder, volume};
-    let scene = match twisted_cylinder(None) {
-        Ok(s) => s,
-        Err(e) => return rejected(budget, e),
-    };
-    // 200 frames per loop of the 2 s clip; the first loop is kept and every later frame compared.
-    let frames = 200u64;
-    let dt = scene.duration / frames as f64;
-    let mut data = scene.data();
-    let rest = scene.rest_volume();
-    let mut first: Vec<Vec<f64>> = Vec::with_capacity(frames as usize);
-    let mut worst = 0.0f64;
-    let clock = match drive(budget, dt, |k| {
-        let frame = (k - 1) % frames;
-        let t = frame as f64 * dt;
-        scene.pose(&mut data, t, SkinningMethod::Dqs).map_err(|e| e.to_string())?;
-        let flat: Vec<f64> =
-            data.skinned.iter().flat_map(|m| m.x.iter().chain(&m.y).chain(&m.z).copied()).collect();
-        if flat.iter().any(|v| !v.is_finite()) {
-            return Err(format!("frame {frame}: non-finite vertex"));
-        }
-        if k <= frames {
-            worst = worst.max((volume(&scene.character, &data) / rest - 1.0).abs());
-            first.push(flat);
-        } else if first[frame as usize].iter().zip(&flat).any(|(a, b)| a.to_bits() != b.to_bits()) {
-            return Err(format!("step {k}: the pose at t = {t} s differs from its first cycle"));
-        }
-        Ok(())
-    }) {
-        Ok(c) => c,
-        Err(s) => return s,
-    };
-    let d = format!(
-        "{} loops of {frames} frames; largest volume change {} of rest",
-        clock.steps / frames,
-        fmt_num(worst)
-    );
-    finish(&clock, dt, worst < 0.02, d)
 }
