@@ -33,11 +33,6 @@ pub fn register(r: &mut Registry) {
         name: "determinism: benchmark beam (backward Euler) on 1, 2, 4 threads",
         run: Box::new(fem_beam),
     });
-    r.conformance.push(ConformanceCase {
-        crate_name: "anim-flip",
-        name: "determinism: 2D dam break (APIC) on 1, 2, 4 threads",
-        run: Box::new(flip_dam_break),
-    });
 }
 
 fn flat(state: &State) -> Vec<f64> {
@@ -118,18 +113,5 @@ fn fem_beam(ctx: &Ctx) -> Vec<Check> {
             sim.step(&mut state, dt).map_err(|e| e.to_string())?;
         }
         Ok(flat(&state))
-    })
-}
-
-fn flip_dam_break(ctx: &Ctx) -> Vec<Check> {
-    let (n, steps) = if ctx.quick { (48, 10) } else { (96, 40) };
-    across_threads("anim-flip", &format!("dam break, {n} cells/m"), || {
-        let mut params = anim_flip::FlipParams::<2>::default();
-        params.transfer = anim_flip::Transfer::Apic;
-        let (mut sim, mut p, _) = anim_flip::scenes::dam_break(n, 0.2, params).map_err(|e| e.to_string())?;
-        for _ in 0..steps {
-            sim.advance(&mut p, 0.01).map_err(|e| e.to_string())?;
-        }
-        Ok(p.x.iter().flatten().chain(p.v.iter().flatten()).copied().collect())
     })
 }

@@ -3,7 +3,6 @@
 pub mod core;
 pub mod determinism;
 pub mod fem;
-pub mod flip;
 pub mod io;
 pub mod material;
 pub mod mpm;
@@ -25,7 +24,6 @@ pub fn all() -> crate::registry::Registry {
     material::register(&mut r);
     fem::register(&mut r);
     mpm::register(&mut r);
-    flip::register(&mut r);
     determinism::register(&mut r);
     soak::register(&mut r);
     presets::register(&mut r);
