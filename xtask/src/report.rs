@@ -19,7 +19,7 @@ pub const TOLERANCES: [f64; 6] = [1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8];
 /// Tolerances a study adds to [`TOLERANCES`] in its cheapest-method tables (its table in
 /// `index.md` and its picks in `cheapest.json`): `(study slug, extra tolerances)`.
 const EXTRA_TOLERANCES: [(&str, &[f64]); 1] =
-    [(crate::cases::flip::DAM_BREAK_SLUG, crate::cases::flip::DAM_BREAK_TOLERANCES)];
+    [(anim_flip::cases::DAM_BREAK_SLUG, anim_flip::cases::DAM_BREAK_TOLERANCES)];
 
 /// The tolerances of `study`'s cheapest-method tables: [`TOLERANCES`] and its extra ones
 /// ([`EXTRA_TOLERANCES`]), largest first.
@@ -83,7 +83,7 @@ pub const SCENE_FAMILIES: [SceneFamily; 8] = [
         study: "fluid_cavity_ghia",
         scene: "fluid/lid-driven-cavity",
         horizon: None,
-        problem: crate::cases::fluid::ghia_study_problem,
+        problem: anim_fluid::cases::ghia_study_problem,
     },
     SceneFamily {
         study: "fluid_pressure_divergence",
@@ -790,7 +790,7 @@ mod tests {
     #[test]
     fn a_study_with_extra_tolerances_gets_their_rows_in_order() {
         // tiny(): fast-rough has error 1e-3, so it meets 5e-2 as well.
-        let r = StudyResult { slug: crate::cases::flip::DAM_BREAK_SLUG.into(), ..tiny() };
+        let r = StudyResult { slug: anim_flip::cases::DAM_BREAK_SLUG.into(), ..tiny() };
         assert_eq!(tolerances(&r), [1e-1, 5e-2, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8]);
         assert_eq!(tolerances(&tiny()), TOLERANCES);
         let md = study_markdown("anim-flip", &r);
