@@ -337,3 +337,5 @@ macro_rules! quick_cases_test {
         }
     };
 }
+
+crate::quick_cases_test!(crate::cases::register);

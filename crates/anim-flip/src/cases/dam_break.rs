@@ -5,7 +5,7 @@
 use super::CRATE;
 use crate::{FlipError, FlipParams, Particles, Transfer, scenes};
 use anim_core::cases::{Check, Ctx, Judge, Point, Series, StudyResult, fmt_num};
-use anim_mpm::scenes::{self as mpm_scenes, MARTIN_MOYCE};
+use anim_mpm::cases::{MARTIN_MOYCE, front_errors, shifted_errors};
 
 /// Surge front `Z` at the table's times, the history `(T, Z)` of every step, and the wall time.
 type SurgeFront = (Vec<f64>, Vec<(f64, f64)>, f64);
@@ -156,8 +156,8 @@ pub(super) fn dam_break_study(ctx: &Ctx) -> StudyResult {
     ] {
         let points = mpm_cells
             .iter()
-            .map(|&n| match mpm_dam_break(n, 2, transfer, anim_mpm::Kernel::Quadratic) {
-                Ok((z, seconds)) => Point { param: n as f64, seconds, error: front_errors(&z).1 },
+            .map(|&n| match anim_mpm::cases::dam_break(n, 2, transfer, anim_mpm::Kernel::Quadratic) {
+                Ok(r) => Point { param: n as f64, seconds: r.seconds, error: front_errors(&r.z).1 },
                 Err(_) => failed(n),
             })
             .collect();
@@ -171,59 +171,4 @@ pub(super) fn dam_break_study(ctx: &Ctx) -> StudyResult {
         param_label: "grid cells per metre".into(),
         series,
     }
-}
-
-/// anim-mpm's 2D dam break (`anim_mpm::scenes::dam_break_2d`: a water column `a x 2a`, a = 0.2 m,
-/// collapsing along a 1 m tank), as anim-mpm's own cases run it. Returns the surge front
-/// `Z = x / a` at the table's times `T` (steps end on them) and the wall time.
-fn mpm_dam_break(
-    n: usize,
-    per_cell: usize,
-    transfer: anim_mpm::Transfer,
-    kernel: anim_mpm::Kernel,
-) -> Result<(Vec<f64>, f64), anim_mpm::MpmError> {
-    let mpm_scenes::Scene { mut sim, state: mut p, dt, .. } =
-        mpm_scenes::dam_break_2d(n, per_cell, transfer, kernel)?;
-    let t_scale = mpm_scenes::dam_break_time_scale();
-    let start = std::time::Instant::now();
-    let mut z = Vec::with_capacity(MARTIN_MOYCE.len());
-    for &(t_star, _) in &MARTIN_MOYCE {
-        let t_end = t_star / t_scale;
-        while sim.time() < t_end - 1e-12 {
-            let step = dt.min(t_end - sim.time());
-            sim.advance(&mut p, step)?;
-        }
-        z.push(mpm_scenes::surge_front(sim.params(), &p));
-    }
-    Ok((z, start.elapsed().as_secs_f64()))
-}
-
-/// The error of both the case and the study: `(max, rms)` relative surge-front error
-/// (anim-mpm's, which `anim run` reports too).
-fn front_errors(z: &[f64]) -> (f64, f64) {
-    mpm_scenes::surge_front_errors(z)
-}
-
-/// The time-origin shift `dT` (the experiment's gate takes time to open, so its clock starts
-/// early) minimising the rms error of `Z_sim(T - dT)` against the table, `dT` in [0, 0.6]; returns
-/// `(dT, max error, rms error)`.
-fn shifted_errors(history: &[(f64, f64)]) -> (f64, f64, f64) {
-    let at = |t: f64| -> f64 {
-        if t <= 0.0 {
-            return history[0].1;
-        }
-        let i = history.partition_point(|(ti, _)| *ti < t).clamp(1, history.len() - 1);
-        let ((t0, z0), (t1, z1)) = (history[i - 1], history[i]);
-        if t1 > t0 { z0 + (z1 - z0) * (t - t0) / (t1 - t0) } else { z1 }
-    };
-    let mut best = (0.0, f64::INFINITY, f64::INFINITY);
-    for k in 0..=60 {
-        let shift = k as f64 * 0.01;
-        let z: Vec<f64> = MARTIN_MOYCE.iter().map(|(t, _)| at(t - shift)).collect();
-        let (max, rms) = front_errors(&z);
-        if rms < best.2 {
-            best = (shift, max, rms);
-        }
-    }
-    best
 }

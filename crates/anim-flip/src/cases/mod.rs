@@ -67,3 +67,5 @@ pub fn register(r: &mut Registry) {
         run: dam_break::dam_break_study,
     });
 }
+
+anim_core::quick_cases_test!(crate::cases::register);

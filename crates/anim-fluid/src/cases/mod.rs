@@ -109,3 +109,5 @@ fn check(
 ) -> Check {
     Check { crate_name: CRATE, case: case.into(), metric, measured, reference, tolerance, judge, source }
 }
+
+anim_core::quick_cases_test!(crate::cases::register);

@@ -127,3 +127,5 @@ pub fn register(r: &mut Registry) {
     });
     r.soak.push(soak::DRAPE);
 }
+
+anim_core::quick_cases_test!(crate::cases::register);

@@ -202,3 +202,5 @@ fn rf_of(name: &str) -> ReferenceFrame {
         _ => ReferenceFrame::LocalWorldAligned,
     }
 }
+
+anim_core::quick_cases_test!(crate::cases::register);

@@ -72,3 +72,5 @@ fn check(
 ) -> Check {
     Check { crate_name: CRATE, case: case.into(), metric, measured, reference: 0.0, tolerance, judge, source }
 }
+
+anim_core::quick_cases_test!(crate::cases::register);

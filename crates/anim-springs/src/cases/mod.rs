@@ -121,3 +121,5 @@ pub fn register(r: &mut Registry) {
     });
     r.soak.push(soak::STIFF_CLOTH);
 }
+
+anim_core::quick_cases_test!(crate::cases::register);
