@@ -19,7 +19,7 @@ pub const TOLERANCES: [f64; 6] = [1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8];
 /// Tolerances a study adds to [`TOLERANCES`] in its cheapest-method tables (its table in
 /// `index.md` and its picks in `cheapest.json`): `(study slug, extra tolerances)`.
 const EXTRA_TOLERANCES: [(&str, &[f64]); 1] =
-    [(crate::cases::flip::DAM_BREAK_SLUG, crate::cases::flip::DAM_BREAK_TOLERANCES)];
+    [(anim_flip::cases::DAM_BREAK_SLUG, anim_flip::cases::DAM_BREAK_TOLERANCES)];
 
 /// The tolerances of `study`'s cheapest-method tables: [`TOLERANCES`] and its extra ones
 /// ([`EXTRA_TOLERANCES`]), largest first.
@@ -58,32 +58,32 @@ pub const SCENE_FAMILIES: [SceneFamily; 8] = [
     SceneFamily {
         study: "core-oscillator",
         scene: "harmonic-oscillator",
-        horizon: Some(crate::cases::core::OSCILLATOR_HORIZON),
+        horizon: Some(anim_core::cases::core::OSCILLATOR_HORIZON),
         problem: no_problem,
     },
     SceneFamily {
         study: "core-kepler",
         scene: "kepler-orbit",
-        horizon: Some(crate::cases::core::KEPLER_HORIZON),
+        horizon: Some(anim_core::cases::core::KEPLER_HORIZON),
         problem: no_problem,
     },
     SceneFamily {
         study: "springs-cloth",
         scene: "springs/hanging-cloth",
         horizon: Some(0.25),
-        problem: crate::cases::springs::study_problem,
+        problem: anim_springs::cases::study_problem,
     },
     SceneFamily {
         study: "fem-beam",
         scene: "fem/cantilever-beam",
         horizon: Some(0.5),
-        problem: crate::cases::fem::study_problem,
+        problem: anim_fem::cases::study_problem,
     },
     SceneFamily {
         study: "fluid_cavity_ghia",
         scene: "fluid/lid-driven-cavity",
         horizon: None,
-        problem: crate::cases::fluid::ghia_study_problem,
+        problem: anim_fluid::cases::ghia_study_problem,
     },
     SceneFamily {
         study: "fluid_pressure_divergence",
@@ -94,8 +94,8 @@ pub const SCENE_FAMILIES: [SceneFamily; 8] = [
     SceneFamily {
         study: "pbd-cloth-position",
         scene: "pbd/hanging-cloth",
-        horizon: Some(crate::cases::pbd::STUDY_T),
-        problem: crate::cases::pbd::study_problem,
+        horizon: Some(anim_pbd::cases::STUDY_T),
+        problem: anim_pbd::cases::study_problem,
     },
     SceneFamily { study: "mpm_dam_break", scene: "mpm/dam-break-2d", horizon: None, problem: no_problem },
 ];
@@ -790,7 +790,7 @@ mod tests {
     #[test]
     fn a_study_with_extra_tolerances_gets_their_rows_in_order() {
         // tiny(): fast-rough has error 1e-3, so it meets 5e-2 as well.
-        let r = StudyResult { slug: crate::cases::flip::DAM_BREAK_SLUG.into(), ..tiny() };
+        let r = StudyResult { slug: anim_flip::cases::DAM_BREAK_SLUG.into(), ..tiny() };
         assert_eq!(tolerances(&r), [1e-1, 5e-2, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8]);
         assert_eq!(tolerances(&tiny()), TOLERANCES);
         let md = study_markdown("anim-flip", &r);
@@ -981,7 +981,7 @@ mod tests {
         assert_eq!(osc["study"], "core-oscillator");
         assert_eq!(osc["crate"], "anim-core");
         assert_eq!(osc["scene"], "harmonic-oscillator");
-        assert_eq!(osc["horizon"], crate::cases::core::OSCILLATOR_HORIZON);
+        assert_eq!(osc["horizon"], anim_core::cases::core::OSCILLATOR_HORIZON);
         assert_eq!(osc["param"], "dt");
         assert_eq!(families[1]["scene"], serde_json::Value::Null);
         let picks = osc["picks"].as_array().unwrap();

@@ -140,36 +140,6 @@ fn patch_test_reproduces_a_linear_field() {
 }
 
 #[test]
-fn internal_forces_conserve_linear_and_angular_momentum() {
-    let mesh = box_mesh([0.0; 3], [1.0, 0.4, 0.3], [4, 2, 2]).unwrap();
-    for model in MaterialModel::ALL {
-        let m = FemModel::new(mesh.clone(), material(model)).unwrap();
-        let x = perturbed(&m.rest_positions(), 0.05, 5);
-        let mut sim = FemSimulation::new(m, FemParams::default()).unwrap();
-        let mut f = vec![0.0; x.len()];
-        sim.internal_forces(&x, &mut f).unwrap();
-        let scale = f.iter().fold(0.0f64, |s, v| s.max(v.abs()));
-        let mut sum = [0.0; 3];
-        let mut torque = [0.0; 3];
-        for i in 0..x.len() / 3 {
-            let (p, q) = (&x[3 * i..3 * i + 3], &f[3 * i..3 * i + 3]);
-            for c in 0..3 {
-                sum[c] += q[c];
-            }
-            torque[0] += p[1] * q[2] - p[2] * q[1];
-            torque[1] += p[2] * q[0] - p[0] * q[2];
-            torque[2] += p[0] * q[1] - p[1] * q[0];
-        }
-        // Linear elasticity is not rotation invariant: its forces have a net torque.
-        let torque_tol = if model == MaterialModel::Linear { f64::INFINITY } else { 1e-12 * scale };
-        for c in 0..3 {
-            assert!(sum[c].abs() < 1e-12 * scale, "{model:?} net force {sum:?}");
-            assert!(torque[c].abs() < torque_tol, "{model:?} net torque {torque:?}");
-        }
-    }
-}
-
-#[test]
 fn explicit_steps_conserve_momentum_of_a_free_body() {
     let mesh = box_mesh([0.0; 3], [1.0, 0.4, 0.3], [4, 2, 2]).unwrap();
     let m = FemModel::new(mesh, material(MaterialModel::StableNeoHookean)).unwrap();

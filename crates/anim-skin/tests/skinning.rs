@@ -60,18 +60,6 @@ fn step_linear_cubic_by_hand() {
 }
 
 #[test]
-fn rotation_slerp_takes_shortest_path() {
-    let a = DQuat::from_rotation_z(0.0);
-    let b = -DQuat::from_rotation_z(1.0); // antipodal representation of 1 rad
-    let c =
-        Channel::new(0, Property::Rotation, Interpolation::Linear, vec![0.0, 1.0], vec![a.into(), b.into()])
-            .unwrap();
-    let q = c.sample(0.25);
-    let want = DQuat::from_rotation_z(0.25);
-    assert!(q.dot(want.into()).abs() > 1.0 - 1e-15, "{q:?}");
-}
-
-#[test]
 fn bad_channels_are_errors() {
     assert!(
         Channel::new(0, Property::Scale, Interpolation::Linear, vec![1.0, 1.0], vec![v3(1.0, 1.0, 1.0); 2])

@@ -1,37 +1,13 @@
-//! Cases per crate. Each module registers its conformance checks, hard cases and studies.
+//! The suites xtask runs over every registered preset. Each crate's own conformance checks,
+//! hard cases, soak runs and studies live in the crate (its `cases` module, feature `cases`) and
+//! reach xtask through `anim::cases()`.
 
-pub mod core;
-pub mod determinism;
-pub mod fem;
-pub mod flip;
-pub mod fluid;
-pub mod io;
-pub mod material;
-pub mod mpm;
-pub mod pbd;
 pub mod presets;
-pub mod rigid;
-pub mod skin;
-pub mod soak;
-pub mod springs;
 
-/// The registry of every crate's cases: what each crate registers itself (`anim::cases()`), then
-/// the cases still kept here, then the suites that run on every registered preset.
+/// The registry of every crate's cases (`anim::cases()`), then the suites that run on every
+/// registered preset.
 pub fn all() -> crate::registry::Registry {
     let mut r = anim::cases();
-    self::core::register(&mut r);
-    io::register(&mut r);
-    springs::register(&mut r);
-    rigid::register(&mut r);
-    pbd::register(&mut r);
-    skin::register(&mut r);
-    material::register(&mut r);
-    fem::register(&mut r);
-    mpm::register(&mut r);
-    fluid::register(&mut r);
-    flip::register(&mut r);
-    determinism::register(&mut r);
-    soak::register(&mut r);
     presets::register(&mut r);
     r
 }

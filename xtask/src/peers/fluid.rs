@@ -11,8 +11,8 @@
 //!    beside our seed mode and our MAC solver at 512 x 512. Taichi is installed with pip when
 //!    missing; on failure it is skipped with a visible note.
 
-use crate::cases::fluid::compile_c;
 use crate::python::json_field;
+use anim_fluid::cases::compile_c;
 use anim_fluid::mac::{MacFluid, MacParams};
 use anim_fluid::pressure::{PressureMethod, PressureSolver};
 use anim_fluid::seed::{SeedFluid, SeedParams};

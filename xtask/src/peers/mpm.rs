@@ -5,8 +5,8 @@
 //! particle-steps per second. Taichi is installed with pip when missing; if that fails the peer
 //! is skipped with a visible note.
 
-use crate::cases::mpm::peer_benchmark;
 use crate::python::json_field as field;
+use anim_mpm::cases::peer_benchmark;
 use std::io::Write;
 
 const SCRIPT: &str = "peers/mpm/taichi_mpm.py";

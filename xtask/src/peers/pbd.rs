@@ -9,9 +9,9 @@
 //! so the headline ratios are at one thread; our two-thread run is listed beside them. The peers
 //! are installed with pip when missing; if that fails the peer is skipped with a visible note.
 
-use crate::cases::pbd::peer_cloth;
 use crate::python::json_field as field;
 use anim_pbd::SolverKind;
+use anim_pbd::cases::peer_cloth;
 use std::io::Write;
 
 const PYPBD: &str = "peers/pbd/pypbd_cloth.py";

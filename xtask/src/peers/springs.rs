@@ -6,7 +6,7 @@
 //! the motions compared by checksums of the final positions. Taichi is installed with pip when
 //! missing; if that fails the peer is skipped with a visible note.
 
-use crate::cases::springs::peer_symplectic_cloth;
+use anim_springs::cases::peer_symplectic_cloth;
 use std::io::Write;
 use std::process::Command;
 

@@ -5,6 +5,7 @@
 //! the cases in quick mode and `cargo xtask conformance`, `stability` and `report` run them from
 //! the workspace registry, so a check lives in one place and is run by both.
 
+pub mod core;
 pub mod float;
 mod soak;
 mod threads;
@@ -247,7 +248,9 @@ pub fn fmt_num(x: f64) -> String {
 }
 
 /// Registers anim-core's own cases (its integrators, Lie groups and linear algebra).
-pub fn register(_r: &mut Registry) {}
+pub fn register(r: &mut Registry) {
+    self::core::register(r);
+}
 
 /// Runs every conformance and stability case that `register` registers, in quick mode, and
 /// returns one line per failed check or unexpected outcome (empty when everything passes): what
@@ -314,3 +317,25 @@ pub fn quick_failures(register: fn(&mut Registry)) -> Vec<String> {
     }
     failures
 }
+
+/// The test a crate's `cases` module declares with one line: every conformance and stability
+/// case of `register` passes in quick mode (see [`quick_failures`]).
+///
+/// `cargo xtask ci` skips this test in the debug test run (`--skip
+/// conformance_and_hard_cases_pass_in_quick_mode`) because its conformance and stability steps
+/// run the same cases right after, in release; `cargo test -p <crate> --features cases` runs it.
+#[macro_export]
+macro_rules! quick_cases_test {
+    ($register:path) => {
+        #[cfg(test)]
+        mod quick_cases {
+            #[test]
+            fn conformance_and_hard_cases_pass_in_quick_mode() {
+                let failures = $crate::cases::quick_failures($register);
+                assert!(failures.is_empty(), "{}", failures.join("\n"));
+            }
+        }
+    };
+}
+
+crate::quick_cases_test!(crate::cases::register);

@@ -1,0 +1,91 @@
+//! The seed mode against the seed's C routines (`xtask/peers/fluid/stable_fluids.c`), compiled
+//! here and run side by side: bit for bit at N = 64 and 128 after 100 steps.
+
+use super::check;
+use crate::FluidError;
+use crate::seed::{SeedFluid, SeedParams};
+use anim_core::cases::{Check, Ctx, Judge};
+use std::path::PathBuf;
+use std::process::Command;
+
+/// Where the C transcription is built: `fluid-c` in the target directory (`CARGO_TARGET_DIR` when
+/// set, else the workspace's `target`).
+fn c_dir() -> PathBuf {
+    let target = std::env::var("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target"));
+    target.join("fluid-c")
+}
+
+/// Compiles the seed's C routines (`xtask/peers/fluid/stable_fluids.c`) with the C compiler
+/// (`$CC`, else `cc`) and `flags` into the executable `name` in the target directory, and
+/// returns its path. The conformance case runs it with `-O2 -ffp-contract=off` (bit for bit with
+/// the seed mode); `cargo xtask bench --peers` times it with `-O3 -march=native`.
+///
+/// # Errors
+/// A message when the directory cannot be created, the compiler cannot be run or fails.
+pub fn compile_c(name: &str, flags: &[&str]) -> Result<PathBuf, String> {
+    let dir = c_dir();
+    std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let exe = dir.join(name);
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../xtask/peers/fluid/stable_fluids.c");
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let out = Command::new(&cc)
+        .args(flags)
+        .arg("-o")
+        .arg(&exe)
+        .arg(&src)
+        .output()
+        .map_err(|e| format!("cannot run {cc}: {e}"))?;
+    if !out.status.success() {
+        return Err(format!("{cc} failed: {}", String::from_utf8_lossy(&out.stderr)));
+    }
+    Ok(exe)
+}
+
+fn seed_run(n: usize, steps: usize) -> Result<SeedFluid, FluidError> {
+    let mut f = SeedFluid::new(n, SeedParams::default())?;
+    for _ in 0..steps {
+        f.apply_source_pattern();
+        f.step()?;
+    }
+    Ok(f)
+}
+
+pub(super) fn seed_bitwise(_ctx: &Ctx) -> Vec<Check> {
+    let case = "seed vs C (cc -O2 -ffp-contract=off), 100 steps";
+    let src = "xtask/peers/fluid/stable_fluids.c (seed 6.2)";
+    let exe = match compile_c("stable_fluids_exact", &["-O2", "-ffp-contract=off"]) {
+        Ok(e) => e,
+        Err(e) => {
+            eprintln!("NOTE: {e}");
+            return vec![check(case, "C compiler available".into(), 0.0, 1.0, 1.0, Judge::AtLeast, src)];
+        }
+    };
+    let mut out = Vec::new();
+    for n in [64, 128] {
+        let file = c_dir().join(format!("seed_{n}.bin"));
+        let ok = Command::new(&exe)
+            .args(["dump", &n.to_string(), "100"])
+            .arg(&file)
+            .status()
+            .is_ok_and(|s| s.success());
+        let c_bytes = if ok { std::fs::read(&file).unwrap_or_default() } else { Vec::new() };
+        let ours = seed_run(n, 100).map(|f| f.to_le_bytes()).unwrap_or_default();
+        let differing = if c_bytes.len() == ours.len() && !ours.is_empty() {
+            ours.chunks(4).zip(c_bytes.chunks(4)).filter(|(a, b)| a != b).count() as f64
+        } else {
+            f64::INFINITY
+        };
+        out.push(check(
+            case,
+            format!("N = {n}: values differing (of {})", ours.len() / 4),
+            differing,
+            0.0,
+            0.0,
+            Judge::AtMost,
+            src,
+        ));
+    }
+    out
+}
