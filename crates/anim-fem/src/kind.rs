@@ -176,9 +176,10 @@ impl View for FemSimulation {
         let mut spheres = Vec::new();
         for o in model.obstacles() {
             match *o {
-                Obstacle::Plane { normal: [0.0, 0.0, 1.0], offset } => ground = Some(offset),
+                Obstacle::Plane { point, normal: [0.0, 0.0, 1.0] } => ground = Some(point[2]),
                 Obstacle::Sphere { center, radius } => spheres.push(Prop::Sphere { center, radius }),
-                Obstacle::Plane { .. } => {}
+                // Other planes are not drawn; a model has no box or capsule obstacles.
+                Obstacle::Plane { .. } | Obstacle::Box { .. } | Obstacle::Capsule { .. } => {}
             }
         }
         let fixed = model.fixed();

@@ -168,7 +168,8 @@ impl View for SpringSimulation {
         context.props.extend(ground.map(|height| Prop::Ground { height }));
         context.props.extend(colliders.iter().filter_map(|c| match c.shape {
             Shape::Sphere { center, radius } => Some(Prop::Sphere { center, radius }),
-            Shape::Plane { .. } => None,
+            // A network has no box or capsule colliders (refused when it is built).
+            Shape::Plane { .. } | Shape::Box { .. } | Shape::Capsule { .. } => None,
         }));
         context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
         context
