@@ -1,8 +1,9 @@
 //! `cargo xtask stability --long`: soak runs. Each crate's hard case runs for `10^5` steps or
 //! ten minutes of wall time, whichever comes first, checking finiteness at every step (the
 //! solvers' own guards) and an energy bound or invariant on a fixed stride. Then every registered
-//! preset (`anim::presets()`, so a new preset gets its row without any edit here) runs for the
-//! same budget through anim-core's `DynScene`: every step checked by its solver's guard (a
+//! preset (`anim::presets()`, so a new preset gets its row without any edit here) runs for
+//! [`PRESET_BUDGET`] (`10^4` steps or one minute: 29 presets stay within half an hour) through
+//! anim-core's `DynScene`: every step checked by its solver's guard (a
 //! `StepError` is a detected divergence), every value of its frame checked finite every
 //! [`FRAME_STRIDE`] steps, and its checkpoint saved and restored into it (a restore refuses a
 //! non-finite or damaged value) every [`CHECKPOINT_STRIDE`] steps and at the end. With `--quick`
@@ -21,6 +22,8 @@ use std::time::{Duration, Instant};
 pub const FRAME_STRIDE: u64 = 10;
 /// Steps between the checks of a preset's checkpoint.
 pub const CHECKPOINT_STRIDE: u64 = 1000;
+/// A preset row's budget: `10^4` steps or one minute of wall time.
+pub const PRESET_BUDGET: Budget = Budget { steps: 10_000, wall: Duration::from_secs(60) };
 /// A preset row's budget with `--quick` (the hard cases keep `Budget::new(true)`).
 pub const QUICK_PRESET_BUDGET: Budget = Budget { steps: 200, wall: Duration::from_secs(3) };
 
@@ -129,7 +132,7 @@ pub fn run(quick: bool, filter: Option<&str>, out: &str) -> bool {
         });
     }
     let hard_cases = rows.len();
-    let preset_budget = if quick { QUICK_PRESET_BUDGET } else { budget };
+    let preset_budget = if quick { QUICK_PRESET_BUDGET } else { PRESET_BUDGET };
     let preset_start = Instant::now();
     for (kind, preset) in anim::presets() {
         let quick_params = if quick && preset.quick_params.is_some() { " (quick params)" } else { "" };
