@@ -6,9 +6,9 @@
 //! - Iterative solvers: conjugate gradients with an identity or Jacobi preconditioner ([`cg`]),
 //!   Jacobi and Gauss-Seidel sweeps ([`stationary`]), behind the [`LinearSolver`] trait so that an
 //!   implicit integrator takes any of them; a sparse direct solve by faer's Cholesky ([`direct`]).
-//! - [`schur`]: the block elimination of seed section 7.1.
+//! - [`schur`]: block elimination by Schur complements.
 //! - [`svd`]: 3x3 singular value and polar decompositions returning proper rotations, the
-//!   building block of corotated, fixed-corotated and snow materials (seed 5.1).
+//!   building block of corotated, fixed-corotated and snow materials.
 //!
 //! Conventions: vectors are `&[f64]` slices; `x` passed to a solver is the initial guess and
 //! receives the solution; shape mismatches are programming errors and panic with a clear message,
