@@ -356,7 +356,7 @@ mod tests {
             let rodrigues = DMat3::IDENTITY + h * theta.sin() + h * h * (1.0 - theta.cos());
             let err = frobenius(exp(axis * theta) - rodrigues);
             assert!(err <= 2e-15, "exp: {err:e}");
-            let err = frobenius(exp_axis_angle(axis, theta) - seed);
+            let err = frobenius(exp_axis_angle(axis, theta) - rodrigues);
             assert!(err <= 2e-15, "exp_axis_angle: {err:e}");
             let err = frobenius(exp_axis_angle(axis, theta) - DMat3::from_axis_angle(axis, theta));
             assert!(err <= 2e-15, "exp_axis_angle vs glam: {err:e}");
