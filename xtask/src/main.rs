@@ -4,8 +4,9 @@
 //! | --- | --- |
 //! | `conformance [--quick] [--filter S]` | every reference case with metric, error, tolerance and verdict; exit 1 on any failure |
 //! | `stability [--quick] [--filter S]` | the named hard cases of every crate with their outcomes; exit 1 on an unexpected outcome |
-//! | `stability --long [--quick] [--filter S] [--out DIR]` | soak: each crate's hard case for `10^5` steps or ten minutes with its energy bound; written to `docs/report/soak.md` |
-//! | `bench [--filter S]` | the criterion benches under `benches/`, printed as a table and written to `target/xtask/bench.csv`; `--peers [--filter S]`: the peer comparisons (springs, rigid, pbd, fem, mpm, fluid, flip), their ratios merged into `docs/report/peers.csv` (a filtered run replaces only its crates' rows) |
+//! | `stability --long [--quick] [--filter S] [--out DIR]` | soak: each crate's hard case for `10^5` steps or ten minutes with its energy bound, then every registered preset for the same budget (its solver's guard at every step, frame and checkpoint finite on a stride; `--quick`: quick params, 200 steps or 3 s); written to `docs/report/soak.md` |
+//! | `scaling [--quick] [--filter S] [--threads 1,2,...]` | thread scaling of every registered preset (quick params with `--quick`): time per step, speed-up over one thread and the same checkpoint bits as one thread, on 1 and all cores unless `--threads`; exit 1 on a failure or a thread-count dependence |
+//! | `bench [--filter S]` | the criterion benches under `benches/` (with `presets`: one step of every registered preset), printed as a table and written to `target/xtask/bench.csv`; `--peers [--filter S]`: the peer comparisons (springs, rigid, pbd, fem, mpm, fluid, flip), their ratios merged into `docs/report/peers.csv` (a filtered run replaces only its crates' rows) |
 //! | `report [--quick] [--filter S] [--out DIR] [--threads 1,2,...]` | conformance, stability and work-precision studies, the cheapest method per tolerance (also `cheapest.json`), thread scaling (1 and all cores unless `--threads`) and the peer ratios of `docs/report/peers.csv`, written to `docs/report/` (Markdown + SVG, and every measured part in `data.json`); `--filter` re-runs only the parts of matching crates or names and keeps the rest from `data.json`; prints its duration |
 //! | `ci` | what CI runs: format, clippy, tests (with doc tests), docs, quick conformance and stability |
 
@@ -31,7 +32,7 @@ use std::process::ExitCode;
 pub static ALLOC: anim_core::alloc_count::CountingAllocator =
     anim_core::alloc_count::CountingAllocator::new();
 
-const USAGE: &str = "usage: cargo xtask <conformance|stability|bench|report|ci> [--quick] [--long] [--filter TEXT] [--out DIR] [--threads 1,2,...]";
+const USAGE: &str = "usage: cargo xtask <conformance|stability|scaling|bench|report|ci> [--quick] [--long] [--filter TEXT] [--out DIR] [--threads 1,2,...]";
 
 #[derive(Debug, Default)]
 struct Args {
@@ -62,6 +63,14 @@ fn parse(args: &[String]) -> Result<Args, String> {
     Ok(parsed)
 }
 
+/// The `--threads` counts, or 1 and all cores.
+fn threads(given: Option<Vec<usize>>) -> Vec<usize> {
+    given.unwrap_or_else(|| {
+        let n = machine::cores();
+        if n > 1 { vec![1, n] } else { vec![1] }
+    })
+}
+
 fn main() -> ExitCode {
     let argv: Vec<String> = std::env::args().skip(1).collect();
     let Some((cmd, rest)) = argv.split_first() else {
@@ -82,14 +91,14 @@ fn main() -> ExitCode {
             soak::run(args.quick, args.filter.as_deref(), args.out.as_deref().unwrap_or("docs/report"))
         }
         "stability" => suites::stability(&ctx, args.filter.as_deref()).passed(),
+        "scaling" => scaling::run(args.quick, args.filter.as_deref(), &threads(args.threads)),
         "bench" => bench::run(args.filter.as_deref()),
-        "report" => {
-            let threads = args.threads.unwrap_or_else(|| {
-                let n = machine::cores();
-                if n > 1 { vec![1, n] } else { vec![1] }
-            });
-            report::run(&ctx, args.out.as_deref().unwrap_or("docs/report"), &threads, args.filter.as_deref())
-        }
+        "report" => report::run(
+            &ctx,
+            args.out.as_deref().unwrap_or("docs/report"),
+            &threads(args.threads),
+            args.filter.as_deref(),
+        ),
         "ci" => ci::run(),
         "help" | "--help" | "-h" => {
             println!("{USAGE}");

@@ -124,7 +124,7 @@ pub struct Report {
 }
 
 /// Runs the report into `out`. With `filter`, only the conformance cases, hard cases, studies and
-/// thread-scaling families whose crate or name contains it are run; every other part is taken
+/// thread-scaling presets whose crate or name contains it are run; every other part is taken
 /// from `out/data.json` (written by every run), so the index stays whole.
 pub fn run(ctx: &Ctx, out: &str, threads: &[usize], filter: Option<&str>) -> bool {
     let start = Instant::now();
@@ -192,14 +192,14 @@ pub fn run(ctx: &Ctx, out: &str, threads: &[usize], filter: Option<&str>) -> boo
         parts.push(p);
     }
     eprintln!("thread scaling on {threads:?} threads");
-    for (i, (krate, scene)) in scaling::family_names().into_iter().enumerate() {
+    for (i, (krate, scene)) in scaling::preset_names().into_iter().enumerate() {
         if !suites::selected(filter, krate, scene) {
             keep(&mut stored, &mut parts, Kind::Scaling, krate, scene);
             continue;
         }
         let t = Instant::now();
         let before = scaling::load_average();
-        let rows = scaling::run_family(i, ctx.quick, threads);
+        let rows = scaling::run_preset(i, ctx.quick, threads);
         let mut p = Part::new(Kind::Scaling, krate, scene, &today, t.elapsed().as_secs_f64());
         p.load = before.zip(scaling::load_average());
         p.scaling = rows;
@@ -515,11 +515,14 @@ pub fn index_markdown(r: &Report) -> String {
     let _ = writeln!(md, "## Thread scaling\n");
     let _ = writeln!(
         md,
-        "Each parallel solver family's fixed scene stepped on rayon pools of 1 to {} threads \
-         (`cargo xtask report --threads 1,2,4,...` for more); time per step is the median of three \
-         batches after {} steps whose states are compared bit for bit with the one-thread run.\n",
+        "Every registered preset ({} parameters) stepped on rayon pools of 1 to {} threads \
+         (`cargo xtask report --threads 1,2,4,...` for more; `cargo xtask scaling` for this table \
+         alone); time per step is the median of three batches after {} steps whose checkpoints \
+         are compared bit for bit with the one-thread run. A preset that ends before the timing \
+         does (its divergence guard, its duration) restarts from its initial checkpoint, untimed.\n",
+        if r.quick { "its quick" } else { "its full" },
         r.scaling.iter().map(|s| s.threads).max().unwrap_or(1),
-        3
+        scaling::CHECK_STEPS
     );
     if let Some((before, after)) = r.load {
         let _ = writeln!(
@@ -567,7 +570,7 @@ pub fn index_markdown(r: &Report) -> String {
     if r.soak {
         let _ = writeln!(
             md,
-            "Long runs of each crate's hard case (`cargo xtask stability --long`): [soak.md](soak.md).\n"
+            "Long runs of each crate's hard case and of every registered preset (`cargo xtask stability --long`): [soak.md](soak.md).\n"
         );
     }
     md

@@ -1,5 +1,5 @@
 //! `docs/report/data.json`: every measured part of the report (a conformance case's checks, a
-//! hard case's outcome, a study's points, a thread-scaling family's rows), each with the date it
+//! hard case's outcome, a study's points, a thread-scaling preset's rows), each with the date it
 //! was measured and how long it took. `cargo xtask report --filter TEXT` re-runs only the parts of
 //! matching crates or names and keeps the others from this file, so one crate's section can be
 //! brought up to date without the whole run (over half an hour in full mode).

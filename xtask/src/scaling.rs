@@ -1,198 +1,94 @@
-//! Thread scaling of each parallel solver family: a fixed scene of each crate (through its
-//! public scene presets) stepped on rayon pools of 1, 2, ... threads; time per step, speed-up
-//! over one thread, and whether the state after the first steps is bit for bit the one-thread
-//! state (it must be: results do not depend on the thread count).
+//! Thread scaling of every registered preset (`anim::presets()`), through anim-core's
+//! `DynScene` alone, so that a newly registered preset gets its row without any edit here: the
+//! preset (its `quick_params` with `--quick`) stepped on rayon pools of 1, 2, ... threads; time
+//! per step, speed-up over one thread, and whether the checkpoint after the first steps is bit
+//! for bit the one-thread checkpoint (it must be: results do not depend on the thread count).
+//!
+//! A preset that ends before the timing does (its divergence guard fires, or its nominal
+//! duration `run.steps()` is reached) restarts from its initial checkpoint; the restore is not
+//! timed. `cargo xtask scaling` prints the table; `cargo xtask report` puts it in the report.
 
+use anim_core::scene::{BuildContext, DynScene, Preset, SceneKind};
 use std::fmt::Write as _;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
-/// A scene being stepped.
-trait Stepper {
-    fn step(&mut self) -> Result<(), String>;
-    /// A hash of the state's bits.
-    fn fingerprint(&self) -> u64;
+/// FNV-1a over bytes.
+fn hash_bytes(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3))
 }
 
-fn hash_f64(values: impl IntoIterator<Item = f64>) -> u64 {
-    // FNV-1a over the bit patterns.
-    values.into_iter().fold(0xcbf2_9ce4_8422_2325, |h, v| (h ^ v.to_bits()).wrapping_mul(0x100_0000_01b3))
+/// The parameters a suite runs a preset with: `quick_params` in quick mode (where it has them).
+pub fn params(preset: &Preset, quick: bool) -> &serde_json::Value {
+    if quick { preset.quick_params.as_ref().unwrap_or(&preset.params) } else { &preset.params }
 }
 
-struct Springs(anim_springs::SpringSimulation, anim_core::integrate::State, f64);
-impl Stepper for Springs {
-    fn step(&mut self) -> Result<(), String> {
-        use anim_core::solver::Solver;
-        self.0.step(&mut self.1, self.2).map(drop).map_err(|e| e.to_string())
-    }
-    fn fingerprint(&self) -> u64 {
-        hash_f64(self.1.x.iter().chain(&self.1.v).copied())
-    }
+/// Builds `preset` of `kind` (quick or full parameters).
+pub fn build(kind: &SceneKind, preset: &Preset, quick: bool) -> Result<Box<dyn DynScene>, String> {
+    (kind.build)(params(preset, quick), &BuildContext::default()).map_err(|e| e.to_string())
 }
 
-/// A PBD scene stepped within its duration: the benchmark cloth's few Gauss-Seidel iterations
-/// do not carry the pins' support across 100^2 particles, so the cloth falls nearly freely and
-/// the constraints at the pins pass the divergence guard's 100x stretch after about 62 steps
-/// (1 s), before the preset's nominal 100-step duration. The timing loop (2 s per thread count
-/// in full mode, about 180 steps) therefore restarts the scene from its initial state every
-/// `max_steps` steps: 30 (0.5 s) for the benchmark cloth, whose peer bench runs 15 at 100^2.
-struct Pbd {
-    sim: anim_pbd::PbdSimulation,
-    state: anim_core::integrate::State,
+/// A scene stepped for as long as the timing needs: back to its initial checkpoint after
+/// `duration` steps, or when a step fails (once per failure: a step that fails right after the
+/// restart is an error).
+struct Runner {
+    scene: Box<dyn DynScene>,
+    start: serde_json::Value,
     dt: f64,
-    start: anim_core::integrate::State,
-    steps: usize,
-    max_steps: usize,
+    duration: usize,
+    /// Steps since the last (re)start.
+    since_start: usize,
+    restarts: usize,
 }
-impl Stepper for Pbd {
-    fn step(&mut self) -> Result<(), String> {
-        use anim_core::solver::Solver;
-        if self.steps == self.max_steps {
-            self.state.clone_from(&self.start);
-            self.steps = 0;
+
+impl Runner {
+    fn new(scene: Box<dyn DynScene>, dt: f64, duration: usize) -> Self {
+        let start = scene.save();
+        Self { scene, start, dt, duration: duration.max(1), since_start: 0, restarts: 0 }
+    }
+
+    fn restart(&mut self) -> Result<(), String> {
+        self.scene.restore(&self.start).map_err(|e| format!("restart from the initial checkpoint: {e}"))?;
+        self.since_start = 0;
+        self.restarts += 1;
+        Ok(())
+    }
+
+    /// One step; its wall time, restarts excluded.
+    fn step(&mut self) -> Result<Duration, String> {
+        if self.since_start >= self.duration {
+            self.restart()?;
         }
-        self.steps += 1;
-        self.sim.step(&mut self.state, self.dt).map(drop).map_err(|e| e.to_string())
+        let t = Instant::now();
+        let mut result = self.scene.step(self.dt).map(drop);
+        let mut elapsed = t.elapsed();
+        if let Err(e) = &result
+            && self.since_start > 0
+        {
+            eprintln!(
+                "    step {} failed ({e}); restarting from the initial checkpoint",
+                self.since_start + 1
+            );
+            self.restart()?;
+            let t = Instant::now();
+            result = self.scene.step(self.dt).map(drop);
+            elapsed = t.elapsed();
+        }
+        result.map_err(|e| format!("step {}: {e}", self.since_start + 1))?;
+        self.since_start += 1;
+        Ok(elapsed)
     }
+
+    /// A hash of the checkpoint's bytes.
     fn fingerprint(&self) -> u64 {
-        hash_f64(self.state.x.iter().chain(&self.state.v).copied())
+        hash_bytes(self.scene.save().to_string().as_bytes())
     }
-}
-
-struct Fem(anim_fem::sim::FemSimulation, anim_core::integrate::State, f64);
-impl Stepper for Fem {
-    fn step(&mut self) -> Result<(), String> {
-        use anim_core::solver::Solver;
-        self.0.step(&mut self.1, self.2).map(drop).map_err(|e| e.to_string())
-    }
-    fn fingerprint(&self) -> u64 {
-        hash_f64(self.1.x.iter().chain(&self.1.v).copied())
-    }
-}
-
-struct Mpm(anim_mpm::scenes::Scene<2>);
-impl Stepper for Mpm {
-    fn step(&mut self) -> Result<(), String> {
-        use anim_core::solver::Solver;
-        let s = &mut self.0;
-        s.sim.step(&mut s.state, s.dt).map(drop).map_err(|e| e.to_string())
-    }
-    fn fingerprint(&self) -> u64 {
-        hash_f64(self.0.state.x.iter().chain(&self.0.state.v).map(|&v| f64::from(v)))
-    }
-}
-
-struct Fluid(anim_fluid::scenes::FluidScene, Vec<f64>);
-impl Stepper for Fluid {
-    fn step(&mut self) -> Result<(), String> {
-        let dt = self.0.dt;
-        self.0.step_by(dt).map(drop).map_err(|e| e.to_string())
-    }
-    fn fingerprint(&self) -> u64 {
-        let mut d = self.1.clone();
-        self.0.density_into(&mut d);
-        let mut v = Vec::new();
-        self.0.velocity_into(&mut v);
-        hash_f64(d.into_iter().chain(v))
-    }
-}
-
-struct Flip(anim_flip::FlipSimulation<2>, anim_flip::Particles<2>);
-impl Stepper for Flip {
-    fn step(&mut self) -> Result<(), String> {
-        self.0.advance(&mut self.1, 2e-3).map(drop).map_err(|e| e.to_string())
-    }
-    fn fingerprint(&self) -> u64 {
-        hash_f64(self.1.x.iter().chain(&self.1.v).flatten().copied())
-    }
-}
-
-struct Skin(anim_skin::scenes::SkinScene, anim_skin::CharacterData, f64, Vec<[f64; 3]>);
-impl Stepper for Skin {
-    fn step(&mut self) -> Result<(), String> {
-        self.2 += 0.02;
-        self.0.pose(&mut self.1, self.2, anim_skin::SkinningMethod::Dqs).map_err(|e| e.to_string())
-    }
-    fn fingerprint(&self) -> u64 {
-        let mut p = self.3.clone();
-        self.1.positions(&mut p);
-        hash_f64(p.into_iter().flatten())
-    }
-}
-
-type Make = fn(bool) -> Result<Box<dyn Stepper>, String>;
-
-/// `(crate, scene described, builder)`; the builder takes `quick`.
-fn families() -> Vec<(&'static str, &'static str, Make)> {
-    vec![
-        ("anim-springs", "benchmark cloth 96^2 (quick) / 128^2, symplectic Euler", |quick| {
-            let s = anim_springs::scenes::benchmark_cloth(if quick { 96 } else { 128 })
-                .map_err(|e| e.to_string())?;
-            let dt = s.dt;
-            let (sim, state) = s.into_simulation().map_err(|e| e.to_string())?;
-            Ok(Box::new(Springs(sim, state, dt)))
-        }),
-        ("anim-springs", "hanging cloth 32^2 (quick) / 48^2, backward Euler + Cholesky", |quick| {
-            let s = anim_springs::scenes::hanging_cloth(Some(if quick { 32 } else { 48 }))
-                .map_err(|e| e.to_string())?;
-            let dt = s.dt;
-            let (sim, state) = s.into_simulation().map_err(|e| e.to_string())?;
-            Ok(Box::new(Springs(sim, state, dt)))
-        }),
-        ("anim-pbd", "benchmark cloth 100^2, XPBD, the preset's solver", |_quick| {
-            let s = match anim_pbd::scenes::by_name("benchmark-cloth", Some(100)) {
-                Some(r) => r.map_err(|e| e.to_string())?,
-                None => return Err("no benchmark-cloth preset".into()),
-            };
-            let dt = s.dt;
-            let (sim, state) = s.into_simulation().map_err(|e| e.to_string())?;
-            Ok(Box::new(Pbd { sim, start: state.clone(), state, dt, steps: 0, max_steps: 30 }))
-        }),
-        ("anim-fem", "cantilever beam, resolution 6 (quick) / 8, backward Euler", |quick| {
-            let s = match anim_fem::scenes::by_name("cantilever-beam", Some(if quick { 6 } else { 8 })) {
-                Some(r) => r.map_err(|e| e.to_string())?,
-                None => return Err("no cantilever-beam preset".into()),
-            };
-            let dt = s.dt;
-            let (sim, state) = s.into_simulation().map_err(|e| e.to_string())?;
-            Ok(Box::new(Fem(sim, state, dt)))
-        }),
-        ("anim-mpm", "2D MLS-MPM benchmark, 128^2 (quick) / 256^2 grid", |quick| {
-            match anim_mpm::scenes::by_name("benchmark-2d", Some(if quick { 128 } else { 256 })) {
-                Some(Ok(anim_mpm::scenes::MpmScene::Two(s))) => Ok(Box::new(Mpm(s))),
-                Some(Ok(_)) => Err("benchmark-2d is not 2D".into()),
-                Some(Err(e)) => Err(e.to_string()),
-                None => Err("no benchmark-2d preset".into()),
-            }
-        }),
-        ("anim-fluid", "3D smoke plume 32^3 (quick) / 48^3, MacCormack + MGPCG", |quick| {
-            match anim_fluid::scenes::by_name("smoke-plume-3d", Some(if quick { 32 } else { 48 })) {
-                Some(Ok(s)) => Ok(Box::new(Fluid(s, Vec::new()))),
-                Some(Err(e)) => Err(e.to_string()),
-                None => Err("no smoke-plume-3d preset".into()),
-            }
-        }),
-        ("anim-flip", "2D dam break 64 (quick) / 128 cells across, APIC, dt = 2 ms", |quick| {
-            let (sim, p, _) = anim_flip::scenes::dam_break(
-                if quick { 64 } else { 128 },
-                0.2,
-                anim_flip::FlipParams::default(),
-            )
-            .map_err(|e| e.to_string())?;
-            Ok(Box::new(Flip(sim, p)))
-        }),
-        ("anim-skin", "twisted cylinder, 2048 (quick) / 4096 segments, DQS", |quick| {
-            let s = anim_skin::scenes::twisted_cylinder(Some(if quick { 2048 } else { 4096 }))
-                .map_err(|e| e.to_string())?;
-            let data = s.data();
-            Ok(Box::new(Skin(s, data, 0.0, Vec::new())))
-        }),
-    ]
 }
 
 /// One measured row.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Row {
     pub krate: String,
+    /// The preset's name.
     pub scene: String,
     pub threads: usize,
     /// Seconds per step (NaN when the run failed).
@@ -214,46 +110,65 @@ pub fn load_average() -> Option<f64> {
 }
 
 /// Steps compared for determinism before the timing starts.
-const CHECK_STEPS: usize = 3;
+pub const CHECK_STEPS: usize = 3;
 
-/// (seconds per step, fingerprint after `CHECK_STEPS` steps) on a pool of `threads` threads.
-fn measure(make: Make, quick: bool, threads: usize) -> Result<(f64, u64), String> {
+/// Wall time of the timed steps per thread count, seconds (three batches share it).
+fn budget(quick: bool) -> f64 {
+    if quick { 0.25 } else { 2.0 }
+}
+
+/// What a scene is built by.
+type Build<'a> = &'a (dyn Fn() -> Result<Box<dyn DynScene>, String> + Sync);
+
+/// (seconds per step, fingerprint after [`CHECK_STEPS`] steps) of the scene `build` makes,
+/// stepped by `dt` on a pool of `threads` threads: the median of three batches of at least two
+/// steps each, together `budget` seconds.
+fn measure(
+    build: Build<'_>,
+    dt: f64,
+    duration: usize,
+    threads: usize,
+    budget: f64,
+) -> Result<(f64, u64), String> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
     pool.install(|| {
-        let mut s = make(quick)?;
+        let mut s = Runner::new(build()?, dt, duration);
         for _ in 0..CHECK_STEPS {
             s.step()?;
         }
         let fingerprint = s.fingerprint();
-        let budget = if quick { 0.25 } else { 2.0 };
         let mut batches = Vec::new();
         for _ in 0..3 {
             let start = Instant::now();
-            let mut n = 0usize;
+            let (mut n, mut stepping) = (0u32, Duration::ZERO);
             while n < 2 || start.elapsed().as_secs_f64() < budget / 3.0 {
-                s.step()?;
+                stepping += s.step()?;
                 n += 1;
             }
-            batches.push(start.elapsed().as_secs_f64() / n as f64);
+            batches.push(stepping.as_secs_f64() / f64::from(n));
+        }
+        if s.restarts > 0 {
+            eprintln!(
+                "    {threads} thread(s): restarted {} time(s) from the initial checkpoint",
+                s.restarts
+            );
         }
         batches.sort_by(f64::total_cmp);
         Ok((batches[1], fingerprint))
     })
 }
 
-/// `(crate, scene)` of every family, in report order.
-pub fn family_names() -> Vec<(&'static str, &'static str)> {
-    families().into_iter().map(|(k, s, _)| (k, s)).collect()
-}
-
-/// Times family `index` (of [`family_names`]) at each of `threads`.
-pub fn run_family(index: usize, quick: bool, threads: &[usize]) -> Vec<Row> {
-    let Some(&(krate, scene, make)) = families().get(index) else { return Vec::new() };
+/// The rows of one scene at each of `threads` (the first is the reference of speed-up and bits).
+fn rows(
+    krate: &str,
+    scene: &str,
+    threads: &[usize],
+    measured: impl Fn(usize) -> Result<(f64, u64), String>,
+) -> Vec<Row> {
     let mut rows = Vec::new();
-    let t0 = Instant::now();
     let mut base: Option<(f64, u64)> = None;
     for &t in threads {
-        let row = match measure(make, quick, t) {
+        let row = match measured(t) {
             Ok((seconds, fp)) => {
                 let b = *base.get_or_insert((seconds, fp));
                 Row {
@@ -278,8 +193,50 @@ pub fn run_family(index: usize, quick: bool, threads: &[usize]) -> Vec<Row> {
         };
         rows.push(row);
     }
-    eprintln!("  scaling {krate:<13} {:>6.1} s", t0.elapsed().as_secs_f64());
     rows
+}
+
+/// `(crate, preset)` of every registered preset, in registry order.
+pub fn preset_names() -> Vec<(&'static str, &'static str)> {
+    anim::presets().into_iter().map(|(k, p)| (k.crate_name, p.name)).collect()
+}
+
+/// Times preset `index` (of [`preset_names`]) at each of `threads`.
+pub fn run_preset(index: usize, quick: bool, threads: &[usize]) -> Vec<Row> {
+    let Some((kind, preset)) = anim::presets().into_iter().nth(index) else { return Vec::new() };
+    let t0 = Instant::now();
+    let make = || build(kind, &preset, quick);
+    let rows = rows(kind.crate_name, preset.name, threads, |t| {
+        measure(&make, preset.run.dt, preset.run.steps(), t, budget(quick))
+    });
+    eprintln!("  scaling {:<13} {:<18} {:>6.1} s", kind.crate_name, preset.name, t0.elapsed().as_secs_f64());
+    rows
+}
+
+/// `cargo xtask scaling`: every selected preset at each of `threads`, the table printed; true
+/// when every run finished with the one-thread bits.
+pub fn run(quick: bool, filter: Option<&str>, threads: &[usize]) -> bool {
+    let start = Instant::now();
+    eprintln!("thread scaling on {threads:?} threads{}", if quick { " (quick params)" } else { "" });
+    let before = load_average();
+    let mut all = Vec::new();
+    for (i, (krate, name)) in preset_names().into_iter().enumerate() {
+        if crate::suites::selected(filter, krate, name) {
+            all.extend(run_preset(i, quick, threads));
+        }
+    }
+    println!("{}", markdown(&all));
+    if let Some((a, b)) = before.zip(load_average()) {
+        println!("1-minute load average {a:.2} before, {b:.2} after ({} cores)", crate::machine::cores());
+    }
+    let bad = all.iter().filter(|r| r.identical != Some(true)).count();
+    println!(
+        "scaling{}: {} rows, {bad} failed or not bit-identical, {:.0} s",
+        if quick { " --quick" } else { "" },
+        all.len(),
+        start.elapsed().as_secs_f64()
+    );
+    bad == 0
 }
 
 /// The rows as a Markdown table.
@@ -338,14 +295,107 @@ mod tests {
         assert!(parse_threads("two").unwrap_err().contains("`two`"));
     }
 
-    #[test]
-    fn every_family_builds_and_steps_in_quick_mode() {
-        for (krate, scene, make) in families() {
-            let mut s = make(true).unwrap_or_else(|e| panic!("{krate} {scene}: {e}"));
-            let before = s.fingerprint();
-            s.step().unwrap_or_else(|e| panic!("{krate} {scene}: {e}"));
-            assert_ne!(before, s.fingerprint(), "{krate} {scene}: a step changed nothing");
+    /// A scene of one number: each step adds `increment()` (the thread count, for a scene
+    /// whose result depends on it); a step that would pass `limit` fails, as a divergence
+    /// guard does.
+    struct Counter {
+        x: f64,
+        t: f64,
+        limit: f64,
+        increment: fn() -> f64,
+    }
+
+    impl DynScene for Counter {
+        fn step(&mut self, dt: f64) -> Result<anim_core::solver::StepReport, anim_core::scene::StepError> {
+            let next = self.x + (self.increment)();
+            if next > self.limit {
+                return Err(anim_core::scene::StepError::new(std::io::Error::other("x past its limit")));
+            }
+            (self.x, self.t) = (next, self.t + dt);
+            Ok(anim_core::solver::StepReport::default())
         }
+        fn time(&self) -> f64 {
+            self.t
+        }
+        fn save(&self) -> serde_json::Value {
+            serde_json::json!({ "x": self.x, "t": self.t })
+        }
+        fn restore(&mut self, saved: &serde_json::Value) -> Result<(), anim_core::scene::CheckpointError> {
+            self.x = anim_core::scene::saved_field(saved, "x")?;
+            self.t = anim_core::scene::saved_field(saved, "t")?;
+            Ok(())
+        }
+        fn method(&self) -> String {
+            "counting".into()
+        }
+        fn context(&self) -> anim_core::scene::Context {
+            anim_core::scene::Context::default()
+        }
+        fn frame(&self, out: &mut anim_core::scene::Frame) {
+            out.time = self.t;
+            out.points.clear();
+            out.points.push(self.x);
+        }
+        fn reference_error(&self) -> Option<f64> {
+            None
+        }
+        fn provoke_overflow(&mut self) -> Option<String> {
+            None
+        }
+    }
+
+    fn counter(limit: f64, increment: fn() -> f64) -> Result<Box<dyn DynScene>, String> {
+        Ok(Box::new(Counter { x: 0.0, t: 0.0, limit, increment }))
+    }
+
+    #[test]
+    fn a_thread_count_dependence_is_flagged() {
+        let dependent = || counter(f64::INFINITY, || rayon::current_num_threads() as f64);
+        let got = rows("anim-x", "s", &[1, 2], |t| measure(&dependent, 0.1, 1000, t, 0.01));
+        assert_eq!(got.iter().map(|r| r.identical).collect::<Vec<_>>(), [Some(true), Some(false)], "{got:?}");
+        let independent = || counter(f64::INFINITY, || 1.0);
+        let got = rows("anim-x", "s", &[1, 2], |t| measure(&independent, 0.1, 1000, t, 0.01));
+        assert_eq!(got.iter().map(|r| r.identical).collect::<Vec<_>>(), [Some(true), Some(true)], "{got:?}");
+        assert!(got.iter().all(|r| r.seconds.is_finite() && r.speedup.is_finite()), "{got:?}");
+    }
+
+    #[test]
+    fn a_scene_that_ends_restarts_from_its_initial_checkpoint() {
+        // Diverges at its 6th step: the run goes back to x = 0 and on.
+        let mut r = Runner::new(counter(5.5, || 1.0).unwrap(), 0.1, 1000);
+        let start = r.fingerprint();
+        for _ in 0..5 {
+            r.step().unwrap();
+        }
+        r.step().unwrap();
+        assert_eq!((r.restarts, r.since_start), (1, 1));
+        // Its nominal duration, 3 steps: the fourth starts over.
+        let mut r = Runner::new(counter(f64::INFINITY, || 1.0).unwrap(), 0.1, 3);
+        for _ in 0..3 {
+            r.step().unwrap();
+        }
+        assert_ne!(r.fingerprint(), start);
+        r.step().unwrap();
+        assert_eq!((r.restarts, r.since_start), (1, 1));
+        r.restart().unwrap();
+        assert_eq!(r.fingerprint(), start);
+        // A scene that fails its first step is an error, not an endless restart.
+        let mut r = Runner::new(counter(0.5, || 1.0).unwrap(), 0.1, 1000);
+        assert!(r.step().unwrap_err().contains("x past its limit"));
+        let got = rows("anim-x", "s", &[1], |t| measure(&|| counter(0.5, || 1.0), 0.1, 1000, t, 0.01));
+        assert_eq!(got[0].identical, None, "{got:?}");
+        assert!(got[0].note.contains("x past its limit"), "{got:?}");
+    }
+
+    #[test]
+    fn a_registered_preset_scales_bit_for_bit() {
+        let Some(i) = preset_names().iter().position(|&(_, name)| name == "oscillator") else {
+            panic!("no oscillator preset")
+        };
+        let got = run_preset(i, true, &[1, 2]);
+        assert_eq!(got.len(), 2);
+        assert!(got.iter().all(|r| r.identical == Some(true) && r.seconds > 0.0), "{got:?}");
+        assert_eq!((got[0].krate.as_str(), got[0].scene.as_str()), ("anim-core", "oscillator"));
     }
 
     #[test]

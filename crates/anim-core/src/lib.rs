@@ -36,6 +36,8 @@ pub mod bspline;
 #[cfg(feature = "cases")]
 pub mod cases;
 pub mod diagnostics;
+pub mod geometry;
+pub mod input;
 pub mod integrate;
 pub mod lie;
 pub mod linalg;

@@ -1,5 +1,6 @@
 //! Boundary conditions and contact: pinned degrees of freedom, kinematic vertex groups that follow
-//! a prescribed motion, and rigid obstacles (a half-space ground, a sphere), each with a Coulomb
+//! a prescribed motion, and rigid obstacles (a half-space ground or any plane, a sphere: anim-core's
+//! shared collider [`Shape`](anim_core::geometry::Shape)), each with a Coulomb
 //! friction coefficient `mu >= 0` given when it is added to a model
 //! ([`FemModel::add_obstacle_with_friction`](crate::model::FemModel::add_obstacle_with_friction);
 //! `mu = 0`, the default of `add_obstacle`, is frictionless).
@@ -72,54 +73,35 @@ pub struct KinematicGroup {
     pub initial: Vec<[f64; 3]>,
 }
 
-/// A rigid obstacle (its friction coefficient is stored by the model, see
-/// [`FemModel::obstacle_friction`](crate::model::FemModel::obstacle_friction)).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Obstacle {
-    /// The half-space `n . x >= offset` is free; `normal` is normalised on use.
-    Plane {
-        /// Outward normal of the solid side.
-        normal: [f64; 3],
-        /// Offset along the normal.
-        offset: f64,
-    },
-    /// A solid sphere.
-    Sphere {
-        /// Centre.
-        center: [f64; 3],
-        /// Radius.
-        radius: f64,
-    },
-}
+/// A rigid obstacle's geometry: anim-core's shared [`Shape`](anim_core::geometry::Shape),
+/// re-exported under this name (its friction coefficient is stored by the model, see
+/// [`FemModel::obstacle_friction`](crate::model::FemModel::obstacle_friction)). FEM contact
+/// handles planes and spheres; a box or capsule is refused when it is added
+/// ([`FemModel::add_obstacle`](crate::model::FemModel::add_obstacle)).
+pub use anim_core::geometry::Shape as Obstacle;
 
-impl Obstacle {
-    /// The ground plane `z >= height`.
-    #[must_use]
-    pub fn ground(height: f64) -> Self {
-        Obstacle::Plane { normal: [0.0, 0.0, 1.0], offset: height }
-    }
-
-    /// Signed distance `phi(x)` (negative inside) and the unit outward normal `grad phi`.
-    #[inline]
-    #[must_use]
-    pub fn distance(&self, x: [f64; 3]) -> (f64, [f64; 3]) {
-        match *self {
-            Obstacle::Plane { normal, offset } => {
-                let l = (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt();
-                let n = [normal[0] / l, normal[1] / l, normal[2] / l];
-                (n[0] * x[0] + n[1] * x[1] + n[2] * x[2] - offset, n)
-            }
-            Obstacle::Sphere { center, radius } => {
-                let d = [x[0] - center[0], x[1] - center[1], x[2] - center[2]];
-                let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                if r > 0.0 {
-                    (r - radius, [d[0] / r, d[1] / r, d[2] / r])
-                } else {
-                    (-radius, [0.0, 0.0, 1.0])
-                }
-            }
+/// Signed distance `phi(x)` (negative inside) of a plane or sphere obstacle and the unit outward
+/// normal `grad phi`.
+///
+/// A plane is evaluated as `n . x - n . point` with `n` the normalised normal (for the ground
+/// `z >= h`, exactly `z - h`). Boxes and capsules never reach here: the model refuses them, and
+/// they are reported as outside (`+inf`).
+#[inline]
+#[must_use]
+pub fn obstacle_distance(obstacle: &Obstacle, x: [f64; 3]) -> (f64, [f64; 3]) {
+    match *obstacle {
+        Obstacle::Plane { point, normal } => {
+            let l = (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt();
+            let n = [normal[0] / l, normal[1] / l, normal[2] / l];
+            let offset = n[0] * point[0] + n[1] * point[1] + n[2] * point[2];
+            (n[0] * x[0] + n[1] * x[1] + n[2] * x[2] - offset, n)
         }
+        Obstacle::Sphere { center, radius } => {
+            let d = [x[0] - center[0], x[1] - center[1], x[2] - center[2]];
+            let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            if r > 0.0 { (r - radius, [d[0] / r, d[1] / r, d[2] / r]) } else { (-radius, [0.0, 0.0, 1.0]) }
+        }
+        Obstacle::Box { .. } | Obstacle::Capsule { .. } => (f64::INFINITY, [0.0, 0.0, 1.0]),
     }
 }
 
@@ -142,9 +124,12 @@ mod tests {
 
     #[test]
     fn obstacle_distances() {
-        let (d, n) = Obstacle::ground(1.0).distance([3.0, 4.0, 0.5]);
+        let (d, n) = obstacle_distance(&Obstacle::ground(1.0), [3.0, 4.0, 0.5]);
         assert_eq!((d, n), (-0.5, [0.0, 0.0, 1.0]));
-        let (d, n) = Obstacle::Sphere { center: [0.0; 3], radius: 1.0 }.distance([0.0, 3.0, 0.0]);
+        let tilted = Obstacle::Plane { point: [0.0, 0.0, 2.0], normal: [0.0, 3.0, 4.0] };
+        let (d, n) = obstacle_distance(&tilted, [0.0, 3.0, 6.0]);
+        assert!((d - 5.0).abs() < 1e-15 && n == [0.0, 0.6, 0.8], "{d} {n:?}");
+        let (d, n) = obstacle_distance(&Obstacle::Sphere { center: [0.0; 3], radius: 1.0 }, [0.0, 3.0, 0.0]);
         assert_eq!((d, n), (2.0, [0.0, 1.0, 0.0]));
     }
 }

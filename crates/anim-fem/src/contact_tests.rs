@@ -109,7 +109,9 @@ fn block_on_incline_of(
     }
     let material = Material::new(MaterialModel::StableNeoHookean, 1e6, 0.3, 1000.0).unwrap();
     let mut model = FemModel::with_order(mesh, material, order).unwrap().with_gravity(EARTH_GRAVITY);
-    model.add_obstacle_with_friction(Obstacle::Plane { normal: [s, 0.0, c], offset: 0.0 }, 1e6, mu).unwrap();
+    model
+        .add_obstacle_with_friction(Obstacle::Plane { point: [0.0; 3], normal: [s, 0.0, c] }, 1e6, mu)
+        .unwrap();
     let params = FemParams::new(integrator).with_friction_eps_v(eps_v);
     let sim = FemSimulation::new(model, params).unwrap();
     let state = sim.rest_state();
@@ -283,6 +285,18 @@ fn bad_friction_input_is_named() {
     model.add_obstacle_with_friction(Obstacle::ground(0.0), 1e6, 0.4).unwrap();
     model.add_obstacle(Obstacle::Sphere { center: [0.0; 3], radius: 1.0 }, 1e6).unwrap();
     assert_eq!(model.obstacle_friction(), &[0.4, 0.0]);
+    // Invalid shapes, and boxes and capsules (no FEM contact), are refused naming the obstacle.
+    for (shape, words) in [
+        (Obstacle::Sphere { center: [0.0; 3], radius: -1.0 }, "sphere radius"),
+        (Obstacle::Plane { point: [0.0; 3], normal: [0.0; 3] }, "plane normal"),
+        (Obstacle::Box { center: [0.0; 3], half_extents: [1.0; 3] }, "a box obstacle"),
+        (Obstacle::Capsule { a: [0.0; 3], b: [0.0, 0.0, 1.0], radius: 0.5 }, "a capsule obstacle"),
+    ] {
+        let err = model.add_obstacle(shape, 1e6).unwrap_err();
+        assert!(matches!(err, FemError::BadObstacle { obstacle: 2, .. }), "{err}");
+        assert!(err.to_string().starts_with("obstacle 2: ") && err.to_string().contains(words), "{err}");
+    }
+    assert_eq!(model.obstacles().len(), 2);
     for eps_v in [0.0, -1.0, f64::NAN] {
         let err =
             FemSimulation::new(model.clone(), FemParams::default().with_friction_eps_v(eps_v)).unwrap_err();

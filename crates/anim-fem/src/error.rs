@@ -102,6 +102,14 @@ pub enum FemError {
     /// Bad material parameters (Young's modulus, Poisson's ratio).
     #[error("material: {0}")]
     Material(#[from] MaterialError),
+    /// An obstacle's shape is invalid or not one FEM contact handles (planes and spheres).
+    #[error("obstacle {obstacle}: {reason}")]
+    BadObstacle {
+        /// Index of the obstacle in the order added.
+        obstacle: usize,
+        /// What is wrong, naming the shape.
+        reason: String,
+    },
     /// A scalar parameter out of its range.
     #[error("parameter `{name}` = {value}: {reason}")]
     BadParameter {

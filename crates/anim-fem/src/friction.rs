@@ -43,7 +43,7 @@
 //! frictional obstacle, made when the simulation is built, so a step does not allocate; they are
 //! summed in vertex order, so results do not depend on the thread count.
 
-use crate::boundary::Obstacle;
+use crate::boundary::{Obstacle, obstacle_distance};
 
 /// Default smoothing velocity `eps_v` of the implicit friction (m/s): tangential speeds below it
 /// count as sticking.
@@ -116,7 +116,7 @@ pub fn lagged_contacts(
             if mu == 0.0 {
                 continue;
             }
-            let (phi, n) = o.distance(start);
+            let (phi, n) = obstacle_distance(o, start);
             if phi < 0.0 {
                 out.push(FrictionContact {
                     vertex: i,

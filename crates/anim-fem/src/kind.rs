@@ -35,7 +35,7 @@ use anim_core::integrate::State;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
-    RunDefaults, SceneKind, Simulated, View, params, saved_state,
+    RunDefaults, SceneKind, Simulated, View, params, restore_state_and_memory, save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
 
@@ -135,18 +135,13 @@ impl Checkpoint for FemSimulation {
     }
 
     fn save(&self, state: &State) -> serde_json::Value {
-        serde_json::json!({ "state": state, "simulation": self.memory() })
+        save_state_and_memory(state, self.memory())
     }
 
     fn restore(&mut self, state: &mut State, saved: &serde_json::Value) -> Result<(), CheckpointError> {
-        let restored = saved_state(saved, "state", state)?;
-        let memory =
-            saved.get("simulation").ok_or_else(|| CheckpointError::Missing { field: "simulation".into() })?;
         // The memory is read whole (a step count) or refused: nothing is changed before this
         // succeeds.
-        self.restore_memory(memory).map_err(|e| CheckpointError::invalid("simulation", e.to_string()))?;
-        *state = restored;
-        Ok(())
+        restore_state_and_memory(saved, state, |memory| self.restore_memory(memory))
     }
 
     /// Moves the first free node to `f64::MAX` along x: the elements around it then have a
@@ -181,9 +176,10 @@ impl View for FemSimulation {
         let mut spheres = Vec::new();
         for o in model.obstacles() {
             match *o {
-                Obstacle::Plane { normal: [0.0, 0.0, 1.0], offset } => ground = Some(offset),
+                Obstacle::Plane { point, normal: [0.0, 0.0, 1.0] } => ground = Some(point[2]),
                 Obstacle::Sphere { center, radius } => spheres.push(Prop::Sphere { center, radius }),
-                Obstacle::Plane { .. } => {}
+                // Other planes are not drawn; a model has no box or capsule obstacles.
+                Obstacle::Plane { .. } | Obstacle::Box { .. } | Obstacle::Capsule { .. } => {}
             }
         }
         let fixed = model.fixed();

@@ -332,7 +332,9 @@ impl FemModel {
     /// largest stiffness given is used for all obstacles).
     ///
     /// # Errors
-    /// [`FemError::BadParameter`] for a non-positive stiffness, sphere radius or plane normal.
+    /// [`FemError::BadParameter`] for a non-positive stiffness; [`FemError::BadObstacle`] for a
+    /// shape that fails [`Shape::check`](anim_core::geometry::Shape::check) (a non-positive
+    /// sphere radius, a zero plane normal) or a box or capsule, which FEM contact does not handle.
     pub fn add_obstacle(&mut self, obstacle: Obstacle, stiffness: f64) -> Result<(), FemError> {
         self.add_obstacle_with_friction(obstacle, stiffness, 0.0)
     }
@@ -343,7 +345,7 @@ impl FemModel {
     ///
     /// # Errors
     /// [`FemError::BadParameter`] for a negative or non-finite friction coefficient (named
-    /// `friction`), a non-positive stiffness, sphere radius or plane normal.
+    /// `friction`), a non-positive stiffness; [`FemError::BadObstacle`] as for `add_obstacle`.
     pub fn add_obstacle_with_friction(
         &mut self,
         obstacle: Obstacle,
@@ -364,22 +366,14 @@ impl FemModel {
                 reason: "must be finite and > 0",
             });
         }
-        match obstacle {
-            Obstacle::Sphere { radius, .. } if !(radius > 0.0) => {
-                return Err(FemError::BadParameter {
-                    name: "sphere radius",
-                    value: radius,
-                    reason: "must be > 0",
-                });
-            }
-            Obstacle::Plane { normal, .. } if !(normal.iter().map(|c| c * c).sum::<f64>() > 0.0) => {
-                return Err(FemError::BadParameter {
-                    name: "plane normal",
-                    value: 0.0,
-                    reason: "must be non-zero",
-                });
-            }
-            _ => {}
+        let index = self.obstacles.len();
+        let bad = |reason: String| FemError::BadObstacle { obstacle: index, reason };
+        obstacle.check().map_err(bad)?;
+        if let Obstacle::Box { .. } | Obstacle::Capsule { .. } = obstacle {
+            return Err(bad(format!(
+                "a {} obstacle has no contact in a finite element model (planes and spheres only)",
+                obstacle.name()
+            )));
         }
         self.obstacles.push(obstacle);
         self.friction.push(friction);

@@ -30,7 +30,7 @@
 //! Degrees of freedom marked fixed keep their value: their rows and columns of the matrix are
 //! replaced by the identity and their gradient entries by zero.
 
-use crate::boundary::Obstacle;
+use crate::boundary::{Obstacle, obstacle_distance};
 use crate::error::FemError;
 use crate::friction::FrictionContact;
 use anim_core::linalg::{CsrMatrix, LinearSolver, SystemMatrix, dot};
@@ -241,7 +241,7 @@ fn contact_terms(
         let p = [x[3 * i], x[3 * i + 1], x[3 * i + 2]];
         let mut block = [0.0; 9];
         for o in pot.obstacles {
-            let (phi, n) = o.distance(p);
+            let (phi, n) = obstacle_distance(o, p);
             if phi < 0.0 {
                 energy += 0.5 * k * phi * phi;
                 if let Some(g) = grad.as_deref_mut() {
@@ -495,7 +495,8 @@ mod tests {
         let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
         let mut model = FemModel::new(mesh, material).unwrap();
         let theta = 0.3_f64;
-        let plane = Obstacle::Plane { normal: [theta.sin(), 0.0, theta.cos()], offset: 0.04 };
+        let (s, c) = theta.sin_cos();
+        let plane = Obstacle::Plane { point: [0.04 * s, 0.0, 0.04 * c], normal: [s, 0.0, c] };
         model.add_obstacle_with_friction(plane, 1e4, 0.4).unwrap();
         let xn = model.rest_positions();
         let n = xn.len();

@@ -27,6 +27,7 @@
 //! [`FemError::NonFiniteElement`] (the element and its `det F`), with messages that begin with
 //! `anim-fem: step N:`.
 
+use crate::boundary::obstacle_distance;
 use crate::error::{FemError, StateField};
 use crate::friction::{self, FrictionContact};
 use crate::ldlt::SparseLdlt;
@@ -477,7 +478,7 @@ impl FemSimulation {
                     continue;
                 }
                 let p = [state.x[3 * i], state.x[3 * i + 1], state.x[3 * i + 2]];
-                let (phi, n) = o.distance(p);
+                let (phi, n) = obstacle_distance(o, p);
                 if phi < 0.0 {
                     let vn: f64 = (0..3).map(|c| state.v[3 * i + c] * n[c]).sum();
                     for c in 0..3 {

@@ -126,5 +126,7 @@ pub trait Hyperelastic<T: Scalar, const D: usize>: Send + Sync {
     }
 }
 
+#[cfg(any(test, feature = "cases"))]
+mod samples;
 #[cfg(test)]
 mod tests;

@@ -74,32 +74,11 @@ impl Boundary {
     }
 }
 
-/// The shape of an analytic collider (in `D` dimensions; the trailing components of 3-vectors
-/// are ignored in 2D).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum Shape {
-    /// The half-space behind a plane through `point` with outward unit normal `normal`.
-    Plane {
-        /// A point of the plane.
-        point: [f32; 3],
-        /// Outward normal (normalised on use).
-        normal: [f32; 3],
-    },
-    /// A solid axis-aligned box.
-    Box {
-        /// Centre.
-        center: [f32; 3],
-        /// Half extents (> 0).
-        half: [f32; 3],
-    },
-    /// A solid sphere (a disk in 2D).
-    Sphere {
-        /// Centre.
-        center: [f32; 3],
-        /// Radius (> 0).
-        radius: f32,
-    },
-}
+/// The shape of an analytic collider: anim-core's shared [`Shape`]
+/// (in `D` dimensions; the trailing components of 3-vectors are ignored in 2D), re-exported here.
+/// MPM handles planes, boxes and spheres (disks in 2D); a capsule is refused when the simulation
+/// is built. The shape is converted to `f32` once then, the precision of the grid.
+pub use anim_core::geometry::Shape;
 
 /// An analytic obstacle: a shape moving with constant velocity, and its boundary condition.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -119,54 +98,90 @@ impl Collider {
         Self { shape, velocity: [0.0; 3], boundary }
     }
 
-    pub(crate) fn validate(&self, index: usize, dim: usize) -> Result<(), MpmError> {
+    /// Checks collider `index` in `dim` dimensions and converts its shape to the grid's `f32`.
+    pub(crate) fn compile(&self, index: usize, dim: usize) -> Result<GridCollider, MpmError> {
         let bad = |reason: String| MpmError::BadCollider { index, reason };
         let finite = |v: &[f32]| v.iter().take(dim).all(|c| c.is_finite());
         if !finite(&self.velocity) {
             return Err(bad("non-finite velocity".into()));
         }
-        match self.shape {
+        self.shape.check_in(dim).map_err(bad)?;
+        let f = |v: [f64; 3]| v.map(|c| c as f32);
+        let shape = match self.shape {
             Shape::Plane { point, normal } => {
+                let (point, normal) = (f(point), f(normal));
                 if !finite(&point) || !finite(&normal) {
                     return Err(bad("non-finite plane".into()));
                 }
                 if normal.iter().take(dim).map(|c| c * c).sum::<f32>() < 1e-12 {
-                    return Err(bad("plane normal is zero".into()));
+                    return Err(bad(format!("plane normal is zero in the first {dim} components")));
                 }
+                GridShape::Plane { point, normal }
             }
-            Shape::Box { center, half } => {
+            Shape::Box { center, half_extents } => {
+                let (center, half) = (f(center), f(half_extents));
                 if !finite(&center) || !half.iter().take(dim).all(|h| *h > 0.0 && h.is_finite()) {
                     return Err(bad(format!("box needs a finite centre and half extents > 0, got {half:?}")));
                 }
+                GridShape::Box { center, half }
             }
             Shape::Sphere { center, radius } => {
+                let (center, radius) = (f(center), radius as f32);
                 if !finite(&center) || !(radius > 0.0) || !radius.is_finite() {
                     return Err(bad(format!("sphere needs a finite centre and radius > 0, got {radius}")));
                 }
+                GridShape::Sphere { center, radius }
             }
-        }
-        self.boundary.validate("collider friction")
+            Shape::Capsule { .. } => {
+                return Err(bad(
+                    "a capsule collider has no MPM grid boundary (planes, boxes and spheres only)".into(),
+                ));
+            }
+        };
+        self.boundary.validate("collider friction")?;
+        Ok(GridCollider { shape, velocity: self.velocity, boundary: self.boundary })
     }
+}
 
+/// A collider's shape in `f32`, as the grid kernels use it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum GridShape {
+    /// The half-space behind a plane through `point` with outward normal `normal`.
+    Plane { point: [f32; 3], normal: [f32; 3] },
+    /// A solid axis-aligned box.
+    Box { center: [f32; 3], half: [f32; 3] },
+    /// A solid sphere (a disk in 2D).
+    Sphere { center: [f32; 3], radius: f32 },
+}
+
+/// A checked [`Collider`] in `f32`, built once per simulation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct GridCollider {
+    shape: GridShape,
+    velocity: [f32; 3],
+    pub(crate) boundary: Boundary,
+}
+
+impl GridCollider {
     /// Signed distance and outward normal at `x`, time `t`.
     #[inline]
     pub(crate) fn sdf<const D: usize>(&self, x: &Vector<D>, t: f32) -> (f32, Vector<D>) {
         let shift = Vector::<D>::from_fn(|i, _| self.velocity[i] * t);
         let y = x - shift;
         match self.shape {
-            Shape::Plane { point, normal } => {
+            GridShape::Plane { point, normal } => {
                 let n = Vector::<D>::from_fn(|i, _| normal[i]).normalize();
                 let p = Vector::<D>::from_fn(|i, _| point[i]);
                 ((y - p).dot(&n), n)
             }
-            Shape::Sphere { center, radius } => {
+            GridShape::Sphere { center, radius } => {
                 let d = y - Vector::<D>::from_fn(|i, _| center[i]);
                 let r = d.norm();
                 let n =
                     if r > 0.0 { d / r } else { Vector::<D>::from_fn(|i, _| if i == 0 { 1.0 } else { 0.0 }) };
                 (r - radius, n)
             }
-            Shape::Box { center, half } => {
+            GridShape::Box { center, half } => {
                 let q = Vector::<D>::from_fn(|i, _| (y[i] - center[i]).abs() - half[i]);
                 let outside = q.map(|c| c.max(0.0));
                 let out_len = outside.norm();
@@ -223,21 +238,44 @@ mod tests {
 
     #[test]
     fn signed_distances() {
+        let compile = |c: Collider, dim| c.compile(0, dim).expect("valid");
         let sphere =
             Collider::fixed(Shape::Sphere { center: [1.0, 1.0, 0.0], radius: 0.5 }, Boundary::Sticky);
-        let (phi, n) = sphere.sdf(&Vector::<2>::new(2.0, 1.0), 0.0);
+        let (phi, n) = compile(sphere, 2).sdf(&Vector::<2>::new(2.0, 1.0), 0.0);
         assert!((phi - 0.5).abs() < 1e-6 && (n - Vector::<2>::new(1.0, 0.0)).norm() < 1e-6);
         let moving = Collider { velocity: [1.0, 0.0, 0.0], ..sphere };
-        let (phi, _) = moving.sdf(&Vector::<2>::new(2.0, 1.0), 1.0);
+        let (phi, _) = compile(moving, 2).sdf(&Vector::<2>::new(2.0, 1.0), 1.0);
         assert!((phi + 0.5).abs() < 1e-6);
-        let bx = Collider::fixed(Shape::Box { center: [0.0; 3], half: [1.0, 2.0, 3.0] }, Boundary::Slip);
+        let bx = compile(
+            Collider::fixed(Shape::Box { center: [0.0; 3], half_extents: [1.0, 2.0, 3.0] }, Boundary::Slip),
+            3,
+        );
         let (phi, n) = bx.sdf(&Vector::<3>::new(0.5, 1.8, 0.0), 0.0);
         assert!((phi + 0.2).abs() < 1e-6 && (n - Vector::<3>::new(0.0, 1.0, 0.0)).norm() < 1e-6);
         let (phi, _) = bx.sdf(&Vector::<3>::new(4.0, 6.0, 0.0), 0.0);
         assert!((phi - 5.0).abs() < 1e-5);
-        let plane =
-            Collider::fixed(Shape::Plane { point: [0.0, 0.1, 0.0], normal: [0.0, 2.0, 0.0] }, Boundary::Slip);
+        let plane = compile(
+            Collider::fixed(Shape::Plane { point: [0.0, 0.1, 0.0], normal: [0.0, 2.0, 0.0] }, Boundary::Slip),
+            3,
+        );
         let (phi, n) = plane.sdf(&Vector::<3>::new(0.3, 0.0, 0.2), 0.0);
         assert!((phi + 0.1).abs() < 1e-6 && (n - Vector::<3>::new(0.0, 1.0, 0.0)).norm() < 1e-6);
+    }
+
+    #[test]
+    fn invalid_and_unsupported_shapes_are_refused_by_index() {
+        let capsule = Shape::Capsule { a: [0.2; 3], b: [0.4; 3], radius: 0.1 };
+        let err = Collider::fixed(capsule, Boundary::Slip).compile(3, 3).unwrap_err();
+        assert!(
+            matches!(&err, MpmError::BadCollider { index: 3, reason } if reason.contains("capsule")),
+            "{err}"
+        );
+        // Zero in the first two components: a plane in 3-D, none in 2-D.
+        let plane =
+            Collider::fixed(Shape::Plane { point: [0.0; 3], normal: [0.0, 0.0, 1.0] }, Boundary::Slip);
+        assert!(plane.compile(0, 3).is_ok());
+        assert!(matches!(plane.compile(1, 2), Err(MpmError::BadCollider { index: 1, .. })));
+        let huge = Collider::fixed(Shape::Sphere { center: [0.5; 3], radius: 1e300 }, Boundary::Slip);
+        assert!(matches!(huge.compile(0, 2), Err(MpmError::BadCollider { index: 0, .. })));
     }
 }

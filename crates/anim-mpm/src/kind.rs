@@ -384,19 +384,18 @@ fn tank(params: &MpmParams, dim: usize) -> Prop {
     Prop::Tank { lo: std::array::from_fn(|k| extent(k, lo)), hi: std::array::from_fn(|k| extent(k, hi)) }
 }
 
-/// A collider's shape at time 0 as a prop (z = 0 in 2D); `None` for planes.
+/// A collider's shape at time 0 as a prop (z = 0 in 2D); `None` for planes (and capsules, which
+/// a simulation refuses).
 fn collider(shape: Shape, dim: usize) -> Option<Prop> {
-    let at = |v: [f32; 3], sign: f64, half: [f32; 3]| -> [f64; 3] {
-        std::array::from_fn(|k| if k < dim { f64::from(v[k]) + sign * f64::from(half[k]) } else { 0.0 })
+    let at = |v: [f64; 3], sign: f64, half: [f64; 3]| -> [f64; 3] {
+        std::array::from_fn(|k| if k < dim { v[k] + sign * half[k] } else { 0.0 })
     };
     match shape {
-        Shape::Box { center, half } => {
+        Shape::Box { center, half_extents: half } => {
             Some(Prop::Cuboid { lo: at(center, -1.0, half), hi: at(center, 1.0, half) })
         }
-        Shape::Sphere { center, radius } => {
-            Some(Prop::Sphere { center: at(center, 0.0, [0.0; 3]), radius: f64::from(radius) })
-        }
-        Shape::Plane { .. } => None,
+        Shape::Sphere { center, radius } => Some(Prop::Sphere { center: at(center, 0.0, [0.0; 3]), radius }),
+        Shape::Plane { .. } | Shape::Capsule { .. } => None,
     }
 }
 

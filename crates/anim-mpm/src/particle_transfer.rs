@@ -8,7 +8,7 @@
 //! P2G data, the gathered sums, the G2P chunk loop) and replace only the innermost loops, so both
 //! do the same operations per particle.
 
-use crate::boundary::{Boundary, Collider};
+use crate::boundary::{Boundary, GridCollider};
 use crate::grid::{BLOCK, SparseGrid, WINDOW, pow};
 use crate::kernel::Spline;
 use crate::material::{Compiled, kirchhoff};
@@ -28,7 +28,7 @@ pub(crate) struct Ctx<'a, const D: usize> {
     pub gravity: Vector<D>,
     pub wall_nodes: usize,
     pub wall: Boundary,
-    pub colliders: &'a [Collider],
+    pub colliders: &'a [GridCollider],
     /// Time at the start of the substep.
     pub time: f32,
     /// Allowed particle coordinate range (same on every axis).

@@ -546,7 +546,7 @@ impl SurgeFront {
 pub fn snowball(n: usize) -> Result<Scene<3>, MpmError> {
     let mut params = MpmParams::with_resolution(n);
     params.colliders.push(Collider::fixed(
-        Shape::Box { center: [0.85, 0.5, 0.5], half: [0.05, 0.45, 0.45] },
+        Shape::Box { center: [0.85, 0.5, 0.5], half_extents: [0.05, 0.45, 0.45] },
         Boundary::Separate { friction: 0.5 },
     ));
     params.wall = Boundary::Separate { friction: 0.3 };

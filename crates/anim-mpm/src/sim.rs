@@ -1,7 +1,7 @@
 //! The simulation: parameters, the step with CFL-adaptive substeps, divergence detection and
 //! the diagnostics every step reports.
 
-use crate::boundary::{Boundary, Collider};
+use crate::boundary::{Boundary, Collider, GridCollider};
 use crate::grid::SparseGrid;
 use crate::kernel::{Cubic, Kernel, Quadratic, Spline};
 use crate::material::{Compiled, Kind, Material, energy};
@@ -153,6 +153,8 @@ pub struct MpmSimulation<const D: usize> {
     params: MpmParams,
     materials: Vec<Material>,
     compiled: Vec<Compiled>,
+    /// The colliders in the grid's `f32`, converted once here.
+    colliders: Vec<GridCollider>,
     pub(crate) grid: SparseGrid<D>,
     out: Particles<D>,
     backup: Particles<D>,
@@ -204,9 +206,12 @@ impl<const D: usize> MpmSimulation<D> {
             return bad("materials", format!("{} materials; need 1 to 65535", materials.len()));
         }
         params.wall.validate("wall friction")?;
-        for (i, c) in params.colliders.iter().enumerate() {
-            c.validate(i, D)?;
-        }
+        let colliders = params
+            .colliders
+            .iter()
+            .enumerate()
+            .map(|(i, c)| c.compile(i, D))
+            .collect::<Result<Vec<_>, _>>()?;
         let compiled =
             materials.iter().enumerate().map(|(i, m)| m.compile(i)).collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
@@ -214,6 +219,7 @@ impl<const D: usize> MpmSimulation<D> {
             params,
             materials,
             compiled,
+            colliders,
             out: Particles::new(),
             backup: Particles::new(),
             remove: Vec::new(),
@@ -484,7 +490,7 @@ impl<const D: usize> MpmSimulation<D> {
             gravity: Vector::<D>::from_fn(|a, _| g[a] as f32),
             wall_nodes: self.params.wall_nodes,
             wall: self.params.wall,
-            colliders: &self.params.colliders,
+            colliders: &self.colliders,
             time: self.time as f32,
             lo: lo as f32,
             hi: hi as f32,

@@ -39,6 +39,6 @@ mod validate;
 
 pub use builder::{EARTH_GRAVITY, MeshMass, PbdBuilder};
 pub use cloth::{Bending, Cloth, ClothHandle, MeshParams};
-pub use error::BuildError;
+pub use error::{BuildError, InputError};
 pub use rope::Chain;
 pub use tet::TetMeshParams;

@@ -163,97 +163,9 @@ impl KinematicBody {
     }
 }
 
-/// A collider's geometry, in the frame of its body (or in world space).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Shape {
-    /// The half-space below a plane: solid where `(x - point) . normal < 0`.
-    Plane {
-        /// A point of the plane.
-        point: [f64; 3],
-        /// Outward normal (normalised when the model is built).
-        normal: [f64; 3],
-    },
-    /// A solid ball.
-    Sphere {
-        /// Centre.
-        center: [f64; 3],
-        /// Radius (> 0).
-        radius: f64,
-    },
-    /// A solid box.
-    Box {
-        /// Centre.
-        center: [f64; 3],
-        /// Half the edge lengths (each > 0).
-        half_extents: [f64; 3],
-    },
-    /// A solid capsule: the points within `radius` of the segment `a b`.
-    Capsule {
-        /// First end of the axis.
-        a: [f64; 3],
-        /// Second end of the axis.
-        b: [f64; 3],
-        /// Radius (> 0).
-        radius: f64,
-    },
-}
-
-impl Shape {
-    /// Signed distance of local point `p` and the outward unit normal of the closest surface
-    /// point (`phi < 0` inside).
-    #[must_use]
-    pub fn signed_distance(&self, p: DVec3) -> (f64, DVec3) {
-        match *self {
-            Shape::Plane { point, normal } => {
-                let n = DVec3::from_array(normal);
-                ((p - DVec3::from_array(point)).dot(n), n)
-            }
-            Shape::Sphere { center, radius } => {
-                let d = p - DVec3::from_array(center);
-                let len = d.length();
-                let n = if len > 0.0 { d / len } else { DVec3::Z };
-                (len - radius, n)
-            }
-            Shape::Capsule { a, b, radius } => {
-                let (a, b) = (DVec3::from_array(a), DVec3::from_array(b));
-                let ab = b - a;
-                let t = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
-                let d = p - (a + t * ab);
-                let len = d.length();
-                let n = if len > 0.0 {
-                    d / len
-                } else {
-                    // On the axis: any direction perpendicular to it.
-                    ab.any_orthonormal_vector()
-                };
-                (len - radius, n)
-            }
-            Shape::Box { center, half_extents } => {
-                let h = DVec3::from_array(half_extents);
-                let d = p - DVec3::from_array(center);
-                let q = d.abs() - h;
-                if q.max_element() > 0.0 {
-                    let outside = q.max(DVec3::ZERO);
-                    let len = outside.length();
-                    let n = (outside * d.signum()) / len;
-                    (len, n)
-                } else {
-                    // Inside: the nearest face.
-                    let (axis, depth) = if q.x >= q.y && q.x >= q.z {
-                        (DVec3::X, q.x)
-                    } else if q.y >= q.z {
-                        (DVec3::Y, q.y)
-                    } else {
-                        (DVec3::Z, q.z)
-                    };
-                    let sign = if d.dot(axis) >= 0.0 { 1.0 } else { -1.0 };
-                    (depth, axis * sign)
-                }
-            }
-        }
-    }
-}
+/// A collider's geometry, in the frame of its body (or in world space): anim-core's shared
+/// [`Shape`] (plane, sphere, box, capsule), re-exported here.
+pub use anim_core::geometry::Shape;
 
 /// A collider: a shape on an optional kinematic body, with its contact parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -290,7 +202,7 @@ impl Collider {
     /// The ground plane `z = height` (z up, the scenes' convention).
     #[must_use]
     pub fn ground(height: f64) -> Self {
-        Self::new(Shape::Plane { point: [0.0, 0.0, height], normal: [0.0, 0.0, 1.0] })
+        Self::new(Shape::ground(height))
     }
 
     /// A sphere.
@@ -342,37 +254,9 @@ impl Collider {
 
     /// Checks the parameters; the reason on failure.
     pub(crate) fn validate(&self, bodies: usize) -> Result<Collider, String> {
-        let finite3 = |v: [f64; 3]| v.iter().all(|c| c.is_finite());
+        self.shape.check()?;
         let mut c = *self;
-        match &mut c.shape {
-            Shape::Plane { point, normal } => {
-                let n = DVec3::from_array(*normal);
-                if !finite3(*point) || !finite3(*normal) || !(n.length() > 0.0) {
-                    return Err(format!(
-                        "plane needs a finite point and a non-zero normal, got {point:?}, {normal:?}"
-                    ));
-                }
-                *normal = n.normalize().to_array();
-            }
-            Shape::Sphere { center, radius } => {
-                if !(finite3(*center) && *radius > 0.0 && radius.is_finite()) {
-                    return Err(format!("sphere needs a finite centre and a positive radius, got {radius}"));
-                }
-            }
-            Shape::Box { center, half_extents } => {
-                if !finite3(*center) || !half_extents.iter().all(|h| *h > 0.0 && h.is_finite()) {
-                    return Err(format!("box needs positive half extents, got {half_extents:?}"));
-                }
-            }
-            Shape::Capsule { a, b, radius } => {
-                if !(finite3(*a) && finite3(*b) && *radius > 0.0 && radius.is_finite()) {
-                    return Err(format!("capsule needs finite ends and a positive radius, got {radius}"));
-                }
-                if DVec3::from_array(*a) == DVec3::from_array(*b) {
-                    return Err("capsule ends coincide (use a sphere)".into());
-                }
-            }
-        }
+        c.shape = c.shape.normalized();
         let nonneg = |v: f64| v >= 0.0 && v.is_finite();
         if !nonneg(c.thickness) {
             return Err(format!("thickness must be non-negative and finite, got {}", c.thickness));

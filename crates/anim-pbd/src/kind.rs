@@ -24,7 +24,7 @@ use anim_core::integrate::State;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
-    RunDefaults, SceneKind, Simulated, View, params, saved_state,
+    RunDefaults, SceneKind, Simulated, View, params, restore_state_and_memory, save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
 
@@ -133,17 +133,12 @@ impl Checkpoint for PbdSimulation {
     }
 
     fn save(&self, state: &State) -> serde_json::Value {
-        serde_json::json!({ "state": state, "simulation": self.memory() })
+        save_state_and_memory(state, self.memory())
     }
 
     fn restore(&mut self, state: &mut State, saved: &serde_json::Value) -> Result<(), CheckpointError> {
-        let restored = saved_state(saved, "state", state)?;
-        let memory =
-            saved.get("simulation").ok_or_else(|| CheckpointError::Missing { field: "simulation".into() })?;
         // The memory is checked and taken whole, or not at all.
-        self.restore_memory(memory).map_err(|e| CheckpointError::invalid("simulation", e.to_string()))?;
-        *state = restored;
-        Ok(())
+        restore_state_and_memory(saved, state, |memory| self.restore_memory(memory))
     }
 
     fn provoke_overflow(&mut self, state: &mut State) -> Option<String> {

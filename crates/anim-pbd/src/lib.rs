@@ -173,8 +173,8 @@ pub mod shapes;
 mod sim;
 
 pub use build::{
-    Bending, BuildError, Chain, Cloth, ClothHandle, EARTH_GRAVITY, MeshMass, MeshParams, PbdBuilder,
-    TetMeshParams,
+    Bending, BuildError, Chain, Cloth, ClothHandle, EARTH_GRAVITY, InputError, MeshMass, MeshParams,
+    PbdBuilder, TetMeshParams,
 };
 pub use collide::{BodyMotion, Collider, KinematicBody, Pose, Shape};
 pub use constraint::{AttachTarget, Constraint, ConstraintFunction, ConstraintParams, ConstraintType};

@@ -29,7 +29,8 @@
 //! ```
 
 use crate::build::{
-    Bending, BuildError, Chain, Cloth, EARTH_GRAVITY, MeshMass, MeshParams, PbdBuilder, TetMeshParams,
+    Bending, BuildError, Chain, Cloth, EARTH_GRAVITY, InputError, MeshMass, MeshParams, PbdBuilder,
+    TetMeshParams,
 };
 use crate::collide::{BodyMotion, Collider, KinematicBody, Pose};
 use crate::constraint::{AttachTarget, ConstraintParams};
@@ -103,12 +104,12 @@ fn resolution(
 ) -> Result<usize, BuildError> {
     let n = n.unwrap_or(default);
     if n < min || n > max {
-        return Err(BuildError::BadParameter {
+        return Err(BuildError::Input(InputError::BadParameter {
             shape,
             name: "resolution",
             requirement: "is out of range for this scene (cloth and hanging cloth 2..=1024, flag 3..=512, rope 2..=100000, blob 2..=40, balloon 0..=6)",
             value: n.to_string(),
-        });
+        }));
     }
     Ok(n)
 }
@@ -123,7 +124,7 @@ fn params(method: Method, solver: SolverKind, iterations: usize, substeps: usize
 /// (bending stiffness 0.05 J).
 ///
 /// # Errors
-/// [`BuildError::BadParameter`] for a resolution outside `[2, 1024]`.
+/// [`InputError::BadParameter`] for a resolution outside `[2, 1024]`.
 pub fn cloth_drape(n: Option<usize>) -> Result<PbdScene, BuildError> {
     let n = resolution("cloth-drape", n, 32, 2, 1024)?;
     let mut b = PbdBuilder::new();
@@ -160,7 +161,7 @@ pub fn cloth_drape(n: Option<usize>) -> Result<PbdScene, BuildError> {
 /// bending with compliance 5 (0.2 J/rad^2).
 ///
 /// # Errors
-/// [`BuildError::BadParameter`] for a resolution outside `[3, 512]`.
+/// [`InputError::BadParameter`] for a resolution outside `[3, 512]`.
 pub fn flag(n: Option<usize>) -> Result<PbdScene, BuildError> {
     let nx = resolution("flag", n, 24, 3, 512)?;
     let nz = (2 * nx).div_ceil(3).max(2);
@@ -206,7 +207,7 @@ pub fn flag(n: Option<usize>) -> Result<PbdScene, BuildError> {
 /// constraints, solved with "small steps" (16 substeps of 2 iterations).
 ///
 /// # Errors
-/// [`BuildError::BadParameter`] for fewer than 2 links.
+/// [`InputError::BadParameter`] for fewer than 2 links.
 pub fn rope(links: Option<usize>) -> Result<PbdScene, BuildError> {
     let links = resolution("rope", links, 100, 2, 100_000)?;
     let mut b = PbdBuilder::new();
@@ -248,7 +249,7 @@ pub fn rope(links: Option<usize>) -> Result<PbdScene, BuildError> {
 /// 0.3, friction 0.6.
 ///
 /// # Errors
-/// [`BuildError::BadParameter`] for a resolution outside `[2, 40]`.
+/// [`InputError::BadParameter`] for a resolution outside `[2, 40]`.
 pub fn soft_blob(cells: Option<usize>) -> Result<PbdScene, BuildError> {
     let cells = resolution("soft-blob", cells, 6, 2, 40)?;
     let (pos, tets) = crate::shapes::tet_blob([0.0, 0.0, 0.0], 0.25, cells);
@@ -285,7 +286,7 @@ pub fn soft_blob(cells: Option<usize>) -> Result<PbdScene, BuildError> {
 /// onto a box. Soft edges (`alpha = 1e-3` m/N), soft isometric bending.
 ///
 /// # Errors
-/// [`BuildError::BadParameter`] for more than 6 subdivisions.
+/// [`InputError::BadParameter`] for more than 6 subdivisions.
 pub fn balloon(s: Option<usize>) -> Result<PbdScene, BuildError> {
     let s = resolution("balloon", s, 3, 0, 6)?;
     let (unit, tris) = crate::shapes::icosphere(s);
@@ -329,7 +330,7 @@ pub fn balloon(s: Option<usize>) -> Result<PbdScene, BuildError> {
 /// sequential Gauss-Seidel, 1 iteration x 8 substeps.
 ///
 /// # Errors
-/// [`BuildError::BadParameter`] for a resolution outside `[2, 1024]`.
+/// [`InputError::BadParameter`] for a resolution outside `[2, 1024]`.
 pub fn hanging_cloth(n: Option<usize>) -> Result<PbdScene, BuildError> {
     let n = resolution("hanging-cloth", n, 14, 2, 1024)?;
     let mut b = PbdBuilder::new();
@@ -378,7 +379,7 @@ pub mod benchmark {
 /// parameters in [`benchmark`], XPBD with 5 sequential Gauss-Seidel iterations.
 ///
 /// # Errors
-/// [`BuildError::BadParameter`] for `n < 2`.
+/// [`InputError::BadParameter`] for `n < 2`.
 pub fn benchmark_cloth(n: usize) -> Result<PbdScene, BuildError> {
     use benchmark::*;
     let mut b = PbdBuilder::new();

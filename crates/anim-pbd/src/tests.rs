@@ -7,8 +7,8 @@
 use crate::collide::{BodyMotion, Collider, KinematicBody, Pose, Shape};
 use crate::constraint::{AttachTarget, ConstraintFunction, ConstraintParams};
 use crate::{
-    Bending, BuildError, Chain, Cloth, EARTH_GRAVITY, MeshMass, MeshParams, Method, PbdBuilder, PbdError,
-    PbdParams, PbdSimulation, SolverKind, TetMeshParams, scenes, shapes,
+    Bending, BuildError, Chain, Cloth, EARTH_GRAVITY, InputError, MeshMass, MeshParams, Method, PbdBuilder,
+    PbdError, PbdParams, PbdSimulation, SolverKind, TetMeshParams, scenes, shapes,
 };
 use anim_core::glam::DVec3;
 use anim_core::integrate::State;
@@ -399,7 +399,7 @@ fn bad_input_is_rejected_naming_the_element() {
     };
     let mut b = two();
     b.particle([0.0, 1.0, 0.0], -1.0);
-    assert_eq!(b.build().unwrap_err(), BuildError::BadMass { particle: 2, mass: -1.0 });
+    assert_eq!(b.build().unwrap_err(), BuildError::Input(InputError::BadMass { particle: 2, mass: -1.0 }));
     let mut b = two();
     b.distance(0, 5, ConstraintParams::rigid());
     assert!(matches!(b.build(), Err(BuildError::ConstraintIndex { constraint: 0, index: 5, .. })));
@@ -449,7 +449,7 @@ fn bad_input_is_rejected_naming_the_element() {
     assert!(matches!(b.build(), Err(BuildError::BadVolumeMesh { .. })));
     let mut b = two();
     b.collider(Collider::sphere([0.0; 3], -1.0));
-    assert!(matches!(b.build(), Err(BuildError::BadCollider { collider: 0, .. })));
+    assert!(matches!(b.build(), Err(BuildError::Input(InputError::BadCollider { collider: 0, .. }))));
     let mut b = two();
     b.attach(0, AttachTarget::Body { body: 3, local: [0.0; 3] }, 0.0, ConstraintParams::rigid());
     assert!(matches!(b.build(), Err(BuildError::BodyIndex { constraint: 0, body: 3, .. })));
@@ -627,7 +627,10 @@ fn every_scene_runs() {
         }
     }
     assert!(scenes::by_name("nope", None).is_none());
-    assert!(matches!(scenes::by_name("rope", Some(1)), Some(Err(BuildError::BadParameter { .. }))));
+    assert!(matches!(
+        scenes::by_name("rope", Some(1)),
+        Some(Err(BuildError::Input(InputError::BadParameter { .. })))
+    ));
 }
 
 #[test]

@@ -24,9 +24,10 @@
 //! ```
 
 use crate::contact::Collider;
-use crate::error::BuildError;
+use crate::error::{BuildError, InputError};
 use crate::network::{Particle, Spring, SpringKind, SpringModel, SpringNetwork};
 use anim_core::glam::DVec3;
+use anim_core::input::check_triangle;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
@@ -170,7 +171,7 @@ fn bad(
     requirement: &'static str,
     value: impl ToString,
 ) -> BuildError {
-    BuildError::BadParameter { shape, name, requirement, value: value.to_string() }
+    BuildError::Input(InputError::BadParameter { shape, name, requirement, value: value.to_string() })
 }
 
 fn check_vec(shape: &'static str, name: &'static str, v: [f64; 3]) -> Result<DVec3, BuildError> {
@@ -260,7 +261,7 @@ impl NetworkBuilder {
     /// Adds a [`Chain`]; returns the range of its particle indices.
     ///
     /// # Errors
-    /// [`BuildError::BadParameter`] for `count < 2`, coincident or non-finite ends; masses and
+    /// [`InputError::BadParameter`] for `count < 2`, coincident or non-finite ends; masses and
     /// springs are checked by [`build`](Self::build).
     pub fn chain(&mut self, c: &Chain) -> Result<Range<usize>, BuildError> {
         const S: &str = "chain";
@@ -286,7 +287,7 @@ impl NetworkBuilder {
     /// Adds a [`Cloth`] grid; returns the range of its particle indices.
     ///
     /// # Errors
-    /// [`BuildError::BadParameter`] for fewer than 2 particles along a side, non-finite or
+    /// [`InputError::BadParameter`] for fewer than 2 particles along a side, non-finite or
     /// parallel edge vectors, or a non-positive total mass.
     pub fn cloth(&mut self, c: &Cloth) -> Result<Range<usize>, BuildError> {
         const S: &str = "cloth";
@@ -357,7 +358,7 @@ impl NetworkBuilder {
     /// Adds a [`Lattice`]; returns the range of its particle indices.
     ///
     /// # Errors
-    /// [`BuildError::BadParameter`] for fewer than 2 particles along an axis, a non-positive
+    /// [`InputError::BadParameter`] for fewer than 2 particles along an axis, a non-positive
     /// spacing or mass, or a non-finite origin.
     pub fn lattice(&mut self, l: &Lattice) -> Result<Range<usize>, BuildError> {
         const S: &str = "lattice";
@@ -465,9 +466,9 @@ impl NetworkBuilder {
     /// depend on the triangle order.
     ///
     /// # Errors
-    /// [`BuildError::TriangleIndex`], [`BuildError::DegenerateTriangle`] (repeated vertex or zero
-    /// area), [`BuildError::NonManifoldEdge`] (with bending springs), [`BuildError::IsolatedVertex`]
-    /// (mass by area), [`BuildError::NonFinitePosition`], [`BuildError::BadParameter`] (no
+    /// [`InputError::TriangleIndex`], [`InputError::DegenerateTriangle`] (repeated vertex or zero
+    /// area), [`InputError::NonManifoldEdge`] (with bending springs), [`InputError::IsolatedVertex`]
+    /// (mass by area), [`InputError::NonFinitePosition`], [`InputError::BadParameter`] (no
     /// triangles, non-positive mass or density).
     pub fn mesh(
         &mut self,
@@ -482,36 +483,28 @@ impl NetworkBuilder {
         let first = self.num_particles();
         for (k, p) in positions.iter().enumerate() {
             if !p.iter().all(|c| c.is_finite()) {
-                return Err(BuildError::NonFinitePosition { particle: first + k, position: *p });
+                return Err(BuildError::Input(InputError::NonFinitePosition {
+                    particle: first + k,
+                    position: *p,
+                }));
             }
         }
         let nv = positions.len();
         let mut area_of = vec![0.0; nv];
         for (t, tri) in triangles.iter().enumerate() {
-            for &index in tri {
-                if index >= nv {
-                    return Err(BuildError::TriangleIndex { triangle: t, index, vertices: nv });
-                }
-            }
+            check_triangle(t, *tri, nv)?;
             let [a, b, c] = *tri;
-            if a == b || b == c || a == c {
-                return Err(BuildError::DegenerateTriangle {
-                    triangle: t,
-                    vertices: *tri,
-                    reason: "repeated vertex",
-                });
-            }
             let (pa, pb, pc) =
                 (DVec3::from(positions[a]), DVec3::from(positions[b]), DVec3::from(positions[c]));
             let area = 0.5 * (pb - pa).cross(pc - pa).length();
             let longest =
                 (pb - pa).length_squared().max((pc - pb).length_squared()).max((pa - pc).length_squared());
             if !(area > 1e-12 * longest) {
-                return Err(BuildError::DegenerateTriangle {
+                return Err(BuildError::Input(InputError::DegenerateTriangle {
                     triangle: t,
                     vertices: *tri,
                     reason: "zero area",
-                });
+                }));
             }
             for &v in tri {
                 area_of[v] += area / 3.0;
@@ -525,7 +518,10 @@ impl NetworkBuilder {
             MeshMass::AreaDensity(rho) => {
                 check_positive(S, "area density", rho)?;
                 if let Some(vertex) = area_of.iter().position(|a| *a == 0.0) {
-                    return Err(BuildError::IsolatedVertex { vertex });
+                    return Err(BuildError::Input(InputError::IsolatedVertex {
+                        vertex,
+                        element: "triangle",
+                    }));
                 }
                 area_of.iter().map(|a| rho * a).collect()
             }
@@ -561,7 +557,9 @@ impl NetworkBuilder {
                         }
                         bending.push((first + c.min(d), first + c.max(d), be));
                     }
-                    many => return Err(BuildError::NonManifoldEdge { a, b, triangles: many }),
+                    many => {
+                        return Err(BuildError::Input(InputError::NonManifoldEdge { a, b, triangles: many }));
+                    }
                 }
             }
             k = end;
@@ -579,39 +577,39 @@ impl NetworkBuilder {
     pub fn build(&self) -> Result<SpringNetwork, BuildError> {
         let n = self.positions.len();
         if n == 0 {
-            return Err(BuildError::NoParticles);
+            return Err(BuildError::Input(InputError::NoParticles));
         }
         if n > crate::network::MAX_PARTICLES {
-            return Err(BuildError::TooLarge {
+            return Err(BuildError::Input(InputError::TooLarge {
                 what: "particles",
                 count: n,
                 max: crate::network::MAX_PARTICLES,
-            });
+            }));
         }
         if self.springs.len() > crate::network::MAX_SPRINGS {
-            return Err(BuildError::TooLarge {
+            return Err(BuildError::Input(InputError::TooLarge {
                 what: "springs",
                 count: self.springs.len(),
                 max: crate::network::MAX_SPRINGS,
-            });
+            }));
         }
         if !self.gravity.iter().all(|g| g.is_finite()) {
-            return Err(BuildError::NonFiniteGravity { gravity: self.gravity });
+            return Err(BuildError::Input(InputError::NonFiniteGravity { gravity: self.gravity }));
         }
         let mut particles = Vec::with_capacity(n);
         for (particle, (&position, &mass)) in self.positions.iter().zip(&self.masses).enumerate() {
             if !position.iter().all(|c| c.is_finite()) {
-                return Err(BuildError::NonFinitePosition { particle, position });
+                return Err(BuildError::Input(InputError::NonFinitePosition { particle, position }));
             }
             if !(mass > 0.0 && mass.is_finite()) {
-                return Err(BuildError::BadMass { particle, mass });
+                return Err(BuildError::Input(InputError::BadMass { particle, mass }));
             }
             particles.push(Particle { mass, pinned: false });
         }
         for (pin, &index) in self.pins.iter().enumerate() {
             match particles.get_mut(index) {
                 Some(p) => p.pinned = true,
-                None => return Err(BuildError::PinIndex { pin, index, particles: n }),
+                None => return Err(BuildError::Input(InputError::PinIndex { pin, index, particles: n })),
             }
         }
         let mut springs = Vec::with_capacity(self.springs.len());
@@ -642,13 +640,17 @@ impl NetworkBuilder {
         for (triangle, t) in self.triangles.iter().enumerate() {
             for &index in t {
                 if index >= n {
-                    return Err(BuildError::TriangleIndex { triangle, index, vertices: n });
+                    return Err(BuildError::Input(InputError::TriangleIndex {
+                        triangle,
+                        index,
+                        vertices: n,
+                    }));
                 }
             }
         }
         let mut colliders = Vec::with_capacity(self.colliders.len());
         for (collider, c) in self.colliders.iter().enumerate() {
-            c.check().map_err(|reason| BuildError::BadCollider { collider, reason })?;
+            c.check().map_err(|reason| BuildError::Input(InputError::BadCollider { collider, reason }))?;
             colliders.push(c.normalized());
         }
         let model = SpringModel::new(

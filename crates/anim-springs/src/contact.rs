@@ -62,25 +62,10 @@ use crate::geom::{MIN_LENGTH, outer};
 use anim_core::glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 
-/// The geometry of a collider.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case", deny_unknown_fields)]
-pub enum Shape {
-    /// The half-space `(x - point) . normal >= 0` is free; particles below the plane are pushed out.
-    Plane {
-        /// A point on the plane.
-        point: [f64; 3],
-        /// The outward normal (any non-zero length; normalised when the network is built).
-        normal: [f64; 3],
-    },
-    /// A solid ball: particles inside are pushed out along the radius.
-    Sphere {
-        /// Centre.
-        center: [f64; 3],
-        /// Radius (> 0).
-        radius: f64,
-    },
-}
+/// The geometry of a collider: anim-core's shared [`Shape`],
+/// re-exported here. The penalty contact handles planes and spheres; a box or capsule is refused
+/// when the network is built ([`NetworkBuilder::build`](crate::NetworkBuilder::build)).
+pub use anim_core::geometry::Shape;
 
 /// A rigid, fixed obstacle acting on every particle through a penalty force (see the
 /// [module docs](self)).
@@ -106,8 +91,7 @@ impl Collider {
     /// damping, friction or smoothing (add them with the `with_` methods).
     #[must_use]
     pub fn ground(height: f64, stiffness: f64) -> Self {
-        let shape = Shape::Plane { point: [0.0, 0.0, height], normal: [0.0, 0.0, 1.0] };
-        Self { shape, stiffness, damping: 0.0, friction: 0.0, smoothing: 0.0 }
+        Self { shape: Shape::ground(height), stiffness, damping: 0.0, friction: 0.0, smoothing: 0.0 }
     }
 
     /// A solid sphere with penalty stiffness `stiffness`, no damping, friction or smoothing.
@@ -143,9 +127,9 @@ impl Collider {
         self
     }
 
-    /// Checks the parameters; returns a description of the first problem.
+    /// Checks the parameters; returns a description of the first problem. Only planes and
+    /// spheres have a penalty force here: a box or capsule is refused, naming the shape.
     pub(crate) fn check(&self) -> Result<(), String> {
-        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
         if !(self.stiffness > 0.0 && self.stiffness.is_finite()) {
             return Err(format!("stiffness must be positive and finite, got {}", self.stiffness));
         }
@@ -158,34 +142,19 @@ impl Collider {
         if !(self.smoothing >= 0.0 && self.smoothing.is_finite()) {
             return Err(format!("smoothing must be non-negative and finite, got {}", self.smoothing));
         }
+        self.shape.check()?;
         match self.shape {
-            Shape::Plane { point, normal } => {
-                if !finite(&point) || !finite(&normal) {
-                    return Err("plane point and normal must be finite".into());
-                }
-                let n = DVec3::from_array(normal).length();
-                if !(n > 1e-12) || !n.is_finite() {
-                    return Err(format!("plane normal must be non-zero, got {normal:?}"));
-                }
-            }
-            Shape::Sphere { center, radius } => {
-                if !finite(&center) {
-                    return Err("sphere centre must be finite".into());
-                }
-                if !(radius > 0.0 && radius.is_finite()) {
-                    return Err(format!("sphere radius must be positive and finite, got {radius}"));
-                }
-            }
+            Shape::Plane { .. } | Shape::Sphere { .. } => Ok(()),
+            Shape::Box { .. } | Shape::Capsule { .. } => Err(format!(
+                "a {} collider has no penalty force in a spring network (planes and spheres only)",
+                self.shape.name()
+            )),
         }
-        Ok(())
     }
 
     /// A copy with a unit plane normal (called once the parameters are checked).
     pub(crate) fn normalized(mut self) -> Self {
-        if let Shape::Plane { point, normal } = self.shape {
-            let n = DVec3::from_array(normal).normalize();
-            self.shape = Shape::Plane { point, normal: n.to_array() };
-        }
+        self.shape = self.shape.normalized();
         self
     }
 
@@ -212,6 +181,8 @@ impl Collider {
                     Some((radius - r, DVec3::Z, 0.0))
                 }
             }
+            // Refused by `check` when the network is built, the only way a collider enters one.
+            Shape::Box { .. } | Shape::Capsule { .. } => None,
         }
     }
 

@@ -23,7 +23,7 @@ use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tole
 use anim_core::scene::systems::integrator;
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
-    RunDefaults, SceneKind, Simulated, View, params, saved_state,
+    RunDefaults, SceneKind, Simulated, View, params, restore_state_and_memory, save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
 
@@ -118,17 +118,12 @@ impl Checkpoint for SpringSimulation {
     }
 
     fn save(&self, state: &State) -> serde_json::Value {
-        serde_json::json!({ "state": state, "simulation": self.memory() })
+        save_state_and_memory(state, self.memory())
     }
 
     fn restore(&mut self, state: &mut State, saved: &serde_json::Value) -> Result<(), CheckpointError> {
-        let restored = saved_state(saved, "state", state)?;
-        let memory =
-            saved.get("simulation").ok_or_else(|| CheckpointError::Missing { field: "simulation".into() })?;
         // The memory is checked and taken whole, or not at all.
-        self.restore_memory(memory).map_err(|e| CheckpointError::invalid("simulation", e.to_string()))?;
-        *state = restored;
-        Ok(())
+        restore_state_and_memory(saved, state, |memory| self.restore_memory(memory))
     }
 
     fn provoke_overflow(&mut self, state: &mut State) -> Option<String> {
@@ -173,7 +168,8 @@ impl View for SpringSimulation {
         context.props.extend(ground.map(|height| Prop::Ground { height }));
         context.props.extend(colliders.iter().filter_map(|c| match c.shape {
             Shape::Sphere { center, radius } => Some(Prop::Sphere { center, radius }),
-            Shape::Plane { .. } => None,
+            // A network has no box or capsule colliders (refused when it is built).
+            Shape::Plane { .. } | Shape::Box { .. } | Shape::Capsule { .. } => None,
         }));
         context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
         context

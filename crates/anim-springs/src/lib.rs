@@ -141,7 +141,7 @@ mod sim;
 
 pub use build::{Chain, Cloth, EARTH_GRAVITY, Lattice, MeshMass, MeshSprings, NetworkBuilder, SpringParams};
 pub use contact::{Collider, Shape};
-pub use error::BuildError;
+pub use error::{BuildError, InputError};
 pub use kind::KIND;
 pub use mesh::TriangleMesh;
 pub use network::{

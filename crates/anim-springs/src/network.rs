@@ -74,7 +74,7 @@
 mod forces;
 mod model;
 
-use crate::error::BuildError;
+use crate::error::{BuildError, InputError};
 pub use crate::geom::MIN_LENGTH;
 pub use model::{MAX_PARTICLES, MAX_SPRINGS, Particle, Spring, SpringKind, SpringModel};
 
@@ -292,10 +292,10 @@ impl SpringNetwork {
     /// Changes gravity between steps.
     ///
     /// # Errors
-    /// [`BuildError::NonFiniteGravity`].
+    /// [`InputError::NonFiniteGravity`].
     pub fn set_gravity(&mut self, g: [f64; 3]) -> Result<(), BuildError> {
         if !g.iter().all(|c| c.is_finite()) {
-            return Err(BuildError::NonFiniteGravity { gravity: g });
+            return Err(BuildError::Input(InputError::NonFiniteGravity { gravity: g }));
         }
         self.model.gravity = DVec3::from_array(g);
         Ok(())

@@ -25,7 +25,7 @@
 
 use crate::build::{Chain, Cloth, EARTH_GRAVITY, Lattice, NetworkBuilder, SpringParams};
 use crate::contact::Collider;
-use crate::error::BuildError;
+use crate::error::{BuildError, InputError};
 use crate::network::SpringNetwork;
 use crate::sim::{SpringError, SpringSimulation};
 use anim_core::glam::{DQuat, DVec3};
@@ -111,12 +111,12 @@ fn resolution(
 ) -> Result<usize, BuildError> {
     let n = n.unwrap_or(default);
     if n < min || n > 4096 {
-        return Err(BuildError::BadParameter {
+        return Err(BuildError::Input(InputError::BadParameter {
             shape,
             name: "resolution",
             requirement: "must lie in [min, 4096] (min is 2 for cloth and jelly, 3 for the rope)",
             value: n.to_string(),
-        });
+        }));
     }
     Ok(n)
 }
@@ -126,7 +126,7 @@ fn resolution(
 /// structural, shear and bending springs of stiffness 1000, 200 and 20 N/m with light damping.
 ///
 /// # Errors
-/// [`BuildError::BadParameter`] for a resolution outside `[2, 4096]`.
+/// [`InputError::BadParameter`] for a resolution outside `[2, 4096]`.
 pub fn hanging_cloth(n: Option<usize>) -> Result<SpringScene, BuildError> {
     let n = resolution("hanging-cloth", n, 32, 2)?;
     let mut b = NetworkBuilder::new();
@@ -162,7 +162,7 @@ pub fn hanging_cloth(n: Option<usize>) -> Result<SpringScene, BuildError> {
 /// released to swing like a pendulum. Total mass 0.1 kg, springs of 200 N/m.
 ///
 /// # Errors
-/// [`BuildError::BadParameter`] for a resolution outside `[3, 4096]`.
+/// [`InputError::BadParameter`] for a resolution outside `[3, 4096]`.
 pub fn swinging_rope(n: Option<usize>) -> Result<SpringScene, BuildError> {
     let n = resolution("swinging-rope", n, 40, 3)?;
     let mut b = NetworkBuilder::new();
@@ -199,7 +199,7 @@ pub fn swinging_rope(n: Option<usize>) -> Result<SpringScene, BuildError> {
 /// along the edges, face diagonals and body diagonals.
 ///
 /// # Errors
-/// [`BuildError::BadParameter`] for a resolution outside `[2, 4096]`.
+/// [`InputError::BadParameter`] for a resolution outside `[2, 4096]`.
 pub fn jelly_drop(n: Option<usize>) -> Result<SpringScene, BuildError> {
     let n = resolution("jelly-drop", n, 6, 2)?;
     let spacing = 0.25 / (n - 1) as f64;
@@ -264,7 +264,7 @@ pub mod benchmark {
 /// [`benchmark`], pinned at two corners, stepped with symplectic Euler.
 ///
 /// # Errors
-/// [`BuildError::BadParameter`] for `n < 2`.
+/// [`InputError::BadParameter`] for `n < 2`.
 pub fn benchmark_cloth(n: usize) -> Result<SpringScene, BuildError> {
     use benchmark::*;
     let mut b = NetworkBuilder::new();

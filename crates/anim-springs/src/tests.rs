@@ -686,7 +686,7 @@ fn builder_errors_name_the_element() {
         b.particle([1.0, 0.0, 0.0], 1.0);
         b
     };
-    assert_eq!(NetworkBuilder::new().build().unwrap_err(), BuildError::NoParticles);
+    assert_eq!(NetworkBuilder::new().build().unwrap_err(), BuildError::Input(InputError::NoParticles));
     let mut b = two();
     b.spring(0, 5, p);
     assert_eq!(b.build().unwrap_err(), BuildError::SpringIndex { spring: 0, index: 5, particles: 2 });
@@ -707,28 +707,50 @@ fn builder_errors_name_the_element() {
     assert!(matches!(b.build().unwrap_err(), BuildError::BadRestLength { spring: 0, .. }));
     let mut b = two();
     b.particle([0.0; 3], 0.0);
-    assert!(matches!(b.build().unwrap_err(), BuildError::BadMass { particle: 2, .. }));
+    assert!(matches!(b.build().unwrap_err(), BuildError::Input(InputError::BadMass { particle: 2, .. })));
     let mut b = two();
     b.particle([f64::INFINITY, 0.0, 0.0], 1.0);
-    assert!(matches!(b.build().unwrap_err(), BuildError::NonFinitePosition { particle: 2, .. }));
+    assert!(matches!(
+        b.build().unwrap_err(),
+        BuildError::Input(InputError::NonFinitePosition { particle: 2, .. })
+    ));
     let mut b = two();
     b.pin(0).pin(9);
-    assert_eq!(b.build().unwrap_err(), BuildError::PinIndex { pin: 1, index: 9, particles: 2 });
+    assert_eq!(
+        b.build().unwrap_err(),
+        BuildError::Input(InputError::PinIndex { pin: 1, index: 9, particles: 2 })
+    );
     let mut b = two();
     b.triangle([0, 1, 2]);
-    assert!(matches!(b.build().unwrap_err(), BuildError::TriangleIndex { triangle: 0, index: 2, .. }));
+    assert!(matches!(
+        b.build().unwrap_err(),
+        BuildError::Input(InputError::TriangleIndex { triangle: 0, index: 2, .. })
+    ));
     let mut b = two();
     b.gravity([0.0, f64::NAN, 0.0]);
-    assert!(matches!(b.build().unwrap_err(), BuildError::NonFiniteGravity { .. }));
+    assert!(matches!(b.build().unwrap_err(), BuildError::Input(InputError::NonFiniteGravity { .. })));
     let mut b = two();
     b.collider(Collider::sphere([0.0; 3], -1.0, 1.0));
-    assert!(matches!(b.build().unwrap_err(), BuildError::BadCollider { collider: 0, .. }));
+    assert!(matches!(b.build().unwrap_err(), BuildError::Input(InputError::BadCollider { collider: 0, .. })));
     let mut b = two();
     b.collider(Collider {
         shape: Shape::Plane { point: [0.0; 3], normal: [0.0; 3] },
         ..Collider::ground(0.0, 1.0)
     });
-    assert!(matches!(b.build().unwrap_err(), BuildError::BadCollider { collider: 0, .. }));
+    assert!(matches!(b.build().unwrap_err(), BuildError::Input(InputError::BadCollider { collider: 0, .. })));
+    // Boxes and capsules have no penalty force here: refused, naming the collider and the shape.
+    for (shape, name) in [
+        (Shape::Box { center: [0.0; 3], half_extents: [1.0; 3] }, "box"),
+        (Shape::Capsule { a: [0.0; 3], b: [0.0, 0.0, 1.0], radius: 0.5 }, "capsule"),
+    ] {
+        let mut b = two();
+        b.collider(Collider::ground(-1.0, 1.0));
+        b.collider(Collider { shape, ..Collider::ground(0.0, 1.0) });
+        let err = b.build().unwrap_err();
+        assert!(matches!(err, BuildError::Input(InputError::BadCollider { collider: 1, .. })), "{err:?}");
+        let message = err.to_string();
+        assert!(message.starts_with("collider 1: a ") && message.contains(name), "{message}");
+    }
 
     // Shapes.
     let cloth = Cloth {
@@ -744,17 +766,17 @@ fn builder_errors_name_the_element() {
     };
     assert!(matches!(
         NetworkBuilder::new().cloth(&cloth).unwrap_err(),
-        BuildError::BadParameter { name: "nx", .. }
+        BuildError::Input(InputError::BadParameter { name: "nx", .. })
     ));
     let parallel = Cloth { nx: 3, v: [2.0, 0.0, 0.0], ..cloth };
     assert!(matches!(
         NetworkBuilder::new().cloth(&parallel).unwrap_err(),
-        BuildError::BadParameter { name: "v", .. }
+        BuildError::Input(InputError::BadParameter { name: "v", .. })
     ));
     let chain = Chain { count: 3, start: [0.0; 3], end: [0.0; 3], mass: 1.0, spring: p };
     assert!(matches!(
         NetworkBuilder::new().chain(&chain).unwrap_err(),
-        BuildError::BadParameter { name: "end", .. }
+        BuildError::Input(InputError::BadParameter { name: "end", .. })
     ));
     let lattice = Lattice {
         n: [2, 2, 2],
@@ -767,27 +789,30 @@ fn builder_errors_name_the_element() {
     };
     assert!(matches!(
         NetworkBuilder::new().lattice(&lattice).unwrap_err(),
-        BuildError::BadParameter { name: "spacing", .. }
+        BuildError::Input(InputError::BadParameter { name: "spacing", .. })
     ));
 
     // Meshes.
     let pos = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [2.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
     let ms = MeshSprings { mass: MeshMass::AreaDensity(1.0), edge: p, bending: Some(p) };
     let err = |tris: &[[usize; 3]]| NetworkBuilder::new().mesh(&pos, tris, &ms).unwrap_err();
-    assert!(matches!(err(&[[0, 1, 7]]), BuildError::TriangleIndex { triangle: 0, index: 7, .. }));
+    assert!(matches!(
+        err(&[[0, 1, 7]]),
+        BuildError::Input(InputError::TriangleIndex { triangle: 0, index: 7, .. })
+    ));
     assert!(matches!(
         err(&[[0, 1, 2], [0, 0, 2]]),
-        BuildError::DegenerateTriangle { triangle: 1, reason: "repeated vertex", .. }
+        BuildError::Input(InputError::DegenerateTriangle { triangle: 1, reason: "repeated vertex", .. })
     ));
     assert!(matches!(
         err(&[[0, 1, 3]]),
-        BuildError::DegenerateTriangle { triangle: 0, reason: "zero area", .. }
+        BuildError::Input(InputError::DegenerateTriangle { triangle: 0, reason: "zero area", .. })
     ));
-    assert!(matches!(err(&[[0, 1, 2]]), BuildError::IsolatedVertex { vertex: 3 }));
-    assert!(matches!(err(&[]), BuildError::BadParameter { name: "triangles", .. }));
+    assert!(matches!(err(&[[0, 1, 2]]), BuildError::Input(InputError::IsolatedVertex { vertex: 3, .. })));
+    assert!(matches!(err(&[]), BuildError::Input(InputError::BadParameter { name: "triangles", .. })));
     let three = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
     let e = NetworkBuilder::new().mesh(&three, &[[0, 1, 2], [1, 0, 3], [0, 1, 4]], &ms).unwrap_err();
-    assert_eq!(e, BuildError::NonManifoldEdge { a: 0, b: 1, triangles: 3 });
+    assert_eq!(e, BuildError::Input(InputError::NonManifoldEdge { a: 0, b: 1, triangles: 3 }));
     let e = NetworkBuilder::new().mesh(&three[..3], &[[0, 1, 2], [1, 0, 2]], &ms).unwrap_err();
     assert!(matches!(e, BuildError::DuplicateTriangle { .. }), "{e}");
     // Messages name the element.

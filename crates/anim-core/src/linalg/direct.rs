@@ -1,4 +1,4 @@
-//! Sparse direct solve by Cholesky factorisation (faer).
+//! Sparse direct solves by Cholesky `L L^T` and `L D L^T` factorisation (faer), one path for both.
 //!
 //! # Method
 //!
@@ -12,9 +12,15 @@
 //! - a **numeric** phase that computes the values of `L`.
 //!
 //! In an implicit integrator the pattern of the system matrix is fixed while its values change
-//! each step, so [`SparseCholesky`] keeps the symbolic factorisation and reuses it while the
+//! each step, so [`SparseDirect`] keeps the symbolic factorisation and reuses it while the
 //! pattern (`row_ptr`, `col_idx`) is unchanged, redoing only the numeric phase on each solve. The
 //! factor values, faer's workspace and the residual vector are kept between solves too.
+//!
+//! The symbolic phase is the same for both factorisations; the numeric phase is the
+//! [`Factorization`] kind: [`Llt`] ([`SparseCholesky`], symmetric positive definite) or [`Ldlt`]
+//! ([`SparseLdlt`], symmetric and possibly indefinite, the Newton matrix without the positive
+//! semi-definite projection). `L D L^T` does no pivoting (faer's simplicial/supernodal
+//! factorisation), so a zero pivot fails.
 //!
 //! # Input
 //!
@@ -26,13 +32,14 @@
 //!
 //! # Failure
 //!
-//! A diagonal entry that is missing, `<= 0` or NaN is reported before factoring as
-//! [`SolveError::BadPivot`] (an SPD matrix has a positive diagonal). A non-positive pivot found
-//! later by the elimination is reported as [`SolveError::Factorization`] with faer's message, as
-//! are faer's allocation/index errors. A non-finite residual after the solve is
+//! For Cholesky, a diagonal entry that is missing, `<= 0` or NaN is reported before factoring as
+//! [`SolveError::BadPivot`] (an SPD matrix has a positive diagonal). A non-positive (Cholesky) or
+//! zero (`L D L^T`) pivot found by the elimination is reported as [`SolveError::Factorization`]
+//! with faer's message, as are faer's allocation/index errors. A non-finite residual after the solve is
 //! [`SolveError::NonFinite`].
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
@@ -42,13 +49,156 @@ use faer::{Conj, MatMut, Par, Side};
 
 use super::{CsrMatrix, LinearSolver, SolveError, SolveInfo, SystemMatrix, norm};
 
-/// Sparse Cholesky solver with a cached symbolic factorisation (see the [module docs](self)).
-pub struct SparseCholesky {
+mod sealed {
+    pub trait Sealed {}
+}
+
+/// The numeric phase of a [`SparseDirect`] solver: which factorisation it computes from the
+/// shared symbolic one, and how it names itself. Implemented by [`Llt`] and [`Ldlt`] only.
+pub trait Factorization: sealed::Sealed {
+    /// The solver's name ([`LinearSolver::name`]).
+    const NAME: &'static str;
+    /// The factorisation's name in error messages.
+    const LABEL: &'static str;
+    /// The solver type's name in `Debug` output.
+    const TYPE_NAME: &'static str;
+
+    /// Checks done before factoring (none by default).
+    ///
+    /// # Errors
+    /// A [`SolveError`] naming the problem.
+    fn check(_a: &CsrMatrix) -> Result<(), SolveError> {
+        Ok(())
+    }
+
+    /// faer's scratch space for the numeric factorisation.
+    fn numeric_scratch(symbolic: &SymbolicCholesky<usize>) -> StackReq;
+
+    /// Factors `mat` into `l_values` and overwrites `x` (holding `b`) with the solution.
+    ///
+    /// # Errors
+    /// [`SolveError::Factorization`] with faer's message.
+    fn factor_and_solve(
+        symbolic: &SymbolicCholesky<usize>,
+        l_values: &mut [f64],
+        mat: SparseColMatRef<'_, usize, f64>,
+        workspace: &mut MemBuffer,
+        x: &mut [f64],
+    ) -> Result<(), SolveError>;
+}
+
+/// Cholesky `L L^T`, for symmetric positive definite matrices; rejects a diagonal entry that is
+/// missing, `<= 0` or NaN as [`SolveError::BadPivot`] before factoring.
+#[derive(Debug, Clone, Copy)]
+pub struct Llt;
+
+/// `L D L^T` without pivoting, for symmetric matrices that need not be positive definite.
+#[derive(Debug, Clone, Copy)]
+pub struct Ldlt;
+
+impl sealed::Sealed for Llt {}
+impl sealed::Sealed for Ldlt {}
+
+impl Factorization for Llt {
+    const NAME: &'static str = "cholesky";
+    const LABEL: &'static str = "Cholesky";
+    const TYPE_NAME: &'static str = "SparseCholesky";
+
+    fn check(a: &CsrMatrix) -> Result<(), SolveError> {
+        for row in 0..a.nrows() {
+            let d = a.get(row, row).unwrap_or(0.0);
+            if !(d > 0.0) {
+                return Err(SolveError::BadPivot { row, value: d });
+            }
+        }
+        Ok(())
+    }
+
+    fn numeric_scratch(symbolic: &SymbolicCholesky<usize>) -> StackReq {
+        symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+    }
+
+    fn factor_and_solve(
+        symbolic: &SymbolicCholesky<usize>,
+        l_values: &mut [f64],
+        mat: SparseColMatRef<'_, usize, f64>,
+        workspace: &mut MemBuffer,
+        x: &mut [f64],
+    ) -> Result<(), SolveError> {
+        let n = x.len();
+        let llt = symbolic
+            .factorize_numeric_llt::<f64>(
+                l_values,
+                mat,
+                Side::Upper,
+                LltRegularization::default(),
+                Par::Seq,
+                MemStack::new(workspace),
+                Default::default(),
+            )
+            .map_err(|e| SolveError::Factorization(format!("numeric Cholesky (matrix not SPD?): {e}")))?;
+        llt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(x, n, 1),
+            Par::Seq,
+            MemStack::new(workspace),
+        );
+        Ok(())
+    }
+}
+
+impl Factorization for Ldlt {
+    const NAME: &'static str = "ldlt";
+    const LABEL: &'static str = "LDLT";
+    const TYPE_NAME: &'static str = "SparseLdlt";
+
+    fn numeric_scratch(symbolic: &SymbolicCholesky<usize>) -> StackReq {
+        symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
+    }
+
+    fn factor_and_solve(
+        symbolic: &SymbolicCholesky<usize>,
+        l_values: &mut [f64],
+        mat: SparseColMatRef<'_, usize, f64>,
+        workspace: &mut MemBuffer,
+        x: &mut [f64],
+    ) -> Result<(), SolveError> {
+        let n = x.len();
+        let ldlt = symbolic
+            .factorize_numeric_ldlt::<f64>(
+                l_values,
+                mat,
+                Side::Upper,
+                LdltRegularization::default(),
+                Par::Seq,
+                MemStack::new(workspace),
+                Default::default(),
+            )
+            .map_err(|e| SolveError::Factorization(format!("numeric LDLT: {e}")))?;
+        ldlt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(x, n, 1),
+            Par::Seq,
+            MemStack::new(workspace),
+        );
+        Ok(())
+    }
+}
+
+/// Sparse Cholesky (`L L^T`) solver with a cached symbolic factorisation.
+pub type SparseCholesky = SparseDirect<Llt>;
+
+/// Sparse `L D L^T` solver with a cached symbolic factorisation.
+pub type SparseLdlt = SparseDirect<Ldlt>;
+
+/// Sparse direct solver of factorisation kind `K` with a cached symbolic factorisation (see the
+/// [module docs](self)).
+pub struct SparseDirect<K: Factorization> {
     /// Pattern the symbolic factorisation was computed for.
     row_ptr: Vec<usize>,
     col_idx: Vec<usize>,
     symbolic: Option<SymbolicCholesky<usize>>,
-    /// Values of `L`.
+    /// Values of `L` (and `D`).
     l_values: Vec<f64>,
     /// faer workspace, sized for the numeric factorisation and a one-column solve.
     workspace: MemBuffer,
@@ -56,11 +206,12 @@ pub struct SparseCholesky {
     residual: Vec<f64>,
     /// Number of symbolic factorisations computed so far.
     symbolic_count: usize,
+    kind: std::marker::PhantomData<fn() -> K>,
 }
 
-impl std::fmt::Debug for SparseCholesky {
+impl<K: Factorization> std::fmt::Debug for SparseDirect<K> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("SparseCholesky")
+        f.debug_struct(K::TYPE_NAME)
             .field("dim", &self.row_ptr.len().saturating_sub(1))
             .field("nnz", &self.col_idx.len())
             .field("factor_len", &self.l_values.len())
@@ -69,13 +220,13 @@ impl std::fmt::Debug for SparseCholesky {
     }
 }
 
-impl Default for SparseCholesky {
+impl<K: Factorization> Default for SparseDirect<K> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl SparseCholesky {
+impl<K: Factorization> SparseDirect<K> {
     /// A solver with no cached factorisation.
     #[must_use]
     pub fn new() -> Self {
@@ -87,6 +238,7 @@ impl SparseCholesky {
             workspace: MemBuffer::new(StackReq::EMPTY),
             residual: Vec::new(),
             symbolic_count: 0,
+            kind: std::marker::PhantomData,
         }
     }
 
@@ -113,13 +265,13 @@ impl SparseCholesky {
             SymmetricOrdering::Amd,
             CholeskySymbolicParams::default(),
         )
-        .map_err(|e| SolveError::Factorization(format!("symbolic Cholesky: {e}")))?;
+        .map_err(|e| SolveError::Factorization(format!("symbolic {}: {e}", K::LABEL)))?;
         let req = StackReq::any_of(&[
-            symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+            K::numeric_scratch(&symbolic),
             symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
         ]);
         self.workspace = MemBuffer::try_new(req)
-            .map_err(|e| SolveError::Factorization(format!("Cholesky workspace: {e}")))?;
+            .map_err(|e| SolveError::Factorization(format!("{} workspace: {e}", K::LABEL)))?;
         self.l_values.clear();
         self.l_values.resize(symbolic.len_val(), 0.0);
         self.row_ptr.clear();
@@ -133,19 +285,15 @@ impl SparseCholesky {
 
     fn solve_csr(&mut self, a: &CsrMatrix, b: &[f64], x: &mut [f64]) -> Result<SolveInfo, SolveError> {
         let n = a.nrows();
-        assert_eq!(n, a.ncols(), "SparseCholesky: the matrix must be square ({} x {})", n, a.ncols());
-        assert_eq!(b.len(), n, "SparseCholesky: b.len() != nrows");
-        assert_eq!(x.len(), n, "SparseCholesky: x.len() != nrows");
+        let name = K::TYPE_NAME;
+        assert_eq!(n, a.ncols(), "{name}: the matrix must be square ({} x {})", n, a.ncols());
+        assert_eq!(b.len(), n, "{name}: b.len() != nrows");
+        assert_eq!(x.len(), n, "{name}: x.len() != nrows");
         let b_norm = norm(b);
         if !b_norm.is_finite() {
             return Err(SolveError::NonFinite { iteration: 0 });
         }
-        for row in 0..n {
-            let d = a.get(row, row).unwrap_or(0.0);
-            if !(d > 0.0) {
-                return Err(SolveError::BadPivot { row, value: d });
-            }
-        }
+        K::check(a)?;
         if n == 0 {
             return Ok(SolveInfo { iterations: 1, relative_residual: 0.0 });
         }
@@ -155,25 +303,8 @@ impl SparseCholesky {
         };
         let pattern = SymbolicSparseColMatRef::new_checked(n, n, a.row_ptr(), None, a.col_idx());
         let mat = SparseColMatRef::new(pattern, a.values());
-        let stack = MemStack::new(&mut self.workspace);
-        let llt = symbolic
-            .factorize_numeric_llt::<f64>(
-                &mut self.l_values,
-                mat,
-                Side::Upper,
-                LltRegularization::default(),
-                Par::Seq,
-                stack,
-                Default::default(),
-            )
-            .map_err(|e| SolveError::Factorization(format!("numeric Cholesky (matrix not SPD?): {e}")))?;
         x.copy_from_slice(b);
-        llt.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(x, n, 1),
-            Par::Seq,
-            MemStack::new(&mut self.workspace),
-        );
+        K::factor_and_solve(symbolic, &mut self.l_values, mat, &mut self.workspace, x)?;
         if self.residual.len() != n {
             self.residual.resize(n, 0.0);
         }
@@ -190,9 +321,9 @@ impl SparseCholesky {
     }
 }
 
-impl LinearSolver for SparseCholesky {
+impl<K: Factorization> LinearSolver for SparseDirect<K> {
     fn name(&self) -> &'static str {
-        "cholesky"
+        K::NAME
     }
 
     fn needs_matrix(&self) -> bool {
@@ -202,7 +333,7 @@ impl LinearSolver for SparseCholesky {
     fn solve(&mut self, a: SystemMatrix<'_>, b: &[f64], x: &mut [f64]) -> Result<SolveInfo, SolveError> {
         match a {
             SystemMatrix::Csr(m) => self.solve_csr(m, b, x),
-            SystemMatrix::Operator(_) => Err(SolveError::NeedsMatrix { solver: "cholesky" }),
+            SystemMatrix::Operator(_) => Err(SolveError::NeedsMatrix { solver: K::NAME }),
         }
     }
 }
@@ -419,5 +550,42 @@ mod tests {
         assert_eq!(x, [0.0; 2]);
         assert_eq!(chol.name(), "cholesky");
         assert!(chol.needs_matrix());
+    }
+
+    #[test]
+    fn ldlt_solves_an_indefinite_symmetric_system() {
+        // [[2, 1, 0], [1, -3, 1], [0, 1, 4]] is symmetric indefinite.
+        let t = [(0, 0, 2.0), (0, 1, 1.0), (1, 0, 1.0), (1, 1, -3.0), (1, 2, 1.0), (2, 1, 1.0), (2, 2, 4.0)];
+        let a = CsrMatrix::from_triplets(3, 3, &t);
+        let x_true = [1.0, -2.0, 0.5];
+        let mut b = [0.0; 3];
+        a.mul_vec(&x_true, &mut b);
+        let mut x = [0.0; 3];
+        let mut ldlt = SparseLdlt::new();
+        let info = ldlt.solve(SystemMatrix::Csr(&a), &b, &mut x).unwrap();
+        assert!(info.relative_residual < 1e-14);
+        for k in 0..3 {
+            assert!((x[k] - x_true[k]).abs() < 1e-14);
+        }
+        // Cholesky refuses the same matrix; LDLT caches its symbolic factorisation the same way.
+        assert!(SparseCholesky::new().solve(SystemMatrix::Csr(&a), &b, &mut x).is_err());
+        ldlt.solve(SystemMatrix::Csr(&a), &b, &mut x).unwrap();
+        assert_eq!(ldlt.symbolic_factorizations(), 1);
+        assert_eq!(ldlt.name(), "ldlt");
+        assert_eq!(
+            ldlt.solve(SystemMatrix::Operator(&a), &b, &mut x),
+            Err(SolveError::NeedsMatrix { solver: "ldlt" })
+        );
+    }
+
+    #[test]
+    fn ldlt_matches_cholesky_on_spd() {
+        let mut rng = ChaCha8Rng::seed_from_u64(33);
+        let a = random_spd(&mut rng, 50);
+        let b: Vec<f64> = (0..50).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let (mut x1, mut x2) = (vec![0.0; 50], vec![0.0; 50]);
+        SparseCholesky::new().solve(SystemMatrix::Csr(&a), &b, &mut x1).expect("SPD");
+        SparseLdlt::new().solve(SystemMatrix::Csr(&a), &b, &mut x2).expect("SPD");
+        assert!(max_abs_diff(&x1, &x2) <= 1e-12);
     }
 }

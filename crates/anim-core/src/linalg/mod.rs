@@ -5,7 +5,8 @@
 //!   sparse types.
 //! - Iterative solvers: conjugate gradients with an identity or Jacobi preconditioner ([`cg`]),
 //!   Jacobi and Gauss-Seidel sweeps ([`stationary`]), behind the [`LinearSolver`] trait so that an
-//!   implicit integrator takes any of them; a sparse direct solve by faer's Cholesky ([`direct`]).
+//!   implicit integrator takes any of them; sparse direct solves by faer's Cholesky and `L D L^T`,
+//!   one symbolic-factorisation cache for both ([`direct`]).
 //! - [`schur`]: block elimination by Schur complements.
 //! - [`svd`]: 3x3 singular value and polar decompositions returning proper rotations, the
 //!   building block of corotated, fixed-corotated and snow materials.
@@ -23,7 +24,7 @@ pub mod svd;
 
 pub use cg::{Cg, Preconditioner};
 pub use csr::{CsrError, CsrMatrix};
-pub use direct::SparseCholesky;
+pub use direct::{Factorization, Ldlt, Llt, SparseCholesky, SparseDirect, SparseLdlt};
 pub use schur::{Eliminate, schur_complement, solve_block, solve_block_diagonal_a};
 pub use stationary::{GaussSeidel, Jacobi, gauss_seidel_sweep, jacobi_sweep};
 pub use svd::{Svd3, polar, polar_f32, svd3, svd3_f32, svd3_real};

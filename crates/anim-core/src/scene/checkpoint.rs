@@ -126,3 +126,32 @@ pub fn saved_state(
     }
     Ok(state)
 }
+
+/// The checkpoint of a solver whose step reads a [`State`](crate::integrate::State) and the
+/// solver's own memory (step counts, warm starts): `{"state": state, "simulation": memory}`.
+#[must_use]
+pub fn save_state_and_memory(
+    state: &crate::integrate::State,
+    memory: serde_json::Value,
+) -> serde_json::Value {
+    serde_json::json!({ "state": state, "simulation": memory })
+}
+
+/// Restores what [`save_state_and_memory`] saved: the state is read and checked against
+/// `state` first ([`saved_state`]), then `restore_memory` takes the memory (whole or not at all),
+/// and only then is `state` replaced, so a refused checkpoint changes nothing.
+///
+/// # Errors
+/// [`CheckpointError`] naming `state` or `simulation` when either is missing or refused.
+pub fn restore_state_and_memory<E: std::fmt::Display>(
+    saved: &serde_json::Value,
+    state: &mut crate::integrate::State,
+    restore_memory: impl FnOnce(&serde_json::Value) -> Result<(), E>,
+) -> Result<(), CheckpointError> {
+    let restored = saved_state(saved, "state", state)?;
+    let memory =
+        saved.get("simulation").ok_or_else(|| CheckpointError::Missing { field: "simulation".into() })?;
+    restore_memory(memory).map_err(|e| CheckpointError::invalid("simulation", e.to_string()))?;
+    *state = restored;
+    Ok(())
+}

@@ -48,7 +48,9 @@ pub mod study;
 pub mod systems;
 mod view;
 
-pub use checkpoint::{Checkpoint, CheckpointError, saved_field, saved_state};
+pub use checkpoint::{
+    Checkpoint, CheckpointError, restore_state_and_memory, save_state_and_memory, saved_field, saved_state,
+};
 pub use dynamic::{DynScene, Simulated, StepError};
 pub use preset::{BuildContext, BuildError, BuildFn, Preset, RunDefaults, SceneKind, params};
 pub use view::{Context, Field, Frame, ImageGrid, Prop, View, frame_box};

@@ -25,14 +25,12 @@ mod conformance;
 mod hard_cases;
 mod projection;
 
-use crate::nalgebra::{Rotation2, Rotation3, SVector, Vector3};
+use crate::samples::{KINDS, Kind, lame, rotation, sample};
 use crate::{Hyperelastic, Lame, Mat, Tangent, svd};
 use anim_core::cases::{Check, ConformanceCase, Judge, Outcome, Registry, StabilityCase};
 use conformance::{finite_differences, invariance, precision, small_strain};
 use hard_cases::{inversion_robust, neo_hookean_inverted};
 use projection::psd_projection;
-use rand::Rng;
-use rand_chacha::ChaCha8Rng;
 
 const CRATE: &str = "anim-material";
 
@@ -71,71 +69,6 @@ pub fn register(r: &mut Registry) {
         expected: || Outcome::Rejected(String::new()),
         run: neo_hookean_inverted,
     });
-}
-
-/// E = 1e4, nu = 0.3.
-fn lame() -> Lame<f64> {
-    Lame::from_young_poisson(1e4, 0.3).unwrap_or(Lame { mu: f64::NAN, lambda: f64::NAN })
-}
-
-fn rotation<const D: usize>(rng: &mut ChaCha8Rng) -> Mat<f64, D> {
-    if D == 2 {
-        let r = Rotation2::new(rng.random_range(-std::f64::consts::PI..std::f64::consts::PI));
-        Mat::<f64, D>::from_fn(|i, j| r.matrix()[(i, j)])
-    } else {
-        let axis: Vector3<f64> = Vector3::new(
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        );
-        let r = Rotation3::new(axis * (3.0 / axis.norm().max(1e-3)) * rng.random_range(0.0..1.0));
-        Mat::<f64, D>::from_fn(|i, j| r.matrix()[(i, j)])
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Kind {
-    General,
-    Rotation,
-    Stretch,
-    NearSingular,
-    Inverted,
-    Degenerate,
-}
-
-const KINDS: [Kind; 6] =
-    [Kind::General, Kind::Rotation, Kind::Stretch, Kind::NearSingular, Kind::Inverted, Kind::Degenerate];
-
-fn sample<const D: usize>(kind: Kind, rng: &mut ChaCha8Rng) -> Mat<f64, D> {
-    let mut s = SVector::<f64, D>::from_fn(|_, _| rng.random_range(0.5..2.0));
-    let (r1, r2) = (rotation::<D>(rng), rotation::<D>(rng));
-    match kind {
-        Kind::General => r1 * Mat::from_diagonal(&s) * r2.transpose(),
-        Kind::Rotation => r1,
-        Kind::Stretch => {
-            if rng.random_bool(0.5) {
-                s[1] = s[0];
-            }
-            Mat::from_diagonal(&s)
-        }
-        Kind::NearSingular => {
-            s[D - 1] = 1e-3;
-            r1 * Mat::from_diagonal(&s) * r2.transpose()
-        }
-        Kind::Inverted => {
-            // sigma_{d-2} + sigma_{d-1} kept away from 0 (the corotated R is not differentiable there).
-            // The negative value is the smallest in magnitude, so the others are >= 1.
-            for k in 0..D - 1 {
-                s[k] = rng.random_range(1.0..2.0);
-            }
-            s[D - 1] = -rng.random_range(0.05..0.6);
-            r1 * Mat::from_diagonal(&s) * r2.transpose()
-        }
-        Kind::Degenerate => {
-            s[D - 1] = 0.0;
-            r1 * Mat::from_diagonal(&s) * r2.transpose()
-        }
-    }
 }
 
 fn fd4<R>(g: impl Fn(f64) -> R, h: f64) -> R

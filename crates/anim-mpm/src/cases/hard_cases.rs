@@ -105,7 +105,7 @@ pub(super) fn snow_compression(ctx: &Ctx) -> Outcome {
         let mut params = MpmParams::with_resolution(64);
         params.wall = Boundary::Sticky;
         params.colliders.push(Collider {
-            shape: Shape::Box { center: [0.5, 0.55, 0.0], half: [0.4, 0.05, 0.0] },
+            shape: Shape::Box { center: [0.5, 0.55, 0.0], half_extents: [0.4, 0.05, 0.0] },
             velocity: [0.0, -1.0, 0.0],
             boundary: Boundary::Sticky,
         });

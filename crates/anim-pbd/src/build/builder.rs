@@ -8,7 +8,7 @@
 //!
 //! The helpers below check the shape builders' own parameters and name the offending one.
 
-use super::error::BuildError;
+use super::error::{BuildError, InputError};
 use crate::collide::{Collider, KinematicBody};
 use crate::constraint::{AttachTarget, ConstraintParams};
 use crate::model::Wind;
@@ -59,17 +59,17 @@ pub struct PbdBuilder {
 /// Standard gravity pointing down the z axis (m/s^2): the scenes' convention is z up.
 pub const EARTH_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
 
-/// A [`BuildError::BadParameter`] of builder `shape`.
+/// A [`InputError::BadParameter`] of builder `shape`.
 pub(super) fn bad(
     shape: &'static str,
     name: &'static str,
     requirement: &'static str,
     value: impl ToString,
 ) -> BuildError {
-    BuildError::BadParameter { shape, name, requirement, value: value.to_string() }
+    BuildError::Input(InputError::BadParameter { shape, name, requirement, value: value.to_string() })
 }
 
-/// `v` as a vector, or a [`BuildError::BadParameter`] if it is not finite.
+/// `v` as a vector, or a [`InputError::BadParameter`] if it is not finite.
 pub(super) fn check_vec(shape: &'static str, name: &'static str, v: [f64; 3]) -> Result<DVec3, BuildError> {
     if v.iter().all(|c| c.is_finite()) {
         Ok(DVec3::from_array(v))
@@ -78,12 +78,12 @@ pub(super) fn check_vec(shape: &'static str, name: &'static str, v: [f64; 3]) ->
     }
 }
 
-/// A [`BuildError::BadParameter`] unless `v` is positive and finite.
+/// A [`InputError::BadParameter`] unless `v` is positive and finite.
 pub(super) fn check_positive(shape: &'static str, name: &'static str, v: f64) -> Result<(), BuildError> {
     if v > 0.0 && v.is_finite() { Ok(()) } else { Err(bad(shape, name, "must be positive and finite", v)) }
 }
 
-/// A [`BuildError::BadParameter`] unless the mass or density is positive and finite.
+/// A [`InputError::BadParameter`] unless the mass or density is positive and finite.
 pub(super) fn check_mass(shape: &'static str, m: MeshMass) -> Result<(), BuildError> {
     match m {
         MeshMass::PerVertex(v) => check_positive(shape, "mass per vertex", v),

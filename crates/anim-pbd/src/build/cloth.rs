@@ -7,9 +7,10 @@
 //! and wind.
 
 use super::builder::{MeshMass, PbdBuilder, bad, check_mass, check_positive, check_vec, key};
-use super::error::BuildError;
+use super::error::{BuildError, InputError};
 use crate::constraint::ConstraintParams;
 use anim_core::glam::DVec3;
+use anim_core::input::check_triangle;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::ops::Range;
@@ -88,7 +89,7 @@ impl PbdBuilder {
     /// A cloth grid; returns where its particles are.
     ///
     /// # Errors
-    /// [`BuildError::BadParameter`] for fewer than 2 particles along a side, parallel `u` and `v`,
+    /// [`InputError::BadParameter`] for fewer than 2 particles along a side, parallel `u` and `v`,
     /// or non-finite input.
     pub fn cloth(&mut self, c: &Cloth) -> Result<ClothHandle, BuildError> {
         if c.nx < 2 || c.ny < 2 {
@@ -128,9 +129,9 @@ impl PbdBuilder {
     /// and wind. Returns the range of its particles.
     ///
     /// # Errors
-    /// [`BuildError::TriangleIndex`], [`BuildError::DegenerateTriangle`],
-    /// [`BuildError::NonManifoldEdge`] (with bending), [`BuildError::IsolatedVertex`] (mass by
-    /// density), [`BuildError::BadParameter`].
+    /// [`InputError::TriangleIndex`], [`InputError::DegenerateTriangle`],
+    /// [`InputError::NonManifoldEdge`] (with bending), [`InputError::IsolatedVertex`] (mass by
+    /// density), [`InputError::BadParameter`].
     pub fn triangle_mesh(
         &mut self,
         positions: &[[f64; 3]],
@@ -142,27 +143,16 @@ impl PbdBuilder {
         let pos: Vec<DVec3> = positions.iter().map(|&p| DVec3::from_array(p)).collect();
         let mut area = vec![0.0; nv];
         for (t, tri) in triangles.iter().enumerate() {
-            for &i in tri {
-                if i >= nv {
-                    return Err(BuildError::TriangleIndex { triangle: t, index: i, vertices: nv });
-                }
-            }
+            check_triangle(t, *tri, nv)?;
             let [a, b, c] = *tri;
-            if a == b || b == c || a == c {
-                return Err(BuildError::DegenerateTriangle {
-                    triangle: t,
-                    vertices: *tri,
-                    reason: "repeated vertex",
-                });
-            }
             let (e1, e2) = (pos[b] - pos[a], pos[c] - pos[a]);
             let twice = e1.cross(e2).length();
             if !(twice > 1e-12 * e1.length_squared().max(e2.length_squared())) {
-                return Err(BuildError::DegenerateTriangle {
+                return Err(BuildError::Input(InputError::DegenerateTriangle {
                     triangle: t,
                     vertices: *tri,
                     reason: "zero area",
-                });
+                }));
             }
             for &i in tri {
                 area[i] += twice / 6.0;
@@ -172,7 +162,10 @@ impl PbdBuilder {
             MeshMass::PerVertex(m) => vec![m; nv],
             MeshMass::Density(rho) => {
                 if let Some(v) = area.iter().position(|&a| a == 0.0) {
-                    return Err(BuildError::IsolatedVertex { vertex: v, element: "triangle" });
+                    return Err(BuildError::Input(InputError::IsolatedVertex {
+                        vertex: v,
+                        element: "triangle",
+                    }));
                 }
                 area.iter().map(|a| rho * a).collect()
             }
@@ -203,7 +196,11 @@ impl PbdBuilder {
             for &(a, b) in &order {
                 let used = &uses[&(a, b)];
                 if used.len() > 2 {
-                    return Err(BuildError::NonManifoldEdge { a, b, triangles: used.len() });
+                    return Err(BuildError::Input(InputError::NonManifoldEdge {
+                        a,
+                        b,
+                        triangles: used.len(),
+                    }));
                 }
                 if used.len() == 2 {
                     // p2 -> p3 is the edge as directed in the first triangle, p0 its opposite vertex.

@@ -1,52 +1,20 @@
-//! What can be wrong with a builder's input: [`BuildError`], one variant per kind of problem,
-//! each naming the element (particle, pin, constraint, triangle, edge, tetrahedron, collider or
-//! body index) and the offending value. Every builder method and
+//! What can be wrong with a builder's input: [`BuildError`], the shared [`InputError`] (particle,
+//! pin, triangle, edge, vertex, collider, parameter, gravity) or one variant per problem only a
+//! position-based model has (constraint, tetrahedron, body, volume mesh), each naming the element
+//! and the offending value. Every builder method and
 //! [`PbdBuilder::build`](crate::PbdBuilder::build) report it; nothing in the builders panics on
 //! user data.
+
+pub use anim_core::input::InputError;
 
 /// A builder input that cannot make a valid model. Every variant names the element.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum BuildError {
-    /// The model has no particles.
-    #[error("the model has no particles")]
-    NoParticles,
-    /// More particles or constraints than 32-bit indices hold.
-    #[error("{count} {what} exceed the maximum of {max}")]
-    TooLarge {
-        /// "particles" or "constraints".
-        what: &'static str,
-        /// How many were given.
-        count: usize,
-        /// The maximum.
-        max: usize,
-    },
-    /// A particle's mass is not a positive finite number.
-    #[error("particle {particle}: mass must be positive and finite, got {mass}")]
-    BadMass {
-        /// Particle index.
-        particle: usize,
-        /// The mass given.
-        mass: f64,
-    },
-    /// A particle's position has a NaN or infinite coordinate.
-    #[error("particle {particle}: position {position:?} is not finite")]
-    NonFinitePosition {
-        /// Particle index.
-        particle: usize,
-        /// The position given.
-        position: [f64; 3],
-    },
-    /// A pin names a particle that does not exist.
-    #[error("pin {pin}: particle {index} does not exist (the model has {particles} particles)")]
-    PinIndex {
-        /// Position in the list of pins.
-        pin: usize,
-        /// The index given.
-        index: usize,
-        /// Number of particles.
-        particles: usize,
-    },
+    /// A problem every particle-model builder can have: a particle, pin, triangle, edge,
+    /// vertex or collider, a builder parameter or gravity (see [`InputError`]).
+    #[error(transparent)]
+    Input(#[from] InputError),
     /// A constraint names a particle that does not exist.
     #[error(
         "constraint {constraint} ({kind}): particle {index} does not exist (the model has {particles} particles)"
@@ -143,36 +111,6 @@ pub enum BuildError {
         /// Number of bodies.
         bodies: usize,
     },
-    /// A triangle names a vertex that does not exist.
-    #[error("triangle {triangle}: vertex {index} does not exist (there are {vertices} vertices)")]
-    TriangleIndex {
-        /// Triangle index.
-        triangle: usize,
-        /// The index given.
-        index: usize,
-        /// Number of vertices.
-        vertices: usize,
-    },
-    /// A triangle repeats a vertex or has (numerically) zero area.
-    #[error("triangle {triangle} {vertices:?} is degenerate: {reason}")]
-    DegenerateTriangle {
-        /// Triangle index.
-        triangle: usize,
-        /// Its vertices.
-        vertices: [usize; 3],
-        /// What is wrong.
-        reason: &'static str,
-    },
-    /// An edge is shared by more than two triangles.
-    #[error("edge ({a}, {b}) is shared by {triangles} triangles; bending needs a manifold mesh")]
-    NonManifoldEdge {
-        /// First vertex.
-        a: usize,
-        /// Second vertex.
-        b: usize,
-        /// Number of triangles sharing it.
-        triangles: usize,
-    },
     /// A mesh for a global volume constraint is not closed and consistently oriented, or its
     /// volume is not positive.
     #[error("volume mesh: {reason}")]
@@ -202,22 +140,6 @@ pub enum BuildError {
         /// What is wrong.
         reason: &'static str,
     },
-    /// With mass by area or volume, a vertex that belongs to no element would get no mass.
-    #[error("vertex {vertex} belongs to no {element}, so mass by density gives it no mass")]
-    IsolatedVertex {
-        /// Vertex index.
-        vertex: usize,
-        /// "triangle" or "tetrahedron".
-        element: &'static str,
-    },
-    /// A collider's parameters are invalid.
-    #[error("collider {collider}: {reason}")]
-    BadCollider {
-        /// Collider index.
-        collider: usize,
-        /// What is wrong.
-        reason: String,
-    },
     /// A kinematic body's pose or motion is not finite.
     #[error("kinematic body {body}: {reason}")]
     BadBody {
@@ -225,23 +147,5 @@ pub enum BuildError {
         body: usize,
         /// What is wrong.
         reason: String,
-    },
-    /// A shape parameter is out of range.
-    #[error("{shape}: {name} {requirement}, got {value}")]
-    BadParameter {
-        /// Which builder ("chain", "cloth", "mesh", "tet mesh", "wind").
-        shape: &'static str,
-        /// The parameter.
-        name: &'static str,
-        /// What it must satisfy.
-        requirement: &'static str,
-        /// The value given.
-        value: String,
-    },
-    /// Gravity has a NaN or infinite component.
-    #[error("gravity {gravity:?} is not finite")]
-    NonFiniteGravity {
-        /// The vector given.
-        gravity: [f64; 3],
     },
 }

@@ -29,7 +29,7 @@ impl PbdBuilder {
     /// A chain; returns the range of its particles.
     ///
     /// # Errors
-    /// [`BuildError::BadParameter`] for fewer than 2 particles, coincident ends or non-finite input.
+    /// [`InputError::BadParameter`](super::InputError::BadParameter) for fewer than 2 particles, coincident ends or non-finite input.
     pub fn chain(&mut self, c: &Chain) -> Result<Range<usize>, BuildError> {
         if c.count < 2 {
             return Err(bad("chain", "count", "must be at least 2", c.count));

@@ -6,7 +6,7 @@
 //! is refused. The boundary faces are recorded, outward, for rendering.
 
 use super::builder::{MeshMass, PbdBuilder, check_mass, key};
-use super::error::BuildError;
+use super::error::{BuildError, InputError};
 use crate::constraint::{ConstraintParams, tet_volume};
 use anim_core::glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -32,8 +32,8 @@ impl PbdBuilder {
     ///
     /// # Errors
     /// [`BuildError::TetIndex`], [`BuildError::DegenerateTet`] (repeated vertex or
-    /// `|V| <= 1e-12 l^3` with `l` the longest edge), [`BuildError::IsolatedVertex`] (mass by
-    /// density), [`BuildError::BadParameter`].
+    /// `|V| <= 1e-12 l^3` with `l` the longest edge), [`InputError::IsolatedVertex`] (mass by
+    /// density), [`InputError::BadParameter`].
     pub fn tet_mesh(
         &mut self,
         positions: &[[f64; 3]],
@@ -86,7 +86,10 @@ impl PbdBuilder {
             MeshMass::PerVertex(m) => vec![m; nv],
             MeshMass::Density(rho) => {
                 if let Some(v) = vol.iter().position(|&a| a == 0.0) {
-                    return Err(BuildError::IsolatedVertex { vertex: v, element: "tetrahedron" });
+                    return Err(BuildError::Input(InputError::IsolatedVertex {
+                        vertex: v,
+                        element: "tetrahedron",
+                    }));
                 }
                 vol.iter().map(|a| rho * a).collect()
             }

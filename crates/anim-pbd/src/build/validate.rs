@@ -8,7 +8,7 @@
 //! directed edge appears once and has its opposite.
 
 use super::builder::{PbdBuilder, Pending, bad};
-use super::error::BuildError;
+use super::error::{BuildError, InputError};
 use crate::constraint::{
     AttachTarget, Constraint, ConstraintFunction, ConstraintParams, IsometricBending, dihedral,
     isometric_weights, tet_volume,
@@ -25,34 +25,38 @@ impl PbdBuilder {
     pub fn build(&self) -> Result<PbdModel, BuildError> {
         let n = self.positions.len();
         if n == 0 {
-            return Err(BuildError::NoParticles);
+            return Err(BuildError::Input(InputError::NoParticles));
         }
         if n >= u32::MAX as usize {
-            return Err(BuildError::TooLarge { what: "particles", count: n, max: u32::MAX as usize - 1 });
+            return Err(BuildError::Input(InputError::TooLarge {
+                what: "particles",
+                count: n,
+                max: u32::MAX as usize - 1,
+            }));
         }
         if self.pending.len() >= u32::MAX as usize {
-            return Err(BuildError::TooLarge {
+            return Err(BuildError::Input(InputError::TooLarge {
                 what: "constraints",
                 count: self.pending.len(),
                 max: u32::MAX as usize - 1,
-            });
+            }));
         }
         if !self.gravity.iter().all(|g| g.is_finite()) {
-            return Err(BuildError::NonFiniteGravity { gravity: self.gravity });
+            return Err(BuildError::Input(InputError::NonFiniteGravity { gravity: self.gravity }));
         }
         let mut particles = Vec::with_capacity(n);
         for (i, (&m, p)) in self.masses.iter().zip(&self.positions).enumerate() {
             if !(m > 0.0 && m.is_finite()) {
-                return Err(BuildError::BadMass { particle: i, mass: m });
+                return Err(BuildError::Input(InputError::BadMass { particle: i, mass: m }));
             }
             if !p.iter().all(|c| c.is_finite()) {
-                return Err(BuildError::NonFinitePosition { particle: i, position: *p });
+                return Err(BuildError::Input(InputError::NonFinitePosition { particle: i, position: *p }));
             }
             particles.push(Particle { mass: m, pinned: false });
         }
         for (k, &p) in self.pins.iter().enumerate() {
             if p >= n {
-                return Err(BuildError::PinIndex { pin: k, index: p, particles: n });
+                return Err(BuildError::Input(InputError::PinIndex { pin: k, index: p, particles: n }));
             }
             particles[p].pinned = true;
         }
@@ -85,7 +89,7 @@ impl PbdBuilder {
             .enumerate()
             .map(|(k, c)| {
                 c.validate(self.bodies.len())
-                    .map_err(|reason| BuildError::BadCollider { collider: k, reason })
+                    .map_err(|reason| BuildError::Input(InputError::BadCollider { collider: k, reason }))
             })
             .collect::<Result<Vec<_>, _>>()?;
         if let Some(w) = self.wind
@@ -103,7 +107,11 @@ impl PbdBuilder {
         }
         for (t, tri) in self.triangles.iter().enumerate() {
             if let Some(&i) = tri.iter().find(|&&i| i >= n) {
-                return Err(BuildError::TriangleIndex { triangle: t, index: i, vertices: n });
+                return Err(BuildError::Input(InputError::TriangleIndex {
+                    triangle: t,
+                    index: i,
+                    vertices: n,
+                }));
             }
         }
         for e in &self.edges {

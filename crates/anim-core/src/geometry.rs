@@ -1,0 +1,313 @@
+//! Collider geometry shared by the particle, position-based, finite-element and MPM solvers:
+//! [`Shape`], a plane, sphere, axis-aligned box or capsule, with its signed distance and outward
+//! unit normal ([`Shape::signed_distance`]) and the check of its parameters ([`Shape::check`]).
+//!
+//! Each solver keeps its own contact model (penalty force, positional constraint, penalty
+//! energy, grid boundary condition) and its own arithmetic where it differs (the finite-element
+//! plane distance `n . x - n . point`, MPM's `f32` kernels); the shape data is this one type, one
+//! scene-file spelling everywhere:
+//!
+//! ```json
+//! { "plane": { "point": [0, 0, 0], "normal": [0, 0, 1] } }
+//! { "sphere": { "center": [0, 0, 1], "radius": 0.5 } }
+//! { "box": { "center": [0, 0, 0], "half_extents": [1, 0.5, 0.25] } }
+//! { "capsule": { "a": [0, 0, 0], "b": [0, 0, 2], "radius": 0.5 } }
+//! ```
+//!
+//! A solver that cannot handle a shape refuses it when its model is built, naming the collider
+//! and the shape ([`Shape::name`]).
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// A solid collider shape. Its signed distance is negative inside, positive outside.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Shape {
+    /// The half-space below a plane: solid where `(x - point) . normal < 0`.
+    Plane {
+        /// A point of the plane.
+        point: [f64; 3],
+        /// Outward normal (any non-zero length; the solvers normalise it).
+        normal: [f64; 3],
+    },
+    /// A solid ball (a disk in 2-D solvers).
+    Sphere {
+        /// Centre.
+        center: [f64; 3],
+        /// Radius (> 0).
+        radius: f64,
+    },
+    /// A solid axis-aligned box.
+    Box {
+        /// Centre.
+        center: [f64; 3],
+        /// Half the edge lengths (each > 0).
+        half_extents: [f64; 3],
+    },
+    /// A solid capsule: the points within `radius` of the segment `a b`.
+    Capsule {
+        /// First end of the axis.
+        a: [f64; 3],
+        /// Second end of the axis.
+        b: [f64; 3],
+        /// Radius (> 0).
+        radius: f64,
+    },
+}
+
+impl Shape {
+    /// The ground plane `z = height` with outward normal `+z`.
+    #[must_use]
+    pub fn ground(height: f64) -> Self {
+        Shape::Plane { point: [0.0, 0.0, height], normal: [0.0, 0.0, 1.0] }
+    }
+
+    /// The shape's scene-file name: "plane", "sphere", "box" or "capsule".
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            Shape::Plane { .. } => "plane",
+            Shape::Sphere { .. } => "sphere",
+            Shape::Box { .. } => "box",
+            Shape::Capsule { .. } => "capsule",
+        }
+    }
+
+    /// Checks the parameters: finite coordinates, a non-zero plane normal, positive radii and
+    /// half extents, distinct capsule ends.
+    ///
+    /// # Errors
+    /// A description of the first problem, naming the shape.
+    pub fn check(&self) -> Result<(), String> {
+        self.check_in(3)
+    }
+
+    /// [`check`](Self::check) for a solver in `dim` (1 to 3) dimensions, which reads only the
+    /// first `dim` components of each vector (a 2-D box needs no third half extent).
+    ///
+    /// # Errors
+    /// A description of the first problem, naming the shape.
+    pub fn check_in(&self, dim: usize) -> Result<(), String> {
+        let dim = dim.clamp(1, 3);
+        let finite = |v: &[f64; 3]| v[..dim].iter().all(|c| c.is_finite());
+        let positive = |v: f64| v > 0.0 && v.is_finite();
+        match self {
+            Shape::Plane { point, normal } => {
+                if !finite(point) || !finite(normal) {
+                    return Err(format!("plane point {point:?} and normal {normal:?} must be finite"));
+                }
+                if !(normal[..dim].iter().map(|c| c * c).sum::<f64>().sqrt() > 1e-12) {
+                    return Err(format!("plane normal must be non-zero, got {normal:?}"));
+                }
+            }
+            Shape::Sphere { center, radius } => {
+                if !finite(center) {
+                    return Err(format!("sphere centre {center:?} must be finite"));
+                }
+                if !positive(*radius) {
+                    return Err(format!("sphere radius must be positive and finite, got {radius}"));
+                }
+            }
+            Shape::Box { center, half_extents } => {
+                if !finite(center) {
+                    return Err(format!("box centre {center:?} must be finite"));
+                }
+                if !half_extents[..dim].iter().all(|h| positive(*h)) {
+                    return Err(format!(
+                        "box half extents must be positive and finite, got {half_extents:?}"
+                    ));
+                }
+            }
+            Shape::Capsule { a, b, radius } => {
+                if !finite(a) || !finite(b) {
+                    return Err(format!("capsule ends {a:?} and {b:?} must be finite"));
+                }
+                if !positive(*radius) {
+                    return Err(format!("capsule radius must be positive and finite, got {radius}"));
+                }
+                if a[..dim] == b[..dim] {
+                    return Err(format!("capsule ends coincide at {a:?} (use a sphere)"));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// A copy with a unit plane normal (other shapes unchanged); call it on a checked shape.
+    #[must_use]
+    pub fn normalized(self) -> Self {
+        match self {
+            Shape::Plane { point, normal } => {
+                Shape::Plane { point, normal: DVec3::from_array(normal).normalize().to_array() }
+            }
+            other => other,
+        }
+    }
+
+    /// Signed distance of point `p` and the outward unit normal of the closest surface point
+    /// (`phi < 0` inside; the gradient of `phi` wherever it is differentiable). The plane normal
+    /// is used as stored: normalise it first ([`Shape::normalized`]). At a sphere's centre the
+    /// normal is `+z`, on a capsule's axis any unit vector perpendicular to it.
+    #[must_use]
+    pub fn signed_distance(&self, p: DVec3) -> (f64, DVec3) {
+        match *self {
+            Shape::Plane { point, normal } => {
+                let n = DVec3::from_array(normal);
+                ((p - DVec3::from_array(point)).dot(n), n)
+            }
+            Shape::Sphere { center, radius } => {
+                let d = p - DVec3::from_array(center);
+                let len = d.length();
+                let n = if len > 0.0 { d / len } else { DVec3::Z };
+                (len - radius, n)
+            }
+            Shape::Capsule { a, b, radius } => {
+                let (a, b) = (DVec3::from_array(a), DVec3::from_array(b));
+                let ab = b - a;
+                let t = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+                let d = p - (a + t * ab);
+                let len = d.length();
+                let n = if len > 0.0 {
+                    d / len
+                } else {
+                    // On the axis: any direction perpendicular to it.
+                    ab.any_orthonormal_vector()
+                };
+                (len - radius, n)
+            }
+            Shape::Box { center, half_extents } => {
+                let h = DVec3::from_array(half_extents);
+                let d = p - DVec3::from_array(center);
+                let q = d.abs() - h;
+                if q.max_element() > 0.0 {
+                    let outside = q.max(DVec3::ZERO);
+                    let len = outside.length();
+                    let n = (outside * d.signum()) / len;
+                    (len, n)
+                } else {
+                    // Inside: the nearest face.
+                    let (axis, depth) = if q.x >= q.y && q.x >= q.z {
+                        (DVec3::X, q.x)
+                    } else if q.y >= q.z {
+                        (DVec3::Y, q.y)
+                    } else {
+                        (DVec3::Z, q.z)
+                    };
+                    let sign = if d.dot(axis) >= 0.0 { 1.0 } else { -1.0 };
+                    (depth, axis * sign)
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= 1e-12
+    }
+
+    #[test]
+    fn distances_match_the_analytic_ones() {
+        let plane = Shape::Plane { point: [0.0, 0.0, 1.0], normal: [0.0, 3.0, 4.0] }.normalized();
+        let (phi, n) = plane.signed_distance(DVec3::new(7.0, 3.0, 5.0));
+        assert!(close(phi, (3.0 * 3.0 + 4.0 * 4.0) / 5.0) && n.abs_diff_eq(DVec3::new(0.0, 0.6, 0.8), 1e-15));
+        let sphere = Shape::Sphere { center: [1.0, 0.0, 0.0], radius: 0.5 };
+        assert!(close(sphere.signed_distance(DVec3::new(1.0, 2.0, 0.0)).0, 1.5));
+        assert!(close(sphere.signed_distance(DVec3::new(1.2, 0.0, 0.0)).0, -0.3));
+        assert_eq!(sphere.signed_distance(DVec3::new(1.0, 0.0, 0.0)), (-0.5, DVec3::Z));
+        let b = Shape::Box { center: [1.0, 0.0, 0.0], half_extents: [1.0, 0.5, 0.25] };
+        // Outside a face, outside an edge, outside a corner, inside.
+        assert!(close(b.signed_distance(DVec3::new(3.0, 0.0, 0.0)).0, 1.0));
+        assert!(close(b.signed_distance(DVec3::new(3.0, 1.5, 0.0)).0, 2f64.sqrt()));
+        assert!(close(b.signed_distance(DVec3::new(-1.0, -1.5, 1.25)).0, 3f64.sqrt()));
+        let (phi, n) = b.signed_distance(DVec3::new(1.1, 0.0, -0.2));
+        assert!(close(phi, -0.05) && n == -DVec3::Z);
+        let c = Shape::Capsule { a: [0.0; 3], b: [0.0, 0.0, 2.0], radius: 0.5 };
+        assert!(close(c.signed_distance(DVec3::new(2.0, 0.0, 1.0)).0, 1.5));
+        assert!(close(c.signed_distance(DVec3::new(0.0, 0.0, 3.0)).0, 0.5));
+        assert!(close(c.signed_distance(DVec3::new(0.0, -0.3, -0.4)).0, 0.0));
+        let (phi, n) = c.signed_distance(DVec3::new(0.0, 0.0, 1.0));
+        assert!(close(phi, -0.5) && close(n.length(), 1.0) && close(n.z, 0.0));
+    }
+
+    #[test]
+    fn normals_are_finite_difference_gradients() {
+        let shapes = [
+            Shape::Plane { point: [0.1, -0.2, 0.3], normal: [1.0, -2.0, 0.5] }.normalized(),
+            Shape::Sphere { center: [0.2, 0.1, -0.1], radius: 0.7 },
+            Shape::Box { center: [0.1, 0.0, 0.2], half_extents: [0.6, 0.4, 0.3] },
+            Shape::Capsule { a: [-0.3, 0.1, 0.0], b: [0.4, -0.2, 0.5], radius: 0.35 },
+        ];
+        let eps = 1e-6;
+        let mut checked = 0;
+        for shape in shapes {
+            for i in 0..200 {
+                // A deterministic spread of points in [-1.5, 1.5]^3.
+                let f = |k: u32| ((i * 37 + k as usize * 101) % 97) as f64 / 97.0 * 3.0 - 1.5;
+                let p = DVec3::new(f(1), f(2), f(3));
+                let (phi, n) = shape.signed_distance(p);
+                assert!(phi.is_finite() && close(n.length(), 1.0), "{shape:?} at {p}");
+                let fd = DVec3::from_array(std::array::from_fn(|a| {
+                    let e = DVec3::AXES[a] * eps;
+                    (shape.signed_distance(p + e).0 - shape.signed_distance(p - e).0) / (2.0 * eps)
+                }));
+                // Skip the ridges where the distance is not differentiable (box edges seen from
+                // inside): there the one-sided differences disagree.
+                let kink = (0..3).any(|a| {
+                    let e = DVec3::AXES[a] * eps;
+                    let fwd = (shape.signed_distance(p + e).0 - phi) / eps;
+                    let bwd = (phi - shape.signed_distance(p - e).0) / eps;
+                    (fwd - bwd).abs() > 1e-3
+                });
+                if kink {
+                    continue;
+                }
+                assert!((fd - n).length() < 1e-5, "{shape:?} at {p}: normal {n}, finite differences {fd}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 700, "{checked}");
+    }
+
+    #[test]
+    fn checks_name_the_shape_and_value() {
+        assert_eq!(Shape::ground(0.5).check(), Ok(()));
+        assert!(
+            Shape::Plane { point: [0.0; 3], normal: [0.0; 3] }.check().unwrap_err().contains("plane normal")
+        );
+        let e = Shape::Sphere { center: [0.0; 3], radius: -1.0 }.check().unwrap_err();
+        assert!(e.contains("sphere radius") && e.contains("-1"), "{e}");
+        let e = Shape::Box { center: [0.0; 3], half_extents: [1.0, 0.0, 1.0] }.check().unwrap_err();
+        assert!(e.contains("box half extents"), "{e}");
+        let e = Shape::Capsule { a: [1.0; 3], b: [1.0; 3], radius: 1.0 }.check().unwrap_err();
+        assert!(e.contains("capsule ends coincide"), "{e}");
+        assert!(Shape::Sphere { center: [f64::NAN; 3], radius: 1.0 }.check().is_err());
+        // In 2-D only the first two components count.
+        let flat = Shape::Box { center: [0.5, 0.5, f64::NAN], half_extents: [0.4, 0.05, 0.0] };
+        assert!(flat.check().is_err() && flat.check_in(2).is_ok());
+        let up = Shape::Plane { point: [0.0; 3], normal: [0.0, 0.0, 1.0] };
+        assert!(up.check().is_ok() && up.check_in(2).is_err());
+    }
+
+    #[test]
+    fn scene_file_spelling() {
+        let s: Shape =
+            serde_json::from_str(r#"{ "box": { "center": [0, 0, 0], "half_extents": [1, 2, 3] } }"#).unwrap();
+        assert_eq!(s, Shape::Box { center: [0.0; 3], half_extents: [1.0, 2.0, 3.0] });
+        assert_eq!(s.name(), "box");
+        assert!(
+            serde_json::from_str::<Shape>(r#"{ "Box": { "center": [0, 0, 0], "half": [1, 2, 3] } }"#)
+                .is_err()
+        );
+        assert!(
+            serde_json::from_str::<Shape>(r#"{ "sphere": { "center": [0, 0, 0], "radius": 1, "r": 2 } }"#)
+                .is_err()
+        );
+        let json = serde_json::to_string(&Shape::ground(1.0)).unwrap();
+        assert_eq!(json, r#"{"plane":{"point":[0.0,0.0,1.0],"normal":[0.0,0.0,1.0]}}"#);
+    }
+}
