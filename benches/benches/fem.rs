@@ -1,7 +1,7 @@
 //! Criterion benches of anim-fem on the benchmark beam (`anim_fem::scenes::benchmark_beam(50)`:
 //! 19,200 tetrahedra, stable Neo-Hookean, clamped, gravity, dt = 0.01 s): one backward Euler
 //! (Newton, sparse Cholesky) step and one symplectic Euler step from a pre-generated sagging
-//! state, the elastic force evaluation (seed 5.2 Algorithm 1) and the stiffness assembly, with
+//! state, the elastic force evaluation (Sifakis & Barbič 2012, Algorithm 1) and the stiffness assembly, with
 //! throughput in elements per second.
 
 use anim_fem::newton::assemble_stiffness;

@@ -1,21 +1,21 @@
-//! Criterion benches of anim-fluid: one seed-mode step (N = 128), one MAC step of the cavity (2D)
+//! Criterion benches of anim-fluid: one step of Stam's solver (N = 128), one MAC step of the cavity (2D)
 //! and of the smoke plume (3D), and one pressure solve per solver, from zero, on the 2D box with a
 //! sphere (N = 128) to a relative residual of 1e-5.
 
 use anim_fluid::mac::{MacFluid, MacParams};
 use anim_fluid::pressure::{PressureMethod, PressureSolver};
 use anim_fluid::scenes;
-use anim_fluid::seed::{SeedFluid, SeedParams};
+use anim_fluid::stam::{StamFluid, StamParams};
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 
-fn seed_step(c: &mut Criterion) {
-    let Ok(mut f) = SeedFluid::new(128, SeedParams::default()) else { return };
+fn stam_step(c: &mut Criterion) {
+    let Ok(mut f) = StamFluid::new(128, StamParams::default()) else { return };
     for _ in 0..20 {
         f.apply_source_pattern();
         let _ = f.step();
     }
-    c.bench_function("fluid/seed_step/N128", |b| {
+    c.bench_function("fluid/stam_step/N128", |b| {
         b.iter(|| {
             f.apply_source_pattern();
             black_box(f.step()).ok();
@@ -67,5 +67,5 @@ fn projection(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, seed_step, mac_steps, projection);
+criterion_group!(benches, stam_step, mac_steps, projection);
 criterion_main!(benches);

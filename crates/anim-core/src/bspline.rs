@@ -1,4 +1,4 @@
-//! B-spline interpolation kernels (seed 5.3.1): quadratic and cubic weights and their gradients.
+//! B-spline interpolation kernels (as in APIC, Jiang et al. 2015): quadratic and cubic weights and their gradients.
 //!
 //! Shared by the particle-grid transfers of `anim-mpm` (collocated grid) and `anim-flip`
 //! (staggered MAC grid, where the same weights are evaluated at face-staggered offsets).
@@ -9,7 +9,7 @@
 //! w_ip = N_i(x_p) = prod_a N((x_p,a - x_i,a) / h)
 //! ```
 //!
-//! with the 1D B-splines of the seed:
+//! with the 1D quadratic and cubic B-splines:
 //!
 //! ```text
 //! quadratic: N(x) = 3/4 - |x|^2                   0 <= |x| < 1/2
@@ -201,7 +201,7 @@ mod tests {
             let (mut sum, mut first, mut second, mut dsum, mut dfirst) = (0.0, 0.0, 0.0, 0.0, 0.0);
             for k in 0..n {
                 let d = f64::from(base + k as i32) - f64::from(xs); // node - particle, in cells
-                // Each weight agrees with the closed-form spline of the seed.
+                // Each weight agrees with the closed-form spline.
                 let exact = kernel.n(d);
                 assert!((f64::from(w[k]) - exact).abs() < 2e-6, "{kernel:?} xs {xs} k {k}");
                 sum += f64::from(w[k]);

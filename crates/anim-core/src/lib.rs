@@ -3,11 +3,11 @@
 //! The shared vocabulary of the anim workspace: the math every solver crate builds on, and the
 //! traits through which `cargo xtask` drives every crate the same way.
 //!
-//! | module | what it models | seed section |
+//! | module | what it models | method / source |
 //! | --- | --- | --- |
-//! | [`lie`] | SO(3)/so(3) hat, vee, exp (Rodrigues), log; SE(3), twists, their exp/log, adjoints, screws | 1.2, 4.1 |
-//! | [`linalg`] | linear operators, CG / Jacobi-PCG, Jacobi and Gauss-Seidel, CSR matrices with faer interop, a sparse direct solve, the Schur-complement block solve, 3x3 SVD and polar decomposition | 2.1, 5.1, 7.1 |
-//! | [`integrate`] | second-order systems `x'' = M^-1 f(x, v)` and the integrators of seed section 2: explicit, symplectic and backward Euler, the beta-blend, position Verlet, leapfrog, velocity Verlet, implicit midpoint and RK4 | 2, 2.1, 2.2 |
+//! | [`lie`] | SO(3)/so(3) hat, vee, exp (Rodrigues), log; SE(3), twists, their exp/log, adjoints, screws | Murray, Li & Sastry 1994; Lynch & Park 2017 |
+//! | [`linalg`] | linear operators, CG / Jacobi-PCG, Jacobi and Gauss-Seidel, CSR matrices with faer interop, a sparse direct solve, the Schur-complement block solve, 3x3 SVD and polar decomposition | conjugate gradients, Schur complements (Zhang 2005), the rotation-variant SVD (Irving, Teran & Fedkiw 2004) |
+//! | [`integrate`] | second-order systems `x'' = M^-1 f(x, v)` and their integrators: explicit, symplectic and backward Euler, the beta-blend, position Verlet, leapfrog, velocity Verlet, implicit midpoint and RK4 | linearised backward Euler (Baraff & Witkin 1998); Verlet; Runge-Kutta |
 //! | [`solver`] | the time-stepping [`Solver`](solver::Solver) trait and the [`StepReport`](solver::StepReport) every step returns | - |
 //! | [`scene`] | the contracts of a runnable scene: [`Checkpoint`](scene::Checkpoint), [`View`](scene::View), the object-safe [`DynScene`](scene::DynScene), and the [`SceneKind`](scene::SceneKind) and [`Preset`](scene::Preset) a crate registers | - |
 //! | [`diagnostics`] | detection of non-finite state at the step that produced it | - |

@@ -1,4 +1,4 @@
-//! The linear tetrahedron (seed 5.2): rest shape `Dm^-1` and volume `W`, deformation gradient
+//! The linear tetrahedron (Sifakis & Barbič 2012): rest shape `Dm^-1` and volume `W`, deformation gradient
 //! `F = Ds Dm^-1`, the nodal forces `H = -W P(F) Dm^-T` with `f4 = -(f1 + f2 + f3)`, and the
 //! element stiffness `K_e = -df/dx`.
 //!
@@ -58,7 +58,7 @@ pub fn gradients(dm_inv: &Matrix3<f64>) -> [[f64; 3]; 4] {
 }
 
 /// The elastic nodal forces of one element: `H = -W P Dm^-T` gives `f_0, f_1, f_2` as its
-/// columns and `f_3 = -(f_0 + f_1 + f_2)` (seed 5.2, Algorithm 1 lines 14-16).
+/// columns and `f_3 = -(f_0 + f_1 + f_2)` (Sifakis & Barbič 2012, Algorithm 1 lines 14-16).
 #[inline]
 #[must_use]
 pub fn nodal_forces(w: f64, p: &Matrix3<f64>, dm_inv: &Matrix3<f64>) -> [[f64; 3]; 4] {
@@ -120,7 +120,7 @@ mod tests {
 
     #[test]
     fn forces_are_the_gradient_formula() {
-        // f_a = -W P b_a for a = 0..3 agrees with the seed's H = -W P Dm^-T, f_3 = -sum.
+        // f_a = -W P b_a for a = 0..3 agrees with Sifakis & Barbič's H = -W P Dm^-T, f_3 = -sum.
         let rest = [[0.1, 0.0, 0.0], [1.0, 0.2, 0.0], [0.0, 1.1, 0.3], [0.2, 0.1, 0.9]];
         let (dm_inv, w) = rest_shape(rest).unwrap();
         let p = Matrix3::new(1.0, 2.0, -0.5, 0.3, -1.2, 0.7, 0.25, 0.5, 2.0);

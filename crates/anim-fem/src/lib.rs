@@ -1,20 +1,20 @@
 //! # anim-fem
 //!
-//! Tetrahedral finite elements for hyperelastic solids (seed section 5.2), with the material
-//! models of seed section 5.1 from `anim-material`.
+//! Tetrahedral finite elements for hyperelastic solids (Sifakis & Barbič 2012), with the material
+//! models of `anim-material`.
 //!
-//! | module | what it models | seed |
+//! | module | what it models | method / source |
 //! | --- | --- | --- |
-//! | [`mesh`] | tetrahedral meshes: validation (degenerate / inverted rest elements named), Gmsh and TetGen input, boundary surface | 5.2 |
+//! | [`mesh`] | tetrahedral meshes: validation (degenerate / inverted rest elements named), Gmsh and TetGen input, boundary surface | - |
 //! | [`generate`] | built-in meshes: tetrahedralised boxes (beams, cubes, bars) at any resolution, graded boxes, Cook's membrane, 10-node refinement | - |
-//! | [`material`] | the six hyperelastic models (linear, StVK, corotated linear, Neo-Hookean, fixed corotated, stable Neo-Hookean) with Lamé parameters from `(E, nu)` | 5.1 |
-//! | [`element`] | the linear tetrahedron: `Dm^-1`, `W = abs(det Dm)/6`, `F = Ds Dm^-1`, forces `H = -W P(F) Dm^-T`, `f4 = -(f1+f2+f3)`, stiffness | 5.2 |
-//! | [`assembly`] | ordered parallel assembly of forces and the sparse stiffness (identical for any thread count) | 5.2 |
-//! | [`model`] | a body of linear or 10-node tetrahedra ([`ElementOrder`](model::ElementOrder)): precomputed rest data, lumped or consistent mass, gravity, loads, pinned and kinematic vertices, obstacles with a friction coefficient each | 5.2 |
+//! | [`material`] | the six hyperelastic models (linear, StVK, corotated linear, Neo-Hookean, fixed corotated, stable Neo-Hookean) with Lamé parameters from `(E, nu)` | Sifakis & Barbič 2012; Stomakhin et al. 2012 (fixed corotated); Smith et al. 2018 (stable Neo-Hookean) |
+//! | [`element`] | the linear tetrahedron: `Dm^-1`, `W = abs(det Dm)/6`, `F = Ds Dm^-1`, forces `H = -W P(F) Dm^-T`, `f4 = -(f1+f2+f3)`, stiffness | Sifakis & Barbič 2012, Algorithm 1 |
+//! | [`assembly`] | ordered parallel assembly of forces and the sparse stiffness (identical for any thread count) | - |
+//! | [`model`] | a body of linear or 10-node tetrahedra ([`ElementOrder`](model::ElementOrder)): precomputed rest data, lumped or consistent mass, gravity, loads, pinned and kinematic vertices, obstacles with a friction coefficient each | - |
 //! | [`boundary`] | kinematic motions, ground and sphere obstacles | - |
 //! | [`friction`] | Coulomb friction at obstacle contacts: velocity-level in explicit steps, IPC's lagged smoothed potential (Li et al. 2020, section 5) in backward Euler | - |
-//! | [`newton`] | Newton on the incremental potential with a backtracking line search, Rayleigh damping `gamma` | 5.2 |
-//! | [`sim`] | symplectic Euler and backward Euler steps, quasi-static solves, the `Solver` implementation | 2, 5.2 |
+//! | [`newton`] | Newton on the incremental potential with a backtracking line search, Rayleigh damping `gamma` | backward Euler as an incremental potential |
+//! | [`sim`] | symplectic Euler and backward Euler steps, quasi-static solves, the `Solver` implementation | symplectic and backward Euler |
 //! | [`tet10`] | the 10-node tetrahedron (no locking in bending or near incompressibility): shape functions, 4-point quadrature, closed-form consistent mass, HRZ lumping | - |
 //! | [`quadratic`] | bodies of 10-node tetrahedra in both time steppers, and the quasi-static front end [`QuadraticModel`](quadratic::QuadraticModel) | - |
 //! | [`ldlt`] | sparse `L D L^T` (faer) for symmetric indefinite Newton matrices | - |

@@ -1,4 +1,4 @@
-//! The constitutive models a body can use (seed 5.1), chosen at run time.
+//! The constitutive models a body can use (from `anim-material`), chosen at run time.
 //!
 //! The models themselves live in `anim-material` (shared with the material point method); this
 //! module names them with [`MaterialModel`], dispatches to them, and bundles a model with its

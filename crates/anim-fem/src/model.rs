@@ -107,7 +107,7 @@ impl FemModel {
     /// A body of linear tetrahedra from a mesh and a material, with lumped mass, no gravity, no
     /// boundary conditions.
     ///
-    /// Precomputes `Dm^-1` and `W` of every element (seed 5.2, Algorithm 1, PRECOMPUTATION).
+    /// Precomputes `Dm^-1` and `W` of every element (Sifakis & Barbič 2012, Algorithm 1, PRECOMPUTATION).
     ///
     /// # Errors
     /// The mesh errors of [`validate`] (degenerate or inverted rest
@@ -614,7 +614,7 @@ impl FemModel {
     }
 
     /// The elastic nodal forces of element `e` into `out` (3 per element node, `3 x 4` or
-    /// `3 x 10` values): seed 5.2's `H = -W P(F) Dm^-T`, `f_4 = -(f_1 + f_2 + f_3)` for linear
+    /// `3 x 10` values): Sifakis & Barbič's `H = -W P(F) Dm^-T`, `f_4 = -(f_1 + f_2 + f_3)` for linear
     /// elements, `-sum_q w_q P(F_q) grad N_a(X_q)` for 10-node elements.
     #[inline]
     pub fn element_forces(&self, e: usize, x: &[f64], out: &mut [f64]) {

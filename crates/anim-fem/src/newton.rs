@@ -1,6 +1,6 @@
 //! Newton's method on the incremental potential, with a backtracking line search.
 //!
-//! Backward Euler (seed 5.2) solves `M (x - x_n - dt v_n) / dt^2 = f_e(x) + f_d + f_ext` with
+//! Backward Euler solves `M (x - x_n - dt v_n) / dt^2 = f_e(x) + f_d + f_ext` with
 //! `v = (x - x_n) / dt`. Its solution minimises the **incremental potential**
 //!
 //! ```text
@@ -11,9 +11,9 @@
 //! ```
 //!
 //! whose gradient is minus the backward Euler residual (the last sum is the lagged friction
-//! potential of [`crate::friction`]). The Rayleigh damping force of the seed,
-//! `f_d = -gamma K v`, uses here the stiffness `K_n = K(x_n)` at the start of the step (the seed
-//! linearises it at the current iterate); with `K_n` frozen, damping is a quadratic potential and
+//! potential of [`crate::friction`]). The Rayleigh damping force
+//! `f_d = -gamma K v` uses here the stiffness `K_n = K(x_n)` at the start of the step (rather
+//! than the stiffness at the current iterate); with `K_n` frozen, damping is a quadratic potential and
 //! the whole step is a minimisation, so a line search on `E` is well defined and every accepted
 //! iterate decreases it. Each Newton iteration solves
 //!
@@ -21,7 +21,7 @@
 //! (M / dt^2 + K(x_k) + gamma/dt K_n + contact) dx = -grad E(x_k)
 //! ```
 //!
-//! (the seed's `[(1 + gamma/dt) K + M/dt^2] dx = ...` with `K_n` in the damping term), then
+//! (the usual `[(1 + gamma/dt) K + M/dt^2] dx = ...` with `K_n` in the damping term), then
 //! halves the step until the Armijo condition `E(x + a dx) <= E(x) + 1e-4 a grad E . dx` holds.
 //! With `dP/dF` projected to positive semi-definite per element (anim-material's `dpdf_psd`) the matrix
 //! is positive definite and `dx` a descent direction. A quasi-static solve is the same

@@ -1,13 +1,13 @@
 //! Time stepping and quasi-static solves of a [`FemModel`].
 //!
-//! - **Symplectic (semi-implicit) Euler** (seed 2, used on seed 5.2's forces):
+//! - **Symplectic (semi-implicit) Euler** on the forces of Sifakis & Barbič 2012:
 //!   `v_{n+1} = v_n + dt M^-1 (f_e(x_n) + f_d + f_ext)`, `x_{n+1} = x_n + dt v_{n+1}`, with the
-//!   elastic forces from the batch algorithm (seed 5.2, Algorithm 1) and the Rayleigh damping
+//!   elastic forces from the batch algorithm (Sifakis & Barbič 2012, Algorithm 1) and the Rayleigh damping
 //!   force `f_d = -gamma K(x_n) v_n` evaluated matrix-free per element. Contact projects
 //!   penetrating vertices to the obstacle surface and removes their approaching normal velocity,
 //!   then applies velocity-level Coulomb friction ([`crate::friction`]).
 //!   With consistent mass, `M a = f` is solved by Jacobi-preconditioned conjugate gradients.
-//! - **Backward Euler** (seed 5.2) by Newton's method on the incremental potential with a
+//! - **Backward Euler** by Newton's method on the incremental potential with a
 //!   backtracking line search ([`newton`]), the stiffness assembled in parallel in
 //!   a fixed order, and a choice of linear solver ([`LinearSolverChoice`]).
 //!
@@ -384,7 +384,7 @@ impl FemSimulation {
         Ok(())
     }
 
-    /// The elastic forces at `x` into `self.force` (seed 5.2, Algorithm 1: per-element
+    /// The elastic forces at `x` into `self.force` (Sifakis & Barbič 2012, Algorithm 1: per-element
     /// `H = -W P Dm^-T`, then an ordered gather), plus `-gamma K(x) v` when damping is on.
     fn elastic_forces(&mut self, x: &[f64], v: &[f64]) -> Result<(), FemError> {
         let model = &self.model;

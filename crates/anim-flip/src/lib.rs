@@ -1,8 +1,8 @@
 //! An incompressible particle fluid: PIC, FLIP and APIC on a staggered (MAC) grid with a
 //! free-surface pressure projection, in 2D and 3D.
 //!
-//! Seed section 5.3.1 writes APIC's grid step as "grid velocity, then Chorin-style pressure
-//! projection `v^{n+1} = Project(v^^{n+1})`": particles carry the fluid (velocity `v_p` and the
+//! APIC (Jiang et al. 2015) as a fluid solver: the grid velocity, then a Chorin-style pressure
+//! projection `v^{n+1} = Project(v^^{n+1})`; particles carry the fluid (velocity `v_p` and the
 //! affine matrix `C_p`), the grid enforces incompressibility. One substep:
 //!
 //! ```text
@@ -18,9 +18,9 @@
 //! The B-splines do not interpolate, so the faces behind the box walls hold the mirror image of
 //! the faces in front with opposite sign, and a kernel sample at a wall has zero normal velocity.
 //!
-//! Choices that depart from the seed's listing, switchable in [`FlipParams`]: positions are
+//! Choices that depart from the plain APIC step, switchable in [`FlipParams`]: positions are
 //! advected through the divergence-free grid velocity (`grid_advection`, default on; off gives
-//! the seed's `x_p += dt v_p`), read multilinearly between the faces (`advection_sampling`,
+//! the plain `x_p += dt v_p`), read multilinearly between the faces (`advection_sampling`,
 //! [`Sampling::Linear`], default; [`Sampling::Kernel`] reads it with the transfer's kernel), and
 //! an optional volume correction (`volume_correction`) adds a target outflow in cells whose
 //! particle density exceeds the rest density. Without it particles compressed in a violent flow

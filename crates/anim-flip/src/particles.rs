@@ -2,8 +2,8 @@
 //!
 //! Every particle stands for the same fluid volume (the cell volume divided by the seeding
 //! density), so its mass drops out of the transfers. `c[p][a]` is the row of the affine matrix
-//! `C_p` for velocity component `a`: the particle's estimate of `grad v_a` (seed 5.3.1,
-//! `C_p = B_p D_p^-1`); PIC and FLIP leave it zero.
+//! `C_p` for velocity component `a`: the particle's estimate of `grad v_a` (APIC, Jiang et
+//! al. 2015: `C_p = B_p D_p^-1`); PIC and FLIP leave it zero.
 
 use crate::error::FlipError;
 

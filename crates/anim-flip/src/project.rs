@@ -1,5 +1,5 @@
 //! Body forces, solid boundary conditions and the free-surface pressure projection
-//! `v = Project(v^)` (seed 5.3.1, Chorin's splitting as in seed section 6.1).
+//! `v = Project(v^)` (Chorin's splitting, as in stable fluids, Stam 1999).
 //!
 //! With the cells labelled by [`crate::classify`], the right-hand side is the negated net
 //! outflow `-h div u` of every fluid cell, the Poisson problem over fluid cells (air

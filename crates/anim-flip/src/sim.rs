@@ -4,7 +4,7 @@
 //! 2. particle-to-grid ([`crate::transfer`]), extrapolate, keep the result for FLIP;
 //! 3. gravity (in a moving tank, less the tank's acceleration: [`crate::tank`]) and solid walls,
 //!    pressure projection ([`crate::project`]), extrapolate;
-//! 4. grid-to-particle (PIC, FLIP or APIC), advect `x += dt v_p` (seed 5.3.1), push particles
+//! 4. grid-to-particle (PIC, FLIP or APIC), advect `x += dt v_p`, push particles
 //!    that entered solid cells back out (counted);
 //! 5. optionally, reseeding ([`crate::reseed`]): top up sparse interior cells, thin crowded ones.
 //!
@@ -50,7 +50,7 @@ pub struct FlipParams<const D: usize> {
     /// Whether a pressure solve that misses its tolerance is an error. Default true.
     pub require_convergence: bool,
     /// Advect positions through the projected grid velocity by the midpoint rule (RK2) instead
-    /// of the seed's `x += dt v_p` with the particle velocity. The grid field is divergence free
+    /// of APIC's `x += dt v_p` with the particle velocity. The grid field is divergence free
     /// and has zero normal velocity at walls, so particles neither pile up against walls nor
     /// compress along their paths as much. Default true.
     pub grid_advection: bool,

@@ -1,4 +1,4 @@
-//! Particle-grid transfers on the MAC grid: PIC, FLIP (blended with PIC) and APIC (seed 5.3.1).
+//! Particle-grid transfers on the MAC grid: PIC, FLIP (blended with PIC) and APIC (Jiang et al. 2015).
 //!
 //! Each velocity component `a` is transferred to the face lattice of axis `a` with the
 //! B-spline weights of [`anim_core::bspline`] evaluated at face-staggered offsets,

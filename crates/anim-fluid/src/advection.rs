@@ -1,9 +1,9 @@
 //! Interpolation and semi-Lagrangian advection on the MAC grid.
 //!
-//! Seed section 6.1, *advect*: `w2(x) = w1(p(x, -dt))`, the value carried along the
+//! Stable fluids (Stam 1999), *advect*: `w2(x) = w1(p(x, -dt))`, the value carried along the
 //! characteristic back to where it came from. The back-trace here is second-order (midpoint:
 //! `x_mid = x - dt/2 u(x)`, `x_back = x - dt u(x_mid)`), and the value is sampled
-//! - **linearly** (the seed's bilinear, extended to trilinear), or
+//! - **linearly** (Stam's bilinear, extended to trilinear), or
 //! - by a **monotone cubic**: per axis a cubic Hermite through the 4 nearest samples with
 //!   central-difference slopes, each slope set to 0 when its sign differs from the interval's
 //!   difference and capped at 3 times it (Fritsch and Carlson 1980), so it never over- or
@@ -28,7 +28,7 @@
 /// (`"sl-linear"`, `"sl-monotone-cubic"`, `"bfecc"`, `"maccormack"`), as scene files name it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Advection {
-    /// Semi-Lagrangian, linear interpolation (the seed's scheme).
+    /// Semi-Lagrangian, linear interpolation (Stam's scheme).
     #[serde(rename = "sl-linear")]
     Linear,
     /// Semi-Lagrangian, monotone cubic interpolation.
@@ -60,7 +60,7 @@ impl Advection {
 
 /// How one step splits advection from the pressure projection.
 ///
-/// - **Advect, then project** (Chorin 1968; Stam 1999, the seed's velocity step): advect the
+/// - **Advect, then project** (Chorin 1968; Stam 1999, his velocity step): advect the
 ///   velocity by itself over `dt`, then project. The projection removes the advected field's
 ///   gradient part and with it kinetic energy: a splitting error of first order in `dt` that
 ///   does not shrink with the grid (on the Taylor-Green vortex about `2 dt` of the amplitude at

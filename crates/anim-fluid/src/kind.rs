@@ -4,12 +4,12 @@
 //!
 //! | preset | what | solver |
 //! | --- | --- | --- |
-//! | `smoke-box-2d` | smoke rising from a source in a closed 128 x 128 box | the seed's stable fluids (`f32`, 20 Gauss-Seidel sweeps) |
+//! | `smoke-box-2d` | smoke rising from a source in a closed 128 x 128 box | Stam's stable fluids (`f32`, 20 Gauss-Seidel sweeps) |
 //! | `smoke-plume-3d` | hot smoke rising around a sphere, open top | 3D MAC grid, MacCormack + MGPCG |
 //! | `lid-driven-cavity` | the Re = 100 cavity stirring bands of dye | 2D MAC grid, MacCormack + MGPCG |
 //!
 //! A scene is the [`FluidScene`] itself stepped as a [`Solver`] whose state is the run's clock:
-//! the sum of the steps' `dt` in `f64` (the seed's solver keeps its own time in sums of the
+//! the sum of the steps' `dt` in `f64` (Stam's solver keeps its own time in sums of the
 //! `f32` step). Its frames have no points: the fields `"density"` (1 per cell) and
 //! `"velocity"` (3 per cell, at the cell centres), x fastest, on the [`ImageGrid`] of the
 //! context, in the grid's own axes (y up, as the solvers and the image). The cavity's
@@ -50,7 +50,7 @@ use serde_json::json;
 pub const KIND: SceneKind = SceneKind {
     kind: "fluid",
     crate_name: "anim-fluid",
-    summary: "grid fluids: the seed's stable fluids and the MAC solver in 2D and 3D, density and velocity per cell",
+    summary: "grid fluids: Stam's stable fluids and the MAC solver in 2D and 3D, density and velocity per cell",
     presets,
     build,
     tolerance: Some(Tolerance { adapter: tolerance_adapter, error: tolerance_error }),
@@ -84,7 +84,7 @@ pub struct FluidSceneParams {
     /// `"maccormack"`). Default: the preset's (MacCormack).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub advection: Option<Advection>,
-    /// How a MAC step splits advection from projection (`"advect-project"`, the seed's order,
+    /// How a MAC step splits advection from projection (`"advect-project"`, Stam's order,
     /// or `"reflection"`, advection-reflection). Default: the preset's (advect-project).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub splitting: Option<Splitting>,
@@ -109,7 +109,7 @@ impl FluidSceneParams {
     /// # Errors
     /// [`BuildError::Invalid`] naming the field: an unknown preset, a resolution above the
     /// preset's limit or one the solver refuses, a tolerance that is not positive and finite, a
-    /// MAC setting given to the seed's solver.
+    /// MAC setting given to Stam's solver.
     pub fn scene(&self) -> Result<FluidScene, BuildError> {
         if let Some(tol) = self.pressure_tolerance
             && !(tol > 0.0 && tol.is_finite())
@@ -152,7 +152,7 @@ impl FluidSceneParams {
             return Err(BuildError::invalid(
                 field,
                 format!(
-                    "{preset} runs the seed's solver (20 Gauss-Seidel sweeps, linear advection), which has no pressure, advection or splitting settings"
+                    "{preset} runs Stam's solver (20 Gauss-Seidel sweeps, linear advection), which has no pressure, advection or splitting settings"
                 ),
             ));
         };
@@ -179,7 +179,7 @@ fn presets() -> Vec<Preset> {
     vec![
         Preset {
             name: "smoke-box-2d",
-            description: "the seed's stable fluids: smoke rising from a source in a closed 128x128 box",
+            description: "Stam's stable fluids (GDC 2003): smoke rising from a source in a closed 128x128 box",
             run: RunDefaults::new(0.1, 100, 2),
             params: json!({ "preset": "smoke-box-2d", "resolution": 128 }),
             quick_params: Some(json!({ "preset": "smoke-box-2d", "resolution": 16 })),
@@ -206,7 +206,7 @@ fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynS
     Ok(Simulated::new(p.scene()?, 0.0).boxed())
 }
 
-/// A [`FluidScene`] stepped by `dt` per step (the seed scene applies its source pattern first),
+/// A [`FluidScene`] stepped by `dt` per step (the Stam scene applies its source pattern first),
 /// with the run's clock as its state: the sum of the steps' `dt`.
 impl Solver for FluidScene {
     type State = f64;
@@ -220,10 +220,11 @@ impl Solver for FluidScene {
     }
 }
 
-/// Saved as `{"time": t, "fluid": memory}` with [`FluidScene::memory`]: the seed's six arrays,
+/// Saved as `{"time": t, "fluid": memory}` with [`FluidScene::memory`]: Stam's solver's six arrays,
 /// or the MAC state and its warm-start pressure.
 impl Checkpoint for FluidScene {
-    const VERSION: u32 = 1;
+    /// 2: Stam's solver saved under `"stam"` (version 1 named it differently).
+    const VERSION: u32 = 2;
 
     fn time(&self, time: &f64) -> f64 {
         *time
@@ -247,7 +248,7 @@ impl Checkpoint for FluidScene {
 
     fn provoke_overflow(&mut self, _: &mut f64) -> Option<String> {
         match &mut self.sim {
-            FluidSim::Seed(f) => {
+            FluidSim::Stam(f) => {
                 // The diffusion sums four neighbours: 2 f32::MAX is infinite.
                 f.density_mut().fill(f32::MAX);
                 Some("the density of every cell set to f32::MAX".into())
@@ -268,7 +269,7 @@ impl Checkpoint for FluidScene {
 impl View for FluidScene {
     fn method(&self) -> String {
         match &self.sim {
-            FluidSim::Seed(_) => "seed stable fluids (f32, 20 Gauss-Seidel sweeps)".to_string(),
+            FluidSim::Stam(_) => "Stam's stable fluids (f32, 20 Gauss-Seidel sweeps)".to_string(),
             FluidSim::Mac(f, _) => format!(
                 "{}D MAC, {} advection, {} splitting, {} pressure",
                 f.dim(),
@@ -282,12 +283,12 @@ impl View for FluidScene {
     /// The image grid (origin at 0, the cell size as spacing, the density shown) and, for the
     /// plume, its sphere in the grid's axes.
     fn context(&self, _: &f64) -> Context {
-        // The seed's source adds 10 per step where it sits and the closed box keeps it all: in
+        // Stam's source adds 10 per step where it sits and the closed box keeps it all: in
         // the 128^2 box after 200 steps the density's median is 17, its 99th percentile 50
         // (measured on the scene's frames), so the scale ends at 50. The MAC scenes' densities
         // lie in [0, 1] (sources and dye of 1, a limited advection).
         let range = match &self.sim {
-            FluidSim::Seed(_) => (0.0, 50.0),
+            FluidSim::Stam(_) => (0.0, 50.0),
             FluidSim::Mac(..) => (0.0, 1.0),
         };
         let mut context = Context::default();

@@ -1,16 +1,16 @@
 //! # anim-fluid
 //!
-//! Grid fluids (seed section 6): Jos Stam's stable fluids reproduced operation for operation,
+//! Grid fluids: Jos Stam's stable fluids (Stam 1999, 2003) reproduced operation for operation,
 //! and beside it a MAC-grid solver for 2D and 3D with better advection and pressure solvers.
 //!
 //! ## What it models
 //!
-//! The incompressible Navier-Stokes equations of seed 6.1,
-//! `div u = 0`, `du/dt = -(u . grad) u - grad p / rho + nu Lap u + f`, solved by the seed's
-//! splitting `w0 -(add force)-> w1 -(advect)-> w2 -(diffuse)-> w3 -(project)-> w4`, with a
+//! The incompressible Navier-Stokes equations,
+//! `div u = 0`, `du/dt = -(u . grad) u - grad p / rho + nu Lap u + f`, solved by the operator
+//! splitting of Stam's stable fluids (1999) `w0 -(add force)-> w1 -(advect)-> w2 -(diffuse)-> w3 -(project)-> w4`, with a
 //! density (smoke) carried by the flow. Two solvers:
 //!
-//! - [`seed`]: the seed's section 6.2 C routines (`IX`, `add_source`, `set_bnd`, `lin_solve`
+//! - [`stam`]: the C routines of Stam's *Real-Time Fluid Dynamics for Games* (GDC 2003) (`IX`, `add_source`, `set_bnd`, `lin_solve`
 //!   with 20 Gauss-Seidel sweeps, `diffuse`, `advect`, `project`, `dens_step`, `vel_step`) on
 //!   an `N x N` grid with a one-cell border, in `f32`, with the same operations in the same
 //!   order: density and velocity are **identical to the last bit** to the C code compiled
@@ -18,7 +18,7 @@
 //!   against the C transcription under `xtask/peers/fluid/` at N = 64 and 128, 100 steps).
 //! - [`mac`]: a staggered (MAC) grid in 2D or 3D (one code base), velocity advection by
 //!   semi-Lagrangian steps with linear or monotone cubic interpolation, or BFECC / MacCormack
-//!   with a limiter ([`advection`]); the seed's advect-then-project splitting or
+//!   with a limiter ([`advection`]); Stam's advect-then-project splitting or
 //!   advection-reflection (Zehnder et al. 2018, [`advection::Splitting`]), second order in
 //!   time; implicit viscosity; projection by Jacobi, red-black
 //!   Gauss-Seidel, conjugate gradients or multigrid-preconditioned CG ([`pressure`]); solid
@@ -31,7 +31,7 @@
 //! ## Scenes
 //!
 //! [`KIND`] registers the crate's scenes with anim-core's scene contracts as the `fluid` kind
-//! ([`kind`]): the presets `smoke-box-2d` (the seed's solver), `smoke-plume-3d` and
+//! ([`kind`]): the presets `smoke-box-2d` (Stam's solver), `smoke-plume-3d` and
 //! `lid-driven-cavity` (the MAC solver), built from their scene-file parameters
 //! ([`kind::FluidSceneParams`]: preset, resolution, pressure solver and tolerance, advection,
 //! splitting), checkpointed and drawn as density and velocity fields on an image grid.
@@ -40,7 +40,7 @@
 //!
 //! | choice | when |
 //! | --- | --- |
-//! | [`seed::SeedFluid`] | the seed's behaviour exactly (games, previews); not divergence free (20 sweeps do not converge) |
+//! | [`stam::StamFluid`] | Stam's GDC 2003 solver exactly (games, previews); not divergence free (20 sweeps do not converge) |
 //! | [`mac::MacFluid`] + [`pressure::PressureMethod::Mgpcg`] | whenever the flow must be incompressible to a tolerance; iterations nearly independent of resolution |
 //! | [`pressure::PressureMethod::ConjugateGradient`] | small grids (below about 64^2), where multigrid's setup does not pay |
 //! | Jacobi, red-black Gauss-Seidel | reference points of the work-precision study; only for loose tolerances on small grids |
@@ -51,7 +51,7 @@
 //! ## Guarantees
 //!
 //! - `step` allocates nothing: every buffer is sized by the constructor (`tests/no_alloc.rs`
-//!   counts the allocations of seed and MAC steps, every pressure method and both splittings).
+//!   counts the allocations of Stam and MAC steps, every pressure method and both splittings).
 //! - Results are bitwise identical for any rayon thread count (every stage reads the previous
 //!   stage's arrays only; red-black ordering; dot products summed over fixed chunks in order).
 //! - Bad input (empty or 1-cell grids, `dt <= 0`, `h <= 0`, negative viscosity, non-finite
@@ -60,7 +60,7 @@
 //!   field, cell, value and the cell's last finite value, and leaves the simulation bitwise as
 //!   it was before the step (the state is copied aside into preallocated buffers first; for the
 //!   MAC solver the warm-start pressure too). Every error message begins with `anim-fluid: `.
-//! - **Checkpoints**: [`scenes::FluidScene::memory`] (built on [`seed::SeedFluid::memory`],
+//! - **Checkpoints**: [`scenes::FluidScene::memory`] (built on [`stam::StamFluid::memory`],
 //!   the serde [`mac::MacState`] and [`mac::MacFluid::memory`]) is everything a step reads
 //!   (velocity, density, temperature, the warm-start pressure, step count, time) as a
 //!   `serde_json` value; restoring it into a scene built the same way continues bit for bit,
@@ -69,22 +69,22 @@
 //!
 //! ## Speed
 //!
-//! The seed mode on one thread against the seed's C code compiled with `cc -O3 -march=native`
+//! Stam's solver on one thread against Stam's C code compiled with `cc -O3 -march=native`
 //! (gcc 12.2; same source pattern, same 20 sweeps), per step, medians of 3 interleaved runs of
-//! `examples/seed_timing.rs` and the C driver's `time` mode on this shared 2-core machine under
+//! `examples/stam_timing.rs` and the C driver's `time` mode on this shared 2-core machine under
 //! heavy load: N = 128: 40 ms against 69 ms (1.7x faster); N = 256: 83 against 139 ms (1.7x);
 //! N = 512: 0.92 against 1.59 s (1.7x). An earlier, quieter run gave 15.5 / 33 ms, 71 / 132 ms
 //! and 0.62 / 0.97 s (2.1x, 1.9x, 1.6x). The gain comes from the contiguous wavefront sweep of
-//! [`seed::lin_solve`]: the same operands per cell, but no strided access and independent chains.
+//! [`stam::lin_solve`]: the same operands per cell, but no strided access and independent chains.
 //! The failure guard (the six arrays copied aside before each step, so that a step producing
 //! NaN can be undone) costs 8 us of a 4.0 ms step at N = 128, 0.13 ms of 27 ms at N = 256 and
-//! 0.7 ms of 184 ms at N = 512 (0.2-0.5%; medians of 3 runs of `examples/seed_timing.rs`, which
+//! 0.7 ms of 184 ms at N = 512 (0.2-0.5%; medians of 3 runs of `examples/stam_timing.rs`, which
 //! times the same copies).
 //! `cargo xtask bench --peers` repeats the comparison (in one loaded run it measured 5.3x, 2.8x
 //! and 2.6x at N = 128, 256, 512), adds MGPCG against red-black Gauss-Seidel at equal residual
 //! and Taichi's stable-fluids example (512 x 512, 500 Jacobi iterations: 477 ms per step on one
-//! thread against 726 ms for our seed mode in the same run; Taichi's vectorised Jacobi sweeps
-//! beat the seed's inherently sequential Gauss-Seidel chains).
+//! thread against 726 ms for our Stam mode in the same run; Taichi's vectorised Jacobi sweeps
+//! beat the inherently sequential Gauss-Seidel chains of Stam's solver).
 //!
 //! ## Accuracy (measured here)
 //!
@@ -119,7 +119,7 @@
 //!
 //! ## Precision
 //!
-//! The seed mode is `f32` (as the seed). The MAC solver is `f64`: its conformance cases ask for
+//! The Stam mode is `f32` (as Stam's C code). The MAC solver is `f64`: its conformance cases ask for
 //! relative pressure residuals down to 1e-10 (Taylor-Green), beyond what `f32` sums reach on
 //! 128^2 grids.
 //!
@@ -160,7 +160,7 @@ pub mod kind;
 pub mod mac;
 pub mod pressure;
 pub mod scenes;
-pub mod seed;
+pub mod stam;
 
 pub use error::FluidError;
 pub use kind::KIND;

@@ -1,6 +1,6 @@
 //! The MAC-grid solver: incompressible Navier-Stokes with smoke, 2D and 3D in one code base.
 //!
-//! Seed section 6.1's splitting `w0 -(force)-> w1 -(advect)-> w2 -(diffuse)-> w3 -(project)-> w4`
+//! The stable-fluids splitting (Stam 1999) `w0 -(force)-> w1 -(advect)-> w2 -(diffuse)-> w3 -(project)-> w4`
 //! on a staggered (MAC, Harlow and Welch 1965) grid: `u` on the x faces, `v` on the y faces, `w`
 //! on the z faces, density `rho` and temperature `T` at cell centres, cell size `h`. One step:
 //!
@@ -69,8 +69,8 @@ pub struct MacParams {
     pub viscosity: f64,
     /// Advection scheme. Default [`Advection::MacCormack`].
     pub advection: Advection,
-    /// How a step splits advection from projection. Default [`Splitting::AdvectProject`] (the
-    /// seed's order); [`Splitting::Reflection`] is second order in `dt` for two projections.
+    /// How a step splits advection from projection. Default [`Splitting::AdvectProject`] (Stam's
+    /// order); [`Splitting::Reflection`] is second order in `dt` for two projections.
     pub splitting: Splitting,
     /// Pressure solver. Default [`PressureMethod::Mgpcg`].
     pub pressure: PressureMethod,

@@ -2,7 +2,7 @@
 //!
 //! | scene | what | solver | why |
 //! | --- | --- | --- | --- |
-//! | [`smoke_box_2d`] | the seed's interactive-style demo: a smoke source at the bottom of a closed box pushes density up, its sideways force flipping every 25 steps | [`seed`](crate::seed) mode, `f32`, 20 Gauss-Seidel sweeps | the seed's routines exactly, as Stam's demo runs them |
+//! | [`smoke_box_2d`] | an interactive-style demo: a smoke source at the bottom of a closed box pushes density up, its sideways force flipping every 25 steps | [Stam's solver](crate::stam), `f32`, 20 Gauss-Seidel sweeps | Stam's routines (GDC 2003) exactly, as his demo runs them |
 //! | [`smoke_plume_3d`] | hot smoke rises from a vent around a sphere into an open-topped box | MAC 3D, MacCormack, MGPCG, buoyancy + vorticity confinement | the 3D solver with an obstacle, inflow and an open boundary |
 //! | [`taylor_green_decay`] | the Taylor-Green vortex in the unit square with free-slip walls, decaying for a given time | MAC 2D, any advection, pressure to 1e-10 | the analytic decay `exp(-2 nu pi^2 t)` checks advection, projection and viscosity together |
 //! | [`lid_driven_cavity`] | the unit square, top wall sliding at 1, Re = 100, bands of passive dye | MAC 2D, MacCormack, MGPCG, implicit viscosity | the classic steady benchmark (Ghia, Ghia and Shin 1982) |
@@ -22,7 +22,7 @@ use crate::advection::{Advection, Splitting};
 use crate::error::FluidError;
 use crate::mac::{MacFluid, MacParams, MacState, Source, Wall};
 use crate::pressure::PressureMethod;
-use crate::seed::{SeedFluid, SeedParams, ix};
+use crate::stam::{StamFluid, StamParams, ix};
 use anim_core::solver::{Solver, StepReport};
 use serde::Deserialize as _;
 
@@ -33,8 +33,8 @@ pub const NAMES: [&str; 3] = ["smoke-box-2d", "smoke-plume-3d", "lid-driven-cavi
 #[derive(Debug, Clone)]
 #[allow(clippy::large_enum_variant)]
 pub enum FluidSim {
-    /// The seed's solver with its source pattern.
-    Seed(SeedFluid),
+    /// Stam's solver (GDC 2003) with its source pattern.
+    Stam(StamFluid),
     /// The MAC solver and its state.
     Mac(MacFluid, MacState),
 }
@@ -61,7 +61,7 @@ impl FluidScene {
         (self.duration / self.dt).round().max(1.0) as usize
     }
 
-    /// Advances one step of the scene's `dt` (the seed scene first applies its source pattern).
+    /// Advances one step of the scene's `dt` (the Stam scene first applies its source pattern).
     ///
     /// # Errors
     /// The solver's [`FluidError`]; the simulation is then as before the step.
@@ -69,17 +69,17 @@ impl FluidScene {
         self.step_by(self.dt)
     }
 
-    /// Advances one step of `dt` (the seed scene first applies its source pattern; its solver
+    /// Advances one step of `dt` (the Stam scene first applies its source pattern; its solver
     /// takes the step in `f32`, so `dt` is rounded to `f32` there).
     ///
     /// # Errors
     /// [`FluidError::BadParameter`] for a non-positive or non-finite `dt`; the solver's
-    /// [`FluidError`]. The fields (the seed scene's sources included), step count and time are
+    /// [`FluidError`]. The fields (the Stam scene's sources included), step count and time are
     /// then as before the step.
     pub fn step_by(&mut self, dt: f64) -> Result<StepReport, FluidError> {
         crate::error::positive("dt", dt)?;
         match &mut self.sim {
-            FluidSim::Seed(f) => {
+            FluidSim::Stam(f) => {
                 let (dt32, before) = (dt as f32, f.params().dt);
                 if dt32 != before {
                     f.set_dt(dt32)?;
@@ -99,7 +99,7 @@ impl FluidScene {
     #[must_use]
     pub fn steps_taken(&self) -> u64 {
         match &self.sim {
-            FluidSim::Seed(f) => f.steps(),
+            FluidSim::Stam(f) => f.steps(),
             FluidSim::Mac(_, s) => s.steps,
         }
     }
@@ -108,7 +108,7 @@ impl FluidScene {
     #[must_use]
     pub fn time(&self) -> f64 {
         match &self.sim {
-            FluidSim::Seed(f) => f.time(),
+            FluidSim::Stam(f) => f.time(),
             FluidSim::Mac(_, s) => s.time,
         }
     }
@@ -117,7 +117,7 @@ impl FluidScene {
     #[must_use]
     pub fn dim(&self) -> usize {
         match &self.sim {
-            FluidSim::Seed(_) => 2,
+            FluidSim::Stam(_) => 2,
             FluidSim::Mac(f, _) => f.dim(),
         }
     }
@@ -126,7 +126,7 @@ impl FluidScene {
     #[must_use]
     pub fn cell_size(&self) -> f64 {
         match &self.sim {
-            FluidSim::Seed(f) => 1.0 / f.n() as f64,
+            FluidSim::Stam(f) => 1.0 / f.n() as f64,
             FluidSim::Mac(f, _) => f.h(),
         }
     }
@@ -135,7 +135,7 @@ impl FluidScene {
     #[must_use]
     pub fn dims(&self) -> [usize; 3] {
         match &self.sim {
-            FluidSim::Seed(f) => [f.n(), f.n(), 1],
+            FluidSim::Stam(f) => [f.n(), f.n(), 1],
             FluidSim::Mac(f, _) => f.dims(),
         }
     }
@@ -152,7 +152,7 @@ impl FluidScene {
     pub fn density_into(&self, out: &mut Vec<f64>) {
         out.clear();
         match &self.sim {
-            FluidSim::Seed(f) => {
+            FluidSim::Stam(f) => {
                 let n = f.n();
                 let d = f.density();
                 out.extend((1..=n).flat_map(|j| (1..=n).map(move |i| f64::from(d[ix(n, i, j)]))));
@@ -175,7 +175,7 @@ impl FluidScene {
         out.clear();
         let dims = self.dims();
         match &self.sim {
-            FluidSim::Seed(f) => {
+            FluidSim::Stam(f) => {
                 let n = f.n();
                 let (u, v) = f.velocity();
                 for j in 1..=n {
@@ -197,14 +197,14 @@ impl FluidScene {
     }
 
     /// Everything the scene's simulation carries from one step to the next, for checkpoints:
-    /// the seed solver's six arrays, step count and time ([`SeedFluid::memory`]), or the MAC
+    /// Stam's solver's six arrays, step count and time ([`StamFluid::memory`]), or the MAC
     /// solver's [`MacState`] (velocities, density, temperature, step count, time) and its
     /// warm-start pressure ([`MacFluid::memory`]). A scene built by the same call and given this
     /// by [`FluidScene::restore_memory`] continues bit for bit.
     #[must_use]
     pub fn memory(&self) -> serde_json::Value {
         match &self.sim {
-            FluidSim::Seed(f) => serde_json::json!({ "solver": "seed", "seed": f.memory() }),
+            FluidSim::Stam(f) => serde_json::json!({ "solver": "stam", "stam": f.memory() }),
             FluidSim::Mac(f, s) => {
                 serde_json::json!({ "solver": "mac", "state": s, "simulation": f.memory() })
             }
@@ -222,12 +222,12 @@ impl FluidScene {
         let solver = memory
             .get("solver")
             .and_then(serde_json::Value::as_str)
-            .ok_or_else(|| FluidError::Checkpoint("no `solver` (\"seed\" or \"mac\")".into()))?;
+            .ok_or_else(|| FluidError::Checkpoint("no `solver` (\"stam\" or \"mac\")".into()))?;
         let field = |key: &str| {
             memory.get(key).ok_or_else(|| FluidError::Checkpoint(format!("no `{key}` in a {solver} memory")))
         };
         match &mut self.sim {
-            FluidSim::Seed(f) if solver == "seed" => f.restore_memory(field("seed")?),
+            FluidSim::Stam(f) if solver == "stam" => f.restore_memory(field("stam")?),
             FluidSim::Mac(f, s) if solver == "mac" => {
                 let state = MacState::deserialize(field("state")?)
                     .map_err(|e| FluidError::Checkpoint(format!("`state`: {e}")))?;
@@ -240,7 +240,7 @@ impl FluidScene {
             _ => Err(FluidError::Checkpoint(format!(
                 "a {solver} memory for a scene run by the {} solver",
                 match self.sim {
-                    FluidSim::Seed(_) => "seed",
+                    FluidSim::Stam(_) => "stam",
                     FluidSim::Mac(..) => "mac",
                 }
             ))),
@@ -260,17 +260,17 @@ pub fn by_name(name: &str, resolution: Option<usize>) -> Option<Result<FluidScen
     })
 }
 
-/// The seed's smoke source in a closed `N x N` box ([`crate::seed::source_pattern`]), dt = 0.1,
+/// Stam's smoke source in a closed `N x N` box ([`crate::stam::source_pattern`]), dt = 0.1,
 /// diff = visc = 1e-4, 200 steps.
 ///
 /// # Errors
 /// [`FluidError::BadGrid`] for `n < 2`.
 pub fn smoke_box_2d(n: usize) -> Result<FluidScene, FluidError> {
-    let params = SeedParams::default();
+    let params = StamParams::default();
     Ok(FluidScene {
         name: "smoke-box-2d",
-        description: "the seed's stable fluids: a smoke source at the bottom of a closed box",
-        sim: FluidSim::Seed(SeedFluid::new(n, params)?),
+        description: "Stam's stable fluids (GDC 2003): a smoke source at the bottom of a closed box",
+        sim: FluidSim::Stam(StamFluid::new(n, params)?),
         dt: f64::from(params.dt),
         duration: 20.0,
     })

@@ -1,4 +1,4 @@
-//! The invariant "`step` allocates nothing": after one warm-up step, stepping the seed solver and
+//! The invariant "`step` allocates nothing": after one warm-up step, stepping Stam's solver and
 //! the MAC solver (every pressure method and both splittings, 2D and 3D, with viscosity,
 //! buoyancy, vorticity confinement, an obstacle and an inflow) on a rayon pool of 2 threads
 //! performs no heap allocation; nor does rebinding a pressure solver to new cell labels. Counted
@@ -34,7 +34,7 @@ fn blocks(mut step: impl FnMut() -> bool, steps: usize) -> Vec<usize> {
 }
 
 #[test]
-fn seed_and_mac_steps_do_not_allocate() {
+fn stam_and_mac_steps_do_not_allocate() {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("pool");
     pool.install(|| {
         for name in ["smoke-box-2d", "smoke-plume-3d", "lid-driven-cavity"] {

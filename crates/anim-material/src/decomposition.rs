@@ -8,7 +8,7 @@
 //! when `det F < 0`. An inverted element thus keeps the rotation `R = U V^T` and shows its
 //! inversion as a negative last singular value (Irving, Teran & Fedkiw, *Invertible finite
 //! elements for robust simulation of large deformation*, SCA 2004). The corotated and fixed
-//! corotated models (seed 5.1) are evaluated on this decomposition.
+//! corotated models are evaluated on this decomposition.
 //!
 //! - 3D: the one-sided Jacobi kernel of `anim_core::linalg::svd` ([`anim_core::linalg::svd3_real`]).
 //! - 2D: closed form. Writing `F = [[a, b], [c, d]]` as a similarity plus a reflection part,

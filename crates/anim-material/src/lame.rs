@@ -1,4 +1,4 @@
-//! Lamé parameters and their validation (seed 5.1).
+//! Lamé parameters and their validation.
 //!
 //! `mu = E / (2 (1 + nu))`, `lambda = E nu / ((1 + nu)(1 - 2 nu))`: the shear modulus and the first
 //! Lamé parameter of isotropic linear elasticity, from Young's modulus `E` and Poisson's ratio `nu`.
@@ -40,7 +40,7 @@ pub struct Lame<T> {
 }
 
 impl<T: Scalar> Lame<T> {
-    /// Lamé parameters from Young's modulus `e` and Poisson's ratio `nu` (seed 5.1).
+    /// Lamé parameters from Young's modulus `e` and Poisson's ratio `nu`.
     ///
     /// # Errors
     /// [`MaterialError`] when `e` is not finite and positive or `nu` is outside `(-1, 0.5)`.

@@ -1,6 +1,6 @@
 //! # anim-material
 //!
-//! Hyperelastic material models (seed section 5.1) shared by the finite element crate (`anim-fem`)
+//! Hyperelastic material models (Sifakis & Barbič 2012; Stomakhin et al. 2012; Smith et al. 2018) shared by the finite element crate (`anim-fem`)
 //! and the material point method crate (`anim-mpm`). This crate holds the constitutive laws only:
 //! no meshes, no grids, no solvers, so MPM uses the models without pulling in FEM's solvers.
 //!

@@ -1,4 +1,4 @@
-//! Grid boundary conditions (the `BC` operator of seed 5.3.2): on the domain walls and on
+//! Grid boundary conditions (the `BC` operator of the MLS-MPM grid update, Hu et al. 2018): on the domain walls and on
 //! analytic colliders (planes, boxes, spheres), fixed or moving with a constant velocity.
 //!
 //! A grid node inside a collider (signed distance `phi(x_i) <= 0`) or within

@@ -1,6 +1,6 @@
 //! # anim-mpm
 //!
-//! The material point method (seed section 5.3): APIC (5.3.1) and MLS-MPM (5.3.2) in 2D and 3D
+//! The material point method: APIC (Jiang et al. 2015) and MLS-MPM (Hu et al. 2018) in 2D and 3D
 //! from one code base (`const D: usize`), with elastic, snow, weakly compressible fluid and sand
 //! materials on a sparse block grid; parallel with rayon and bitwise deterministic for any
 //! number of threads.
@@ -9,7 +9,7 @@
 //!
 //! Matter is a set of **particles** ([`Particles`]: position, velocity, the affine matrix `C_p`,
 //! the deformation gradient `F_p`, a plastic scalar, mass, rest volume, material), carried
-//! through a background **grid** each step (seed 5.3.1):
+//! through a background **grid** each step (APIC, Jiang et al. 2015):
 //!
 //! ```text
 //! P2G   m_i = sum_p w_ip m_p,   (m v)_i = sum_p w_ip [m_p v_p + m_p C_p (x_i - x_p)] + forces
@@ -20,9 +20,9 @@
 //!
 //! - [`kernel`]: quadratic and cubic B-splines `w_ip`, `D_p = h^2/4 I` and `h^2/3 I`;
 //! - [`transfer`](Transfer): APIC computes the grid force `-sum_p V_p P F_p^T grad w_ip`;
-//!   MLS-MPM fuses it into the affine momentum, `m_p C_p - dt D_p^-1 V_p P F_p^T` (seed 5.3.2);
+//!   MLS-MPM fuses it into the affine momentum, `m_p C_p - dt D_p^-1 V_p P F_p^T` (Hu et al. 2018);
 //! - [`material`]: elastic (the shared `anim-material` fixed corotated and Neo-Hookean models),
-//!   snow exactly as the seed (`F = F_E F_P`, singular values of `F_E` clamped to
+//!   snow as in Stomakhin et al. 2013 (`F = F_E F_P`, singular values of `F_E` clamped to
 //!   `[1 - theta_c, 1 + theta_s]`, Lamé parameters hardened by `exp(xi (1 - J_P))`, `xi = 10`,
 //!   `E = 1e4`, `nu = 0.2`), a weakly compressible fluid with the `J`-based equation of state,
 //!   and Drucker-Prager sand; the return maps live in [`plasticity`], sand's log-strain
@@ -42,10 +42,9 @@
 //!   from [`kind::MpmSceneParams`] (preset, resolution, transfer, kernel, particles per cell) and
 //!   run as a [`kind::MpmRun`] (checkpoints and frames).
 //!
-//! The seed's MLS-MPM listing prints the G2P affine update as `C_p = 1/dx^2 sum ...`; the factor
-//! is `D_p^-1 = 4/dx^2` for the quadratic kernel (its own APIC listing and Hu et al. 2018), and
-//! its snow listing prints `F_P^{n+1} = (F_P^{n+1})^-1 F^{n+1}` for `F_E^-1 F^{n+1}`; both are
-//! implemented in the corrected form.
+//! The G2P affine update is `C_p = D_p^-1 sum ...` with `D_p^-1 = 4/dx^2` for the quadratic
+//! kernel (Jiang et al. 2015; Hu et al. 2018), and snow's plastic update is
+//! `F_P^{n+1} = F_E^-1 F^{n+1}` (Stomakhin et al. 2013).
 //!
 //! ## A step
 //!

@@ -3,11 +3,11 @@
 //! | material | elastic part | plasticity ([`plasticity`](crate::plasticity)) |
 //! | --- | --- | --- |
 //! | [`Material::Elastic`] | shared [`FixedCorotated`] or [`NeoHookean`] (`anim-material`) | none |
-//! | [`Material::Snow`] | shared [`FixedCorotated`] on `F_E`, Lamé parameters hardened by `exp(xi (1 - J_P))` | singular values of `F_E` clamped to `[1 - theta_c, 1 + theta_s]` (seed 5.3.2) |
+//! | [`Material::Snow`] | shared [`FixedCorotated`] on `F_E`, Lamé parameters hardened by `exp(xi (1 - J_P))` | singular values of `F_E` clamped to `[1 - theta_c, 1 + theta_s]` (Stomakhin et al. 2013) |
 //! | [`Material::Fluid`] | weakly compressible: `p(J) = K/gamma (J^-gamma - 1)`, `tau = -p J I` | `F` reset to `J^(1/d) I` (no shear memory) |
 //! | [`Material::Sand`] | Hencky (St. Venant-Kirchhoff in log strain, [`hencky`]): `tau = U (2 mu eps + lambda tr(eps) I) U^T` | Drucker-Prager return map with hardening (Klár et al. 2016) |
 //!
-//! The MLS-MPM momentum of seed 5.3.2 needs `V_p^0 P(F_p) F_p^T`, the Kirchhoff stress times
+//! The MLS-MPM momentum (Hu et al. 2018) needs `V_p^0 P(F_p) F_p^T`, the Kirchhoff stress times
 //! the rest volume, and APIC's grid force `f_i = -sum_p V_p^0 P F_p^T grad w_ip` needs the same
 //! product, so this module computes exactly that (`kirchhoff`).
 
@@ -45,18 +45,18 @@ impl Default for Elastic {
     }
 }
 
-/// Snow (Stomakhin et al. 2013, seed 5.3.2), defaults as in the seed.
+/// Snow (Stomakhin et al. 2013).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Snow {
-    /// Young's modulus `E_0`; default `1e4` (seed).
+    /// Young's modulus `E_0`; default `1e4`.
     pub young: f64,
-    /// Poisson's ratio; default `0.2` (seed).
+    /// Poisson's ratio; default `0.2`.
     pub poisson: f64,
     /// Critical compression `theta_c`; default `2.5e-2`.
     pub theta_c: f64,
     /// Critical stretch `theta_s`; default `7.5e-3`.
     pub theta_s: f64,
-    /// Hardening coefficient `xi`; default `10` (seed).
+    /// Hardening coefficient `xi`; default `10`.
     pub hardening: f64,
     /// Rest density; default `400`.
     pub density: f64,

@@ -1,13 +1,12 @@
 //! Plasticity: the return maps applied to a particle's deformation gradient after its update
 //! `F <- (I + dt grad v) F`.
 //!
-//! **Snow** (seed 5.3.2; Stomakhin, Schroeder, Chai, Teran & Selle, *A material point method
+//! **Snow** (Stomakhin, Schroeder, Chai, Teran & Selle, *A material point method
 //! for snow simulation*, SIGGRAPH 2013). With `F = F_E F_P`, the trial elastic part
 //! `F_E^ = F^{n+1} (F_P^n)^-1` (in practice `(I + dt grad v) F_E^n`) is decomposed
 //! `F_E^ = U diag(sigma^) V^T`, its singular values clamped to `[1 - theta_c, 1 + theta_s]`,
 //! `F_E = U diag(sigma) V^T`, and the rest goes to the plastic part,
-//! `F_P^{n+1} = F_E^-1 F^{n+1}` (the seed prints `(F_P^{n+1})^-1 F^{n+1}`, a typo: it is
-//! `F_E`'s inverse). Only `J_P = det F_P` enters the hardening `exp(xi (1 - J_P))`, so it is all
+//! `F_P^{n+1} = F_E^-1 F^{n+1}`. Only `J_P = det F_P` enters the hardening `exp(xi (1 - J_P))`, so it is all
 //! that is stored: `J_P^{n+1} = J_P^n prod sigma^_i / prod sigma_i`.
 //!
 //! **Fluid.** A weakly compressible fluid has no shear memory: after the update only

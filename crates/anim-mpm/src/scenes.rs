@@ -3,10 +3,10 @@
 //!
 //! | scene | D | what | materials |
 //! | --- | --- | --- | --- |
-//! | `three-materials` | 2 | the classic jelly, snow and water blocks falling into a box | fixed corotated, snow (seed defaults), fluid |
+//! | `three-materials` | 2 | the classic jelly, snow and water blocks falling into a box | fixed corotated, snow (default parameters), fluid |
 //! | `dam-break-2d` | 2 | the dam break of the report's study against Martin & Moyce (1952): a 0.2 x 0.4 m column in a 1 m tank with no-slip walls ([`dam_break_2d`], [`SurgeFront`]) | fluid (`K` = 2.5 MPa) |
 //! | `dam-break-3d` | 3 | a water column collapsing along a box | fluid |
-//! | `snowball` | 3 | a snowball thrown against a wall, flattening and sliding down | snow (seed defaults), box collider with friction |
+//! | `snowball` | 3 | a snowball thrown against a wall, flattening and sliding down | snow (default parameters), box collider with friction |
 //! | `benchmark-2d` | 2 | the `mpm88` fluid scene of the peer benchmark (8192 particles at 128^2) | fluid |
 //! | `benchmark-3d` | 3 | the `mpm3d` fluid scene of the peer benchmark (65536 particles at 64^3) | fluid |
 //!

@@ -17,10 +17,10 @@ use serde::{Deserialize, Serialize};
 /// The transfer scheme; `"apic"` or `"mls-mpm"` in scene files and serialised parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum Transfer {
-    /// APIC (seed 5.3.1): grid forces from `grad w_ip`, `F` updated with `sum v_i grad w_ip^T`.
+    /// APIC (Jiang et al. 2015): grid forces from `grad w_ip`, `F` updated with `sum v_i grad w_ip^T`.
     #[serde(rename = "apic")]
     Apic,
-    /// MLS-MPM (seed 5.3.2): stress fused into the affine momentum, `F` updated with `C_p`.
+    /// MLS-MPM (Hu et al. 2018): stress fused into the affine momentum, `F` updated with `C_p`.
     #[default]
     #[serde(rename = "mls-mpm")]
     Mls,

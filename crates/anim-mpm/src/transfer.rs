@@ -1,5 +1,6 @@
 //! The transfers of one step: stress, particle-to-grid (P2G), the grid update, grid-to-particle
-//! (G2P) with the deformation-gradient update, for APIC (seed 5.3.1) and MLS-MPM (seed 5.3.2).
+//! (G2P) with the deformation-gradient update, for APIC (Jiang et al. 2015) and MLS-MPM (Hu et
+//! al. 2018).
 //!
 //! With `w_ip` the kernel weights, `dx = x_i - x_p`, `D_p^-1 = k/h^2` (`k = 4` quadratic, `3`
 //! cubic) and `tau_p = P(F_p) F_p^T`:
@@ -13,8 +14,8 @@
 //!             then the material's return map
 //! ```
 //!
-//! The seed's MLS G2P prints `C_p = 1/dx^2 sum ...`; the factor is `D_p^-1 = 4/dx^2` (quadratic),
-//! as in its APIC listing and in Hu et al. (2018). MLS-MPM's `F` update with `C_p` is done at
+//! The MLS G2P sets `C_p = D_p^-1 sum ...` with `D_p^-1 = 4/dx^2` (quadratic), as in APIC and
+//! in Hu et al. (2018). MLS-MPM's `F` update with `C_p` is done at
 //! the end of G2P here rather than at the start of the next P2G: the same `C_p` is used, so the
 //! result is identical, and every particle state is complete after a step.
 //!

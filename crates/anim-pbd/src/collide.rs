@@ -47,7 +47,7 @@
 //! [`BodyMotion`] of time (or a target set between steps with
 //! [`PbdSimulation::set_body_target`](crate::PbdSimulation::set_body_target)). Within a step the
 //! pose moves linearly from its start to its end; substeps see the interpolated pose and friction
-//! acts relative to the body's velocity at the contact point (the seed's `x^obs, v^obs`).
+//! acts relative to the body's velocity at the contact point (`x^obs, v^obs`).
 
 use anim_core::glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};

@@ -1,6 +1,6 @@
-//! Constraints as the seed defines them (section 3): a cardinality `n_j`, a function
+//! Constraints as position based dynamics defines them (Müller et al. 2007): a cardinality `n_j`, a function
 //! `C_j: R^{3 n_j} -> R`, an index set `{i_1, ..., i_{n_j}}`, a stiffness `k_j` in `[0, 1]` and a
-//! type, equality (`C_j = 0`) or inequality (`C_j >= 0`); plus, for XPBD (seed 3.1), a compliance
+//! type, equality (`C_j = 0`) or inequality (`C_j >= 0`); plus, for XPBD (Macklin et al. 2016), a compliance
 //! `alpha_j >= 0` (the inverse stiffness, in SI units of `C^2 / J`) and a damping `beta_j >= 0`.
 //!
 //! # The functions
@@ -22,7 +22,7 @@
 //! Every function here is invariant under rigid motions of its particles, except
 //! [`Attachment`](ConstraintFunction::Attachment), whose target is external. So
 //! `sum_i grad_i C = 0` and `sum_i x_i x grad_i C = 0`, and a projection
-//! `dx_i = -s w_i grad_i C` changes neither linear nor angular momentum (the seed's remark on
+//! `dx_i = -s w_i grad_i C` changes neither linear nor angular momentum (Müller et al.'s remark on
 //! ghost forces; checked in the tests and by `cargo xtask conformance`).
 //!
 //! # Isometric bending as one scalar constraint
@@ -52,7 +52,7 @@ use serde::{Deserialize, Serialize};
 /// Below this length a direction is undefined (about `1.5e-154`, `sqrt(f64::MIN_POSITIVE)`).
 pub const MIN_LENGTH: f64 = 1.491_668_146_240_041_3e-154;
 
-/// Equality (`C = 0`) or inequality (`C >= 0`), the seed's "type".
+/// Equality (`C = 0`) or inequality (`C >= 0`), a constraint's "type" in PBD.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ConstraintType {
@@ -65,7 +65,7 @@ pub enum ConstraintType {
 
 /// The stiffness, compliance and damping of a constraint.
 ///
-/// PBD uses `stiffness` (the seed's `k` in `[0, 1]`); XPBD uses `compliance` and `damping`.
+/// PBD uses `stiffness` (Müller et al.'s `k` in `[0, 1]`); XPBD uses `compliance` and `damping`.
 /// Both are stored so that one model runs under either method.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -358,7 +358,7 @@ pub fn isometric_weights(p: [[f64; 3]; 4]) -> Option<([f64; 4], f64)> {
 }
 
 impl Constraint {
-    /// The seed's cardinality `n_j` (for a global volume: the number of vertices of its mesh,
+    /// The cardinality `n_j` (for a global volume: the number of vertices of its mesh,
     /// which needs the model: see [`PbdModel::cardinality`](crate::PbdModel::cardinality); this
     /// returns 0 for it).
     #[must_use]

@@ -1,13 +1,13 @@
 //! # anim-pbd
 //!
-//! Position based dynamics (seed section 3) and extended PBD, XPBD (section 3.1): cloth, ropes,
+//! Position based dynamics (Müller et al. 2007) and extended PBD, XPBD (Macklin et al. 2016): cloth, ropes,
 //! soft bodies and balloons as particles held by constraints, with collisions against planes,
 //! spheres, boxes and capsules, friction and restitution. Parallel, and bitwise deterministic for
 //! any number of threads.
 //!
 //! ## What it models
 //!
-//! The seed's model, exactly: `N` **vertices** ([`Particle`]) with mass `m_i`, position `x_i`,
+//! The model of Müller et al. 2007, exactly: `N` **vertices** ([`Particle`]) with mass `m_i`, position `x_i`,
 //! velocity `v_i` and inverse mass `w_i = 1/m_i` (0 for a pinned particle), and `M`
 //! **constraints** ([`Constraint`]), each with a cardinality `n_j`, a function
 //! `C_j: R^{3 n_j} -> R`, an index set, a stiffness `k_j` in `[0, 1]` and a type, equality
@@ -30,9 +30,9 @@
 //! is a [`BuildError`] naming the element (bad index, negative mass, `k` outside `[0, 1]`, negative
 //! compliance, degenerate rest shape, open volume mesh, ...).
 //!
-//! ## The loop (seed 3 and 3.1)
+//! ## The loop (Müller et al. 2007; Macklin et al. 2016)
 //!
-//! [`PbdSimulation`] runs the seed's 17-line loop, per substep of `h = dt / substeps`:
+//! [`PbdSimulation`] runs the 17-line loop of Müller et al. 2007 (Algorithm 1), per substep of `h = dt / substeps`:
 //!
 //! ```text
 //! (5)  v_i <- v_i + h w_i f_ext(x_i)          (7)  p_i <- x_i + h v_i
@@ -42,7 +42,7 @@
 //! ```
 //!
 //! with the projection of a constraint (mass-weighted, so that it carries no linear or angular
-//! impulse, the seed's remark on ghost forces)
+//! impulse, Müller et al.'s remark on ghost forces)
 //!
 //! ```text
 //! PBD:   dp_i = -k' C / (sum_j w_j |grad_j C|^2) w_i grad_i C,   k' = 1 - (1 - k)^(1/n_s)
@@ -50,7 +50,7 @@
 //!        dp_i = w_i grad_i C dlambda,  lambda <- lambda + dlambda                               (eq. 17)
 //! ```
 //!
-//! **Stiffness.** PBD multiplies the seed's step by `k' = 1 - (1 - k)^(1/n_s)`, `n_s` the solver
+//! **Stiffness.** PBD multiplies the projection step by `k' = 1 - (1 - k)^(1/n_s)`, `n_s` the solver
 //! iterations per substep, as Müller et al. 2007 (section 3.3) do, so that a lone constraint keeps
 //! the fraction `1 - k` of its error whatever `n_s` ([`PbdParams::stiffness_correction`] turns it
 //! off and uses `k` raw). Even so PBD's effective stiffness depends on `dt` (as `1/dt^2`) and,
@@ -67,8 +67,8 @@
 //! | choice | when |
 //! | --- | --- |
 //! | [`Method::Xpbd`] (default) | whenever the material matters: stiffness from a compliance in SI units, independent of `dt` and iterations |
-//! | [`Method::Pbd`] | when only "stiff" or "soft" matters and you tune `k` visually, as in the seed |
-//! | [`SolverKind::GaussSeidel`] | the seed's sequential sweep in model order: one thread, the reference |
+//! | [`Method::Pbd`] | when only "stiff" or "soft" matters and you tune `k` visually, as in the original PBD |
+//! | [`SolverKind::GaussSeidel`] | PBD's sequential sweep in model order: one thread, the reference |
 //! | [`SolverKind::ColoredGaussSeidel`] | the same convergence per iteration, constraints grouped into independent colours (computed once); the fastest on one thread (about 30% faster than model order: no dependency chains), parallel for very large colours |
 //! | [`SolverKind::Jacobi`] | every constraint from the same positions, averaged per particle: embarrassingly parallel but needs several times the iterations |
 //! | `substeps` > 1 | long chains and stiff materials: many substeps of 1-2 iterations converge far better than the same work in iterations (Macklin et al. 2019); `cargo xtask report` has the curves |

@@ -15,7 +15,7 @@ use anim_core::glam::DVec3;
 use anim_core::integrate::State;
 use serde::{Deserialize, Serialize};
 
-/// A particle: the seed's vertex `i` with mass `m_i` (its position and velocity live in the
+/// A particle: PBD's vertex `i` with mass `m_i` (its position and velocity live in the
 /// state). A pinned particle has inverse mass `w_i = 0`: nothing moves it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -140,7 +140,7 @@ impl PbdModel {
         &self.positions
     }
 
-    /// The constraints, in the order they were added (the seed's order of Gauss-Seidel).
+    /// The constraints, in the order they were added (the Gauss-Seidel order).
     #[must_use]
     pub fn constraints(&self) -> &[Constraint] {
         &self.constraints
@@ -211,7 +211,7 @@ impl PbdModel {
         State::new(x, v)
     }
 
-    /// The seed's cardinality `n_j` of constraint `j`.
+    /// The cardinality `n_j` of constraint `j` (the number of particles it involves).
     ///
     /// # Panics
     /// If `j` is out of range.

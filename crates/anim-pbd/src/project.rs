@@ -1,5 +1,5 @@
 //! Constraint projection: the kernels behind line (10) of the PBD loop, `projectConstraints`, for
-//! PBD (seed section 3) and XPBD (section 3.1, equations 17 and 18), shared by the three
+//! PBD (Müller et al. 2007) and XPBD (Macklin et al. 2016, equations 17 and 18), shared by the three
 //! solvers.
 //!
 //! # One projection
@@ -7,11 +7,11 @@
 //! For a constraint `C` of cardinality `n` with gradient `g_k = grad_{p_k} C` and inverse masses
 //! `w_k`, let `D = sum_k w_k |g_k|^2`.
 //!
-//! - **PBD** (seed 3, the mass-weighted step): `dp_k = -k' C / D w_k g_k`, with the stiffness
+//! - **PBD** (the mass-weighted step): `dp_k = -k' C / D w_k g_k`, with the stiffness
 //!   correction `k' = 1 - (1 - k)^(1/n_s)` of Müller et al. 2007 (section 3.3) over `n_s` solver
 //!   iterations, so that a single constraint keeps the fraction `(1 - k)` of its error after the
 //!   iterations whatever `n_s` is. An inequality is projected only while `C < 0`.
-//! - **XPBD** (seed 3.1): with `alpha~ = alpha / h^2` and the multiplier `lambda` accumulated over
+//! - **XPBD**: with `alpha~ = alpha / h^2` and the multiplier `lambda` accumulated over
 //!   the iterations of the (sub)step (reset to 0 at its start, line 4 of the XPBD loop),
 //!
 //!   ```text

@@ -1,10 +1,10 @@
-//! The simulation: the seed's PBD loop (section 3) and XPBD loop (section 3.1) over a
+//! The simulation: the PBD loop (Müller et al. 2007) and XPBD loop (Macklin et al. 2016) over a
 //! [`PbdModel`], with three constraint solvers, substepping, and a guard that stops a step which
 //! produced a non-finite value or blew up, naming the step, the particle and the constraint.
 //!
 //! # The loop
 //!
-//! One step of `dt` is `substeps` substeps of `h = dt / substeps`, each the seed's loop body:
+//! One step of `dt` is `substeps` substeps of `h = dt / substeps`, each the body of Müller et al.'s loop (Algorithm 1):
 //!
 //! ```text
 //! (5)  forall vertices i:  v_i <- v_i + h w_i f_ext(x_i)            gravity, wind, user forces
@@ -18,7 +18,7 @@
 //! (16) velocityUpdate(v_1..v_N)                                       restitution
 //! ```
 //!
-//! XPBD (seed 3.1) is the same loop with `lambda <- 0` before the iterations (line 4 of its
+//! XPBD (Macklin et al. 2016) is the same loop with `lambda <- 0` before the iterations (line 4 of its
 //! algorithm) and equations 17/18 in the projection; its prediction
 //! `x~ = x^n + h v^n + h^2 M^-1 f_ext` is lines (5) and (7) together. Choosing many substeps with
 //! one iteration each is the "small steps" scheme of Macklin et al. 2019.
@@ -260,7 +260,7 @@ impl PbdSimulation {
         Ok(())
     }
 
-    /// One substep of length `h` starting at time `t` (substep `k` of `s`): the seed's loop body,
+    /// One substep of length `h` starting at time `t` (substep `k` of `s`): the PBD loop body,
     /// stage by stage. Returns the number of contacts.
     fn substep(&mut self, t: f64, h: f64, k: usize, s: usize) -> usize {
         let (model, params, d) = (&self.model, &self.params, &mut self.data);

@@ -100,7 +100,7 @@ fn linear_momentum_is_conserved_over_a_run() {
     }
 }
 
-/// XPBD's promise (seed 3.1): a hanging chain settles at the static stretch `alpha T` of every
+/// XPBD's promise (Macklin et al. 2016): a hanging chain settles at the static stretch `alpha T` of every
 /// link whatever the iteration count and time step.
 #[test]
 fn xpbd_chain_static_stretch() {

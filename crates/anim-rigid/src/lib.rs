@@ -3,10 +3,10 @@
 //! Articulated rigid bodies: kinematic-tree models loaded from URDF, forward kinematics by
 //! joint-frame composition and by the product of exponentials, geometric Jacobians and their time
 //! derivatives, inverse kinematics by the Paden-Kahan subproblems and by damped least squares
-//! (seed sections 1.2 and 4.1-4.5); and dynamics: spatial (Plücker) vector algebra, inverse
+//! (Murray, Li & Sastry 1994; Lynch & Park 2017); and dynamics: spatial (Plücker) vector algebra, inverse
 //! dynamics by RNEA, the mass matrix by CRBA, forward dynamics by ABA and by a sparse Cholesky
 //! factorisation, energies and momentum, contact-free simulation of trees and free bodies with
-//! Lie-group time steppers (seed section 4.6). Built on anim-core's [`lie`](anim_core::lie) and
+//! Lie-group time steppers (Featherstone 2008). Built on anim-core's [`lie`](anim_core::lie) and
 //! [`integrate`](anim_core::integrate) modules.
 //!
 //! ## Model, Data, configuration (Pinocchio's split)
@@ -35,7 +35,7 @@
 //! | [`compute_joint_jacobians_time_variation`], [`frame_jacobian_time_variation`] | `dJ/dt` along `v` | `d/dt Ad(world_M_i) S = [V_i, J_k]` |
 //! | [`AnalyticIk`] | all (up to 8) IK solutions of 6R arms | Paden-Kahan subproblems ([`paden_kahan`]) |
 //! | [`NumericalIk`] | IK for any chain | Levenberg-Marquardt on `log(T⁻¹T*)` with limits and a null-space objective |
-//! | [`rnea`] | inverse dynamics `τ = ID(q, v, v̇)` | `τ = H(q) v̇ + C(q, v)` (seed 4.6), Newton-Euler passes |
+//! | [`rnea`] | inverse dynamics `τ = ID(q, v, v̇)` | `τ = H(q) v̇ + C(q, v)` (Featherstone 2008), Newton-Euler passes |
 //! | [`nonlinear_effects`], [`gravity_torques`] | the bias `C(q, v)` and gravity `g(q)` terms | `C = ID(q, v, 0)`, `g = ID(q, 0, 0)` |
 //! | [`crba`] | the mass matrix `H(q)` | `H_ij = S_iᵀ Iᶜ_i S_j`, composite rigid bodies |
 //! | [`aba`] | forward dynamics `v̇ = FD(q, v, τ)` in `O(n)` | articulated-body inertias |
@@ -43,7 +43,7 @@
 //! | [`kinetic_energy`], [`potential_energy`], [`spatial_momentum`], [`center_of_mass`] | conserved quantities | `½ vᵀ H v`, `-Σ m g·c`, `Σ Iᵢ vᵢ` |
 //!
 //! Twists and spatial vectors are ordered **linear first** (`(v, ω)`, `(f, n)`, as in
-//! Murray-Li-Sastry and Pinocchio; the seed and Featherstone write them angular first, see
+//! Murray-Li-Sastry and Pinocchio; Featherstone writes them angular first, see
 //! [`spatial`]), and Jacobian rows likewise, so results compare entry by entry with Pinocchio.
 //! The dynamics are explained with their equations in [`dynamics`]; [`spatial`] types motions
 //! ([`Motion`]) and forces ([`Force`]) apart so that they cannot be added by mistake.

@@ -1,4 +1,4 @@
-//! The Paden-Kahan subproblems (seed 4.5; Murray, Li & Sastry, *A Mathematical Introduction to
+//! The Paden-Kahan subproblems (Murray, Li & Sastry, *A Mathematical Introduction to
 //! Robotic Manipulation*, ch. 2.3 and 3.3): the three geometric problems that analytic inverse
 //! kinematics reduces to.
 //!

@@ -1,4 +1,4 @@
-//! Forward kinematics by the product of exponentials (seed 4.4; Murray, Li & Sastry ch. 3.2).
+//! Forward kinematics by the product of exponentials (Murray, Li & Sastry ch. 3.2).
 //!
 //! For the chain of joints `1..n` that carries a frame, take every joint at the neutral
 //! configuration: its world placement `M_i⁰`, its *space screw* `S_i = Ad(M_i⁰) S_i^local`

@@ -1,21 +1,21 @@
 //! Spatial (Plücker) vector algebra: motion and force 6-vectors, their transforms between
-//! frames, the two cross products, rigid-body and articulated-body inertias. Seed section 4.6.1;
+//! frames, the two cross products, rigid-body and articulated-body inertias:
 //! Featherstone, *Rigid Body Dynamics Algorithms* (2008), chapter 2.
 //!
 //! # Two dual spaces
 //!
 //! A rigid body's velocity is one element of the 6-dimensional space `M⁶` of **motions**. Read at
 //! a point `O` it is the pair (velocity of the body point passing through `O`, angular velocity):
-//! `v_P = v_O + ω × OP` (seed 4.6.1). Forces live in the dual space `F⁶`: a wrench read at `O` is
+//! `v_P = v_O + ω × OP`. Forces live in the dual space `F⁶`: a wrench read at `O` is
 //! (resultant force, moment about `O`), and its moment about another point is
-//! `n_P = n_O + f × OP` (seed 4.6.1). The pairing `v · f = v_O·f + ω·n_O` is the power, the same at every
+//! `n_P = n_O + f × OP`. The pairing `v · f = v_O·f + ω·n_O` is the power, the same at every
 //! point. Keeping the spaces apart as two types, [`Motion`] and [`Force`], makes the algebra
 //! type-checked: a motion can be added to a motion, a force to a force, and a motion paired with
 //! a force, but `Motion + Force` does not compile.
 //!
 //! # Coordinates: linear first
 //!
-//! The seed and Featherstone write Plücker coordinates **angular first**,
+//! Featherstone writes Plücker coordinates **angular first**,
 //! `v̂ = (ω, v_O)` and `f̂ = (n_O, f)`. This crate stores them **linear first**, `(v_O, ω)` and
 //! `(f, n_O)`, like [`Twist`], the kinematics Jacobians and Pinocchio, so that every vector,
 //! matrix and `q̇`-ordering compares entry for entry with Pinocchio. Featherstone's 6x6

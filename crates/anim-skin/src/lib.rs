@@ -1,7 +1,7 @@
 //! # anim-skin
 //!
-//! Skeletal animation and skinning (seed section 1.1): a joint hierarchy posed by keyframed
-//! clips, and meshes deformed by linear blend skinning (LBS) or dual-quaternion skinning (DQS),
+//! Skeletal animation and skinning: a joint hierarchy posed by keyframed clips, and meshes
+//! deformed by linear blend skinning (LBS) or dual-quaternion skinning (DQS, Kavan et al. 2008),
 //! loaded from glTF 2.0.
 //!
 //! ## What it models

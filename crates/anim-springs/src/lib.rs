@@ -1,6 +1,6 @@
 //! # anim-springs
 //!
-//! Mass-spring systems (seed section 2): cloth, ropes and jelly made of point masses joined by
+//! Mass-spring systems: cloth, ropes and jelly made of point masses joined by
 //! Hooke springs, stepped by every integrator of anim-core, in parallel and bitwise
 //! deterministic for any thread count.
 //!
@@ -8,14 +8,14 @@
 //!
 //! - **Particles** with a mass, pinned or free ([`Particle`]); positions and velocities live in
 //!   anim-core's [`State`](anim_core::integrate::State) as `x = [x0, y0, z0, x1, ...]`.
-//! - **Springs** `(i, j, l, k, c)` ([`Spring`]): Hooke's law of the seed plus damping along the
+//! - **Springs** `(i, j, l, k, c)` ([`Spring`]): Hooke's law plus damping along the
 //!   spring,
 //!
 //!   ```text
 //!   f_ij = -k (|x_i - x_j| - l) (x_i - x_j)/|x_i - x_j|  -  c ((v_i - v_j) . n) n,    f_i = sum_j f_ij
 //!   ```
 //!
-//!   (seed 2: "胡克定律", `f_i = sum_{j != i} f_ij`, `dv_i/dt = f_i / m_i`, `dx_i/dt = v_i`).
+//!   (Hooke's law, `f_i = sum_{j != i} f_ij`, `dv_i/dt = f_i / m_i`, `dx_i/dt = v_i`).
 //! - **Gravity** and **colliders** (a ground plane, spheres) as penalty forces with friction
 //!   ([`contact`]).
 //! - **Builders** ([`NetworkBuilder`]): a chain, a cloth grid with structural, shear and bending
@@ -44,7 +44,7 @@
 //!
 //! ## Which integrator, which solver
 //!
-//! Seed 2.1: explicit methods are simple but "explode" when `dt` exceeds `c sqrt(m / k)` with
+//! Explicit methods are simple but "explode" when `dt` exceeds `c sqrt(m / k)` with
 //! `c ~ 1`; implicit methods cost more per step and allow much larger steps. Measured by
 //! `cargo xtask stability` on a hanging chain of 8 masses with damping ratio 0.05 as `k` sweeps
 //! `1e2 .. 1e8` (the fitted `c` in `dt <= c sqrt(m/k)` with the per-particle `m` and per-spring
@@ -63,10 +63,10 @@
 //!
 //! Implicit steps solve `(M - h^2 beta K - h beta D) dv = r` with Newton: Jacobi-preconditioned
 //! CG (matrix-free, the default) is the fastest on cloth; sparse Cholesky is exact and robust on
-//! small or stiff systems (contact); Jacobi and Gauss-Seidel sweeps (seed 2.1) work on the
+//! small or stiff systems (contact); Jacobi and Gauss-Seidel sweeps work on the
 //! assembled matrix but need many sweeps when `h^2 k / m` is large. `cargo xtask report` has the
 //! work-precision curves of all of them on the cloth. For animation take one Newton iteration,
-//! the seed's linearised step ([`scenes::animation_newton`]): anim-core's Newton has no line
+//! the linearised backward Euler of Baraff & Witkin 1998 ([`scenes::animation_newton`]): anim-core's Newton has no line
 //! search, and full Newton on folding stiff cloth can stall.
 //!
 //! Orders measured on the two-particle spring (`cargo xtask conformance`): 1.02 explicit Euler,

@@ -13,7 +13,7 @@
 //! network never holds positions; it reads them from the state it is handed. Pinned particles
 //! have inverse mass 0: the integrators keep their velocity (zero for a fixed pin).
 //!
-//! # Forces (seed section 2)
+//! # Forces
 //!
 //! For a spring `s = (i, j)` with rest length `l`, stiffness `k` and damping `c`, let
 //! `d = x_i - x_j`, `L = |d|`, `n = d / L`. The force on `i` is
@@ -22,7 +22,7 @@
 //! f_ij = -k (L - l) n  -  c ((v_i - v_j) . n) n,        f_ji = -f_ij,
 //! ```
 //!
-//! Hooke's law of the seed plus damping along the spring (it damps stretching, not rotation).
+//! Hooke's law plus damping along the spring (it damps stretching, not rotation).
 //! Each particle also feels gravity `m g` and the penalty forces of the [colliders](crate::contact).
 //!
 //! **Coincident endpoints.** When `L` is below [`MIN_LENGTH`] (about `1.5e-154`, far below any

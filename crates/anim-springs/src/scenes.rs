@@ -8,8 +8,8 @@
 //! | [`jelly_drop`] | a tilted jelly cube falls on the ground and bounces | linearised backward Euler, `dt = 1/200` s | sparse Cholesky (faer) | contact stiffness plus a small system: a direct solve is exact and fast |
 //! | [`benchmark_cloth`] | the `n x n` cloth of the benches and the Taichi comparison | symplectic Euler, `dt = 2e-5` s | none | the method Taichi's mass-spring examples use |
 //!
-//! Implicit scenes take one Newton iteration per step, the seed's linearised scheme (see
-//! [`animation_newton`]). All scenes are z-up with gravity [`EARTH_GRAVITY`]. The resolution argument scales the particle
+//! Implicit scenes take one Newton iteration per step, the linearised backward Euler of Baraff and
+//! Witkin (1998) (see [`animation_newton`]). All scenes are z-up with gravity [`EARTH_GRAVITY`]. The resolution argument scales the particle
 //! count; `None` takes the scene's default.
 //!
 //! ```
@@ -87,7 +87,7 @@ pub fn by_name(name: &str, resolution: Option<usize>) -> Option<Result<SpringSce
     })
 }
 
-/// Newton settings for animation: the seed's linearised implicit step (one Newton iteration,
+/// Newton settings for animation: the linearised implicit step (one Newton iteration,
 /// `[M - h^2 K(x0) - h D(x0)] dv = h f(x0) + h^2 K v0`, Baraff and Witkin's scheme), with the
 /// linear solve to a relative residual of `1e-6`.
 ///
@@ -95,7 +95,7 @@ pub fn by_name(name: &str, resolution: Option<usize>) -> Option<Result<SpringSce
 /// Newton on a cloth that folds, with compressed springs whose definite Jacobian drops their
 /// transverse stiffness, can stall (the hanging cloth at `dt = 0.01` s does after about half a
 /// second), and each step costs several linear solves. One iteration of the linearised step is
-/// what the seed writes down, is stable at large steps, and costs one solve.
+/// Baraff and Witkin's scheme as published, is stable at large steps, and costs one solve.
 #[must_use]
 pub fn animation_newton() -> NewtonParams {
     let mut p = NewtonParams::linearized();

@@ -1,7 +1,7 @@
 //! A network with its integrator, as anim-core's [`Solver`]: steps, reports, and stops a run that
 //! blows up before it produces NaN.
 //!
-//! An explicit method stepped beyond `dt ~ c sqrt(m / k)` (seed 2.1) grows an oscillation
+//! An explicit method stepped beyond `dt ~ c sqrt(m / k)` grows an oscillation
 //! geometrically: springs stretch to many times their rest length long before any value becomes
 //! infinite. After every step [`SpringSimulation`] measures the largest stretch ratio
 //! `|x_i - x_j| / l` ([`SpringNetwork::max_stretch`]); above the bound (default

@@ -1,9 +1,8 @@
 /*
- * Jos Stam's stable fluids, transcribed from the seed (section 6.2) routine for routine, with the
- * seed's two typographical slips fixed as in Stam's published code: `advect ( N, 1, u, u0, u0,
- * v0, dt )` (the seed drops the `u0` argument) and the closing brace inside `project`.
+ * Jos Stam's stable fluids, transcribed routine for routine from the code of his *Real-Time Fluid
+ * Dynamics for Games* (GDC 2003).
  *
- * Driver: a fixed source pattern (the same as `anim_fluid::seed::SeedSources::pattern`), stepped
+ * Driver: a fixed source pattern (the same as `anim_fluid::stam::source_pattern`), stepped
  * with sim_main's order (vel_step, then dens_step).
  *
  *   stable_fluids dump N STEPS OUT   writes dens, u, v ((N+2)^2 f32 each, little endian) to OUT

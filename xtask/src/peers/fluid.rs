@@ -1,21 +1,21 @@
 //! `cargo xtask bench --peers`, anim-fluid part:
 //!
-//! 1. the seed mode against the seed's C routines (`peers/fluid/stable_fluids.c`, compiled with
+//! 1. Stam's solver against Stam's C routines (`peers/fluid/stable_fluids.c`, compiled with
 //!    `cc -O3 -march=native`), per-step time at N = 128, 256, 512, same source pattern and
 //!    iterations (20 Gauss-Seidel sweeps), both on one thread;
 //! 2. MGPCG against red-black Gauss-Seidel at equal divergence residual on the 2D box with a
-//!    sphere at N = 512, the pressure solve timed alone: the residual 20 sweeps leave (the
-//!    seed's budget), and a tolerance of 1e-4 (Gauss-Seidel capped at about 60 s);
+//!    sphere at N = 512, the pressure solve timed alone: the residual 20 sweeps leave (Stam's
+//!    budget), and a tolerance of 1e-4 (Gauss-Seidel capped at about 60 s);
 //! 3. Taichi's stable-fluids example (`peers/fluid/taichi_stable_fluid.py`: 512 x 512, RK3
 //!    semi-Lagrangian, 500 Jacobi pressure iterations) on the CPU, one thread and all threads,
-//!    beside our seed mode and our MAC solver at 512 x 512. Taichi is installed with pip when
+//!    beside our Stam mode and our MAC solver at 512 x 512. Taichi is installed with pip when
 //!    missing; on failure it is skipped with a visible note.
 
 use crate::python::json_field;
 use anim_fluid::cases::compile_c;
 use anim_fluid::mac::{MacFluid, MacParams};
 use anim_fluid::pressure::{PressureMethod, PressureSolver};
-use anim_fluid::seed::{SeedFluid, SeedParams};
+use anim_fluid::stam::{StamFluid, StamParams};
 use std::process::Command;
 use std::time::Instant;
 
@@ -24,14 +24,14 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// Per-step seconds of our seed mode (single thread), median of `repeats` runs of `steps`.
-fn seed_per_step(n: usize, steps: usize, repeats: usize) -> f64 {
+/// Per-step seconds of our Stam mode (single thread), median of `repeats` runs of `steps`.
+fn stam_per_step(n: usize, steps: usize, repeats: usize) -> f64 {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build();
     let run = || {
         median(
             (0..repeats)
                 .map(|_| {
-                    let Ok(mut f) = SeedFluid::new(n, SeedParams::default()) else { return f64::NAN };
+                    let Ok(mut f) = StamFluid::new(n, StamParams::default()) else { return f64::NAN };
                     for _ in 0..5 {
                         f.apply_source_pattern();
                         let _ = f.step();
@@ -106,24 +106,24 @@ fn taichi(threads: usize) -> Result<f64, String> {
 pub fn run() -> bool {
     let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     println!("\npeer benchmark (anim-fluid)");
-    // 1. seed mode vs C -O3.
+    // 1. Stam mode vs C -O3.
     println!(
-        "\n1. seed mode (f32, 20 Gauss-Seidel sweeps) vs the seed's C code (cc -O3 -march=native), one thread, median of 3 runs"
+        "\n1. Stam mode (f32, 20 Gauss-Seidel sweeps) vs Stam's C code (cc -O3 -march=native), one thread, median of 3 runs"
     );
-    println!("| N | C -O3 per step | anim-fluid seed per step | C / ours |\n| --- | --- | --- | --- |");
+    println!("| N | C -O3 per step | anim-fluid Stam per step | C / ours |\n| --- | --- | --- | --- |");
     match compile_c("stable_fluids_o3", &["-O3", "-march=native"]) {
         Ok(exe) => {
             for n in [128, 256, 512] {
                 let steps = (6400 / n).max(4);
                 let c = c_per_step(&exe, n, steps, 3);
-                let ours = seed_per_step(n, steps, 3);
+                let ours = stam_per_step(n, steps, 3);
                 match c {
                     Some(c) => {
                         println!("| {n} | {:.2} ms | {:.2} ms | {:.2}x |", c * 1e3, ours * 1e3, c / ours);
                         super::ratios::record(
                             "anim-fluid",
-                            &format!("seed stable fluids N = {n}, 20 Gauss-Seidel sweeps"),
-                            "the seed's C (cc -O3 -march=native)",
+                            &format!("Stam's stable fluids N = {n}, 20 Gauss-Seidel sweeps"),
+                            "Stam's C (cc -O3 -march=native)",
                             1,
                             ours,
                             c,
@@ -174,7 +174,7 @@ pub fn run() -> bool {
     match crate::python::ensure("taichi", &["taichi==1.7.4"], "") {
         Err(e) => println!("\nNOTE: Taichi peer SKIPPED: {e}\n"),
         Ok(()) => {
-            let seed = seed_per_step(512, 5, 1);
+            let stam = stam_per_step(512, 5, 1);
             let mac = box_with_sphere(512, PressureMethod::Mgpcg, 1e-5, 1000).map(|(mut f, mut s)| {
                 f.set_advection(anim_fluid::advection::Advection::Linear);
                 let _ = f.advance(&mut s, 1e-3);
@@ -192,10 +192,10 @@ pub fn run() -> bool {
                         if t == 1 {
                             super::ratios::record(
                                 "anim-fluid",
-                                "stable fluids 512 x 512: our seed mode (20 GS sweeps) vs Taichi (500 Jacobi)",
+                                "stable fluids 512 x 512: our Stam mode (20 GS sweeps) vs Taichi (500 Jacobi)",
                                 "Taichi 1.7.4 stable_fluid",
                                 1,
-                                seed,
+                                stam,
                                 s,
                             );
                         }
@@ -203,7 +203,7 @@ pub fn run() -> bool {
                     Err(e) => println!("| taichi stable_fluid | {t} | failed: {e} |"),
                 }
             }
-            println!("| anim-fluid seed mode (20 GS sweeps) | 1 | {:.1} ms |", seed * 1e3);
+            println!("| anim-fluid Stam mode (20 GS sweeps) | 1 | {:.1} ms |", stam * 1e3);
             if let Some(m) = mac {
                 println!("| anim-fluid MAC, sl-linear, MGPCG 1e-5 (f64) | {threads} | {:.1} ms |", m * 1e3);
             }

@@ -164,11 +164,11 @@ mod tests {
         let path = dir.join("peers.csv");
         std::fs::remove_dir_all(&dir).ok();
         assert_eq!(update(&path, vec![row("anim-fem", "beam, 1 step", 1.0)]), Ok(1));
-        assert_eq!(update(&path, vec![row("anim-fluid", "seed", 3.0)]), Ok(2));
+        assert_eq!(update(&path, vec![row("anim-fluid", "stam", 3.0)]), Ok(2));
         let back = read(&path).unwrap();
-        assert_eq!(back, vec![row("anim-fem", "beam, 1 step", 1.0), row("anim-fluid", "seed", 3.0)]);
+        assert_eq!(back, vec![row("anim-fem", "beam, 1 step", 1.0), row("anim-fluid", "stam", 3.0)]);
         let md = markdown(&back);
-        assert!(md.contains("| 2026-01-02 | Test CPU, 3 GHz, 2 cores | anim-fluid | seed |"), "{md}");
+        assert!(md.contains("| 2026-01-02 | Test CPU, 3 GHz, 2 cores | anim-fluid | stam |"), "{md}");
         assert!(md.contains("| 1.500 |"), "{md}");
         std::fs::write(&path, "date,cpu\nx,y\n").unwrap();
         assert!(read(&path).unwrap_err().contains("peers.csv: row 1"));

@@ -265,7 +265,7 @@ fn the_cavity_takes_the_studys_resolution_and_pressure_solver() {
     changed.scene.params.insert("splitting".into(), "reflection".into());
     let e = choose(&mut changed, 0.03, &t).unwrap_err();
     assert!(e.contains("sets `splitting`, but the fluid_cavity_ghia study measured the preset's own"), "{e}");
-    // The seed solver's smoke box is not a mapped preset.
+    // Stam's solver's smoke box is not a mapped preset.
     let e = choose(&mut builtin("smoke-box-2d"), 1e-2, &t).unwrap_err();
     assert!(e.contains("no entry for fluid/smoke-box-2d scenes"), "{e}");
 }

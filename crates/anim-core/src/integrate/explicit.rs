@@ -1,4 +1,4 @@
-//! Explicit and symplectic Euler (seed 2.1).
+//! Explicit and symplectic Euler.
 
 use super::{
     IntegrateError, Integrator, SecondOrderSystem, State, StepInfo, check_inputs, commit, fit, for_chunks2,
@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 /// Explicit (forward) Euler: `v1 = v0 + h a(t0, x0, v0)`, `x1 = x0 + h v0`.
 ///
 /// First order; on an undamped oscillator the energy grows by a factor `1 + (omega h)^2` per
-/// step, so it is stable only with damping. Included as the seed's baseline.
+/// step, so it is stable only with damping. Included as the baseline.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct ExplicitEuler {
     steps: u64,
@@ -67,7 +67,7 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for ExplicitEuler {
 ///
 /// First order and symplectic: on a harmonic oscillator the energy error stays bounded (it
 /// oscillates with amplitude `O(omega h)`) for `omega h < 2`, the stability bound behind the
-/// seed's `dt <= c sqrt(m / k)`.
+/// usual explicit step bound `dt <= c sqrt(m / k)`.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct SymplecticEuler {
     steps: u64,

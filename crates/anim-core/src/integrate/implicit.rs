@@ -1,4 +1,4 @@
-//! Implicit integrators solved by Newton's method: the seed's beta-blend (backward Euler at
+//! Implicit integrators solved by Newton's method: the beta-blend (backward Euler at
 //! `beta = 1`) and the implicit midpoint rule.
 //!
 //! Both solve for the velocity change `dv = v1 - v0` from
@@ -12,13 +12,13 @@
 //!
 //! | method | alpha | gamma | eta | zeta | `t_e` |
 //! | --- | --- | --- | --- | --- | --- |
-//! | beta-blend (seed 2.1) | beta | beta | beta | 1 | `t0 + beta h` |
+//! | beta-blend | beta | beta | beta | 1 | `t0 + beta h` |
 //! | implicit midpoint | 1/2 | 1/4 | 1/2 | 1/2 | `t0 + h/2` |
 //!
 //! Each Newton iteration solves `(M - c_v D - c_x K) delta = -g` with `c_x = gamma h^2`,
 //! `c_v = eta h`, `K = df/dx`, `D = df/dv`. The first iteration linearises at `(x0, v0)`, which
-//! makes it exactly the seed's linearised scheme `[I - beta h^2 M^-1 K] v1 = v0 + h M^-1 f(x0)`
-//! (Baraff and Witkin's form once damping is included); later iterations linearise at the
+//! makes it exactly the linearised scheme `[I - beta h^2 M^-1 K] v1 = v0 + h M^-1 f(x0)`
+//! (Baraff and Witkin's linearised backward Euler, 1998, once damping is included); later iterations linearise at the
 //! current iterate. [`NewtonParams::linearized`] stops after that first iteration.
 //!
 //! Fixed degrees of freedom (zero inverse mass) keep `dv = 0`: their rows of the Newton matrix are
@@ -51,7 +51,8 @@ pub struct NewtonParams {
     /// Give up (with [`IntegrateError::NewtonNotConverged`]) after this many iterations.
     /// Default `20`.
     pub max_iterations: usize,
-    /// Take exactly one iteration from `(x0, v0)`: the seed's linearised scheme. Default `false`.
+    /// Take exactly one iteration from `(x0, v0)`: the linearised scheme (Baraff & Witkin 1998).
+    /// Default `false`.
     pub linearized: bool,
     /// Backtracking line search on `||g||` from the second iteration on: the step is halved
     /// until the residual decreases by the Armijo factor `1 - 1e-4 alpha`. Keeps Newton
@@ -79,7 +80,7 @@ impl Default for NewtonParams {
 }
 
 impl NewtonParams {
-    /// The seed's linearised scheme: one Newton iteration.
+    /// The linearised scheme of Baraff & Witkin (1998): one Newton iteration.
     #[must_use]
     pub fn linearized() -> Self {
         Self { linearized: true, ..Self::default() }
@@ -337,7 +338,7 @@ impl NewtonCore {
                 self.dv[i] = self.w[i] * self.rhs[i];
             }
         } else if g0 > 0.0 {
-            // The first iteration is the seed's linearised step from (x0, v0).
+            // The first iteration is the linearised step from (x0, v0).
             info.linear_iterations += self
                 .solve_linear(system, solver, c_x, c_v)
                 .map_err(|source| IntegrateError::LinearSolve { step, newton_iteration: 0, source })?;
@@ -510,7 +511,7 @@ fn residual_at<S: MechanicalSystem + ?Sized>(
     norm(g)
 }
 
-/// The seed's beta-blend (seed 2.1): `[I - beta h^2 M^-1 K] v1 = v0 + h M^-1 f(x0)`,
+/// The beta-blend of symplectic and backward Euler: `[I - beta h^2 M^-1 K] v1 = v0 + h M^-1 f(x0)`,
 /// `x1 = x0 + h v1`, solved to convergence by Newton (or linearised, see [`NewtonParams`]).
 ///
 /// `beta = 1` is backward Euler: unconditionally stable, first order, numerically dissipative.

@@ -1,4 +1,4 @@
-//! Time integration of second-order systems `x'' = M^-1 f(t, x, v)` (seed section 2).
+//! Time integration of second-order systems `x'' = M^-1 f(t, x, v)`.
 //!
 //! Springs, FEM bodies and articulated rigid bodies are all second-order systems. This module is
 //! the one place their time integrators live; no crate writes its own copy.
@@ -13,27 +13,28 @@
 //!   [`LinearSolver`](crate::linalg::LinearSolver). A zero inverse mass marks a fixed (kinematic)
 //!   degree of freedom: it keeps its velocity.
 //!
-//! # The integrators (seed 2.1, 2.2)
+//! # The integrators
 //!
 //! | integrator | update | order | notes |
 //! | --- | --- | --- | --- |
 //! | [`ExplicitEuler`] | `v1 = v0 + h a(x0)`, `x1 = x0 + h v0` | 1 | energy grows on oscillators |
 //! | [`SymplecticEuler`] | `v1 = v0 + h a(x0)`, `x1 = x0 + h v1` | 1 | symplectic, bounded energy error |
-//! | [`BetaBlend`] | `(M - beta h^2 K) v1 = M v0 + h f(x0)` (seed), solved by Newton on `M(v1 - v0) = h f(x0 + beta h v1)`, `x1 = x0 + h v1` | 1 | `beta = 0` is symplectic Euler, `beta = 1` backward Euler |
+//! | [`BetaBlend`] | `(M - beta h^2 K) v1 = M v0 + h f(x0)` (linearised), solved by Newton on `M(v1 - v0) = h f(x0 + beta h v1)`, `x1 = x0 + h v1` | 1 | `beta = 0` is symplectic Euler, `beta = 1` backward Euler |
 //! | [`PositionVerlet`] | `x1 = 2 x0 - x_-1 + h^2 a(x0)` | 2 | Stormer's form; keeps the previous position |
 //! | [`Leapfrog`] | `v_{1/2} = v_{-1/2} + h a(x0)`, `x1 = x0 + h v_{1/2}` | 2 | keeps the staggered velocity |
 //! | [`VelocityVerlet`] | half kick, drift, half kick | 2 | one force evaluation per step |
 //! | [`ImplicitMidpoint`] | `v1 = v0 + h a((x0+x1)/2, (v0+v1)/2)`, `x1 = x0 + h (v0+v1)/2` | 2 | symplectic, implicit (Newton) |
 //! | [`Rk4`] | classical Runge-Kutta | 4 | not symplectic; the high-order reference |
 //!
-//! The seed names `beta = 1/2` "middle-point". In the seed's form, where the position always
-//! advances with `v1`, every `beta` gives a first-order method: `beta = 1/2` evaluates the force at
-//! the midpoint of the positions but not of the velocities. The second-order implicit midpoint rule
-//! is [`ImplicitMidpoint`].
+//! The beta-blend at `beta = 1/2` is sometimes called "middle-point". In this form, where the
+//! position always advances with `v1`, every `beta` gives a first-order method: `beta = 1/2`
+//! evaluates the force at the midpoint of the positions but not of the velocities. The
+//! second-order implicit midpoint rule is [`ImplicitMidpoint`].
 //!
-//! With one Newton iteration ([`NewtonParams::linearized`]) [`BetaBlend`] is exactly the seed's
-//! linearised scheme `[I - beta h^2 M^-1 K(x0)] v1 = v0 + h M^-1 f(x0)`: Newton starts from the
-//! point where the force is evaluated at `x0`.
+//! With one Newton iteration ([`NewtonParams::linearized`]) [`BetaBlend`] is exactly the
+//! linearised scheme `[I - beta h^2 M^-1 K(x0)] v1 = v0 + h M^-1 f(x0)`, at `beta = 1` the
+//! linearised backward Euler of Baraff & Witkin (1998): Newton starts from the point where the
+//! force is evaluated at `x0`.
 //!
 //! # Invariants
 //! - No integrator allocates in `step` after the first step of a given size.
@@ -270,7 +271,7 @@ pub enum IntegratorKind {
 }
 
 impl IntegratorKind {
-    /// Every kind the seed names (beta-blend at 0, 1/2 and 1), plus midpoint and RK4.
+    /// Every kind: explicit Euler, the beta-blend at 0, 1/2 and 1, the Verlet family, midpoint and RK4.
     pub const ALL: [IntegratorKind; 10] = [
         IntegratorKind::ExplicitEuler,
         IntegratorKind::SymplecticEuler,

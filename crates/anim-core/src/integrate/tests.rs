@@ -90,8 +90,8 @@ fn implicit_midpoint_conserves_linear_oscillator_energy_at_large_steps() {
 }
 
 #[test]
-fn linearized_beta_blend_is_the_seed_formula() {
-    // On a linear system one Newton iteration from (x0, v0) is the seed's scheme
+fn linearized_beta_blend_is_the_closed_form_formula() {
+    // On a linear system one Newton iteration from (x0, v0) is the linearised scheme
     // (1 + beta h^2 k / m) v1 = v0 + h f(x0) / m, x1 = x0 + h v1, in closed form.
     let (m, k, h) = (0.5, 8.0, 0.1);
     for beta in [0.0, 0.25, 0.5, 1.0] {

@@ -1,4 +1,4 @@
-//! The Verlet family (seed 2.2): position (Stormer) Verlet, leapfrog and velocity Verlet.
+//! The Verlet family (Verlet 1967): position (Stormer) Verlet, leapfrog and velocity Verlet.
 //!
 //! All three are second order and symplectic, and on a force that depends only on position
 //! they produce the same trajectory up to rounding: they differ in what they store between
@@ -103,7 +103,7 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for PositionVerlet {
     }
 }
 
-/// Leapfrog: `v_{n+1/2} = v_{n-1/2} + h a(x_n)`, `x_{n+1} = x_n + h v_{n+1/2}` (seed 2.2).
+/// Leapfrog: `v_{n+1/2} = v_{n-1/2} + h a(x_n)`, `x_{n+1} = x_n + h v_{n+1/2}`.
 ///
 /// Keeps the staggered velocity between steps; the first step (or the first after an outside
 /// change of the state) starts it with a half kick `v_{1/2} = v_0 + h/2 a(x_0)`. The reported
@@ -204,7 +204,7 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for Leapfrog {
     }
 }
 
-/// Velocity Verlet (seed 2.2): `v_{1/2} = v0 + h/2 a(x0)`, `x1 = x0 + h v_{1/2}`,
+/// Velocity Verlet: `v_{1/2} = v0 + h/2 a(x0)`, `x1 = x0 + h v_{1/2}`,
 /// `v1 = v_{1/2} + h/2 a(x1)`.
 ///
 /// Keeps `a(x1)` for the next step's first half kick, so a step costs one evaluation (two on

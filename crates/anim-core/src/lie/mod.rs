@@ -1,6 +1,6 @@
 //! Lie groups of rigid motion: rotations SO(3) and rigid motions SE(3), with their algebras,
-//! exponential and logarithm maps, Jacobians, adjoints and screws. Seed sections 1.2 and 4.1;
-//! the conventions follow Murray, Li & Sastry, *A Mathematical Introduction to Robotic
+//! exponential and logarithm maps, Jacobians, adjoints and screws
+//! (Murray, Li & Sastry 1994; Lynch & Park, *Modern Robotics*, 2017); the conventions follow Murray, Li & Sastry, *A Mathematical Introduction to Robotic
 //! Manipulation* (1994), chapter 2.
 //!
 //! # Rotations: [`so3`]
@@ -15,8 +15,7 @@
 //! ```
 //!
 //! [`so3::exp`] takes the rotation vector `w = ωθ` directly. The inverse, [`so3::log`], reads
-//! `cos θ = (tr R - 1)/2` and `sin θ ω = vee(R) = (r₃₂ - r₂₃, r₁₃ - r₃₁, r₂₁ - r₁₂)/2`; the seed
-//! writes the axis without the factor `1/2`, which is a typo. Dividing by `sin θ` fails at `θ = 0`
+//! `cos θ = (tr R - 1)/2` and `sin θ ω = vee(R) = (r₃₂ - r₂₃, r₁₃ - r₃₁, r₂₁ - r₁₂)/2`. Dividing by `sin θ` fails at `θ = 0`
 //! and `θ = π`, so the implementation takes `θ = atan2(sin θ, cos θ)`, uses a Taylor series near
 //! `0` and reads the axis from the symmetric part `(R + Rᵀ)/2 - cos θ I = (1 - cos θ) ω ωᵀ` near
 //! `π`; `exp(log R) = R` holds to about `1e-15` at every angle.

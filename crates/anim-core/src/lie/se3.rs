@@ -1,12 +1,12 @@
 //! The rigid-motion group SE(3), its Lie algebra se(3) of twists, and screws.
 //!
 //! A rigid motion `g = (R, t)` maps a point `q_b` of frame `b` to `q_a = R q_b + t` in frame `a`;
-//! in homogeneous form `g = [[R, t], [0, 1]]` (seed section 4.1). A twist `ξ = (v, ω)` — linear
-//! part **first**, angular part second, as in the seed and in Murray, Li & Sastry — is the
+//! in homogeneous form `g = [[R, t], [0, 1]]`. A twist `ξ = (v, ω)` — linear
+//! part **first**, angular part second, as in Murray, Li & Sastry (1994) — is the
 //! element `ξ̂ = [[ω̂, v], [0, 0]]` of se(3).
 //!
 //! - [`Se3::exp`]: `exp(ξ̂) = [[exp(ω̂), J_l(ω) v], [0, 1]]`, where `J_l` is
-//!   [`so3::left_jacobian`]. For a unit `ω` and angle `θ` this is the seed's
+//!   [`so3::left_jacobian`]. For a unit `ω` and angle `θ` this is Murray, Li & Sastry's
 //!   `[[e^{ω̂θ}, (I - e^{ω̂θ})(ω × v) + ω ωᵀ v θ], [0, 1]]` ([`Se3::exp_screw`]).
 //! - [`Se3::log`]: `ω = so3::log(R)`, `v = J_l(ω)⁻¹ t`; the exact inverse of `exp` for rotation
 //!   angles below `π`.
@@ -295,7 +295,7 @@ impl Se3 {
     /// The exponential map `se(3) → SE(3)`: `exp(ξ̂) = [[exp(ω̂), J_l(ω) v], [0, 1]]`.
     ///
     /// Valid for any `‖ω‖` (including `0`, a pure translation by `v`). With `ω` a unit vector
-    /// and `ξ` scaled by `θ`, this is the seed's
+    /// and `ξ` scaled by `θ`, this is Murray, Li & Sastry's
     /// `[[e^{ω̂θ}, (I - e^{ω̂θ})(ω × v) + ω ωᵀ v θ], [0, 1]]`.
     #[inline]
     #[must_use]
@@ -596,13 +596,13 @@ mod tests {
     }
 
     #[test]
-    fn exp_matches_seed_formula_for_unit_axes() {
+    fn exp_matches_closed_form_for_unit_axes() {
         let mut rng = ChaCha8Rng::seed_from_u64(23);
         for _ in 0..2000 {
             let w = random_unit(&mut rng);
             let v = random_vec(&mut rng, 2.0);
             let theta = rng.random_range(-2.0 * PI..2.0 * PI);
-            // Seed 4.1: [[e^{ω̂θ}, (I - e^{ω̂θ})(ω × v) + ω ωᵀ v θ], [0, 1]].
+            // Murray, Li & Sastry: [[e^{ω̂θ}, (I - e^{ω̂θ})(ω × v) + ω ωᵀ v θ], [0, 1]].
             let wh = so3::hat(w);
             let r = DMat3::IDENTITY + wh * theta.sin() + wh * wh * (1.0 - theta.cos());
             let t = (DMat3::IDENTITY - r) * w.cross(v) + w * w.dot(v) * theta;
@@ -796,7 +796,7 @@ mod tests {
 
     #[test]
     fn screw_motion_moves_its_axis_along_itself() {
-        // The seed's revolute/helical twist: a point q on the axis, pitch h. Moving along the screw
+        // A revolute/helical twist: a point q on the axis, pitch h. Moving along the screw
         // by θ translates every point of the axis by h θ along it and rotates the rest about it.
         let axis = DVec3::new(1.0, 2.0, 2.0) / 3.0;
         let point = DVec3::new(2.0, -1.0, 0.0); // point · axis = 0
@@ -809,7 +809,7 @@ mod tests {
             assert!((moved - (on_axis + 0.25 * theta * axis)).length() <= 1e-14);
         }
         assert!((so3::log(g.rotation) - axis * theta).length() <= 1e-14);
-        // Zero pitch: the seed's v = -ω × q, a pure rotation about the line.
+        // Zero pitch: v = -ω × q, a pure rotation about the line.
         let revolute = Twist::new(-axis.cross(point), axis);
         assert!(twist_err(revolute, Screw { pitch: 0.0, ..screw }.to_twist()) <= 1e-15);
     }

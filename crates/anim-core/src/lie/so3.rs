@@ -2,7 +2,7 @@
 //!
 //! A rotation is a [`DMat3`] `R` with `RᵀR = I` and `det R = +1`; an element of so(3) is a
 //! skew-symmetric matrix `ŵ`, written here by its *rotation vector* `w ∈ R³` (axis times angle,
-//! also called exponential coordinates). Seed section 4.1.
+//! also called exponential coordinates); Murray, Li & Sastry (1994), chapter 2.
 //!
 //! | function | maps | formula |
 //! | --- | --- | --- |
@@ -86,7 +86,7 @@ pub fn exp(w: DVec3) -> DMat3 {
     identity_hat_outer(theta.cos(), a, b, w)
 }
 
-/// The rotation by `theta` radians about the **unit** vector `axis`, as in the seed:
+/// The rotation by `theta` radians about the **unit** vector `axis` (Rodrigues' formula):
 /// `R = I + sin θ ω̂ + (1 - cos θ) ω̂²`.
 ///
 /// Equal to [`exp`]`(axis * theta)` for a unit axis and any `theta` (negative or beyond `π` is
@@ -346,17 +346,17 @@ mod tests {
     }
 
     #[test]
-    fn exp_matches_seed_closed_form_for_unit_axes() {
+    fn exp_matches_rodrigues_formula_for_unit_axes() {
         let mut rng = ChaCha8Rng::seed_from_u64(4);
         for _ in 0..2000 {
             let axis = random_unit(&mut rng);
             let theta = rng.random_range(-2.0 * PI..2.0 * PI);
-            // Seed 4.1: R = I + sin θ ω̂ + (1 - cos θ) ω̂².
+            // Rodrigues: R = I + sin θ ω̂ + (1 - cos θ) ω̂².
             let h = hat(axis);
-            let seed = DMat3::IDENTITY + h * theta.sin() + h * h * (1.0 - theta.cos());
-            let err = frobenius(exp(axis * theta) - seed);
+            let rodrigues = DMat3::IDENTITY + h * theta.sin() + h * h * (1.0 - theta.cos());
+            let err = frobenius(exp(axis * theta) - rodrigues);
             assert!(err <= 2e-15, "exp: {err:e}");
-            let err = frobenius(exp_axis_angle(axis, theta) - seed);
+            let err = frobenius(exp_axis_angle(axis, theta) - rodrigues);
             assert!(err <= 2e-15, "exp_axis_angle: {err:e}");
             let err = frobenius(exp_axis_angle(axis, theta) - DMat3::from_axis_angle(axis, theta));
             assert!(err <= 2e-15, "exp_axis_angle vs glam: {err:e}");

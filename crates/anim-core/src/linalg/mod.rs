@@ -7,9 +7,9 @@
 //!   Jacobi and Gauss-Seidel sweeps ([`stationary`]), behind the [`LinearSolver`] trait so that an
 //!   implicit integrator takes any of them; sparse direct solves by faer's Cholesky and `L D L^T`,
 //!   one symbolic-factorisation cache for both ([`direct`]).
-//! - [`schur`]: the block elimination of seed section 7.1.
+//! - [`schur`]: block elimination by Schur complements.
 //! - [`svd`]: 3x3 singular value and polar decompositions returning proper rotations, the
-//!   building block of corotated, fixed-corotated and snow materials (seed 5.1).
+//!   building block of corotated, fixed-corotated and snow materials.
 //!
 //! Conventions: vectors are `&[f64]` slices; `x` passed to a solver is the initial guess and
 //! receives the solution; shape mismatches are programming errors and panic with a clear message,

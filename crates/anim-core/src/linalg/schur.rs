@@ -1,4 +1,4 @@
-//! Block elimination by Schur complements (seed section 7.1).
+//! Block elimination by Schur complements.
 //!
 //! # Method
 //!
@@ -17,7 +17,7 @@
 //!
 //! These are the identities `M L = [[A - B D^-1 C, B D^-1], [0, I]]` with
 //! `L = [[I, 0], [-D^-1 C, D^-1]]`, and `T M = [[I, A^-1 B], [0, D - C A^-1 B]]` with
-//! `T = [[A^-1, 0], [-C A^-1, I]]` (seed 7.1; Zhang (ed.), *The Schur Complement and Its
+//! `T = [[A^-1, 0], [-C A^-1, I]]` (Zhang (ed.), *The Schur Complement and Its
 //! Applications*, Springer 2005, chapter 1). `M` is invertible iff the eliminated block and its
 //! Schur complement both are.
 //!

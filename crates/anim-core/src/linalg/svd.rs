@@ -9,7 +9,7 @@
 //!   reflection is moved onto the smallest singular value.
 //!
 //! This "rotation variant" of the SVD is what the corotated, fixed-corotated and snow
-//! constitutive models need (seed 5.1; Irving, Teran & Fedkiw, *Invertible finite elements for
+//! constitutive models need (Irving, Teran & Fedkiw, *Invertible finite elements for
 //! robust simulation of large deformation*, SCA 2004, section 5; Stomakhin et al., *A material
 //! point method for snow simulation*, SIGGRAPH 2013): an inverted element keeps a rotation `U V^T`
 //! and shows its inversion as a negative `sigma_2`.

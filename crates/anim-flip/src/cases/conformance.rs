@@ -222,7 +222,7 @@ pub(super) fn angular_momentum(_ctx: &Ctx) -> Vec<Check> {
         }
         Ok((p.angular_momentum([0.5, 0.5])[2] - l0) / l0)
     };
-    let source = "APIC (Jiang et al. 2015; seed 5.3.1): exact for affine fields";
+    let source = "APIC (Jiang et al. 2015): exact for affine fields";
     let apic = run(Transfer::Apic).unwrap_or(f64::NAN);
     let pic = run(Transfer::Pic).unwrap_or(f64::NAN);
     vec![

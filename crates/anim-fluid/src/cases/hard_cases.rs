@@ -4,7 +4,7 @@
 use crate::advection::Advection;
 use crate::mac::{MacFluid, MacParams, MacState};
 use crate::scenes::{self, FluidSim};
-use crate::seed::{SeedFluid, SeedParams};
+use crate::stam::{StamFluid, StamParams};
 use anim_core::cases::{Budget, Ctx, Outcome, Soak, drive, finish, fmt_num, rejected};
 use std::f64::consts::PI;
 
@@ -71,15 +71,15 @@ pub(super) fn huge_force(_ctx: &Ctx) -> Outcome {
 }
 
 pub(super) fn empty_grid(_ctx: &Ctx) -> Outcome {
-    match (MacFluid::new([0, 0, 1], 2, 0.1, MacParams::default()), SeedFluid::new(0, SeedParams::default())) {
-        (Err(a), Err(b)) => Outcome::Rejected(format!("MAC: {a}; seed: {b}")),
+    match (MacFluid::new([0, 0, 1], 2, 0.1, MacParams::default()), StamFluid::new(0, StamParams::default())) {
+        (Err(a), Err(b)) => Outcome::Rejected(format!("MAC: {a}; Stam: {b}")),
         _ => Outcome::Stable("accepted an empty grid".into()),
     }
 }
 
 pub(super) fn one_cell(_ctx: &Ctx) -> Outcome {
-    match (MacFluid::new([1, 1, 1], 3, 0.1, MacParams::default()), SeedFluid::new(1, SeedParams::default())) {
-        (Err(a), Err(b)) => Outcome::Rejected(format!("MAC: {a}; seed: {b}")),
+    match (MacFluid::new([1, 1, 1], 3, 0.1, MacParams::default()), StamFluid::new(1, StamParams::default())) {
+        (Err(a), Err(b)) => Outcome::Rejected(format!("MAC: {a}; Stam: {b}")),
         _ => Outcome::Stable("accepted a 1-cell grid".into()),
     }
 }
@@ -104,21 +104,21 @@ pub(super) fn non_positive(_ctx: &Ctx) -> Outcome {
         Err(e) => msgs.push(format!("{e}")),
         Ok(_) => return Outcome::Stable("accepted a zero tolerance".into()),
     }
-    match SeedFluid::new(8, SeedParams { dt: -0.1, ..SeedParams::default() }) {
-        Err(e) => msgs.push(format!("seed: {e}")),
-        Ok(_) => return Outcome::Stable("seed accepted dt < 0".into()),
+    match StamFluid::new(8, StamParams { dt: -0.1, ..StamParams::default() }) {
+        Err(e) => msgs.push(format!("Stam: {e}")),
+        Ok(_) => return Outcome::Stable("Stam's solver accepted dt < 0".into()),
     }
     Outcome::Rejected(msgs.join("; "))
 }
 
 pub(super) fn nan_source(_ctx: &Ctx) -> Outcome {
     let mut msgs = Vec::new();
-    if let Ok(mut f) = SeedFluid::new(16, SeedParams::default()) {
+    if let Ok(mut f) = StamFluid::new(16, StamParams::default()) {
         f.apply_source_pattern();
         f.sources_mut().1[40] = f32::NAN;
         match f.step() {
-            Err(e) => msgs.push(format!("seed: {e}")),
-            Ok(()) => return Outcome::Stable("seed NaN passed silently".into()),
+            Err(e) => msgs.push(format!("Stam: {e}")),
+            Ok(()) => return Outcome::Stable("Stam's solver let NaN pass silently".into()),
         }
     }
     if let Ok((mut f, mut s)) = MacFluid::new([16, 16, 1], 2, 1.0 / 16.0, MacParams::default()) {

@@ -1,5 +1,5 @@
-//! anim-fluid's cases (feature `cases`): the seed mode against a compiled C transcription of the
-//! seed's routines (bit for bit at N = 64 and 128); divergence after projection for every
+//! anim-fluid's cases (feature `cases`): Stam's solver against a compiled C transcription of
+//! his routines (bit for bit at N = 64 and 128); divergence after projection for every
 //! pressure solver (2D with an obstacle, 3D); Taylor-Green decay against `exp(-2 nu k^2 t)` at
 //! N = 128 per advection scheme and splitting (advect-then-project, advection-reflection); the
 //! lid-driven cavity at Re = 100 against Ghia, Ghia and Shin (1982) per resolution and scheme;
@@ -13,10 +13,10 @@
 mod conformance;
 mod ghia;
 mod hard_cases;
-mod seed_c;
+mod stam_c;
 mod study;
 
-pub use seed_c::compile_c;
+pub use stam_c::compile_c;
 pub use study::ghia_study_problem;
 
 use anim_core::cases::{
@@ -28,7 +28,7 @@ const CRATE: &str = "anim-fluid";
 /// Registers the crate's conformance checks, hard cases, soak run and studies.
 pub fn register(r: &mut Registry) {
     for (name, run) in [
-        ("seed mode vs C transcription, bit for bit", seed_c::seed_bitwise as fn(&Ctx) -> Vec<Check>),
+        ("Stam's solver vs its C transcription, bit for bit", stam_c::stam_bitwise as fn(&Ctx) -> Vec<Check>),
         ("divergence after projection per pressure solver", conformance::divergence),
         ("Taylor-Green vortex decay (N = 128; 64 in --quick)", conformance::taylor_green),
         ("lid-driven cavity Re = 100 vs Ghia et al. 1982", ghia::ghia),
@@ -71,7 +71,7 @@ pub fn register(r: &mut Registry) {
     });
     r.stability.push(StabilityCase {
         crate_name: CRATE,
-        name: "NaN source (seed and MAC)",
+        name: "NaN source (Stam and MAC)",
         expected: diverged,
         run: hard_cases::nan_source,
     });

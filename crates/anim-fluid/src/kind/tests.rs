@@ -113,7 +113,7 @@ fn every_preset_builds_steps_and_draws() {
 #[test]
 fn frames_and_context_are_the_scenes_fields_and_grid() {
     for (name, res, range, method) in [
-        ("smoke-box-2d", 16, (0.0, 50.0), "seed stable fluids (f32, 20 Gauss-Seidel sweeps)"),
+        ("smoke-box-2d", 16, (0.0, 50.0), "Stam's stable fluids (f32, 20 Gauss-Seidel sweeps)"),
         (
             "smoke-plume-3d",
             8,
@@ -208,7 +208,7 @@ fn foreign_and_damaged_checkpoints_are_refused_and_change_nothing() {
         (
             "lid-driven-cavity",
             smoke.clone(),
-            "`fluid`: anim-fluid: checkpoint does not fit this simulation: a seed memory",
+            "`fluid`: anim-fluid: checkpoint does not fit this simulation: a stam memory",
         ),
         (
             "smoke-box-2d",
@@ -236,10 +236,22 @@ fn foreign_and_damaged_checkpoints_are_refused_and_change_nothing() {
             }),
             "the checkpoint has no `time`",
         ),
-        ("smoke-plume-3d", edit(&p, &|v| v["version"] = json!(2)), "layout version 2"),
+        ("smoke-plume-3d", edit(&p, &|v| v["version"] = json!(3)), "layout version 3"),
+        (
+            // A checkpoint written before version 2, with Stam's solver under its old key.
+            "smoke-box-2d",
+            edit(&smoke, &|v| {
+                v["version"] = json!(1);
+                let fluid = v["saved"]["fluid"].as_object_mut().expect("object");
+                let memory = fluid.remove("stam").expect("stam memory");
+                fluid.insert("solver".into(), json!("seed"));
+                fluid.insert("seed".into(), memory);
+            }),
+            "a checkpoint of layout version 1; this build reads version 2",
+        ),
         (
             "smoke-box-2d",
-            edit(&smoke, &|v| v["saved"]["fluid"]["seed"]["u"] = json!([0.0])),
+            edit(&smoke, &|v| v["saved"]["fluid"]["stam"]["u"] = json!([0.0])),
             "`fluid`: anim-fluid: checkpoint does not fit this simulation: `u` has 1 values",
         ),
     ];
@@ -302,7 +314,7 @@ fn bad_parameters_name_their_field() {
         assert_eq!(
             err(p),
             format!(
-                "field `{field}`: smoke-box-2d runs the seed's solver (20 Gauss-Seidel sweeps, linear advection), which has no pressure, advection or splitting settings"
+                "field `{field}`: smoke-box-2d runs Stam's solver (20 Gauss-Seidel sweeps, linear advection), which has no pressure, advection or splitting settings"
             )
         );
     }

@@ -1,4 +1,4 @@
-//! Advection of the MAC fields: seed 6.1's *advect* step, `w2(x) = w1(p(x, -dt))`, on the
+//! Advection of the MAC fields: the *advect* step of stable fluids (Stam 1999), `w2(x) = w1(p(x, -dt))`, on the
 //! staggered grid.
 //!
 //! Every sample (a face of velocity component `a`, or a cell centre for density and temperature)

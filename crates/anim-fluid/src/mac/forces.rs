@@ -1,4 +1,4 @@
-//! Body forces and sources: seed 6.1's *add force* step, `w1 = w0 + dt f`, for smoke.
+//! Body forces and sources: the *add force* step of stable fluids (Stam 1999), `w1 = w0 + dt f`, for smoke.
 //!
 //! - **Buoyancy** (Fedkiw, Stam and Jensen 2001): `f = (-alpha rho + beta (T - T_amb)) e_y`,
 //!   dense smoke sinks and hot smoke rises; evaluated on each interior `v` face from the mean of

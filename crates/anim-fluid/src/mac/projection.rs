@@ -1,4 +1,4 @@
-//! Pressure projection: seed 6.1's *project* step, `w4 = w3 - grad p` with `Lap p = div w3`.
+//! Pressure projection: the *project* step of stable fluids (Stam 1999), `w4 = w3 - grad p` with `Lap p = div w3`.
 //!
 //! The Helmholtz-Hodge decomposition splits the velocity into a divergence-free part and a
 //! gradient; projection keeps the first (Chorin 1968). On the MAC grid:

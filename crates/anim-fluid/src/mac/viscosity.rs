@@ -1,4 +1,4 @@
-//! Implicit viscosity: seed 6.1's *diffuse* step, `du/dt = nu Lap u`, by backward Euler.
+//! Implicit viscosity: the *diffuse* step of stable fluids (Stam 1999), `du/dt = nu Lap u`, by backward Euler.
 //!
 //! Each velocity component solves, on its own face lattice,
 //!
@@ -6,8 +6,8 @@
 //! (I - nu dt Lap) u = u*,   i.e.   (1 + kappa m) u_f - kappa sum_nb u_nb = u*_f,   kappa = nu dt / h^2
 //! ```
 //!
-//! with `m` the number of neighbour terms: unconditionally stable at any `nu dt / h^2`, as Stam
-//! (1999) and the seed's `diffuse` are, but solved here to convergence rather than by a fixed
+//! with `m` the number of neighbour terms: unconditionally stable at any `nu dt / h^2`, as Stam's
+//! (1999) diffusion and his `diffuse` routine (2003) are, but solved here to convergence rather than by a fixed
 //! number of Gauss-Seidel sweeps. The unknowns are the free faces; faces fixed by a wall or an
 //! obstacle (and the normal faces of the domain) are known values that move to the right-hand
 //! side. Beyond the domain in a tangential direction a no-slip wall of velocity `u_wall` half a

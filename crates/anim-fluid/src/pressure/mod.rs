@@ -1,6 +1,6 @@
 //! Pressure projection on a MAC grid: the Poisson problem over labelled cells and its solvers.
 //!
-//! Seed section 6.1: `w4 = w3 - grad p` with `Lap p = div w3`. On a MAC grid (velocities on cell
+//! The projection of stable fluids (Stam 1999): `w4 = w3 - grad p` with `Lap p = div w3`. On a MAC grid (velocities on cell
 //! faces, pressure at cell centres) with cells labelled [`CellLabel::Fluid`],
 //! [`CellLabel::Air`] (free surface or open boundary, `p = 0`: the ghost-fluid Dirichlet
 //! condition) and [`CellLabel::Solid`] (walls and obstacles, `dp/dn` set by the wall velocity:

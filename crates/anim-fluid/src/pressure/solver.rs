@@ -87,7 +87,7 @@ impl PressureSolver {
     /// A solver for `op` by `method`, stopping at relative residual `tolerance` or after
     /// `max_iterations` (sweeps or CG iterations). A tolerance of 0 (or `f64::MIN_POSITIVE`,
     /// which [`crate::mac::MacParams`] accepts) runs exactly `max_iterations` sweeps of Jacobi or
-    /// Gauss-Seidel without residual checks, like the seed's fixed 20.
+    /// Gauss-Seidel without residual checks, like the fixed 20 of Stam's solver.
     ///
     /// # Errors
     /// [`FluidError::BadParameter`] for a negative or non-finite tolerance or zero iterations.

@@ -66,31 +66,31 @@ fn mac_memory_needs_the_warm_start_pressure() {
 
 #[test]
 fn malformed_or_foreign_memories_are_refused_and_change_nothing() {
-    let mut seed = by_name("smoke-box-2d", Some(8)).unwrap().unwrap();
+    let mut stam = by_name("smoke-box-2d", Some(8)).unwrap().unwrap();
     let mut mac = by_name("lid-driven-cavity", Some(8)).unwrap().unwrap();
     let mut mac3 = by_name("smoke-plume-3d", Some(6)).unwrap().unwrap();
-    for scene in [&mut seed, &mut mac, &mut mac3] {
+    for scene in [&mut stam, &mut mac, &mut mac3] {
         scene.step().unwrap();
     }
-    let other_seed = by_name("smoke-box-2d", Some(10)).unwrap().unwrap().memory();
+    let other_stam = by_name("smoke-box-2d", Some(10)).unwrap().unwrap().memory();
     let other_mac = by_name("lid-driven-cavity", Some(10)).unwrap().unwrap().memory();
     let edit = |m: &serde_json::Value, f: &dyn Fn(&mut serde_json::Value)| {
         let mut m = m.clone();
         f(&mut m);
         m
     };
-    let (sm, mm, m3) = (seed.memory(), mac.memory(), mac3.memory());
-    // 0: the seed's 2D box, 1: a MAC 2D cavity, 2: the MAC 3D plume.
+    let (sm, mm, m3) = (stam.memory(), mac.memory(), mac3.memory());
+    // 0: Stam's 2D box, 1: a MAC 2D cavity, 2: the MAC 3D plume.
     let cases: Vec<(usize, serde_json::Value, &str)> = vec![
         (0, serde_json::json!(42), "no `solver`"),
-        (0, mm.clone(), "a mac memory for a scene run by the seed solver"),
-        (0, other_seed, "N = 10 grid, this fluid has N = 8"),
-        (0, edit(&sm, &|m| m["seed"]["u"].as_array_mut().unwrap().truncate(5)), "`u` has 5 values"),
-        (0, edit(&sm, &|m| m["seed"]["v"][3] = "x".into()), "not a seed-fluid memory"),
-        (0, edit(&sm, &|m| m["seed"]["steps"] = (-1).into()), "not a seed-fluid memory"),
-        (0, edit(&sm, &|m| m["seed"]["params"]["dt"] = 0.5.into()), "settings"),
-        (0, edit(&sm, &|m| m["seed"]["extra"] = 1.into()), "unknown field `extra`"),
-        (1, sm.clone(), "a seed memory for a scene run by the mac solver"),
+        (0, mm.clone(), "a mac memory for a scene run by the stam solver"),
+        (0, other_stam, "N = 10 grid, this fluid has N = 8"),
+        (0, edit(&sm, &|m| m["stam"]["u"].as_array_mut().unwrap().truncate(5)), "`u` has 5 values"),
+        (0, edit(&sm, &|m| m["stam"]["v"][3] = "x".into()), "not a Stam-fluid memory"),
+        (0, edit(&sm, &|m| m["stam"]["steps"] = (-1).into()), "not a Stam-fluid memory"),
+        (0, edit(&sm, &|m| m["stam"]["params"]["dt"] = 0.5.into()), "settings"),
+        (0, edit(&sm, &|m| m["stam"]["extra"] = 1.into()), "unknown field `extra`"),
+        (1, sm.clone(), "a stam memory for a scene run by the mac solver"),
         (1, other_mac, "u has 110 values, expected 72"),
         (1, edit(&mm, &|m| m["simulation"]["dims"] = serde_json::json!([8, 9, 1])), "[8, 9, 1] grid"),
         (
@@ -109,7 +109,7 @@ fn malformed_or_foreign_memories_are_refused_and_change_nothing() {
         ),
         (2, edit(&m3, &|m| m["state"]["vel"][2] = serde_json::json!([])), "w has 0 values, expected 378"),
     ];
-    let mut scenes = [seed, mac, mac3];
+    let mut scenes = [stam, mac, mac3];
     for (which, memory, expect) in cases {
         let scene = &mut scenes[which];
         let before = memory_text(scene);

@@ -93,7 +93,7 @@ pub(super) fn invariance(ctx: &Ctx) -> Vec<Check> {
                     de,
                     1e-2,
                     Judge::AtLeast,
-                    "seed 5.1: small strain cannot guarantee rotational invariance",
+                    "Sifakis & Barbič 2012: small strain cannot guarantee rotational invariance",
                 )];
             }
             vec![
@@ -163,7 +163,7 @@ pub(super) fn small_strain(ctx: &Ctx) -> Vec<Check> {
                 diff,
                 1e-12,
                 Judge::AtMost,
-                "linear elasticity, seed 5.1",
+                "linear elasticity, Sifakis & Barbič 2012",
             ));
             // Order of the stress difference: P(I + eps H) - P_lin(I + eps H) = O(eps^2).
             let mut orders = Vec::new();

@@ -1,4 +1,4 @@
-//! The corotated models: linear elasticity in the rotated frame (seed 5.1) and fixed corotated
+//! The corotated models: linear elasticity in the rotated frame (Sifakis & Barbič 2012) and fixed corotated
 //! (Stomakhin, Howes, Schroeder & Teran, *Energetically consistent invertible elasticity*, SCA
 //! 2012).
 
@@ -7,7 +7,7 @@ use crate::decomposition::svd;
 use crate::{Hyperelastic, Lame, Mat, Scalar, Tangent};
 use nalgebra::SVector;
 
-/// Corotated linear elasticity (seed 5.1): with the polar decomposition `F = R S`,
+/// Corotated linear elasticity (Sifakis & Barbič 2012): with the polar decomposition `F = R S`,
 ///
 /// ```text
 /// psi = mu |S - I|^2 + lambda/2 tr^2(S - I) = mu sum (sigma_i - 1)^2 + lambda/2 (sum sigma_i - d)^2,
@@ -23,7 +23,7 @@ use nalgebra::SVector;
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct CorotatedLinear;
 
-/// Fixed corotated (Stomakhin et al. 2012; seed 5.1), with `J = det F = prod sigma_i`:
+/// Fixed corotated (Stomakhin et al. 2012), with `J = det F = prod sigma_i`:
 ///
 /// ```text
 /// psi = mu |F - R|^2 + lambda/2 (J - 1)^2 = mu sum (sigma_i - 1)^2 + lambda/2 (J - 1)^2,

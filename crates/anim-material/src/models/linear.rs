@@ -1,9 +1,9 @@
-//! Linear (small-strain) elasticity, seed 5.1.
+//! Linear (small-strain) elasticity (Sifakis & Barbič 2012).
 
 use super::delta;
 use crate::{Hyperelastic, Lame, Mat, Scalar, Tangent};
 
-/// Linear elasticity on the small strain `eps = (F + F^T)/2 - I` (seed 5.1):
+/// Linear elasticity on the small strain `eps = (F + F^T)/2 - I`:
 ///
 /// ```text
 /// psi = mu eps:eps + lambda/2 tr^2(eps),   P = 2 mu eps + lambda tr(eps) I,

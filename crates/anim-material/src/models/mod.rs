@@ -1,4 +1,5 @@
-//! The hyperelastic models of seed section 5.1 and the stable Neo-Hookean model.
+//! The hyperelastic models (Sifakis & Barbič 2012; Stomakhin et al. 2012 for fixed corotated)
+//! and the stable Neo-Hookean model (Smith et al. 2018).
 //!
 //! | model | energy density `psi(F)` |
 //! |---|---|

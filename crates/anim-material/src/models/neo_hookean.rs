@@ -1,11 +1,11 @@
-//! Compressible Neo-Hookean with the `log J` volume term, seed 5.1.
+//! Compressible Neo-Hookean with the `log J` volume term (Sifakis & Barbič 2012).
 
 use super::delta;
 use crate::decomposition::{cofactor, determinant};
 use crate::{Hyperelastic, Lame, Mat, Scalar, Tangent};
 use num_traits::Float;
 
-/// Compressible Neo-Hookean (seed 5.1), `J = det F`:
+/// Compressible Neo-Hookean (Sifakis & Barbič 2012), `J = det F`:
 ///
 /// ```text
 /// psi = mu/2 (tr(F^T F) - d) - mu log J + lambda/2 log^2 J,

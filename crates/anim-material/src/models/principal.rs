@@ -1,7 +1,7 @@
 //! Isotropic energies written in the singular values of `F`, and their derivatives through the
 //! rotation-variant SVD.
 //!
-//! For `psi(F) = psi_hat(sigma)` with `F = U diag(sigma) V^T` (seed 5.1):
+//! For `psi(F) = psi_hat(sigma)` with `F = U diag(sigma) V^T`:
 //!
 //! ```text
 //! P(F) = U diag(dpsi_hat/dsigma_i) V^T.

@@ -1,9 +1,9 @@
-//! St. Venant-Kirchhoff, seed 5.1.
+//! St. Venant-Kirchhoff (Sifakis & Barbič 2012).
 
 use super::delta;
 use crate::{Hyperelastic, Lame, Mat, Scalar, Tangent};
 
-/// St. Venant-Kirchhoff: linear elasticity on the Green strain `E = (F^T F - I)/2` (seed 5.1):
+/// St. Venant-Kirchhoff: linear elasticity on the Green strain `E = (F^T F - I)/2`:
 ///
 /// ```text
 /// psi = mu E:E + lambda/2 tr^2(E),   P = F S,  S = 2 mu E + lambda tr(E) I,

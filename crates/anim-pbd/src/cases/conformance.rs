@@ -55,7 +55,7 @@ pub(super) fn xpbd_chain(_ctx: &Ctx) -> Vec<Check> {
                 reference: 0.0,
                 tolerance: 0.01,
                 judge: Judge::AtMost,
-                source: "link j stretches by alpha T_j, T_j the weight below it (seed 3.1)",
+                source: "link j stretches by alpha T_j, T_j the weight below it (XPBD, Macklin et al. 2016)",
             });
         }
     }
@@ -104,7 +104,7 @@ pub(super) fn pbd_stiffness(_ctx: &Ctx) -> Vec<Check> {
             reference: 1.0,
             tolerance: 10.0,
             judge: Judge::AtLeast,
-            source: "seed 3.1: PBD gets stiffer with smaller dt and more iterations",
+            source: "Macklin et al. 2016: PBD gets stiffer with smaller dt and more iterations",
         });
         checks.push(Check {
             crate_name: CRATE,
@@ -250,7 +250,7 @@ pub(super) fn momentum(_ctx: &Ctx) -> Vec<Check> {
                 reference: 0.0,
                 tolerance: 16.0,
                 judge: Judge::AtMost,
-                source: "seed 3: w-weighted projection along grad C has no ghost forces",
+                source: "Müller et al. 2007: w-weighted projection along grad C has no ghost forces",
             });
         }
     }

@@ -8,9 +8,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
-    /// Position based dynamics with the seed's stiffness `k` in `[0, 1]` (seed 3).
+    /// Position based dynamics with a stiffness `k` in `[0, 1]` (Müller et al. 2007).
     Pbd,
-    /// Extended PBD with compliance and multipliers (seed 3.1): stiffness independent of the
+    /// Extended PBD with compliance and multipliers (Macklin et al. 2016): stiffness independent of the
     /// iteration count and time step. The default.
     #[default]
     Xpbd,
@@ -20,7 +20,7 @@ pub enum Method {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SolverKind {
-    /// Sequential Gauss-Seidel in model order, as the seed. The default.
+    /// Sequential Gauss-Seidel in model order, as in Müller et al. 2007. The default.
     #[default]
     GaussSeidel,
     /// Graph-coloured Gauss-Seidel, parallel within a colour.

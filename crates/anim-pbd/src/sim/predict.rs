@@ -5,7 +5,7 @@
 //! (7)  p_i <- x_i + h v_i
 //! ```
 //!
-//! which together are XPBD's prediction `x~ = x^n + h v^n + h^2 M^-1 f_ext` (seed 3.1). Pinned
+//! which together are XPBD's prediction `x~ = x^n + h v^n + h^2 M^-1 f_ext` (Macklin et al. 2016). Pinned
 //! particles (`w_i = 0`) keep their velocity. The wind acts on the model's triangles as a drag
 //! along each face normal, `f = drag A ((v_wind - u) . n) n` with `A` the area, `n` the normal
 //! and `u` the mean velocity of the corners, the wind's speed modulated by `1 + gust sin(pi t)`;

@@ -3,7 +3,7 @@
 //! algorithm). Each projection is one kernel of [`crate::project`]; what differs between the three
 //! solvers is the order of the projections and which positions they read.
 //!
-//! - [`SolverKind::GaussSeidel`]: the seed's sequential sweep, constraints in model order, then
+//! - [`SolverKind::GaussSeidel`]: the sequential sweep of Müller et al. 2007, constraints in model order, then
 //!   the contacts. Fastest convergence per iteration; one thread.
 //! - [`SolverKind::ColoredGaussSeidel`]: the constraints are coloured once (greedy, in model
 //!   order) so that no two of a colour share a movable particle; colours are swept in order, the

@@ -1,6 +1,6 @@
 //! Rigid-body dynamics of kinematic trees: inverse dynamics (RNEA), the joint-space mass matrix
 //! (CRBA), forward dynamics (ABA, and `H⁻¹ (τ - C)` through a sparse `LᵀDL` factorisation),
-//! energies and momentum. Seed section 4.6; Featherstone, *Rigid Body Dynamics Algorithms*
+//! energies and momentum: Featherstone, *Rigid Body Dynamics Algorithms*
 //! (2008), chapters 5-7; the spatial algebra is [`crate::spatial`].
 //!
 //! # The equation of motion
@@ -9,12 +9,12 @@
 //! joints, the angular velocity in the joint frame, see [`crate::model`]) obeys
 //!
 //! ```text
-//! τ = H(q) v̇ + C(q, v)                                                         (seed 4.6)
+//! τ = H(q) v̇ + C(q, v)
 //! ```
 //!
 //! where `τ` are the joint forces, `H(q)` the symmetric positive-definite joint-space mass
 //! matrix, and `C(q, v) = c(q, v) + g(q)` the bias: Coriolis and centrifugal forces plus the
-//! gravity term. The seed names the two problems `v̇ = FD(model, q, v, τ)` and
+//! gravity term. Featherstone names the two problems `v̇ = FD(model, q, v, τ)` and
 //! `τ = ID(model, q, v, v̇)`:
 //!
 //! | function | computes | cost | Featherstone |

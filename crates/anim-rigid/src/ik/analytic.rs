@@ -1,4 +1,4 @@
-//! Analytic inverse kinematics of 6R arms by the Paden-Kahan subproblems (seed 4.5; Murray,
+//! Analytic inverse kinematics of 6R arms by the Paden-Kahan subproblems (Murray,
 //! Li & Sastry ch. 3.3).
 //!
 //! The target `g_d` of the tool frame gives `g₁ = g_d M⁻¹ = e^{ξ̂₁θ₁} ··· e^{ξ̂₆θ₆}` (space

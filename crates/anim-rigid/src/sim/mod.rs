@@ -1,4 +1,4 @@
-//! Contact-free simulation of articulated trees and free rigid bodies (seed 4.6): the state,
+//! Contact-free simulation of articulated trees and free rigid bodies (Featherstone 2008): the state,
 //! the forces that are not in the model (applied torques, joint damping, joint limits), and time
 //! steppers that move `q` on its manifold.
 //!

@@ -89,7 +89,7 @@ pub(super) fn stable_dt_sweep(ctx: &Ctx, kind: IntegratorKind) -> Outcome {
         log_dt.push(lo.ln());
         cs.push(lo / t);
     }
-    // Fit log dt = log c + s log sqrt(m/k); the seed's bound has s = 1.
+    // Fit log dt = log c + s log sqrt(m/k); the explicit bound `dt <= c sqrt(m/k)` has s = 1.
     let n = log_t.len() as f64;
     let (mx, my) = (log_t.iter().sum::<f64>() / n, log_dt.iter().sum::<f64>() / n);
     let sxy: f64 = log_t.iter().zip(&log_dt).map(|(x, y)| (x - mx) * (y - my)).sum();
@@ -118,7 +118,7 @@ pub(super) fn stable_dt_sweep(ctx: &Ctx, kind: IntegratorKind) -> Outcome {
 }
 
 /// The stiff hard case: a 10x10 cloth of 0.1 kg with k = 1e6 springs, pinned at two corners, on
-/// the seed's linearised backward Euler (one Newton iteration:
+/// the linearised backward Euler of Baraff & Witkin 1998 (one Newton iteration:
 /// `[M - h^2 K(x0) - h D] v1 = M v0 + h f(x0)`, the definite K solved by Jacobi-PCG).
 pub(super) fn stiff_cloth() -> Result<(SpringSimulation, State), String> {
     let mut b = NetworkBuilder::new();
@@ -165,7 +165,7 @@ pub(super) fn stiff_backward_euler(_ctx: &Ctx) -> Outcome {
             return Err(format!("energy {e0} -> {e1}, max stretch ratio {stretch}"));
         }
         Ok(format!(
-            "linearised backward Euler (seed 2.1), {steps} steps (2 s), omega dt = {:.0}; energy {} -> {} J (dissipative), max stretch ratio {}, at most {cg} CG iterations per step",
+            "linearised backward Euler (Baraff & Witkin 1998), {steps} steps (2 s), omega dt = {:.0}; energy {} -> {} J (dissipative), max stretch ratio {}, at most {cg} CG iterations per step",
             (1e6f64 / 1e-3).sqrt() * dt,
             fmt_num(e0),
             fmt_num(e1),

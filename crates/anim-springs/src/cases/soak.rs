@@ -15,7 +15,7 @@ pub(super) const STIFF_CLOTH: SoakCase = SoakCase {
 };
 
 fn stiff_cloth(budget: Budget) -> Soak {
-    // The seed's linearised backward Euler is not a minimiser of the incremental potential, so it
+    // The linearised backward Euler (Baraff & Witkin 1998) is not a minimiser of the incremental potential, so it
     // may raise the energy while the cloth swings through large rotations; the bound is that it
     // never does so after the first tenth of the run. (Newton to convergence stalls here: with the
     // residual-norm line search it stops near a relative residual of 1e-5 at omega dt = 1000.)

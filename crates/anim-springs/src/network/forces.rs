@@ -1,7 +1,7 @@
 //! Forces and Jacobians of a spring network: the per-spring kernels and the two-pass parallel
 //! evaluation behind anim-core's [`SecondOrderSystem`] and [`MechanicalSystem`].
 //!
-//! Per spring `s = (i, j)` with `d = x_i - x_j`, `L = |d|`, `n = d / L` (seed section 2):
+//! Per spring `s = (i, j)` with `d = x_i - x_j`, `L = |d|`, `n = d / L`:
 //!
 //! ```text
 //! f_s = -k (L - l) n - c ((v_i - v_j) . n) n          force on i; j takes -f_s

@@ -1,4 +1,4 @@
-//! The seed's stable fluids (section 6.2), reproduced operation for operation in `f32`.
+//! Stam's stable fluids solver, reproduced operation for operation in `f32`.
 //!
 //! Jos Stam, *Real-Time Fluid Dynamics for Games* (GDC 2003): density and velocity live at the
 //! centres of an `N x N` grid with a one-cell border (`(N+2)^2` values, `IX(i,j) = i + (N+2) j`),
@@ -9,7 +9,7 @@
 //! dens_step: d += dt d0;  d = (I - diff dt Lap)^-1 d;  d = advect(d, u)
 //! ```
 //!
-//! with the seed's `lin_solve` (20 Gauss-Seidel sweeps of
+//! with Stam's `lin_solve` (20 Gauss-Seidel sweeps of
 //! `x_ij = (x0_ij + a (x_{i-1,j} + x_{i+1,j} + x_{i,j-1} + x_{i,j+1})) / c`, then `set_bnd`),
 //! `advect` (back-trace `x - dt N u`, clamp to `[0.5, N + 0.5]`, bilinear), `project`
 //! (central-difference divergence, the same 20 sweeps with `a = 1, c = 4`, central-difference
@@ -34,27 +34,27 @@
 use crate::error::{self, FluidError};
 use serde::Deserialize as _;
 
-/// Gauss-Seidel sweeps per `lin_solve`, as in the seed.
+/// Gauss-Seidel sweeps per `lin_solve`, as in Stam's code.
 pub const SWEEPS: usize = 20;
 
 /// Rows advanced together by the wavefront sweep of [`lin_solve`].
 const BAND: usize = 8;
 
-/// Index of cell `(i, j)` in an `(N+2)^2` array: the seed's `IX` macro.
+/// Index of cell `(i, j)` in an `(N+2)^2` array: Stam's `IX` macro.
 #[inline]
 #[must_use]
 pub const fn ix(n: usize, i: usize, j: usize) -> usize {
     i + (n + 2) * j
 }
 
-/// `x += dt s` over the whole array, border included (seed `add_source`).
+/// `x += dt s` over the whole array, border included (Stam's `add_source`).
 pub fn add_source(x: &mut [f32], s: &[f32], dt: f32) {
     for (xi, &si) in x.iter_mut().zip(s) {
         *xi += dt * si;
     }
 }
 
-/// The seed's boundary conditions: border cells copy their interior neighbour, negated for the
+/// Stam's boundary conditions (`set_bnd`): border cells copy their interior neighbour, negated for the
 /// normal velocity component (`b = 1`: u at the x walls, `b = 2`: v at the y walls); corners are
 /// the mean of their two border neighbours.
 pub fn set_bnd(n: usize, b: u8, x: &mut [f32]) {
@@ -71,7 +71,7 @@ pub fn set_bnd(n: usize, b: u8, x: &mut [f32]) {
 }
 
 /// One lexicographic Gauss-Seidel sweep over the interior, as a wavefront over bands of rows
-/// (same operands for every cell as the seed's loop; see the module doc).
+/// (same operands for every cell as Stam's loop; see the module doc).
 fn gauss_seidel_sweep(n: usize, x: &mut [f32], x0: &[f32], a: f32, c: f32) {
     let w = n + 2;
     let mut j0 = 1;
@@ -91,7 +91,7 @@ fn gauss_seidel_sweep(n: usize, x: &mut [f32], x0: &[f32], a: f32, c: f32) {
 }
 
 /// [`SWEEPS`] Gauss-Seidel sweeps of `x_ij = (x0_ij + a * (sum of the 4 neighbours)) / c`, each
-/// followed by [`set_bnd`] (seed `lin_solve`).
+/// followed by [`set_bnd`] (Stam's `lin_solve`).
 pub fn lin_solve(n: usize, b: u8, x: &mut [f32], x0: &[f32], a: f32, c: f32) {
     for _ in 0..SWEEPS {
         gauss_seidel_sweep(n, x, x0, a, c);
@@ -99,14 +99,14 @@ pub fn lin_solve(n: usize, b: u8, x: &mut [f32], x0: &[f32], a: f32, c: f32) {
     }
 }
 
-/// Implicit diffusion `(I - diff dt Lap) x = x0` with `a = dt diff N^2` (seed `diffuse`).
+/// Implicit diffusion `(I - diff dt Lap) x = x0` with `a = dt diff N^2` (Stam's `diffuse`).
 pub fn diffuse(n: usize, b: u8, x: &mut [f32], x0: &[f32], diff: f32, dt: f32) {
     let nf = n as f32;
     let a = dt * diff * nf * nf;
     lin_solve(n, b, x, x0, a, 1.0 + 4.0 * a);
 }
 
-/// Semi-Lagrangian advection of `d0` by `(u, v)` into `d` (seed `advect`).
+/// Semi-Lagrangian advection of `d0` by `(u, v)` into `d` (Stam's `advect`).
 pub fn advect(n: usize, b: u8, d: &mut [f32], d0: &[f32], u: &[f32], v: &[f32], dt: f32) {
     let nf = n as f32;
     let dt0 = dt * nf;
@@ -143,7 +143,7 @@ pub fn advect(n: usize, b: u8, d: &mut [f32], d0: &[f32], u: &[f32], v: &[f32], 
 }
 
 /// Makes `(u, v)` divergence free: central-difference divergence into `div`, Poisson solve for
-/// `p` by [`lin_solve`], `u -= grad p` (seed `project`).
+/// `p` by [`lin_solve`], `u -= grad p` (Stam's `project`).
 pub fn project(n: usize, u: &mut [f32], v: &mut [f32], p: &mut [f32], div: &mut [f32]) {
     let nf = n as f32;
     let w = n + 2;
@@ -168,7 +168,7 @@ pub fn project(n: usize, u: &mut [f32], v: &mut [f32], p: &mut [f32], div: &mut 
     set_bnd(n, 2, v);
 }
 
-/// The seed's `dens_step`: add the source `x0`, diffuse, advect by `(u, v)`. `x0` is scratch
+/// Stam's `dens_step`: add the source `x0`, diffuse, advect by `(u, v)`. `x0` is scratch
 /// afterwards (as in C, where the swapped pointers reuse it).
 pub fn dens_step(n: usize, x: &mut [f32], x0: &mut [f32], u: &[f32], v: &[f32], diff: f32, dt: f32) {
     add_source(x, x0, dt);
@@ -178,7 +178,7 @@ pub fn dens_step(n: usize, x: &mut [f32], x0: &mut [f32], u: &[f32], v: &[f32], 
     advect(n, 0, x, x0, u, v, dt);
 }
 
-/// The seed's `vel_step`: add the forces `(u0, v0)`, diffuse, project, self-advect, project.
+/// Stam's `vel_step`: add the forces `(u0, v0)`, diffuse, project, self-advect, project.
 /// `u0`, `v0` are scratch afterwards.
 pub fn vel_step(n: usize, u: &mut [f32], v: &mut [f32], u0: &mut [f32], v0: &mut [f32], visc: f32, dt: f32) {
     add_source(u, u0, dt);
@@ -212,9 +212,9 @@ pub fn source_pattern(n: usize, step: u64, d: &mut [f32], u: &mut [f32], v: &mut
     }
 }
 
-/// Settings of [`SeedFluid`].
+/// Settings of [`StamFluid`].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct SeedParams {
+pub struct StamParams {
     /// Time step. Default 0.1 (Stam's demo).
     pub dt: f32,
     /// Density diffusion coefficient `diff`. Default 1e-4.
@@ -223,21 +223,21 @@ pub struct SeedParams {
     pub visc: f32,
 }
 
-impl Default for SeedParams {
+impl Default for StamParams {
     fn default() -> Self {
         Self { dt: 0.1, diff: 1e-4, visc: 1e-4 }
     }
 }
 
-/// The seed's solver state: `N`, the six `(N+2)^2` arrays of the C program and its settings.
+/// Stam's solver state: `N`, the six `(N+2)^2` arrays of the C program and its settings.
 ///
-/// Fill the sources ([`SeedFluid::sources_mut`], or [`SeedFluid::apply_source_pattern`]) before
-/// each [`SeedFluid::step`], as the seed's `get_force_source` does; the step consumes them.
-/// [`SeedFluid::memory`] and [`SeedFluid::restore_memory`] checkpoint it.
+/// Fill the sources ([`StamFluid::sources_mut`], or [`StamFluid::apply_source_pattern`]) before
+/// each [`StamFluid::step`], as the `get_force_source` of Stam's demo does; the step consumes them.
+/// [`StamFluid::memory`] and [`StamFluid::restore_memory`] checkpoint it.
 #[derive(Debug, Clone)]
-pub struct SeedFluid {
+pub struct StamFluid {
     n: usize,
-    params: SeedParams,
+    params: StamParams,
     steps: u64,
     time: f64,
     dens: Vec<f32>,
@@ -250,12 +250,12 @@ pub struct SeedFluid {
     backup: [Vec<f32>; 6],
 }
 
-/// What [`SeedFluid::memory`] writes: everything a step reads.
+/// What [`StamFluid::memory`] writes: everything a step reads.
 #[derive(serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
-struct SeedMemory {
+struct StamMemory {
     n: usize,
-    params: SeedParams,
+    params: StamParams,
     steps: u64,
     time: f64,
     density: Vec<f32>,
@@ -266,13 +266,13 @@ struct SeedMemory {
     v_source: Vec<f32>,
 }
 
-impl SeedFluid {
+impl StamFluid {
     /// An `N x N` fluid at rest.
     ///
     /// # Errors
-    /// [`FluidError::BadGrid`] for `N < 2` (the seed's border handling needs two interior cells),
+    /// [`FluidError::BadGrid`] for `N < 2` (Stam's border handling needs two interior cells),
     /// [`FluidError::BadParameter`] for `dt <= 0`, negative `diff` or `visc`, or non-finite ones.
-    pub fn new(n: usize, params: SeedParams) -> Result<Self, FluidError> {
+    pub fn new(n: usize, params: StamParams) -> Result<Self, FluidError> {
         if n < 2 {
             return Err(FluidError::BadGrid { what: "N", min: 2, got: n });
         }
@@ -303,7 +303,7 @@ impl SeedFluid {
 
     /// The settings.
     #[must_use]
-    pub fn params(&self) -> SeedParams {
+    pub fn params(&self) -> StamParams {
         self.params
     }
 
@@ -357,7 +357,7 @@ impl SeedFluid {
         source_pattern(self.n, self.steps, &mut self.dens_prev, &mut self.u_prev, &mut self.v_prev);
     }
 
-    /// The seed's `sim_main` after `get_force_source`: `vel_step`, then `dens_step`.
+    /// The `sim_main` of Stam's demo after `get_force_source`: `vel_step`, then `dens_step`.
     ///
     /// # Errors
     /// [`FluidError::NonFinite`] naming the field, the cell (`i`, `j` index the `(N+2)^2` array,
@@ -370,12 +370,12 @@ impl SeedFluid {
         self.step_backed_up()
     }
 
-    /// [`SeedFluid::apply_source_pattern`], then [`SeedFluid::step`], as one step: on error
+    /// [`StamFluid::apply_source_pattern`], then [`StamFluid::step`], as one step: on error
     /// the six arrays are as before the call, the sources included (the ones the pattern
     /// replaced).
     ///
     /// # Errors
-    /// As [`SeedFluid::step`].
+    /// As [`StamFluid::step`].
     pub fn step_with_source_pattern(&mut self) -> Result<(), FluidError> {
         self.back_up();
         self.apply_source_pattern();
@@ -396,7 +396,7 @@ impl SeedFluid {
         }
     }
 
-    /// The step after [`SeedFluid::back_up`]; on error the arrays are restored from the backup.
+    /// The step after [`StamFluid::back_up`]; on error the arrays are restored from the backup.
     fn step_backed_up(&mut self) -> Result<(), FluidError> {
         let (n, p) = (self.n, self.params);
         vel_step(n, &mut self.u, &mut self.v, &mut self.u_prev, &mut self.v_prev, p.visc, p.dt);
@@ -438,11 +438,11 @@ impl SeedFluid {
 
     /// Everything a step reads (the six arrays, step count, time, `N` and the settings), for
     /// checkpoints: a fluid built with the same `N` and settings and given this by
-    /// [`SeedFluid::restore_memory`] continues bit for bit (`f32` values round-trip exactly
+    /// [`StamFluid::restore_memory`] continues bit for bit (`f32` values round-trip exactly
     /// through JSON).
     #[must_use]
     pub fn memory(&self) -> serde_json::Value {
-        let m = SeedMemory {
+        let m = StamMemory {
             n: self.n,
             params: self.params,
             steps: self.steps,
@@ -457,15 +457,15 @@ impl SeedFluid {
         serde_json::to_value(m).unwrap_or(serde_json::Value::Null)
     }
 
-    /// Restores what [`SeedFluid::memory`] returned. Nothing changes on error.
+    /// Restores what [`StamFluid::memory`] returned. Nothing changes on error.
     ///
     /// # Errors
-    /// [`FluidError::Checkpoint`] naming the problem: not a seed-fluid memory (missing, unknown
+    /// [`FluidError::Checkpoint`] naming the problem: not a Stam-fluid memory (missing, unknown
     /// or mistyped fields), another `N` or other settings, an array of the wrong length, a
     /// non-finite value (naming the array and index) or a non-finite time.
     pub fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), FluidError> {
-        let m = SeedMemory::deserialize(memory)
-            .map_err(|e| FluidError::Checkpoint(format!("not a seed-fluid memory: {e}")))?;
+        let m = StamMemory::deserialize(memory)
+            .map_err(|e| FluidError::Checkpoint(format!("not a Stam-fluid memory: {e}")))?;
         if m.n != self.n {
             return Err(FluidError::Checkpoint(format!(
                 "the checkpoint is of an N = {} grid, this fluid has N = {}",
@@ -530,8 +530,8 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
 mod tests {
     use super::*;
 
-    fn run(n: usize, steps: usize) -> SeedFluid {
-        let mut f = SeedFluid::new(n, SeedParams::default()).unwrap();
+    fn run(n: usize, steps: usize) -> StamFluid {
+        let mut f = StamFluid::new(n, StamParams::default()).unwrap();
         for _ in 0..steps {
             f.apply_source_pattern();
             f.step().unwrap();
@@ -541,7 +541,7 @@ mod tests {
 
     #[test]
     fn matches_c_output_bit_for_bit_at_n32() {
-        let reference = include_bytes!("../testdata/seed_n32_s20.bin");
+        let reference = include_bytes!("../testdata/stam_n32_s20.bin");
         let ours = run(32, 20).to_le_bytes();
         assert_eq!(ours.len(), reference.len());
         let first = ours.chunks(4).zip(reference.chunks(4)).position(|(a, b)| a != b);
@@ -550,38 +550,38 @@ mod tests {
 
     #[test]
     fn matches_c_checksum_at_n64() {
-        let expected = include_str!("../testdata/seed_n64_s100.fnv1a").trim();
+        let expected = include_str!("../testdata/stam_n64_s100.fnv1a").trim();
         let ours = format!("{:016x}", fnv1a(&run(64, 100).to_le_bytes()));
         assert_eq!(ours, expected);
     }
 
-    /// The wavefront sweep against the seed's literal loop order (i outer, j inner).
+    /// The wavefront sweep against the literal loop order of Stam's C code (i outer, j inner).
     #[test]
-    fn wavefront_sweep_equals_seed_loop_order() {
+    fn wavefront_sweep_equals_c_loop_order() {
         for n in [2, 5, 9, 17] {
             let size = (n + 2) * (n + 2);
             let x0: Vec<f32> = (0..size).map(|k| ((k * 7919) % 101) as f32 * 0.37 - 11.0).collect();
             let mut ours: Vec<f32> = (0..size).map(|k| ((k * 104_729) % 37) as f32 * 0.11).collect();
-            let mut seed = ours.clone();
+            let mut c_order = ours.clone();
             let (a, c) = (0.73f32, 1.0 + 4.0 * 0.73f32);
             gauss_seidel_sweep(n, &mut ours, &x0, a, c);
             for i in 1..=n {
                 for j in 1..=n {
-                    seed[ix(n, i, j)] = (x0[ix(n, i, j)]
-                        + a * (seed[ix(n, i - 1, j)]
-                            + seed[ix(n, i + 1, j)]
-                            + seed[ix(n, i, j - 1)]
-                            + seed[ix(n, i, j + 1)]))
+                    c_order[ix(n, i, j)] = (x0[ix(n, i, j)]
+                        + a * (c_order[ix(n, i - 1, j)]
+                            + c_order[ix(n, i + 1, j)]
+                            + c_order[ix(n, i, j - 1)]
+                            + c_order[ix(n, i, j + 1)]))
                         / c;
                 }
             }
-            assert!(ours.iter().zip(&seed).all(|(a, b)| a.to_bits() == b.to_bits()), "n = {n}");
+            assert!(ours.iter().zip(&c_order).all(|(a, b)| a.to_bits() == b.to_bits()), "n = {n}");
         }
     }
 
     /// Projection lowers the divergence of a smooth field (a wrong sign or scale in the gradient
     /// would raise it). 20 sweeps do not converge: at N = 16 they remove about a third of the
-    /// smoothest mode's divergence, which is what the seed's routine does.
+    /// smoothest mode's divergence, which is what Stam's routine does.
     #[test]
     fn project_reduces_divergence() {
         let n = 16;
@@ -616,16 +616,16 @@ mod tests {
 
     #[test]
     fn rejects_bad_input() {
-        assert!(matches!(SeedFluid::new(1, SeedParams::default()), Err(FluidError::BadGrid { .. })));
-        let p = SeedParams { dt: 0.0, ..SeedParams::default() };
-        assert!(matches!(SeedFluid::new(8, p), Err(FluidError::BadParameter { name: "dt", .. })));
-        let p = SeedParams { visc: -1.0, ..SeedParams::default() };
-        assert!(matches!(SeedFluid::new(8, p), Err(FluidError::BadParameter { name: "visc", .. })));
+        assert!(matches!(StamFluid::new(1, StamParams::default()), Err(FluidError::BadGrid { .. })));
+        let p = StamParams { dt: 0.0, ..StamParams::default() };
+        assert!(matches!(StamFluid::new(8, p), Err(FluidError::BadParameter { name: "dt", .. })));
+        let p = StamParams { visc: -1.0, ..StamParams::default() };
+        assert!(matches!(StamFluid::new(8, p), Err(FluidError::BadParameter { name: "visc", .. })));
     }
 
     #[test]
     fn non_finite_source_is_reported() {
-        let mut f = SeedFluid::new(8, SeedParams::default()).unwrap();
+        let mut f = StamFluid::new(8, StamParams::default()).unwrap();
         f.sources_mut().0[ix(8, 4, 4)] = f32::NAN;
         assert!(matches!(f.step(), Err(FluidError::NonFinite { field: "density", step: 0, .. })));
     }
@@ -636,7 +636,7 @@ mod tests {
     #[test]
     fn overflow_is_reported_and_the_step_undone() {
         let n = 8;
-        let mut f = SeedFluid::new(n, SeedParams { dt: 4.0, ..SeedParams::default() }).unwrap();
+        let mut f = StamFluid::new(n, StamParams { dt: 4.0, ..StamParams::default() }).unwrap();
         for _ in 0..3 {
             f.apply_source_pattern();
             f.step().unwrap();
@@ -670,7 +670,7 @@ mod tests {
         assert_eq!(f.steps(), 3);
         assert_eq!(f.time().to_bits(), before.time().to_bits());
         assert_eq!(f.to_le_bytes(), before.to_le_bytes());
-        let text = |f: &SeedFluid| serde_json::to_string(&f.memory()).unwrap();
+        let text = |f: &StamFluid| serde_json::to_string(&f.memory()).unwrap();
         assert_eq!(text(&f), text(&before), "sources differ");
         // The same step with the force removed goes through.
         f.sources_mut().1[ix(n, 3, 5)] = 0.0;

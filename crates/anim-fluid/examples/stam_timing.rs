@@ -1,10 +1,10 @@
-//! Per-step time of the seed mode (and of the copy its failure guard makes each step): `cargo run --release -p anim-fluid --example seed_timing -- N STEPS`.
+//! Per-step time of Stam's solver (and of the copy its failure guard makes each step): `cargo run --release -p anim-fluid --example stam_timing -- N STEPS`.
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let n: usize = args.get(1).map_or(Ok(128), |s| s.parse())?;
     let steps: usize = args.get(2).map_or(Ok(50), |s| s.parse())?;
-    let mut f = anim_fluid::seed::SeedFluid::new(n, anim_fluid::seed::SeedParams::default())?;
+    let mut f = anim_fluid::stam::StamFluid::new(n, anim_fluid::stam::StamParams::default())?;
     for _ in 0..5 {
         f.apply_source_pattern();
         f.step()?;

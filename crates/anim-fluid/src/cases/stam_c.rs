@@ -1,9 +1,9 @@
-//! The seed mode against the seed's C routines (`xtask/peers/fluid/stable_fluids.c`), compiled
+//! Stam's solver against its C transcription (`xtask/peers/fluid/stable_fluids.c`), compiled
 //! here and run side by side: bit for bit at N = 64 and 128 after 100 steps.
 
 use super::check;
 use crate::FluidError;
-use crate::seed::{SeedFluid, SeedParams};
+use crate::stam::{StamFluid, StamParams};
 use anim_core::cases::{Check, Ctx, Judge};
 use std::path::PathBuf;
 use std::process::Command;
@@ -17,10 +17,10 @@ fn c_dir() -> PathBuf {
     target.join("fluid-c")
 }
 
-/// Compiles the seed's C routines (`xtask/peers/fluid/stable_fluids.c`) with the C compiler
+/// Compiles the C transcription of Stam's routines (`xtask/peers/fluid/stable_fluids.c`) with the C compiler
 /// (`$CC`, else `cc`) and `flags` into the executable `name` in the target directory, and
 /// returns its path. The conformance case runs it with `-O2 -ffp-contract=off` (bit for bit with
-/// the seed mode); `cargo xtask bench --peers` times it with `-O3 -march=native`.
+/// Stam's solver); `cargo xtask bench --peers` times it with `-O3 -march=native`.
 ///
 /// # Errors
 /// A message when the directory cannot be created, the compiler cannot be run or fails.
@@ -43,8 +43,8 @@ pub fn compile_c(name: &str, flags: &[&str]) -> Result<PathBuf, String> {
     Ok(exe)
 }
 
-fn seed_run(n: usize, steps: usize) -> Result<SeedFluid, FluidError> {
-    let mut f = SeedFluid::new(n, SeedParams::default())?;
+fn stam_run(n: usize, steps: usize) -> Result<StamFluid, FluidError> {
+    let mut f = StamFluid::new(n, StamParams::default())?;
     for _ in 0..steps {
         f.apply_source_pattern();
         f.step()?;
@@ -52,9 +52,9 @@ fn seed_run(n: usize, steps: usize) -> Result<SeedFluid, FluidError> {
     Ok(f)
 }
 
-pub(super) fn seed_bitwise(_ctx: &Ctx) -> Vec<Check> {
-    let case = "seed vs C (cc -O2 -ffp-contract=off), 100 steps";
-    let src = "xtask/peers/fluid/stable_fluids.c (seed 6.2)";
+pub(super) fn stam_bitwise(_ctx: &Ctx) -> Vec<Check> {
+    let case = "Stam's solver vs C (cc -O2 -ffp-contract=off), 100 steps";
+    let src = "xtask/peers/fluid/stable_fluids.c (Stam 2003)";
     let exe = match compile_c("stable_fluids_exact", &["-O2", "-ffp-contract=off"]) {
         Ok(e) => e,
         Err(e) => {
@@ -64,14 +64,14 @@ pub(super) fn seed_bitwise(_ctx: &Ctx) -> Vec<Check> {
     };
     let mut out = Vec::new();
     for n in [64, 128] {
-        let file = c_dir().join(format!("seed_{n}.bin"));
+        let file = c_dir().join(format!("stam_{n}.bin"));
         let ok = Command::new(&exe)
             .args(["dump", &n.to_string(), "100"])
             .arg(&file)
             .status()
             .is_ok_and(|s| s.success());
         let c_bytes = if ok { std::fs::read(&file).unwrap_or_default() } else { Vec::new() };
-        let ours = seed_run(n, 100).map(|f| f.to_le_bytes()).unwrap_or_default();
+        let ours = stam_run(n, 100).map(|f| f.to_le_bytes()).unwrap_or_default();
         let differing = if c_bytes.len() == ours.len() && !ours.is_empty() {
             ours.chunks(4).zip(c_bytes.chunks(4)).filter(|(a, b)| a != b).count() as f64
         } else {
