@@ -4,7 +4,7 @@
 
 use crate::machine::Machine;
 use crate::peers::ratios::{self, PeerRow};
-use crate::registry::{Ctx, StudyResult, fmt_num};
+use crate::registry::{Ctx, StudyResult, StudyUse, fmt_num};
 use crate::report_data::{self, Data, Kind, Part};
 use crate::scaling;
 use crate::suites::{self, ConformanceRun, StabilityRun};
@@ -16,17 +16,12 @@ use std::time::Instant;
 /// Tolerances of the "cheapest method" tables.
 pub const TOLERANCES: [f64; 6] = [1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8];
 
-/// Tolerances a study adds to [`TOLERANCES`] in its cheapest-method tables (its table in
-/// `index.md` and its picks in `cheapest.json`): `(study slug, extra tolerances)`.
-const EXTRA_TOLERANCES: [(&str, &[f64]); 1] =
-    [(anim_flip::cases::DAM_BREAK_SLUG, anim_flip::cases::DAM_BREAK_TOLERANCES)];
-
-/// The tolerances of `study`'s cheapest-method tables: [`TOLERANCES`] and its extra ones
-/// ([`EXTRA_TOLERANCES`]), largest first.
-pub fn tolerances(study: &StudyResult) -> Vec<f64> {
+/// The tolerances of `study`'s cheapest-method tables: [`TOLERANCES`] and the extra ones its
+/// crate registered for it (`StudyUse::extra_tolerances`), largest first.
+pub fn tolerances(study: &StudyResult, uses: &[StudyUse]) -> Vec<f64> {
     let mut tols = TOLERANCES.to_vec();
-    for (_, extra) in EXTRA_TOLERANCES.iter().filter(|(slug, _)| *slug == study.slug) {
-        tols.extend(extra.iter().filter(|t| !TOLERANCES.contains(t)));
+    for u in uses.iter().filter(|u| u.study == study.slug) {
+        tols.extend(u.extra_tolerances.iter().filter(|t| !TOLERANCES.contains(t)));
     }
     tols.sort_by(|a, b| b.total_cmp(a));
     tols
@@ -34,71 +29,6 @@ pub fn tolerances(study: &StudyResult) -> Vec<f64> {
 
 /// Tolerances of the headline table.
 const HEADLINE: [f64; 3] = [1e-1, 1e-2, 1e-3];
-
-/// A study whose problem a scene of `anim run` runs (or shares its method settings with), for
-/// `anim run --tolerance`.
-pub struct SceneFamily {
-    /// The study's slug.
-    pub study: &'static str,
-    /// `KIND` (any scene of that kind) or `KIND/PRESET` (that preset only).
-    pub scene: &'static str,
-    /// Simulated time the study measured over (`None`: the error is not a trajectory's, e.g. a
-    /// steady state or one pressure projection).
-    pub horizon: Option<f64>,
-    /// The study problem's parameters the picker scales by (names and values).
-    pub problem: fn(quick: bool) -> Vec<(&'static str, f64)>,
-}
-
-fn no_problem(_quick: bool) -> Vec<(&'static str, f64)> {
-    Vec::new()
-}
-
-/// The studies `anim run --tolerance` picks from.
-pub const SCENE_FAMILIES: [SceneFamily; 8] = [
-    SceneFamily {
-        study: "core-oscillator",
-        scene: "harmonic-oscillator",
-        horizon: Some(anim_core::cases::core::OSCILLATOR_HORIZON),
-        problem: no_problem,
-    },
-    SceneFamily {
-        study: "core-kepler",
-        scene: "kepler-orbit",
-        horizon: Some(anim_core::cases::core::KEPLER_HORIZON),
-        problem: no_problem,
-    },
-    SceneFamily {
-        study: "springs-cloth",
-        scene: "springs/hanging-cloth",
-        horizon: Some(0.25),
-        problem: anim_springs::cases::study_problem,
-    },
-    SceneFamily {
-        study: "fem-beam",
-        scene: "fem/cantilever-beam",
-        horizon: Some(0.5),
-        problem: anim_fem::cases::study_problem,
-    },
-    SceneFamily {
-        study: "fluid_cavity_ghia",
-        scene: "fluid/lid-driven-cavity",
-        horizon: None,
-        problem: anim_fluid::cases::ghia_study_problem,
-    },
-    SceneFamily {
-        study: "fluid_pressure_divergence",
-        scene: "fluid/smoke-plume-3d",
-        horizon: None,
-        problem: no_problem,
-    },
-    SceneFamily {
-        study: "pbd-cloth-position",
-        scene: "pbd/hanging-cloth",
-        horizon: Some(anim_pbd::cases::STUDY_T),
-        problem: anim_pbd::cases::study_problem,
-    },
-    SceneFamily { study: "mpm_dam_break", scene: "mpm/dam-break-2d", horizon: None, problem: no_problem },
-];
 
 /// Everything the report shows.
 pub struct Report {
@@ -121,6 +51,9 @@ pub struct Report {
     pub seconds: f64,
     /// Whether `soak.md` (from `stability --long`) is beside the index.
     pub soak: bool,
+    /// What the crates registered their studies to serve (`--tolerance` scenes, extra
+    /// tolerances).
+    pub study_uses: Vec<StudyUse>,
 }
 
 /// Runs the report into `out`. With `filter`, only the conformance cases, hard cases, studies and
@@ -286,6 +219,7 @@ impl Report {
             machine: data.machine.clone(),
             seconds: data.parts.iter().map(|p| p.seconds).sum(),
             soak,
+            study_uses: anim::cases().study_uses,
         }
     }
 }
@@ -396,17 +330,17 @@ pub fn cheapest_table(r: &Report) -> CheapestTable {
         .studies
         .iter()
         .map(|(krate, s)| {
-            let scene = SCENE_FAMILIES.iter().find(|f| f.study == s.slug);
+            let scene = r.study_uses.iter().find(|u| u.study == s.slug && u.scene.is_some());
             Family {
                 study: s.slug.clone(),
                 krate: (*krate).into(),
                 title: s.title.clone(),
                 error: s.error_label.clone(),
                 param: s.param_label.clone(),
-                scene: scene.map(|f| f.scene.to_string()),
-                horizon: scene.and_then(|f| f.horizon),
+                scene: scene.and_then(|u| u.scene).map(str::to_string),
+                horizon: scene.and_then(|u| u.horizon),
                 problem: scene
-                    .map(|f| (f.problem)(r.quick).into_iter().map(|(k, v)| (k.to_string(), v)).collect())
+                    .map(|u| (u.problem)(r.quick).into_iter().map(|(k, v)| (k.to_string(), v)).collect())
                     .unwrap_or_default(),
                 series: s
                     .series
@@ -421,7 +355,7 @@ pub fn cheapest_table(r: &Report) -> CheapestTable {
                             .collect(),
                     })
                     .collect(),
-                picks: tolerances(s)
+                picks: tolerances(s, &r.study_uses)
                     .into_iter()
                     .map(|tol| match cheapest(s, tol) {
                         Some((method, param, seconds, error)) => Pick {
@@ -510,7 +444,7 @@ pub fn index_markdown(r: &Report) -> String {
     let _ = writeln!(md, "\n## Work-precision studies\n");
     for (krate, s) in &r.studies {
         let _ = writeln!(md, "<a id=\"{}\"></a>\n", s.slug);
-        md.push_str(&study_markdown(krate, s));
+        md.push_str(&study_markdown(krate, s, &r.study_uses));
     }
     let _ = writeln!(md, "## Thread scaling\n");
     let _ = writeln!(
@@ -587,7 +521,7 @@ pub fn cheapest(result: &StudyResult, tol: f64) -> Option<(String, f64, f64, f64
         .map(|(s, p)| (s.label.clone(), p.param, p.seconds, p.error))
 }
 
-fn study_markdown(crate_name: &str, r: &StudyResult) -> String {
+fn study_markdown(crate_name: &str, r: &StudyResult, uses: &[StudyUse]) -> String {
     let mut md = String::new();
     let _ = writeln!(md, "### {} ({crate_name})\n", r.title);
     let _ = writeln!(md, "![{}]({}.svg)\n", r.title, r.slug);
@@ -598,7 +532,7 @@ fn study_markdown(crate_name: &str, r: &StudyResult) -> String {
         "| tolerance | method | {} | wall time | error |\n| --- | --- | --- | --- | --- |",
         r.param_label
     );
-    for tol in tolerances(r) {
+    for tol in tolerances(r, uses) {
         match cheapest(r, tol) {
             Some((label, param, secs, err)) => {
                 let _ = writeln!(

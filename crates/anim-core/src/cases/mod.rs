@@ -185,6 +185,41 @@ pub struct Study {
     pub run: fn(&Ctx) -> StudyResult,
 }
 
+/// What a study's measurements serve besides its report section: the scenes `anim run
+/// --tolerance` picks a method for from its points, and extra tolerances for its
+/// cheapest-method tables.
+#[derive(Debug, Clone, Copy)]
+pub struct StudyUse {
+    /// The study's slug ([`StudyResult::slug`]).
+    pub study: &'static str,
+    /// The scenes it measures: a kind (`"harmonic-oscillator"`, any scene of it) or kind and
+    /// preset joined by a slash (`"fem/cantilever-beam"`, that preset only); `None` when no
+    /// scene picks from it.
+    pub scene: Option<&'static str>,
+    /// Simulated time the study measured over (`None`: the error is not a trajectory's, e.g. a
+    /// steady state or one pressure projection).
+    pub horizon: Option<f64>,
+    /// The study problem's parameters the picker scales by (names and values), quick or full.
+    pub problem: fn(quick: bool) -> Vec<(&'static str, f64)>,
+    /// Tolerances added to the standard ones in its cheapest-method tables.
+    pub extra_tolerances: &'static [f64],
+}
+
+impl StudyUse {
+    /// The study `study` serves the scenes `scene`, measured over `horizon`, with no problem
+    /// parameters and no extra tolerances (set them with struct update syntax).
+    #[must_use]
+    pub const fn scene(study: &'static str, scene: &'static str, horizon: Option<f64>) -> Self {
+        Self { study, scene: Some(scene), horizon, problem: no_problem, extra_tolerances: &[] }
+    }
+}
+
+/// A study problem without parameters to scale by.
+#[must_use]
+pub fn no_problem(_quick: bool) -> Vec<(&'static str, f64)> {
+    Vec::new()
+}
+
 /// Everything registered.
 #[derive(Default)]
 pub struct Registry {
@@ -196,6 +231,8 @@ pub struct Registry {
     pub studies: Vec<Study>,
     /// Soak runs.
     pub soak: Vec<SoakCase>,
+    /// What the studies' measurements serve (scenes for `--tolerance`, extra tolerances).
+    pub study_uses: Vec<StudyUse>,
 }
 
 /// Median wall time of `f`, in seconds: repeats `f` in batches until each batch lasts at least

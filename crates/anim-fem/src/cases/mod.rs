@@ -23,7 +23,7 @@ use crate::generate::box_mesh;
 use crate::material::{Material, MaterialModel};
 use crate::model::{EARTH_GRAVITY, FemModel};
 use crate::sim::{FemParams, FemSimulation};
-use anim_core::cases::{ConformanceCase, Outcome, Registry, SoakCase, StabilityCase, Study};
+use anim_core::cases::{ConformanceCase, Outcome, Registry, SoakCase, StabilityCase, Study, StudyUse};
 use conformance::{material_derivatives, patch_and_momentum};
 use hard_cases::{
     explicit_divergence, graded, inverted_recovery_fc, inverted_recovery_snh, near_incompressible,
@@ -101,6 +101,10 @@ pub fn register(r: &mut Registry) {
         run: explicit_divergence,
     });
     r.studies.push(Study { crate_name: CRATE, name: "FEM beam work-precision", run: beam_study });
+    r.study_uses.push(StudyUse {
+        problem: study_problem,
+        ..StudyUse::scene("fem-beam", "fem/cantilever-beam", Some(0.5))
+    });
     r.soak.push(SoakCase {
         crate_name: CRATE,
         name: "E = 1e8 Pa stable Neo-Hookean cantilever, backward Euler at dt = 1/24 s",

@@ -52,7 +52,7 @@ const STUDY_YOUNG: f64 = 1e6;
 const STUDY_CELLS: usize = 2;
 
 /// The study problem's parameters `anim run --tolerance` scales a picked step by: Young's modulus
-/// (Pa), density (kg/m^3, [`cantilever_dynamic`]'s) and cell size (m).
+/// (Pa), density (kg/m^3, `cantilever_dynamic`'s) and cell size (m).
 pub fn study_problem(_quick: bool) -> Vec<(&'static str, f64)> {
     vec![("young", STUDY_YOUNG), ("density", CANTILEVER_DENSITY), ("cell", 0.1 / STUDY_CELLS as f64)]
 }

@@ -20,7 +20,7 @@ pub use stam_c::compile_c;
 pub use study::ghia_study_problem;
 
 use anim_core::cases::{
-    Check, ConformanceCase, Ctx, Judge, Outcome, Registry, SoakCase, StabilityCase, Study,
+    Check, ConformanceCase, Ctx, Judge, Outcome, Registry, SoakCase, StabilityCase, Study, StudyUse,
 };
 
 const CRATE: &str = "anim-fluid";
@@ -90,6 +90,11 @@ pub fn register(r: &mut Registry) {
         name: "advection and splitting: Taylor-Green error vs time",
         run: study::study_taylor_green,
     });
+    r.study_uses.push(StudyUse {
+        problem: study::ghia_study_problem,
+        ..StudyUse::scene("fluid_cavity_ghia", "fluid/lid-driven-cavity", None)
+    });
+    r.study_uses.push(StudyUse::scene("fluid_pressure_divergence", "fluid/smoke-plume-3d", None));
     r.soak.push(SoakCase {
         crate_name: CRATE,
         name: "vortex in a box at CFL 10, semi-Lagrangian, 64x64 MAC",

@@ -19,7 +19,7 @@ mod soak;
 pub use dam_break::{DamBreak, MARTIN_MOYCE, dam_break, front_errors, shifted_errors};
 pub use peers::{PeerRun, peer_benchmark};
 
-use anim_core::cases::{ConformanceCase, Outcome, Registry, SoakCase, StabilityCase, Study};
+use anim_core::cases::{ConformanceCase, Outcome, Registry, SoakCase, StabilityCase, Study, StudyUse};
 use bodies::{colliding_disks, resting_block};
 use conservation::conservation;
 use dam_break::{dam_break_case, dam_break_study};
@@ -104,6 +104,7 @@ pub fn register(r: &mut Registry) {
     });
 
     r.studies.push(Study { crate_name: CRATE, name: "MPM dam break surge front", run: dam_break_study });
+    r.study_uses.push(StudyUse::scene("mpm_dam_break", "mpm/dam-break-2d", None));
     r.soak.push(SoakCase {
         crate_name: CRATE,
         name: "three materials (elastic, snow, fluid) in a box, MLS-MPM, 64 cells",

@@ -19,7 +19,7 @@ mod peer;
 mod soak;
 mod study;
 
-use anim_core::cases::{ConformanceCase, Outcome, Registry, StabilityCase, Study};
+use anim_core::cases::{ConformanceCase, Outcome, Registry, StabilityCase, Study, StudyUse};
 use conformance::{CRATE, determinism, gradients, momentum, pbd_stiffness, xpbd_chain};
 use hard_cases::{
     coincident, degenerate_rest, injected_nan, invalid_input, mass_ratio, over_stretched, pins_next_to_free,
@@ -119,6 +119,10 @@ pub fn register(r: &mut Registry) {
         crate_name: CRATE,
         name: "PBD hanging cloth: constraint error",
         run: cloth_constraint_study,
+    });
+    r.study_uses.push(StudyUse {
+        problem: study_problem,
+        ..StudyUse::scene("pbd-cloth-position", "pbd/hanging-cloth", Some(STUDY_T))
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,

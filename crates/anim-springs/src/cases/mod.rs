@@ -17,7 +17,7 @@ mod study;
 pub use peer::{PeerRun, peer_symplectic_cloth};
 pub use study::study_problem;
 
-use anim_core::cases::{ConformanceCase, Outcome, Registry, StabilityCase, Study};
+use anim_core::cases::{ConformanceCase, Outcome, Registry, StabilityCase, Study, StudyUse};
 use anim_core::integrate::IntegratorKind;
 
 const CRATE: &str = "anim-springs";
@@ -113,6 +113,10 @@ pub fn register(r: &mut Registry) {
         crate_name: CRATE,
         name: "integrators and linear solvers on the cloth",
         run: study::cloth_study,
+    });
+    r.study_uses.push(StudyUse {
+        problem: study::study_problem,
+        ..StudyUse::scene("springs-cloth", "springs/hanging-cloth", Some(0.25))
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,

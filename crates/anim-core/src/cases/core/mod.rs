@@ -9,7 +9,7 @@ mod study;
 
 pub use study::{KEPLER_HORIZON, OSCILLATOR_HORIZON};
 
-use crate::cases::{ConformanceCase, Outcome, Registry, StabilityCase, Study};
+use crate::cases::{ConformanceCase, Outcome, Registry, StabilityCase, Study, StudyUse};
 use crate::integrate::study::advance;
 use crate::integrate::systems::{HarmonicOscillator, KeplerOrbit};
 use crate::integrate::{Integrator, IntegratorKind, NewtonParams, State};
@@ -112,6 +112,9 @@ pub fn register(r: &mut Registry) {
         name: "integrators on the Kepler orbit",
         run: study::kepler_study,
     });
+    // `anim run --tolerance` picks an integrator for the oscillator and Kepler kinds from these.
+    r.study_uses.push(StudyUse::scene("core-oscillator", "harmonic-oscillator", Some(OSCILLATOR_HORIZON)));
+    r.study_uses.push(StudyUse::scene("core-kepler", "kepler-orbit", Some(KEPLER_HORIZON)));
 
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
