@@ -4,12 +4,12 @@
 //! XPBD's static stretch of a hanging chain for every iteration count and time step,
 //! PBD's effective stiffness against both, momentum conservation of every internal constraint
 //! with unequal masses, constraint gradients against finite differences, determinism across
-//! thread counts ([`conformance`], on the chain of [`chain`]; the cloth drape on 1, 2 and 4 threads:
-//! [`determinism`]); hard cases (1000:1 mass ratio, 10x
+//! thread counts (`conformance`, on the chain of `chain`; the cloth drape on 1, 2 and 4 threads:
+//! `determinism`); hard cases (1000:1 mass ratio, 10x
 //! over-stretch, pins next to free particles, zero compliance, coincident and degenerate
-//! stencils, bad input, an injected NaN: [`hard_cases`]); a work-precision study on the hanging
-//! cloth (PBD vs XPBD, iterations vs substeps: [`study`]); and the timed runs of
-//! `cargo xtask bench --peers` ([`peer`]); a soak run of the cloth drape ([`soak`]).
+//! stencils, bad input, an injected NaN: `hard_cases`); a work-precision study on the hanging
+//! cloth (PBD vs XPBD, iterations vs substeps: `study`); and the timed runs of
+//! `cargo xtask bench --peers` (`peer`); a soak run of the cloth drape (`soak`).
 
 mod chain;
 mod conformance;

@@ -1,15 +1,15 @@
 //! The crate's conformance checks, hard cases, soak runs and studies (feature `cases`): run by
 //! its own tests in quick mode and by `cargo xtask conformance`, `stability` and `report`.
 //!
-//! Kinematics ([`kinematics`]): frame placements, Jacobians and their time derivatives against
+//! Kinematics (`kinematics`): frame placements, Jacobians and their time derivatives against
 //! Pinocchio on the Panda and the UR5; Jacobians against finite differences; the three forms of
 //! forward kinematics; Paden-Kahan subproblems on random solvable instances; analytic IK
-//! solutions reproducing their targets. Hard cases of inverse kinematics ([`ik`]): IK at
+//! solutions reproducing their targets. Hard cases of inverse kinematics (`ik`): IK at
 //! singularities, unreachable targets, workspace-boundary targets, and the numerical IK success
-//! rate on the Panda. Dynamics ([`dynamics`]): RNEA, CRBA, ABA against Pinocchio, cross-checks,
+//! rate on the Panda. Dynamics (`dynamics`): RNEA, CRBA, ABA against Pinocchio, cross-checks,
 //! steppers, the T-handle, their hard cases and the work-precision study. Determinism of the
-//! Panda swing across thread counts ([`determinism`]) and a soak run of the pendulum chain
-//! ([`soak`]).
+//! Panda swing across thread counts (`determinism`) and a soak run of the pendulum chain
+//! (`soak`).
 
 mod determinism;
 mod dynamics;
