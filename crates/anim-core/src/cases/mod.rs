@@ -10,7 +10,9 @@ pub mod float;
 mod soak;
 mod threads;
 
-pub use soak::{Budget, Clock, Soak, SoakCase, drive, finish, rejected};
+pub use soak::{
+    Budget, Clock, ENERGY_STRIDE, Soak, SoakCase, drive, energy_above, energy_exceeds, finish, rejected,
+};
 pub use threads::{across_threads, differing_bits};
 
 use std::time::Instant;

@@ -124,3 +124,18 @@ pub struct SoakCase {
     /// Runs the case within the budget.
     pub run: fn(Budget) -> Soak,
 }
+
+/// Steps (or frames) between the energy checks of a soak case.
+pub const ENERGY_STRIDE: u64 = 10;
+
+/// Whether energy `e` is above the initial `e0` beyond rounding (relative `1e-9`); true for NaN.
+#[must_use]
+pub fn energy_exceeds(e: f64, e0: f64) -> bool {
+    !(e <= e0 + 1e-9 * e0.abs().max(1e-12))
+}
+
+/// The detail of an energy bound broken at step `k`.
+#[must_use]
+pub fn energy_above(k: u64, e: f64, e0: f64) -> String {
+    format!("step {k}: energy {e} J above its initial value {e0} J")
+}

@@ -7,21 +7,10 @@ use crate::generate;
 use crate::material::{Material, MaterialModel};
 use crate::model::{EARTH_GRAVITY, FemModel};
 use crate::sim::{FemParams, FemSimulation};
-use anim_core::cases::{Budget, Soak, drive, finish, fmt_num, rejected};
+use anim_core::cases::{
+    Budget, ENERGY_STRIDE, Soak, drive, energy_above, energy_exceeds, finish, fmt_num, rejected,
+};
 use anim_core::solver::Solver;
-
-/// Energy-check stride (steps).
-const STRIDE: u64 = 10;
-
-/// Whether `e` is above `e0` beyond rounding.
-fn exceeds(e: f64, e0: f64) -> bool {
-    !(e <= e0 + 1e-9 * e0.abs().max(1e-12))
-}
-
-/// The error text of a bound broken at step `k`.
-fn above(k: u64, e: f64, e0: f64) -> String {
-    format!("step {k}: energy {e} J above its initial value {e0} J")
-}
 
 pub(super) fn fem_stiff_beam(budget: Budget) -> Soak {
     let setup = || -> Result<FemSimulation, FemError> {
@@ -42,10 +31,10 @@ pub(super) fn fem_stiff_beam(budget: Budget) -> Soak {
     let mut last = e0;
     let clock = match drive(budget, dt, |k| {
         sim.step(&mut state, dt).map_err(|e| e.to_string())?;
-        if k.is_multiple_of(STRIDE) {
+        if k.is_multiple_of(ENERGY_STRIDE) {
             last = sim.total_energy(&state);
-            if exceeds(last, e0) {
-                return Err(above(k, last, e0));
+            if energy_exceeds(last, e0) {
+                return Err(energy_above(k, last, e0));
             }
         }
         Ok(())
@@ -55,7 +44,7 @@ pub(super) fn fem_stiff_beam(budget: Budget) -> Soak {
     };
     let tip = state.x.chunks(3).map(|p| p[2]).fold(f64::INFINITY, f64::min);
     let d = format!(
-        "20x2x2 cells (240 tets); total energy {} -> {} J, checked every {STRIDE} steps; lowest point z = {} m",
+        "20x2x2 cells (240 tets); total energy {} -> {} J, checked every {ENERGY_STRIDE} steps; lowest point z = {} m",
         fmt_num(e0),
         fmt_num(last),
         fmt_num(tip)

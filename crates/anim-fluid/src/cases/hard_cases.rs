@@ -5,16 +5,10 @@ use crate::advection::Advection;
 use crate::mac::{MacFluid, MacParams, MacState};
 use crate::scenes::{self, FluidSim};
 use crate::stam::{StamFluid, StamParams};
-use anim_core::cases::{Budget, Ctx, Outcome, Soak, drive, finish, fmt_num, rejected};
+use anim_core::cases::{
+    Budget, Ctx, ENERGY_STRIDE, Outcome, Soak, drive, energy_exceeds, finish, fmt_num, rejected,
+};
 use std::f64::consts::PI;
-
-/// Energy stride of the soak run.
-const STRIDE: u64 = 10;
-
-/// Whether `e` is above `e0` beyond rounding.
-fn exceeds(e: f64, e0: f64) -> bool {
-    !(e <= e0 + 1e-9 * e0.abs().max(1e-12))
-}
 
 pub(super) fn cfl10(_ctx: &Ctx) -> Outcome {
     let (n, speed) = (64, 1.0);
@@ -154,10 +148,10 @@ pub(super) fn soak_cfl10(budget: Budget) -> Soak {
     let mut last = e0;
     let clock = match drive(budget, dt, |k| {
         f.advance(&mut s, dt).map_err(|e| e.to_string())?;
-        if k.is_multiple_of(STRIDE) {
+        if k.is_multiple_of(ENERGY_STRIDE) {
             last = kinetic(&s);
             let (lo, hi) = s.density.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
-            if exceeds(last, e0) || lo < -1e-12 || hi > 1.0 + 1e-12 {
+            if energy_exceeds(last, e0) || lo < -1e-12 || hi > 1.0 + 1e-12 {
                 return Err(format!(
                     "step {k}: kinetic energy {last} (initial {e0}), density in [{lo}, {hi}]"
                 ));
@@ -169,7 +163,7 @@ pub(super) fn soak_cfl10(budget: Budget) -> Soak {
         Err(s) => return s,
     };
     let d = format!(
-        "kinetic energy per unit area {} -> {}, checked every {STRIDE} steps",
+        "kinetic energy per unit area {} -> {}, checked every {ENERGY_STRIDE} steps",
         fmt_num(e0),
         fmt_num(last)
     );

@@ -2,20 +2,9 @@
 //! MLS-MPM at 64 cells, stepped for `10^5` frames or ten minutes, its kinetic plus gravitational
 //! energy checked every few frames against its initial value.
 
-use anim_core::cases::{Budget, Soak, drive, finish, fmt_num, rejected};
-
-/// Energy-check stride (frames).
-const STRIDE: u64 = 10;
-
-/// Whether `e` is above `e0` beyond rounding.
-fn exceeds(e: f64, e0: f64) -> bool {
-    !(e <= e0 + 1e-9 * e0.abs().max(1e-12))
-}
-
-/// The error text of a bound broken at step `k`.
-fn above(k: u64, e: f64, e0: f64) -> String {
-    format!("step {k}: energy {e} J above its initial value {e0} J")
-}
+use anim_core::cases::{
+    Budget, ENERGY_STRIDE, Soak, drive, energy_above, energy_exceeds, finish, fmt_num, rejected,
+};
 
 /// Kinetic plus gravitational energy of the particles (their elastic energy is not negative, so
 /// this sum may not exceed the initial total of a dissipative run that starts at rest shape).
@@ -42,10 +31,10 @@ pub(super) fn mpm_three_materials(budget: Budget) -> Soak {
     let (mut last, mut substeps) = (e0, 0usize);
     let clock = match drive(budget, dt, |k| {
         substeps += scene.sim.advance(&mut scene.state, dt).map_err(|e| e.to_string())?.substeps;
-        if k.is_multiple_of(STRIDE) {
+        if k.is_multiple_of(ENERGY_STRIDE) {
             last = mpm_energy(&scene.state, g);
-            if exceeds(last, e0) {
-                return Err(above(k, last, e0));
+            if energy_exceeds(last, e0) {
+                return Err(energy_above(k, last, e0));
             }
         }
         Ok(())
@@ -54,7 +43,7 @@ pub(super) fn mpm_three_materials(budget: Budget) -> Soak {
         Err(s) => return s,
     };
     let d = format!(
-        "{} particles, {substeps} substeps; kinetic + gravitational energy {} -> {} J, checked every {STRIDE} frames",
+        "{} particles, {substeps} substeps; kinetic + gravitational energy {} -> {} J, checked every {ENERGY_STRIDE} frames",
         scene.state.len(),
         fmt_num(e0),
         fmt_num(last)

@@ -2,10 +2,9 @@
 //! on a 24x24 cloth draped on a sphere, its kinetic and gravitational energy checked on a fixed
 //! stride.
 
-use anim_core::cases::{Budget, Soak, SoakCase, drive, finish, fmt_num, rejected};
-
-/// Energy-stride of the soak run.
-const STRIDE: u64 = 10;
+use anim_core::cases::{
+    Budget, ENERGY_STRIDE, Soak, SoakCase, drive, energy_above, energy_exceeds, finish, fmt_num, rejected,
+};
 
 /// The cloth-drape soak case.
 pub(super) const DRAPE: SoakCase = SoakCase {
@@ -14,16 +13,6 @@ pub(super) const DRAPE: SoakCase = SoakCase {
     bound: "kinetic + gravitational energy never above its initial value",
     run: drape,
 };
-
-/// Whether `e` is above `e0` beyond rounding.
-fn exceeds(e: f64, e0: f64) -> bool {
-    !(e <= e0 + 1e-9 * e0.abs().max(1e-12))
-}
-
-/// The error text of a bound broken at step `k`.
-fn above(k: u64, e: f64, e0: f64) -> String {
-    format!("step {k}: energy {e} J above its initial value {e0} J")
-}
 
 fn drape(budget: Budget) -> Soak {
     let scene = crate::scenes::cloth_drape(Some(24)).map_err(|e| e.to_string());
@@ -36,10 +25,10 @@ fn drape(budget: Budget) -> Soak {
     let mut last = e0;
     let clock = match drive(budget, dt, |k| {
         sim.advance(&mut state, dt).map_err(|e| e.to_string())?;
-        if k.is_multiple_of(STRIDE) {
+        if k.is_multiple_of(ENERGY_STRIDE) {
             last = sim.model().kinetic_and_gravity_energy(&state.x, &state.v);
-            if exceeds(last, e0) {
-                return Err(above(k, last, e0));
+            if energy_exceeds(last, e0) {
+                return Err(energy_above(k, last, e0));
             }
         }
         Ok(())
@@ -61,7 +50,7 @@ fn drape(budget: Budget) -> Soak {
         }
     }
     let d = format!(
-        "kinetic + gravitational energy {} -> {} J, checked every {STRIDE} steps; largest distance strain at the end {}",
+        "kinetic + gravitational energy {} -> {} J, checked every {ENERGY_STRIDE} steps; largest distance strain at the end {}",
         fmt_num(e0),
         fmt_num(last),
         fmt_num(strain)

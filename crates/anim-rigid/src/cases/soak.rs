@@ -1,11 +1,8 @@
 //! The pendulum-chain soak run (`cargo xtask stability --long`): `10^5` steps or ten minutes of
 //! RK4 on a 32-link chain falling from horizontal, its energy checked on a fixed stride.
 
-use anim_core::cases::{Budget, Soak, SoakCase, drive, finish, fmt_num, rejected};
+use anim_core::cases::{Budget, ENERGY_STRIDE, Soak, SoakCase, drive, finish, fmt_num, rejected};
 use anim_core::solver::Solver;
-
-/// Energy-stride of the soak run.
-const STRIDE: u64 = 10;
 
 /// The pendulum-chain soak case.
 pub(super) const CHAIN: SoakCase = SoakCase {
@@ -31,7 +28,7 @@ fn chain(budget: Budget) -> Soak {
     let (mut gain, mut loss) = (0.0f64, 0.0f64);
     let clock = match drive(budget, dt, |k| {
         sim.step(&mut state, dt).map_err(|e| e.to_string())?;
-        if k.is_multiple_of(STRIDE) {
+        if k.is_multiple_of(ENERGY_STRIDE) {
             let de = sim.energy(&state) - e0;
             gain = gain.max(de);
             loss = loss.max(-de);
@@ -45,7 +42,7 @@ fn chain(budget: Budget) -> Soak {
         Err(s) => return s,
     };
     let d = format!(
-        "largest energy gain {} J ({} of m g L = {} J), largest loss {} J ({}; RK4 is not symplectic and dissipates slowly), checked every {STRIDE} steps",
+        "largest energy gain {} J ({} of m g L = {} J), largest loss {} J ({}; RK4 is not symplectic and dissipates slowly), checked every {ENERGY_STRIDE} steps",
         fmt_num(gain),
         fmt_num(gain / scale),
         fmt_num(scale),

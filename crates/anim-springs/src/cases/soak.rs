@@ -1,10 +1,7 @@
 //! The stiff-cloth soak run (`cargo xtask stability --long`): `10^5` steps or ten minutes of
 //! linearised backward Euler on a k = 1e6 cloth, its energy and stretch checked on a fixed stride.
 
-use anim_core::cases::{Budget, Soak, SoakCase, drive, finish, fmt_num, rejected};
-
-/// Energy-stride of the soak run.
-const STRIDE: u64 = 10;
+use anim_core::cases::{Budget, ENERGY_STRIDE, Soak, SoakCase, drive, finish, fmt_num, rejected};
 
 /// The stiff-cloth soak case.
 pub(super) const STIFF_CLOTH: SoakCase = SoakCase {
@@ -29,7 +26,7 @@ fn stiff_cloth(budget: Budget) -> Soak {
     let (mut last, mut stretch, mut early, mut late) = (e0, 0.0f64, 0.0f64, 0.0f64);
     let clock = match drive(budget, dt, |k| {
         sim.advance(&mut state, dt).map_err(|e| e.to_string())?;
-        if k.is_multiple_of(STRIDE) {
+        if k.is_multiple_of(ENERGY_STRIDE) {
             last = sim.network_mut().energy_parts(&state.x, &state.v).total();
             stretch = stretch.max(sim.network().max_stretch(&state.x).map_or(f64::NAN, |s| s.ratio));
             let excess = (last - e0).max(0.0);
@@ -48,7 +45,7 @@ fn stiff_cloth(budget: Budget) -> Soak {
         Err(s) => return s,
     };
     let d = format!(
-        "energy {} -> {} J, checked every {STRIDE} steps; largest excess over the initial energy {} J in the first tenth, {} J after it; max stretch ratio {}",
+        "energy {} -> {} J, checked every {ENERGY_STRIDE} steps; largest excess over the initial energy {} J in the first tenth, {} J after it; max stretch ratio {}",
         fmt_num(e0),
         fmt_num(last),
         fmt_num(early),
