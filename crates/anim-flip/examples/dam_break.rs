@@ -5,7 +5,7 @@
 //!
 //! A water column `a x 2a` (`a = 0.2 m`) collapses along the floor of a 1 m tank. The surge front
 //! `Z = (x_front - x0) / a` (the rightmost particle) is compared with the experiment's readings at
-//! `T = t sqrt(2 g / a)` (Martin & Moyce's tables 2 and 6, `REFERENCES.md`, as anim-mpm's dam
+//! `T = t sqrt(2 g / a)` (Martin & Moyce's tables 2 and 6, as anim-mpm's dam
 //! break holds them; the readings advance in steps of a quarter inch, 0.11 in `Z`). Printed per
 //! run: the front at each reading, the largest and rms relative error, the same with the time
 //! origin shifted by the `dT` in `[0, 0.6]` that minimises the largest error (the experiment's

@@ -77,7 +77,7 @@ pub(super) fn dam_break_case(ctx: &Ctx) -> Vec<Check> {
             "2D dam break a = 0.2 m, {n} cells/m, 2x2 ppc, {}, {walls} walls; Z = {detail}",
             transfer.name()
         );
-        let source = "Martin & Moyce (1952) tables 2 and 6 (REFERENCES.md)";
+        let source = "Martin & Moyce (1952) tables 2 and 6";
         checks.push(Check {
             crate_name: CRATE,
             case: case.clone(),
@@ -114,7 +114,7 @@ pub(super) fn dam_break_case(ctx: &Ctx) -> Vec<Check> {
             reference: 0.0,
             tolerance: 0.05,
             judge: Judge::AtMost,
-            source: "Martin & Moyce (1952); time-origin shift as in Lethe's dam-break example (REFERENCES.md)",
+            source: "Martin & Moyce (1952); time-origin shift as in Lethe's dam-break example",
         });
     }
     checks

@@ -148,7 +148,7 @@ pub(super) fn small_strain(ctx: &Ctx) -> Vec<Check> {
                 rest,
                 1e-11,
                 Judge::AtMost,
-                "psi(I) = 0, P(I) = 0; P(Q) = 0 for rotations (REFERENCES.md)",
+                "psi(I) = 0, P(I) = 0; P(Q) = 0 for rotations",
             ));
             if name == "LinearElastic" {
                 return out;

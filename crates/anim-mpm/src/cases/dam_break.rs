@@ -6,7 +6,7 @@ use crate::scenes;
 use crate::{Kernel, MpmError, MpmSimulation, Particles, Transfer};
 use anim_core::cases::{Check, Ctx, Judge, Point, Series, StudyResult, fmt_num};
 
-/// Martin & Moyce (1952), tables 2 and 6 (REFERENCES.md), `a` = 2.25 in, `n^2 = 2`:
+/// Martin & Moyce (1952), tables 2 and 6, `a` = 2.25 in, `n^2 = 2`:
 /// `T = t sqrt(2 g / a)` and `Z = x / a` (anim-mpm's copy, which `anim run` measures against).
 pub const MARTIN_MOYCE: [(f64, f64); 15] = scenes::MARTIN_MOYCE;
 
@@ -100,7 +100,7 @@ pub(super) fn dam_break_case(ctx: &Ctx) -> Vec<Check> {
             Err(e) => (f64::NAN, f64::NAN, (f64::NAN, f64::NAN, f64::NAN), e.to_string()),
         };
         let case = format!("2D dam break a = 0.2 m, {n}^2, 2x2 ppc, {transfer:?} {kernel:?}; Z = {detail}");
-        let source = "Martin & Moyce (1952) tables 2 and 6 (REFERENCES.md)";
+        let source = "Martin & Moyce (1952) tables 2 and 6";
         checks.push(Check {
             crate_name: CRATE,
             case: case.clone(),
@@ -133,7 +133,7 @@ pub(super) fn dam_break_case(ctx: &Ctx) -> Vec<Check> {
             reference: 0.0,
             tolerance: 0.10,
             judge: Judge::AtMost,
-            source: "Martin & Moyce (1952); time-origin shift as in Lethe's dam-break example (REFERENCES.md)",
+            source: "Martin & Moyce (1952); time-origin shift as in Lethe's dam-break example",
         });
     }
     checks
