@@ -304,6 +304,27 @@ impl<const D: usize> MpmSimulation<D> {
         })
     }
 
+    /// Mass, linear momentum and angular momentum about the origin (`sum m x x v`) of the grid
+    /// nodes of the last step ([`grid_nodes`](Self::grid_nodes)), summed in `f64` in node order:
+    /// what the transfers must carry over from and back to the particles ([`totals`](Self::totals)).
+    #[must_use]
+    pub fn grid_totals(&self) -> (f64, [f64; 3], [f64; 3]) {
+        let (mut gm, mut gp, mut gl) = (0.0f64, [0.0f64; 3], [0.0f64; 3]);
+        for (x, m, v) in self.grid_nodes() {
+            let m = f64::from(m);
+            gm += m;
+            let x3 = [f64::from(x[0]), f64::from(x[1]), if D == 3 { f64::from(x[2]) } else { 0.0 }];
+            let v3 = [f64::from(v[0]), f64::from(v[1]), if D == 3 { f64::from(v[2]) } else { 0.0 }];
+            for a in 0..3 {
+                gp[a] += m * v3[a];
+            }
+            gl[0] += m * (x3[1] * v3[2] - x3[2] * v3[1]);
+            gl[1] += m * (x3[2] * v3[0] - x3[0] * v3[2]);
+            gl[2] += m * (x3[0] * v3[1] - x3[1] * v3[0]);
+        }
+        (gm, gp, gl)
+    }
+
     /// Mass, momenta and energies of a particle state, summed in `f64` in a fixed order
     /// (identical for any thread count).
     pub fn totals(&mut self, st: &Particles<D>) -> Totals {

@@ -45,8 +45,6 @@ fn free_space(transfer: Transfer, kernel: Kernel) -> MpmParams {
 /// particles before, the grid after P2G, and the particles after G2P.
 fn conservation<const D: usize>(transfer: Transfer, kernel: Kernel, portable: bool) -> [f64; 5] {
     let params = free_space(transfer, kernel);
-    let d_inv = f64::from(kernel.d_inv());
-    let h = params.h();
     let mut sim =
         MpmSimulation::<D>::new(params, vec![Material::Elastic(Elastic::default())]).expect("valid");
     if portable {
@@ -56,21 +54,7 @@ fn conservation<const D: usize>(transfer: Transfer, kernel: Kernel, portable: bo
     let before = sim.totals(&p);
     sim.advance(&mut p, 1e-3).expect("step");
     let after = sim.totals(&p);
-    // Grid totals in f64.
-    let (mut gm, mut gp, mut gl) = (0.0f64, [0.0f64; 3], [0.0f64; 3]);
-    for (x, m, v) in sim.grid_nodes() {
-        let m = f64::from(m);
-        gm += m;
-        let x3 = [f64::from(x[0]), f64::from(x[1]), if D == 3 { f64::from(x[2]) } else { 0.0 }];
-        let v3 = [f64::from(v[0]), f64::from(v[1]), if D == 3 { f64::from(v[2]) } else { 0.0 }];
-        for a in 0..3 {
-            gp[a] += m * v3[a];
-        }
-        gl[0] += m * (x3[1] * v3[2] - x3[2] * v3[1]);
-        gl[1] += m * (x3[2] * v3[0] - x3[0] * v3[2]);
-        gl[2] += m * (x3[0] * v3[1] - x3[1] * v3[0]);
-    }
-    let _ = (d_inv, h);
+    let (gm, gp, gl) = sim.grid_totals();
     let norm = |a: [f64; 3]| (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
     let diff = |a: [f64; 3], b: [f64; 3]| norm([a[0] - b[0], a[1] - b[1], a[2] - b[2]]);
     // Scales: sum m |v| and sum m |x| |v|.

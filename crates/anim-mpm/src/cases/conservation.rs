@@ -50,19 +50,7 @@ fn conservation_errors<const D: usize>(
         let before = sim.totals(&p);
         sim.advance(&mut p, 2e-4)?;
         let after = sim.totals(&p);
-        let (mut gm, mut gp, mut gl) = (0.0f64, [0.0f64; 3], [0.0f64; 3]);
-        for (x, m, v) in sim.grid_nodes() {
-            let m = f64::from(m);
-            gm += m;
-            let x3 = [f64::from(x[0]), f64::from(x[1]), if D == 3 { f64::from(x[2]) } else { 0.0 }];
-            let v3 = [f64::from(v[0]), f64::from(v[1]), if D == 3 { f64::from(v[2]) } else { 0.0 }];
-            for a in 0..3 {
-                gp[a] += m * v3[a];
-            }
-            gl[0] += m * (x3[1] * v3[2] - x3[2] * v3[1]);
-            gl[1] += m * (x3[2] * v3[0] - x3[0] * v3[2]);
-            gl[2] += m * (x3[0] * v3[1] - x3[1] * v3[0]);
-        }
+        let (gm, gp, gl) = sim.grid_totals();
         let (mut sp, mut sl) = (0.0, 0.0);
         for i in 0..p.len() {
             let m = f64::from(p.mass[i]);
