@@ -1,4 +1,5 @@
-//! `cargo xtask ci`: what CI runs, in order, stopping at the first failure.
+//! `cargo xtask ci`: what CI runs, in order; it goes on after a failed lint or doc step (so one run
+//! shows every problem) and stops after failed tests.
 
 use crate::registry::Ctx;
 use crate::suites;

@@ -125,14 +125,15 @@ pub fn run(ctx: &Ctx, out: &str, threads: &[usize], filter: Option<&str>) -> boo
         parts.push(p);
     }
     eprintln!("thread scaling on {threads:?} threads");
-    for (i, (krate, scene)) in scaling::preset_names().into_iter().enumerate() {
+    for (kind, preset) in anim::presets() {
+        let (krate, scene) = (kind.crate_name, preset.name);
         if !suites::selected(filter, krate, scene) {
             keep(&mut stored, &mut parts, Kind::Scaling, krate, scene);
             continue;
         }
         let t = Instant::now();
         let before = scaling::load_average();
-        let rows = scaling::run_preset(i, ctx.quick, threads);
+        let rows = scaling::run_preset(kind, &preset, ctx.quick, threads);
         let mut p = Part::new(Kind::Scaling, krate, scene, &today, t.elapsed().as_secs_f64());
         p.load = before.zip(scaling::load_average());
         p.scaling = rows;
@@ -167,7 +168,9 @@ pub fn run(ctx: &Ctx, out: &str, threads: &[usize], filter: Option<&str>) -> boo
         report.seconds / 60.0,
         dir.join("index.md").display()
     );
-    ok && report.conformance.passed() && report.stability.passed()
+    ok && report.conformance.passed()
+        && report.stability.passed()
+        && report.scaling.iter().all(scaling::passed)
 }
 
 impl Report {

@@ -8,81 +8,10 @@
 //! duration `run.steps()` is reached) restarts from its initial checkpoint; the restore is not
 //! timed. `cargo xtask scaling` prints the table; `cargo xtask report` puts it in the report.
 
-use anim_core::scene::{BuildContext, DynScene, Preset, SceneKind};
+use crate::registry::differing_bits;
+use anim_core::scene::{BuildContext, DynScene, Frame, Looped, Preset, SceneKind};
 use std::fmt::Write as _;
 use std::time::{Duration, Instant};
-
-/// FNV-1a over bytes.
-fn hash_bytes(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3))
-}
-
-/// The parameters a suite runs a preset with: `quick_params` in quick mode (where it has them).
-pub fn params(preset: &Preset, quick: bool) -> &serde_json::Value {
-    if quick { preset.quick_params.as_ref().unwrap_or(&preset.params) } else { &preset.params }
-}
-
-/// Builds `preset` of `kind` (quick or full parameters).
-pub fn build(kind: &SceneKind, preset: &Preset, quick: bool) -> Result<Box<dyn DynScene>, String> {
-    (kind.build)(params(preset, quick), &BuildContext::default()).map_err(|e| e.to_string())
-}
-
-/// A scene stepped for as long as the timing needs: back to its initial checkpoint after
-/// `duration` steps, or when a step fails (once per failure: a step that fails right after the
-/// restart is an error).
-struct Runner {
-    scene: Box<dyn DynScene>,
-    start: serde_json::Value,
-    dt: f64,
-    duration: usize,
-    /// Steps since the last (re)start.
-    since_start: usize,
-    restarts: usize,
-}
-
-impl Runner {
-    fn new(scene: Box<dyn DynScene>, dt: f64, duration: usize) -> Self {
-        let start = scene.save();
-        Self { scene, start, dt, duration: duration.max(1), since_start: 0, restarts: 0 }
-    }
-
-    fn restart(&mut self) -> Result<(), String> {
-        self.scene.restore(&self.start).map_err(|e| format!("restart from the initial checkpoint: {e}"))?;
-        self.since_start = 0;
-        self.restarts += 1;
-        Ok(())
-    }
-
-    /// One step; its wall time, restarts excluded.
-    fn step(&mut self) -> Result<Duration, String> {
-        if self.since_start >= self.duration {
-            self.restart()?;
-        }
-        let t = Instant::now();
-        let mut result = self.scene.step(self.dt).map(drop);
-        let mut elapsed = t.elapsed();
-        if let Err(e) = &result
-            && self.since_start > 0
-        {
-            eprintln!(
-                "    step {} failed ({e}); restarting from the initial checkpoint",
-                self.since_start + 1
-            );
-            self.restart()?;
-            let t = Instant::now();
-            result = self.scene.step(self.dt).map(drop);
-            elapsed = t.elapsed();
-        }
-        result.map_err(|e| format!("step {}: {e}", self.since_start + 1))?;
-        self.since_start += 1;
-        Ok(elapsed)
-    }
-
-    /// A hash of the checkpoint's bytes.
-    fn fingerprint(&self) -> u64 {
-        hash_bytes(self.scene.save().to_string().as_bytes())
-    }
-}
 
 /// One measured row.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -99,7 +28,8 @@ pub struct Row {
     pub speedup: f64,
     /// Whether the state after the first steps equals the one-thread state bit for bit.
     pub identical: Option<bool>,
-    /// An error, if the scene failed.
+    /// An error, if the scene failed; or the steps that failed within the preset's duration (each
+    /// followed by a restart), which also fail the row.
     pub note: String,
 }
 
@@ -120,23 +50,33 @@ fn budget(quick: bool) -> f64 {
 /// What a scene is built by.
 type Build<'a> = &'a (dyn Fn() -> Result<Box<dyn DynScene>, String> + Sync);
 
-/// (seconds per step, fingerprint after [`CHECK_STEPS`] steps) of the scene `build` makes,
-/// stepped by `dt` on a pool of `threads` threads: the median of three batches of at least two
-/// steps each, together `budget` seconds.
+/// What [`measure`] found on one pool.
+struct Measured {
+    /// Median seconds per step.
+    seconds: f64,
+    /// The checkpoint and frame values after [`CHECK_STEPS`] steps.
+    fingerprint: Vec<f64>,
+    /// Steps that failed before the preset's duration ended (each followed by a restart).
+    failures: Vec<String>,
+}
+
+/// The scene `build` makes, stepped by `dt` on a pool of `threads` threads (back to its start
+/// every `duration` steps): its fingerprint after [`CHECK_STEPS`] steps, then the median of three
+/// batches of at least two steps each, together `budget` seconds.
 fn measure(
     build: Build<'_>,
     dt: f64,
     duration: usize,
     threads: usize,
     budget: f64,
-) -> Result<(f64, u64), String> {
+) -> Result<Measured, String> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
     pool.install(|| {
-        let mut s = Runner::new(build()?, dt, duration);
+        let mut s = Looped::new(build()?, dt, duration);
         for _ in 0..CHECK_STEPS {
             s.step()?;
         }
-        let fingerprint = s.fingerprint();
+        let fingerprint = crate::cases::presets::fingerprint(s.scene(), &mut Frame::default());
         let mut batches = Vec::new();
         for _ in 0..3 {
             let start = Instant::now();
@@ -147,41 +87,61 @@ fn measure(
             }
             batches.push(stepping.as_secs_f64() / f64::from(n));
         }
-        if s.restarts > 0 {
-            eprintln!(
-                "    {threads} thread(s): restarted {} time(s) from the initial checkpoint",
-                s.restarts
-            );
-        }
         batches.sort_by(f64::total_cmp);
-        Ok((batches[1], fingerprint))
+        Ok(Measured { seconds: batches[1], fingerprint, failures: s.failures().to_vec() })
     })
 }
 
-/// The rows of one scene at each of `threads` (the first is the reference of speed-up and bits).
+/// The rows of one scene at each of `threads`; the first count is the reference of speed-up and
+/// bits (a failed reference leaves the other rows without a comparison).
 fn rows(
     krate: &str,
     scene: &str,
     threads: &[usize],
-    measured: impl Fn(usize) -> Result<(f64, u64), String>,
+    measured: impl Fn(usize) -> Result<Measured, String>,
 ) -> Vec<Row> {
     let mut rows = Vec::new();
-    let mut base: Option<(f64, u64)> = None;
+    let mut base: Option<Result<Measured, ()>> = None;
     for &t in threads {
-        let row = match measured(t) {
-            Ok((seconds, fp)) => {
-                let b = *base.get_or_insert((seconds, fp));
+        let result = measured(t);
+        let reference = base.get_or_insert_with(|| {
+            result
+                .as_ref()
+                .map(|m| Measured {
+                    seconds: m.seconds,
+                    fingerprint: m.fingerprint.clone(),
+                    failures: Vec::new(),
+                })
+                .map_err(drop)
+        });
+        let row = match (result, reference) {
+            (Ok(m), reference) => {
+                let (speedup, identical) = match reference {
+                    Ok(b) => {
+                        (b.seconds / m.seconds, Some(differing_bits(&b.fingerprint, &m.fingerprint) == 0))
+                    }
+                    Err(()) => (f64::NAN, None),
+                };
+                let note = if m.failures.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "{} step(s) failed within the preset's duration: {}",
+                        m.failures.len(),
+                        m.failures[0]
+                    )
+                };
                 Row {
                     krate: krate.into(),
                     scene: scene.into(),
                     threads: t,
-                    seconds,
-                    speedup: b.0 / seconds,
-                    identical: Some(b.1 == fp),
-                    note: String::new(),
+                    seconds: m.seconds,
+                    speedup,
+                    identical,
+                    note,
                 }
             }
-            Err(e) => Row {
+            (Err(e), _) => Row {
                 krate: krate.into(),
                 scene: scene.into(),
                 threads: t,
@@ -196,16 +156,15 @@ fn rows(
     rows
 }
 
-/// `(crate, preset)` of every registered preset, in registry order.
-pub fn preset_names() -> Vec<(&'static str, &'static str)> {
-    anim::presets().into_iter().map(|(k, p)| (k.crate_name, p.name)).collect()
+/// Whether a row passed: same bits as the reference and no failed step.
+pub fn passed(row: &Row) -> bool {
+    row.identical == Some(true) && row.note.is_empty()
 }
 
-/// Times preset `index` (of [`preset_names`]) at each of `threads`.
-pub fn run_preset(index: usize, quick: bool, threads: &[usize]) -> Vec<Row> {
-    let Some((kind, preset)) = anim::presets().into_iter().nth(index) else { return Vec::new() };
+/// Times `preset` of `kind` (quick parameters when `quick`) at each of `threads`.
+pub fn run_preset(kind: &SceneKind, preset: &Preset, quick: bool, threads: &[usize]) -> Vec<Row> {
     let t0 = Instant::now();
-    let make = || build(kind, &preset, quick);
+    let make = || (kind.build)(preset.params_for(quick), &BuildContext::default()).map_err(|e| e.to_string());
     let rows = rows(kind.crate_name, preset.name, threads, |t| {
         measure(&make, preset.run.dt, preset.run.steps(), t, budget(quick))
     });
@@ -214,22 +173,22 @@ pub fn run_preset(index: usize, quick: bool, threads: &[usize]) -> Vec<Row> {
 }
 
 /// `cargo xtask scaling`: every selected preset at each of `threads`, the table printed; true
-/// when every run finished with the one-thread bits.
+/// when every run finished with the one-thread bits and no failed step.
 pub fn run(quick: bool, filter: Option<&str>, threads: &[usize]) -> bool {
     let start = Instant::now();
     eprintln!("thread scaling on {threads:?} threads{}", if quick { " (quick params)" } else { "" });
     let before = load_average();
     let mut all = Vec::new();
-    for (i, (krate, name)) in preset_names().into_iter().enumerate() {
-        if crate::suites::selected(filter, krate, name) {
-            all.extend(run_preset(i, quick, threads));
+    for (kind, preset) in anim::presets() {
+        if crate::suites::selected(filter, kind.crate_name, preset.name) {
+            all.extend(run_preset(kind, &preset, quick, threads));
         }
     }
     println!("{}", markdown(&all));
     if let Some((a, b)) = before.zip(load_average()) {
         println!("1-minute load average {a:.2} before, {b:.2} after ({} cores)", crate::machine::cores());
     }
-    let bad = all.iter().filter(|r| r.identical != Some(true)).count();
+    let bad = all.iter().filter(|r| !passed(r)).count();
     println!(
         "scaling{}: {} rows, {bad} failed or not bit-identical, {:.0} s",
         if quick { " --quick" } else { "" },
@@ -247,8 +206,10 @@ pub fn markdown(rows: &[Row]) -> String {
     );
     for r in rows {
         let same = match r.identical {
-            Some(true) => "yes".to_string(),
+            Some(true) if r.note.is_empty() => "yes".to_string(),
+            Some(true) => format!("yes; **{}**", r.note.replace('|', "/")),
             Some(false) => "**no**".to_string(),
+            None if r.note.is_empty() => "no one-thread run to compare with".to_string(),
             None => format!("failed: {}", r.note.replace('|', "/")),
         };
         let _ = writeln!(
@@ -264,7 +225,8 @@ pub fn markdown(rows: &[Row]) -> String {
     s
 }
 
-/// Parses `--threads 1,2,4`: at least one count, each at least 1; 1 is put first if missing.
+/// Parses `--threads 1,2,4`: at least one count, each at least 1; 1 is put first (the reference
+/// of speed-up and bits) wherever it was given, and added if missing.
 pub fn parse_threads(s: &str) -> Result<Vec<usize>, String> {
     let mut v = Vec::new();
     for part in s.split(',') {
@@ -273,13 +235,11 @@ pub fn parse_threads(s: &str) -> Result<Vec<usize>, String> {
         if n == 0 {
             return Err("--threads: counts start at 1".into());
         }
-        if !v.contains(&n) {
+        if n != 1 && !v.contains(&n) {
             v.push(n);
         }
     }
-    if !v.contains(&1) {
-        v.insert(0, 1);
-    }
+    v.insert(0, 1);
     Ok(v)
 }
 
@@ -291,6 +251,7 @@ mod tests {
     fn thread_lists_parse() {
         assert_eq!(parse_threads("1,2"), Ok(vec![1, 2]));
         assert_eq!(parse_threads("4, 8"), Ok(vec![1, 4, 8]));
+        assert_eq!(parse_threads("4,1,2"), Ok(vec![1, 4, 2]));
         assert!(parse_threads("0").is_err());
         assert!(parse_threads("two").unwrap_err().contains("`two`"));
     }
@@ -361,38 +322,50 @@ mod tests {
 
     #[test]
     fn a_scene_that_ends_restarts_from_its_initial_checkpoint() {
-        // Diverges at its 6th step: the run goes back to x = 0 and on.
-        let mut r = Runner::new(counter(5.5, || 1.0).unwrap(), 0.1, 1000);
-        let start = r.fingerprint();
-        for _ in 0..5 {
+        let x = |r: &Looped| r.scene().save()["x"].as_f64();
+        // Diverges at its 6th step: the run goes back to x = 0 and on, and says so.
+        let mut r = Looped::new(counter(5.5, || 1.0).unwrap(), 0.1, 1000);
+        for _ in 0..6 {
             r.step().unwrap();
         }
-        r.step().unwrap();
-        assert_eq!((r.restarts, r.since_start), (1, 1));
-        // Its nominal duration, 3 steps: the fourth starts over.
-        let mut r = Runner::new(counter(f64::INFINITY, || 1.0).unwrap(), 0.1, 3);
-        for _ in 0..3 {
+        assert_eq!((r.restarts(), x(&r)), (1, Some(1.0)));
+        assert_eq!(r.failures().len(), 1, "{:?}", r.failures());
+        assert!(r.failures()[0].contains("step 6"), "{:?}", r.failures());
+        // Its nominal duration, 3 steps: the fourth starts over, and that is no failure.
+        let mut r = Looped::new(counter(f64::INFINITY, || 1.0).unwrap(), 0.1, 3);
+        for _ in 0..4 {
             r.step().unwrap();
         }
-        assert_ne!(r.fingerprint(), start);
-        r.step().unwrap();
-        assert_eq!((r.restarts, r.since_start), (1, 1));
-        r.restart().unwrap();
-        assert_eq!(r.fingerprint(), start);
+        assert_eq!((r.restarts(), x(&r), r.failures().len()), (1, Some(1.0), 0));
         // A scene that fails its first step is an error, not an endless restart.
-        let mut r = Runner::new(counter(0.5, || 1.0).unwrap(), 0.1, 1000);
+        let mut r = Looped::new(counter(0.5, || 1.0).unwrap(), 0.1, 1000);
         assert!(r.step().unwrap_err().contains("x past its limit"));
         let got = rows("anim-x", "s", &[1], |t| measure(&|| counter(0.5, || 1.0), 0.1, 1000, t, 0.01));
         assert_eq!(got[0].identical, None, "{got:?}");
         assert!(got[0].note.contains("x past its limit"), "{got:?}");
+        // A failure within the duration fails the row although the bits agree.
+        let got = rows("anim-x", "s", &[1, 2], |t| measure(&|| counter(5.5, || 1.0), 0.1, 1000, t, 0.01));
+        assert!(got.iter().all(|r| r.identical == Some(true) && !passed(r)), "{got:?}");
     }
 
     #[test]
-    fn a_registered_preset_scales_bit_for_bit() {
-        let Some(i) = preset_names().iter().position(|&(_, name)| name == "oscillator") else {
-            panic!("no oscillator preset")
-        };
-        let got = run_preset(i, true, &[1, 2]);
+    fn the_first_count_is_the_reference() {
+        // The reference run fails: the others are not compared with anything.
+        let got = rows("anim-x", "s", &[1, 2], |t| {
+            if t == 1 {
+                Err("no".into())
+            } else {
+                measure(&|| counter(f64::INFINITY, || 1.0), 0.1, 1000, t, 0.01)
+            }
+        });
+        assert_eq!(got.iter().map(|r| r.identical).collect::<Vec<_>>(), [None, None], "{got:?}");
+        assert!(got[1].speedup.is_nan(), "{got:?}");
+    }
+
+    #[test]
+    fn a_registered_preset_gets_a_row_per_thread_count() {
+        let (kind, preset) = anim::preset("oscillator").expect("the oscillator preset");
+        let got = run_preset(kind, &preset, true, &[1, 2]);
         assert_eq!(got.len(), 2);
         assert!(got.iter().all(|r| r.identical == Some(true) && r.seconds > 0.0), "{got:?}");
         assert_eq!((got[0].krate.as_str(), got[0].scene.as_str()), ("anim-core", "oscillator"));

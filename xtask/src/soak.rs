@@ -14,7 +14,7 @@
 //! without breaking its bound; anything else is a failure and `stability --long` exits 1.
 
 use crate::registry::{Budget, Outcome, Soak, drive, finish, fmt_num, rejected};
-use anim_core::scene::{DynScene, Frame, Preset, SceneKind};
+use anim_core::scene::{BuildContext, DynScene, Frame, Preset, SceneKind};
 use std::fmt::Write as _;
 use std::time::{Duration, Instant};
 
@@ -35,13 +35,6 @@ struct Row {
     soak: Soak,
 }
 
-fn selected(filter: Option<&str>, crate_name: &str, name: &str) -> bool {
-    filter.is_none_or(|f| {
-        let f = f.to_lowercase();
-        crate_name.to_lowercase().contains(&f) || name.to_lowercase().contains(&f)
-    })
-}
-
 /// The first non-finite value of `frame`, named.
 fn non_finite(frame: &Frame) -> Option<String> {
     if !frame.time.is_finite() {
@@ -56,17 +49,22 @@ fn non_finite(frame: &Frame) -> Option<String> {
     })
 }
 
-/// Saves the checkpoint and restores it into the scene (which continues bit for bit): the
-/// restore checks sizes and finiteness, and a non-finite number is saved as `null`, which no
-/// restore reads.
+/// Saves the checkpoint and restores it into the scene, which must then save the same text (so
+/// it continues bit for bit): the restore checks sizes and finiteness, and a non-finite number
+/// is saved as `null`, which no restore reads.
 fn checkpoint_restores(scene: &mut dyn DynScene) -> Result<(), String> {
     let saved = scene.save();
-    scene.restore(&saved).map_err(|e| format!("its checkpoint does not restore: {e}"))
+    scene.restore(&saved).map_err(|e| format!("its checkpoint does not restore: {e}"))?;
+    let (again, before): (String, String) = (scene.save().to_string(), saved.to_string());
+    if again != before {
+        return Err("restored from its checkpoint, it saves a different one".into());
+    }
+    Ok(())
 }
 
 /// Soaks `preset` (quick parameters when `quick`) for `budget`.
 fn soak_preset(kind: &SceneKind, preset: &Preset, quick: bool, budget: Budget) -> Soak {
-    let mut scene = match crate::scaling::build(kind, preset, quick) {
+    let mut scene = match (kind.build)(preset.params_for(quick), &BuildContext::default()) {
         Ok(s) => s,
         Err(e) => return rejected(budget, e),
     };
@@ -118,7 +116,7 @@ pub fn run(quick: bool, filter: Option<&str>, out: &str) -> bool {
         );
     };
     for case in crate::cases::all().soak {
-        if !selected(filter, case.crate_name, case.name) {
+        if !crate::suites::selected(filter, case.crate_name, case.name) {
             continue;
         }
         eprintln!("soak: {} / {} ...", case.crate_name, case.name);
@@ -137,7 +135,7 @@ pub fn run(quick: bool, filter: Option<&str>, out: &str) -> bool {
     for (kind, preset) in anim::presets() {
         let quick_params = if quick && preset.quick_params.is_some() { " (quick params)" } else { "" };
         let name = format!("preset {}{quick_params}: {}", preset.name, preset.description);
-        if !selected(filter, kind.crate_name, &name) {
+        if !crate::suites::selected(filter, kind.crate_name, preset.name) {
             continue;
         }
         eprintln!("soak: {} / preset {} ...", kind.crate_name, preset.name);

@@ -1,6 +1,6 @@
 //! Running the conformance and stability suites and printing their tables.
 
-use crate::registry::{Check, Ctx, Outcome, fmt_num};
+use crate::registry::{Check, Ctx, Judge, Outcome, fmt_num};
 use std::time::Instant;
 
 /// Results of a conformance run.
@@ -33,6 +33,19 @@ pub fn conformance(ctx: &Ctx, filter: Option<&str>) -> ConformanceRun {
         let t = Instant::now();
         let mut got = (case.run)(ctx);
         eprintln!("  {:<40} {:>4} checks  {:>7.2} s", case.name, got.len(), t.elapsed().as_secs_f64());
+        if got.is_empty() {
+            // A case that measured nothing has failed (its setup, or its reference data).
+            got.push(Check {
+                crate_name: case.crate_name,
+                case: format!("{}: no checks", case.name),
+                metric: "checks made".into(),
+                measured: f64::NAN,
+                reference: 0.0,
+                tolerance: 1.0,
+                judge: Judge::AtLeast,
+                source: "the case's own registration",
+            });
+        }
         checks.append(&mut got);
     }
     let run = ConformanceRun { checks, seconds: start.elapsed().as_secs_f64() };

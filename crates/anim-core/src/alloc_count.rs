@@ -116,33 +116,50 @@ pub fn preset_step_allocations(
         let mut out = Vec::new();
         for preset in (kind.presets)() {
             let name = preset.name;
-            let params = preset.quick_params.as_ref().unwrap_or(&preset.params);
-            let mut scene = (kind.build)(params, &crate::scene::BuildContext::default())
+            let mut scene = (kind.build)(preset.params_for(true), &crate::scene::BuildContext::default())
                 .map_err(|e| format!("{name}: {e}"))?;
             let dt = preset.run.dt;
             scene.step(dt).map_err(|e| format!("{name}: step 1: {e}"))?;
-            let mut blocks = Vec::new();
-            for _ in 0..3 {
-                let mut failed = None;
-                blocks.push(alloc.count(|| {
-                    for _ in 0..4 {
-                        if let Err(e) = scene.step(dt) {
-                            failed = Some(e.to_string());
-                            return;
-                        }
-                    }
-                }));
-                if let Some(e) = failed {
-                    return Err(format!("{name}: {e}"));
-                }
-                if blocks.last() == Some(&0) {
-                    break;
-                }
-            }
+            let blocks = step_allocations(alloc, scene.as_mut(), dt).map_err(|e| format!("{name}: {e}"))?;
             out.push(PresetAllocations { preset: name, blocks });
         }
         Ok(out)
     })
+}
+
+/// The allocations of `scene`'s next steps by `dt`: blocks of four steps, up to three, stopping
+/// at the first clean one (the last block is 0 exactly when the steps allocate nothing; a rayon
+/// pool's bookkeeping can allocate now and then under load). Call it on a worker of a rayon pool
+/// (`ThreadPool::install`) after the buffers are sized: a parallel call from a thread outside
+/// every pool goes through rayon's global injector, which allocates now and then. `alloc` must
+/// be the process's global allocator.
+///
+/// # Errors
+/// The message of a step that fails.
+pub fn step_allocations(
+    alloc: &CountingAllocator,
+    scene: &mut dyn crate::scene::DynScene,
+    dt: f64,
+) -> Result<Vec<usize>, String> {
+    let mut blocks = Vec::new();
+    for _ in 0..3 {
+        let mut failed = None;
+        blocks.push(alloc.count(|| {
+            for _ in 0..4 {
+                if let Err(e) = scene.step(dt) {
+                    failed = Some(e.to_string());
+                    return;
+                }
+            }
+        }));
+        if let Some(e) = failed {
+            return Err(e);
+        }
+        if blocks.last() == Some(&0) {
+            break;
+        }
+    }
+    Ok(blocks)
 }
 
 /// The test that every preset of a scene kind steps without allocating once its first step is

@@ -5,8 +5,9 @@
 //! - **determinism**: the same steps on rayon pools of 1, 2 and 4 threads end in the same
 //!   checkpoint and the same frame, bit for bit;
 //! - **no allocation per step**: after [`STEPS`] steps (buffers sized, a particle fluid's active
-//!   cells grown), three more steps make no heap allocation (counted by the process's counting
-//!   allocator, on every thread);
+//!   cells grown), the next block of four steps makes no heap allocation (counted by the
+//!   process's counting allocator, on every thread; up to three blocks, as
+//!   `anim_core::alloc_count::step_allocations` counts);
 //! - **checkpoint**: a scene restored from the JSON text of a checkpoint continues bit for bit
 //!   like the one that never stopped;
 //! - **non-finite guard**: a step that meets a provoked overflow fails and leaves the checkpoint
@@ -15,34 +16,25 @@
 //!
 //! Quick mode runs each preset's `quick_params` (a coarser version of the same scene).
 
-use crate::registry::{Check, ConformanceCase, Ctx, Judge, Registry};
+use crate::registry::{Check, ConformanceCase, Ctx, Judge, Registry, across_threads, differing_bits};
 use anim_core::scene::{BuildContext, DynScene, Frame, Preset, SceneKind};
 use std::sync::OnceLock;
 
 /// Steps taken before the contracts are checked.
 const STEPS: usize = 3;
-/// Thread counts compared.
-const THREADS: [usize; 3] = [1, 2, 4];
 const SOURCE: &str = "the scene contracts of anim-core";
 
-/// One pool per thread count in [`THREADS`], built once and every thread started: a pool built
-/// or dropped while allocations are counted would count its threads' start or end.
-fn pools() -> Result<&'static [(usize, rayon::ThreadPool)], String> {
-    static POOLS: OnceLock<Result<Vec<(usize, rayon::ThreadPool)>, String>> = OnceLock::new();
-    POOLS
-        .get_or_init(|| {
-            THREADS
-                .iter()
-                .map(|&n| {
-                    let pool =
-                        rayon::ThreadPoolBuilder::new().num_threads(n).build().map_err(|e| e.to_string())?;
-                    pool.broadcast(|_| ());
-                    Ok((n, pool))
-                })
-                .collect()
-        })
-        .as_deref()
-        .map_err(Clone::clone)
+/// The 2-thread pool the allocations are counted in, built once and every thread started: a
+/// pool built or dropped while allocations are counted would count its threads' start or end.
+fn pool() -> Result<&'static rayon::ThreadPool, String> {
+    static POOL: OnceLock<Result<rayon::ThreadPool, String>> = OnceLock::new();
+    POOL.get_or_init(|| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().map_err(|e| e.to_string())?;
+        pool.broadcast(|_| ());
+        Ok(pool)
+    })
+    .as_ref()
+    .map_err(Clone::clone)
 }
 
 pub fn register(r: &mut Registry) {
@@ -58,7 +50,7 @@ pub fn register(r: &mut Registry) {
 }
 
 /// Every number of a checkpoint, in document order, then every value of the frame.
-fn fingerprint(scene: &dyn DynScene, frame: &mut Frame) -> Vec<f64> {
+pub(crate) fn fingerprint(scene: &dyn DynScene, frame: &mut Frame) -> Vec<f64> {
     fn walk(v: &serde_json::Value, out: &mut Vec<f64>) {
         match v {
             serde_json::Value::Number(n) => out.push(n.as_f64().unwrap_or(f64::NAN)),
@@ -78,13 +70,6 @@ fn fingerprint(scene: &dyn DynScene, frame: &mut Frame) -> Vec<f64> {
     out
 }
 
-fn differing(a: &[f64], b: &[f64]) -> f64 {
-    if a.len() != b.len() {
-        return a.len().max(b.len()) as f64;
-    }
-    a.iter().zip(b).filter(|(x, y)| x.to_bits() != y.to_bits()).count() as f64
-}
-
 fn check(kind: &SceneKind, case: String, metric: &str, measured: f64) -> Check {
     Check {
         crate_name: kind.crate_name,
@@ -99,8 +84,7 @@ fn check(kind: &SceneKind, case: String, metric: &str, measured: f64) -> Check {
 }
 
 fn contracts(kind: &'static SceneKind, preset: &Preset, ctx: &Ctx) -> Vec<Check> {
-    let params =
-        if ctx.quick { preset.quick_params.as_ref().unwrap_or(&preset.params) } else { &preset.params };
+    let params = preset.params_for(ctx.quick);
     let (name, dt) = (preset.name, preset.run.dt);
     let build = || (kind.build)(params, &BuildContext::default()).map_err(|e| e.to_string());
     let run = |steps: usize| -> Result<Vec<f64>, String> {
@@ -115,56 +99,29 @@ fn contracts(kind: &'static SceneKind, preset: &Preset, ctx: &Ctx) -> Vec<Check>
     let mut out = Vec::new();
 
     // Determinism across thread counts.
-    let pools = match pools() {
-        Ok(p) => p,
-        Err(e) => return failed("the thread pools", e),
-    };
-    let mut finals = Vec::new();
-    for (threads, pool) in pools {
-        finals.push((*threads, pool.install(|| run(STEPS + 2))));
-    }
-    let reference = match &finals[0].1 {
-        Ok(v) => v.clone(),
-        Err(e) => return failed("1 thread", e.clone()),
-    };
-    for (threads, result) in &finals[1..] {
-        let measured = result.as_ref().map_or(f64::NAN, |v| differing(&reference, v));
-        out.push(check(
-            kind,
-            format!("{name}: {threads} threads vs 1 ({} values)", reference.len()),
-            "checkpoint and frame values whose bits differ",
-            measured,
-        ));
-    }
+    out.extend(across_threads(kind.crate_name, &format!("{name}: checkpoint and frame"), || run(STEPS + 2)));
 
     // No allocation once the buffers are sized. The steps run inside a pool, as a worker: a
     // parallel call made from a thread outside every pool goes through rayon's global injector,
     // whose queue allocates a block every few dozen calls (rayon's cost, not the solver's; a
     // run loop that wants none steps inside `ThreadPool::install`).
-    let Some((_, pool)) = pools.iter().find(|(n, _)| *n == 2) else {
-        return failed("the 2-thread pool", String::new());
+    let pool = match pool() {
+        Ok(p) => p,
+        Err(e) => return failed("the 2-thread pool", e),
     };
     let measured = pool.install(|| -> Result<(Box<dyn DynScene>, usize), String> {
         let mut scene = build()?;
         for _ in 0..STEPS {
             scene.step(dt).map_err(|e| e.to_string())?;
         }
-        let mut result = Ok(());
-        let allocations = crate::ALLOC.count(|| {
-            for _ in 0..3 {
-                if let Err(e) = scene.step(dt) {
-                    result = Err(e.to_string());
-                    return;
-                }
-            }
-        });
-        result.map(|()| (scene, allocations))
+        let blocks = anim_core::alloc_count::step_allocations(&crate::ALLOC, scene.as_mut(), dt)?;
+        Ok((scene, blocks.last().copied().unwrap_or(usize::MAX)))
     });
     let mut scene = match measured {
         Ok((scene, allocations)) => {
             out.push(check(
                 kind,
-                format!("{name}: steps {} to {}, 2 threads", STEPS + 1, STEPS + 3),
+                format!("{name}: a block of 4 steps after step {STEPS}, 2 threads"),
                 "heap allocations",
                 allocations as f64,
             ));
@@ -191,12 +148,12 @@ fn contracts(kind: &'static SceneKind, preset: &Preset, ctx: &Ctx) -> Vec<Check>
         Ok(fingerprint(fresh.as_ref(), &mut Frame::default()))
     })();
     let measured = match (&uninterrupted, &resumed) {
-        (Ok(a), Ok(b)) => differing(a, b),
+        (Ok(a), Ok(b)) => differing_bits(a, b) as f64,
         _ => f64::NAN,
     };
     out.push(check(
         kind,
-        format!("{name}: resumed from a checkpoint after {} steps, 2 more", STEPS + 3),
+        format!("{name}: resumed from a checkpoint, 2 more steps"),
         "values whose bits differ from the uninterrupted run",
         measured,
     ));
@@ -204,9 +161,11 @@ fn contracts(kind: &'static SceneKind, preset: &Preset, ctx: &Ctx) -> Vec<Check>
     // A provoked overflow fails the step and leaves the checkpoint as it was.
     let before = scene.save();
     if let Some(what) = scene.provoke_overflow() {
-        let poisoned = scene.save();
+        // Compared as text: `-0.0` and `0.0` are equal numbers but not the same bits.
+        let poisoned = scene.save().to_string();
         let failed_step = scene.step(dt);
-        let unchanged = scene.save() == poisoned;
+        let after: String = scene.save().to_string();
+        let unchanged = after == poisoned;
         let measured = match failed_step {
             Err(e) if e.to_string().contains("non-finite") && unchanged => 0.0,
             Err(_) if unchanged => 1.0,

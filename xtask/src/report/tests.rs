@@ -273,7 +273,8 @@ fn cheapest_json_lists_every_tolerance_with_the_measured_pick() {
     assert_eq!(osc["study"], "core-oscillator");
     assert_eq!(osc["crate"], "anim-core");
     assert_eq!(osc["scene"], "harmonic-oscillator");
-    assert_eq!(osc["horizon"], anim_core::cases::core::OSCILLATOR_HORIZON);
+    // 10.3 periods of the unit oscillator, `m = k = 1`.
+    assert_eq!(osc["horizon"], 10.3 * 2.0 * std::f64::consts::PI);
     assert_eq!(osc["param"], "dt");
     assert_eq!(families[1]["scene"], serde_json::Value::Null);
     let picks = osc["picks"].as_array().unwrap();

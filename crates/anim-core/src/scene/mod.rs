@@ -43,6 +43,7 @@
 
 mod checkpoint;
 mod dynamic;
+mod looped;
 mod preset;
 pub mod study;
 pub mod systems;
@@ -52,5 +53,6 @@ pub use checkpoint::{
     Checkpoint, CheckpointError, restore_state_and_memory, save_state_and_memory, saved_field, saved_state,
 };
 pub use dynamic::{DynScene, Simulated, StepError};
+pub use looped::Looped;
 pub use preset::{BuildContext, BuildError, BuildFn, Preset, RunDefaults, SceneKind, params};
 pub use view::{Context, Field, Frame, ImageGrid, Prop, View, frame_box};

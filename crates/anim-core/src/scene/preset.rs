@@ -54,6 +54,15 @@ pub struct Preset {
     pub quick_params: Option<serde_json::Value>,
 }
 
+impl Preset {
+    /// The parameters a suite runs the preset with: its `quick_params` when `quick` (and it has
+    /// them), else its `params`.
+    #[must_use]
+    pub fn params_for(&self, quick: bool) -> &serde_json::Value {
+        if quick { self.quick_params.as_ref().unwrap_or(&self.params) } else { &self.params }
+    }
+}
+
 /// What a scene built from a file may need beyond its parameters.
 #[derive(Debug, Clone, Default)]
 pub struct BuildContext<'a> {
