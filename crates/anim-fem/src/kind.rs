@@ -26,7 +26,6 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-use crate::boundary::Obstacle;
 use crate::material::MaterialModel;
 use crate::model::ElementOrder;
 use crate::scenes;
@@ -35,7 +34,8 @@ use anim_core::integrate::State;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
-    RunDefaults, SceneKind, Simulated, View, params, restore_state_and_memory, save_state_and_memory,
+    RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
+    save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
 
@@ -172,16 +172,9 @@ impl View for FemSimulation {
     /// the ground.
     fn context(&self, state: &State) -> Context {
         let model = self.model();
-        let mut ground = None;
-        let mut spheres = Vec::new();
-        for o in model.obstacles() {
-            match *o {
-                Obstacle::Plane { point, normal: [0.0, 0.0, 1.0] } => ground = Some(point[2]),
-                Obstacle::Sphere { center, radius } => spheres.push(Prop::Sphere { center, radius }),
-                // Other planes are not drawn; a model has no box or capsule obstacles.
-                Obstacle::Plane { .. } | Obstacle::Box { .. } | Obstacle::Capsule { .. } => {}
-            }
-        }
+        let ground = ground_height(model.obstacles());
+        // A model has no box or capsule obstacles (refused when they are added).
+        let spheres: Vec<Prop> = model.obstacles().iter().filter_map(Prop::of_shape).collect();
         let fixed = model.fixed();
         // `Context` is non-exhaustive: filled field by field.
         let mut context = Context::default();

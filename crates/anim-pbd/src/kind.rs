@@ -17,14 +17,14 @@
 //! tetrahedra, its edges and tetrahedra, the particles of zero inverse mass as pins, and the
 //! static colliders: ground, spheres, capsules and boxes).
 
-use crate::collide::Shape;
 use crate::scenes;
 use crate::sim::{Method, PbdSimulation};
 use anim_core::integrate::State;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
-    RunDefaults, SceneKind, Simulated, View, params, restore_state_and_memory, save_state_and_memory,
+    RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
+    save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
 
@@ -170,19 +170,12 @@ impl View for PbdSimulation {
         if triangles.is_empty() && !model.tets().is_empty() {
             triangles = boundary_triangles(model.tets(), state.x.len() / 3);
         }
-        let (mut ground, mut spheres, mut others) = (None, Vec::new(), Vec::new());
-        for c in model.colliders().iter().filter(|c| c.body.is_none()) {
-            match c.shape {
-                Shape::Plane { point, normal: [0.0, 0.0, 1.0] } => ground = Some(point[2]),
-                Shape::Sphere { center, radius } => spheres.push(Prop::Sphere { center, radius }),
-                Shape::Capsule { a, b, radius } => others.push(Prop::Capsule { a, b, radius }),
-                Shape::Box { center, half_extents: h } => others.push(Prop::Cuboid {
-                    lo: [center[0] - h[0], center[1] - h[1], center[2] - h[2]],
-                    hi: [center[0] + h[0], center[1] + h[1], center[2] + h[2]],
-                }),
-                Shape::Plane { .. } => {}
-            }
-        }
+        let fixed = || model.colliders().iter().filter(|c| c.body.is_none()).map(|c| &c.shape);
+        let ground = ground_height(fixed());
+        // Spheres first, then capsules and boxes, each in collider order.
+        let props: Vec<Prop> = fixed().filter_map(Prop::of_shape).collect();
+        let (spheres, others): (Vec<Prop>, Vec<Prop>) =
+            props.into_iter().partition(|p| matches!(p, Prop::Sphere { .. }));
         let edges = model.edges().to_vec();
         let mean = if edges.is_empty() {
             0.01

@@ -14,7 +14,6 @@
 //! [`View`] (the particles and their velocities; springs as lines, cloth triangles, pinned
 //! particles, the ground and sphere colliders).
 
-use crate::contact::Shape;
 use crate::scenes;
 use crate::sim::SpringSimulation;
 use anim_core::integrate::{IntegratorKind, State};
@@ -23,7 +22,8 @@ use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tole
 use anim_core::scene::systems::integrator;
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
-    RunDefaults, SceneKind, Simulated, View, params, restore_state_and_memory, save_state_and_memory,
+    RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
+    save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
 
@@ -148,10 +148,7 @@ impl View for SpringSimulation {
     fn context(&self, state: &State) -> Context {
         let network = self.network();
         let colliders = network.model().colliders();
-        let ground = colliders.iter().find_map(|c| match c.shape {
-            Shape::Plane { point, normal: [0.0, 0.0, 1.0] } => Some(point[2]),
-            _ => None,
-        });
+        let ground = ground_height(colliders.iter().map(|c| &c.shape));
         let springs = network.springs();
         let mean_length = if springs.is_empty() {
             0.01
@@ -166,11 +163,7 @@ impl View for SpringSimulation {
             network.particles().iter().enumerate().filter(|(_, p)| p.pinned).map(|(i, _)| i).collect();
         context.point_radius = 0.15 * mean_length;
         context.props.extend(ground.map(|height| Prop::Ground { height }));
-        context.props.extend(colliders.iter().filter_map(|c| match c.shape {
-            Shape::Sphere { center, radius } => Some(Prop::Sphere { center, radius }),
-            // A network has no box or capsule colliders (refused when it is built).
-            Shape::Plane { .. } | Shape::Box { .. } | Shape::Capsule { .. } => None,
-        }));
+        context.props.extend(colliders.iter().filter_map(|c| Prop::of_shape(&c.shape)));
         context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
         context
     }

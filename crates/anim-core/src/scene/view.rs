@@ -4,6 +4,7 @@
 //! works in another frame (a fluid with y up, a 2D solver in its plane) turns its points into
 //! this one in [`View::frame`].
 
+use crate::geometry::Shape;
 use crate::solver::Solver;
 
 /// The static part of a scene's picture, fixed for the run: the cells that join the points,
@@ -86,6 +87,32 @@ pub enum Prop {
         /// The point it is tied to.
         point: usize,
     },
+}
+
+impl Prop {
+    /// The prop a collider shape is drawn as: a sphere, capsule or box (a cuboid). Planes are
+    /// `None`: the previews draw only the ground ([`ground_height`]).
+    #[must_use]
+    pub fn of_shape(shape: &Shape) -> Option<Self> {
+        match *shape {
+            Shape::Sphere { center, radius } => Some(Prop::Sphere { center, radius }),
+            Shape::Capsule { a, b, radius } => Some(Prop::Capsule { a, b, radius }),
+            Shape::Box { center, half_extents: h } => Some(Prop::Cuboid {
+                lo: [center[0] - h[0], center[1] - h[1], center[2] - h[2]],
+                hi: [center[0] + h[0], center[1] + h[1], center[2] + h[2]],
+            }),
+            Shape::Plane { .. } => None,
+        }
+    }
+}
+
+/// The height of the first plane among `shapes` whose normal points straight up (`+z`, any
+/// length): the ground a preview draws.
+pub fn ground_height<'a>(shapes: impl IntoIterator<Item = &'a Shape>) -> Option<f64> {
+    shapes.into_iter().find_map(|s| match *s {
+        Shape::Plane { point, normal: [nx, ny, nz] } if nx == 0.0 && ny == 0.0 && nz > 0.0 => Some(point[2]),
+        _ => None,
+    })
 }
 
 /// A regular grid of cells whose fields an image scene writes.
@@ -219,7 +246,29 @@ pub trait View: Solver {
 
 #[cfg(test)]
 mod tests {
-    use super::frame_box;
+    use super::{Prop, Shape, frame_box, ground_height};
+
+    #[test]
+    fn shapes_are_drawn_as_props_and_the_first_upward_plane_is_the_ground() {
+        let b = Shape::Box { center: [1.0, 2.0, 3.0], half_extents: [0.5, 0.25, 2.0] };
+        assert_eq!(Prop::of_shape(&b), Some(Prop::Cuboid { lo: [0.5, 1.75, 1.0], hi: [1.5, 2.25, 5.0] }));
+        let s = Shape::Sphere { center: [0.0, 0.0, 1.0], radius: 0.5 };
+        assert_eq!(Prop::of_shape(&s), Some(Prop::Sphere { center: [0.0, 0.0, 1.0], radius: 0.5 }));
+        let c = Shape::Capsule { a: [0.0; 3], b: [0.0, 1.0, 0.0], radius: 0.1 };
+        assert_eq!(Prop::of_shape(&c), Some(Prop::Capsule { a: [0.0; 3], b: [0.0, 1.0, 0.0], radius: 0.1 }));
+        let plane = |z: f64, normal: [f64; 3]| Shape::Plane { point: [5.0, 5.0, z], normal };
+        assert_eq!(Prop::of_shape(&plane(0.0, [0.0, 0.0, 1.0])), None);
+        // A tilted or downward plane is no ground; an upward normal of any length is.
+        let shapes = [
+            plane(9.0, [0.0, 0.1, 1.0]),
+            plane(8.0, [0.0, 0.0, -1.0]),
+            s,
+            plane(-0.5, [0.0, 0.0, 2.0]),
+            plane(3.0, [0.0, 0.0, 1.0]),
+        ];
+        assert_eq!(ground_height(&shapes), Some(-0.5));
+        assert_eq!(ground_height(&shapes[..3]), None);
+    }
 
     #[test]
     fn the_frame_box_frames_the_points_and_reaches_the_ground() {
