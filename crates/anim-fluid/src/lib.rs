@@ -15,7 +15,7 @@
 //!   an `N x N` grid with a one-cell border, in `f32`, with the same operations in the same
 //!   order: density and velocity are **identical to the last bit** to the C code compiled
 //!   without contraction (unit tests against committed C output; `cargo xtask conformance`
-//!   against the C transcription under `xtask/peers/fluid/` at N = 64 and 128, 100 steps).
+//!   against the C transcription in `testdata/stable_fluids.c` at N = 64 and 128, 100 steps).
 //! - [`mac`]: a staggered (MAC) grid in 2D or 3D (one code base), velocity advection by
 //!   semi-Lagrangian steps with linear or monotone cubic interpolation, or BFECC / MacCormack
 //!   with a limiter ([`advection`]); Stam's advect-then-project splitting or

@@ -1,6 +1,6 @@
 //! `cargo xtask bench --peers`, anim-fluid part:
 //!
-//! 1. Stam's solver against Stam's C routines (`peers/fluid/stable_fluids.c`, compiled with
+//! 1. Stam's solver against Stam's C routines (anim-fluid's `testdata/stable_fluids.c`, compiled with
 //!    `cc -O3 -march=native`), per-step time at N = 128, 256, 512, same source pattern and
 //!    iterations (20 Gauss-Seidel sweeps), both on one thread;
 //! 2. MGPCG against red-black Gauss-Seidel at equal divergence residual on the 2D box with a

@@ -1,4 +1,4 @@
-//! Stam's solver against its C transcription (`xtask/peers/fluid/stable_fluids.c`), compiled
+//! Stam's solver against its C transcription (`testdata/stable_fluids.c`), compiled
 //! here and run side by side: bit for bit at N = 64 and 128 after 100 steps.
 
 use super::check;
@@ -8,17 +8,17 @@ use anim_core::cases::{Check, Ctx, Judge};
 use std::path::PathBuf;
 use std::process::Command;
 
-/// Where the C transcription is built: `fluid-c` in the target directory (`CARGO_TARGET_DIR` when
-/// set, else the workspace's `target`).
+/// Where the C transcription is built: `fluid-c` in `CARGO_TARGET_DIR` when set, else a folder
+/// of this process in the system's temporary directory (never beside the crate's sources).
 fn c_dir() -> PathBuf {
-    let target = std::env::var("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target"));
-    target.join("fluid-c")
+    match std::env::var_os("CARGO_TARGET_DIR") {
+        Some(target) => PathBuf::from(target).join("fluid-c"),
+        None => std::env::temp_dir().join(format!("anim-fluid-c-{}", std::process::id())),
+    }
 }
 
-/// Compiles the C transcription of Stam's routines (`xtask/peers/fluid/stable_fluids.c`) with the C compiler
-/// (`$CC`, else `cc`) and `flags` into the executable `name` in the target directory, and
+/// Compiles the C transcription of Stam's routines (the crate's `testdata/stable_fluids.c`) with
+/// the C compiler (`$CC`, else `cc`) and `flags` into the executable `name` (see `c_dir`), and
 /// returns its path. The conformance case runs it with `-O2 -ffp-contract=off` (bit for bit with
 /// Stam's solver); `cargo xtask bench --peers` times it with `-O3 -march=native`.
 ///
@@ -28,7 +28,10 @@ pub fn compile_c(name: &str, flags: &[&str]) -> Result<PathBuf, String> {
     let dir = c_dir();
     std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     let exe = dir.join(name);
-    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../xtask/peers/fluid/stable_fluids.c");
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("testdata/stable_fluids.c");
+    if !src.is_file() {
+        return Err(format!("the C transcription {} is missing", src.display()));
+    }
     let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     let out = Command::new(&cc)
         .args(flags)
@@ -54,12 +57,20 @@ fn stam_run(n: usize, steps: usize) -> Result<StamFluid, FluidError> {
 
 pub(super) fn stam_bitwise(_ctx: &Ctx) -> Vec<Check> {
     let case = "Stam's solver vs C (cc -O2 -ffp-contract=off), 100 steps";
-    let src = "xtask/peers/fluid/stable_fluids.c (Stam 2003)";
+    let src = "anim-fluid testdata/stable_fluids.c (Stam 2003)";
     let exe = match compile_c("stable_fluids_exact", &["-O2", "-ffp-contract=off"]) {
         Ok(e) => e,
         Err(e) => {
             eprintln!("NOTE: {e}");
-            return vec![check(case, "C compiler available".into(), 0.0, 1.0, 1.0, Judge::AtLeast, src)];
+            return vec![check(
+                case,
+                format!("C transcription compiled ({e})"),
+                0.0,
+                1.0,
+                1.0,
+                Judge::AtLeast,
+                src,
+            )];
         }
     };
     let mut out = Vec::new();
