@@ -171,8 +171,9 @@ impl Shape {
                 let n = if len > 0.0 {
                     d / len
                 } else {
-                    // On the axis: any direction perpendicular to it.
-                    ab.any_orthonormal_vector()
+                    // On the axis: any direction perpendicular to it (glam's construction needs
+                    // the unit axis).
+                    ab.normalize().any_orthonormal_vector()
                 };
                 (len - radius, n)
             }
@@ -232,6 +233,34 @@ mod tests {
         assert!(close(c.signed_distance(DVec3::new(0.0, -0.3, -0.4)).0, 0.0));
         let (phi, n) = c.signed_distance(DVec3::new(0.0, 0.0, 1.0));
         assert!(close(phi, -0.5) && close(n.length(), 1.0) && close(n.z, 0.0));
+    }
+
+    #[test]
+    fn capsule_normal_on_the_axis_is_unit_and_perpendicular() {
+        // Axis ends and points exactly on the axis (dyadic coordinates, so the closest axis point
+        // is computed without rounding): y-axis capsules both ways, a z-axis one, diagonal ones.
+        type Case = ([f64; 3], [f64; 3], &'static [[f64; 3]]);
+        let cases: [Case; 6] = [
+            (
+                [0.0, -1.0, 0.5],
+                [0.0, 2.0, 0.5],
+                &[[0.0, -1.0, 0.5], [0.0, 0.5, 0.5], [0.0, 1.25, 0.5], [0.0, 2.0, 0.5]],
+            ),
+            ([0.0, 3.0, 0.0], [0.0, 1.0, 0.0], &[[0.0, 3.0, 0.0], [0.0, 2.0, 0.0], [0.0, 1.0, 0.0]]),
+            ([0.0; 3], [0.0, 0.0, 2.0], &[[0.0, 0.0, 1.0]]),
+            ([0.0; 3], [1.0, 2.0, 2.0], &[[0.0; 3], [0.25, 0.5, 0.5], [0.5, 1.0, 1.0], [1.0, 2.0, 2.0]]),
+            ([1.0; 3], [-2.0; 3], &[[1.0; 3], [-0.5; 3], [-2.0; 3]]),
+            ([0.0; 3], [2.0, -1.0, -2.0], &[[1.0, -0.5, -1.0]]),
+        ];
+        for (a, b, points) in cases {
+            let c = Shape::Capsule { a, b, radius: 0.25 };
+            let axis = (DVec3::from_array(b) - DVec3::from_array(a)).normalize();
+            for &p in points {
+                let (phi, n) = c.signed_distance(DVec3::from_array(p));
+                assert_eq!(phi, -0.25, "{c:?} at {p:?} is not on the axis");
+                assert!(close(n.length(), 1.0) && close(n.dot(axis), 0.0), "{c:?} at {p:?}: normal {n}");
+            }
+        }
     }
 
     #[test]
