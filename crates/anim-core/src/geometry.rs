@@ -74,8 +74,9 @@ impl Shape {
         }
     }
 
-    /// Checks the parameters: finite coordinates, a non-zero plane normal, positive radii and
-    /// half extents, distinct capsule ends.
+    /// Checks the parameters: finite coordinates, a non-zero plane normal that normalises to a
+    /// finite unit vector, positive radii and half extents, distinct capsule ends whose squared
+    /// distance is positive and finite.
     ///
     /// # Errors
     /// A description of the first problem, naming the shape.
@@ -92,6 +93,9 @@ impl Shape {
         let dim = dim.clamp(1, 3);
         let finite = |v: &[f64; 3]| v[..dim].iter().all(|c| c.is_finite());
         let positive = |v: f64| v > 0.0 && v.is_finite();
+        // The first `dim` components, the others zero.
+        let vector =
+            |v: &[f64; 3]| DVec3::from_array(std::array::from_fn(|i| if i < dim { v[i] } else { 0.0 }));
         match self {
             Shape::Plane { point, normal } => {
                 if !finite(point) || !finite(normal) {
@@ -99,6 +103,12 @@ impl Shape {
                 }
                 if !(normal[..dim].iter().map(|c| c * c).sum::<f64>().sqrt() > 1e-12) {
                     return Err(format!("plane normal must be non-zero, got {normal:?}"));
+                }
+                // A normal whose squared length overflows would normalise to zero.
+                if vector(normal).try_normalize().is_none() {
+                    return Err(format!(
+                        "plane normal {normal:?} is too long to normalise to a finite unit vector"
+                    ));
                 }
             }
             Shape::Sphere { center, radius } => {
@@ -128,6 +138,15 @@ impl Shape {
                 }
                 if a[..dim] == b[..dim] {
                     return Err(format!("capsule ends coincide at {a:?} (use a sphere)"));
+                }
+                // The distance divides by the squared axis length: it must neither underflow to
+                // zero (ends distinct but too close) nor overflow (ends too far apart).
+                let axis_squared = (vector(b) - vector(a)).length_squared();
+                if !positive(axis_squared) {
+                    return Err(format!(
+                        "capsule axis from {a:?} to {b:?} has squared length {axis_squared}: it must be \
+                         positive and finite (ends too close together or too far apart)"
+                    ));
                 }
             }
         }
@@ -320,6 +339,41 @@ mod tests {
         assert!(flat.check().is_err() && flat.check_in(2).is_ok());
         let up = Shape::Plane { point: [0.0; 3], normal: [0.0, 0.0, 1.0] };
         assert!(up.check().is_ok() && up.check_in(2).is_err());
+    }
+
+    #[test]
+    fn checks_refuse_what_overflows_or_underflows() {
+        // The squared length of this normal overflows: it would normalise to zero.
+        let huge = Shape::Plane { point: [0.0; 3], normal: [1e200, 0.0, 0.0] };
+        let e = huge.check().unwrap_err();
+        assert!(e.contains("plane normal") && e.contains("unit"), "{e}");
+        assert!(huge.check_in(2).is_err());
+        // Only the first `dim` components count: a huge third one is fine in 2-D.
+        assert!(Shape::Plane { point: [0.0; 3], normal: [0.0, 1.0, 1e200] }.check_in(2).is_ok());
+        assert!(Shape::Plane { point: [0.0; 3], normal: [1e150, 0.0, 0.0] }.check().is_ok());
+        // Capsule ends distinct but so close, or so far apart, that the squared axis length
+        // underflows to zero or overflows: the distance would be NaN.
+        for (a, b) in [
+            ([0.0; 3], [1e-170, 0.0, 0.0]),
+            ([1e-300, -1e-300, 0.0], [0.0; 3]),
+            ([1e200, 0.0, 0.0], [-1e200, 0.0, 0.0]),
+            ([f64::MAX, 0.0, 0.0], [-f64::MAX, 0.0, 0.0]),
+        ] {
+            let capsule = Shape::Capsule { a, b, radius: 0.5 };
+            let e = capsule.check().expect_err(&format!("{capsule:?}"));
+            assert!(e.contains("capsule axis"), "{e}");
+            // Unchecked, its distance would not be a number.
+            let nan = [DVec3::from_array(a), DVec3::new(0.1, 0.2, 0.3)]
+                .into_iter()
+                .any(|p| capsule.signed_distance(p).0.is_nan());
+            assert!(nan, "{capsule:?}");
+        }
+        let e = Shape::Capsule { a: [0.0; 3], b: [0.0, 0.0, 1e-170], radius: 0.5 }.check_in(3).unwrap_err();
+        assert!(e.contains("capsule axis"), "{e}");
+        // In 2-D the ends differ only in the ignored third component: they coincide.
+        let e = Shape::Capsule { a: [0.0; 3], b: [0.0, 0.0, 1.0], radius: 0.5 }.check_in(2).unwrap_err();
+        assert!(e.contains("capsule ends coincide"), "{e}");
+        assert!(Shape::Capsule { a: [0.0; 3], b: [1e-150, 0.0, 0.0], radius: 0.5 }.check().is_ok());
     }
 
     #[test]
