@@ -284,19 +284,44 @@ mod tests {
 
     #[test]
     fn normals_are_finite_difference_gradients() {
+        use rand::{Rng, SeedableRng};
+        use rand_chacha::ChaCha8Rng;
+
+        let (capsule_a, capsule_b) = (DVec3::new(-0.3, 0.1, 0.0), DVec3::new(0.4, -0.2, 0.5));
+        let (box_center, box_half) = (DVec3::new(0.1, 0.0, 0.2), DVec3::new(0.6, 0.4, 0.3));
         let shapes = [
             Shape::Plane { point: [0.1, -0.2, 0.3], normal: [1.0, -2.0, 0.5] }.normalized(),
             Shape::Sphere { center: [0.2, 0.1, -0.1], radius: 0.7 },
-            Shape::Box { center: [0.1, 0.0, 0.2], half_extents: [0.6, 0.4, 0.3] },
-            Shape::Capsule { a: [-0.3, 0.1, 0.0], b: [0.4, -0.2, 0.5], radius: 0.35 },
+            Shape::Box { center: box_center.to_array(), half_extents: box_half.to_array() },
+            Shape::Capsule { a: capsule_a.to_array(), b: capsule_b.to_array(), radius: 0.35 },
         ];
+        // A seeded sample of [-1.5, 1.5]^3, then the places where the distance has a kink: points
+        // on the capsule's axis (its ends included), the sphere's centre, and the box's ridges
+        // (edges and corners of its surface, and the inner ridges where two or three faces are
+        // equally near).
+        let mut rng = ChaCha8Rng::seed_from_u64(0x6e6f726d);
+        let mut points: Vec<DVec3> = (0..200)
+            .map(|_| DVec3::from_array(std::array::from_fn(|_| rng.random_range(-1.5..1.5))))
+            .collect();
+        points.extend([0.0, 0.25, 0.5, 0.75, 1.0].map(|t| capsule_a.lerp(capsule_b, t)));
+        points.push(DVec3::new(0.2, 0.1, -0.1));
+        for signs in [DVec3::ONE, DVec3::new(-1.0, 1.0, -1.0), DVec3::new(1.0, -1.0, 1.0)] {
+            for ridge in [
+                box_half,
+                DVec3::new(box_half.x, box_half.y, 0.0),
+                DVec3::new(box_half.x, 0.1, box_half.z),
+                DVec3::new(0.0, box_half.y, box_half.z),
+                DVec3::new(0.5, 0.3, 0.0),
+                DVec3::new(0.5, 0.3, 0.2),
+                DVec3::new(0.4, 0.2, 0.1),
+            ] {
+                points.push(box_center + signs * ridge);
+            }
+        }
         let eps = 1e-6;
         let mut checked = 0;
         for shape in shapes {
-            for i in 0..200 {
-                // A deterministic spread of points in [-1.5, 1.5]^3.
-                let f = |k: u32| ((i * 37 + k as usize * 101) % 97) as f64 / 97.0 * 3.0 - 1.5;
-                let p = DVec3::new(f(1), f(2), f(3));
+            for &p in &points {
                 let (phi, n) = shape.signed_distance(p);
                 assert!(phi.is_finite() && close(n.length(), 1.0), "{shape:?} at {p}");
                 let fd = DVec3::from_array(std::array::from_fn(|a| {
