@@ -238,6 +238,8 @@ mod tests {
         let sphere = Shape::Sphere { center: [1.0, 0.0, 0.0], radius: 0.5 };
         assert!(close(sphere.signed_distance(DVec3::new(1.0, 2.0, 0.0)).0, 1.5));
         assert!(close(sphere.signed_distance(DVec3::new(1.2, 0.0, 0.0)).0, -0.3));
+        let unit = Shape::Sphere { center: [0.0; 3], radius: 1.0 };
+        assert!((unit.signed_distance(DVec3::new(0.0, 0.3, 0.0)).0 + 0.7).abs() < 1e-15);
         assert_eq!(sphere.signed_distance(DVec3::new(1.0, 0.0, 0.0)), (-0.5, DVec3::Z));
         let b = Shape::Box { center: [1.0, 0.0, 0.0], half_extents: [1.0, 0.5, 0.25] };
         // Outside a face, outside an edge, outside a corner, inside.
@@ -246,10 +248,24 @@ mod tests {
         assert!(close(b.signed_distance(DVec3::new(-1.0, -1.5, 1.25)).0, 3f64.sqrt()));
         let (phi, n) = b.signed_distance(DVec3::new(1.1, 0.0, -0.2));
         assert!(close(phi, -0.05) && n == -DVec3::Z);
+        // The normals: outside a face, inside near a face, outside an edge.
+        let (d, n) = b.signed_distance(DVec3::new(1.0, 0.0, 0.5));
+        assert!((d - 0.25).abs() < 1e-15 && n == DVec3::Z);
+        let (d, n) = b.signed_distance(DVec3::new(1.9, 0.0, 0.0));
+        assert!((d + 0.1).abs() < 1e-15 && n == DVec3::X, "{d} {n}");
+        let (d, n) = b.signed_distance(DVec3::new(3.0, 1.5, 0.0));
+        assert!(
+            (d - 2f64.sqrt()).abs() < 1e-15 && (n - DVec3::new(1.0, 1.0, 0.0).normalize()).length() < 1e-15
+        );
         let c = Shape::Capsule { a: [0.0; 3], b: [0.0, 0.0, 2.0], radius: 0.5 };
         assert!(close(c.signed_distance(DVec3::new(2.0, 0.0, 1.0)).0, 1.5));
         assert!(close(c.signed_distance(DVec3::new(0.0, 0.0, 3.0)).0, 0.5));
         assert!(close(c.signed_distance(DVec3::new(0.0, -0.3, -0.4)).0, 0.0));
+        // The normals beside the axis and beyond an end.
+        let (d, n) = c.signed_distance(DVec3::new(1.0, 0.0, 1.0));
+        assert!((d - 0.5).abs() < 1e-15 && n == DVec3::X);
+        let (d, n) = c.signed_distance(DVec3::new(0.0, 0.0, 3.0));
+        assert!((d - 0.5).abs() < 1e-15 && n == DVec3::Z);
         let (phi, n) = c.signed_distance(DVec3::new(0.0, 0.0, 1.0));
         assert!(close(phi, -0.5) && close(n.length(), 1.0) && close(n.z, 0.0));
     }
