@@ -432,6 +432,20 @@ fn bad_input_is_rejected_naming_the_element() {
     let mut b = two();
     b.collider(Collider::sphere([0.0; 3], -1.0));
     assert!(matches!(b.build(), Err(BuildError::Input(InputError::BadCollider { collider: 0, .. }))));
+    // A non-finite mesh vertex is reported as such (not as a zero-area triangle), numbered after
+    // the particles already there.
+    let mesh = MeshParams {
+        mass: MeshMass::PerVertex(0.01),
+        stretch: ConstraintParams::rigid(),
+        bending: Bending::None,
+    };
+    let nan = [0.0, f64::NAN, 0.0];
+    let e = two().triangle_mesh(&[[0.0; 3], [1.0, 0.0, 0.0], nan], &[[0, 1, 2]], &mesh).unwrap_err();
+    assert!(
+        matches!(e, BuildError::Input(InputError::NonFinitePosition { particle: 4, position })
+            if position[1].is_nan()),
+        "{e}"
+    );
     let mut b = two();
     b.attach(0, AttachTarget::Body { body: 3, local: [0.0; 3] }, 0.0, ConstraintParams::rigid());
     assert!(matches!(b.build(), Err(BuildError::BodyIndex { constraint: 0, body: 3, .. })));
