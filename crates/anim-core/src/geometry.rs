@@ -74,8 +74,9 @@ impl Shape {
         }
     }
 
-    /// Checks the parameters: finite coordinates, a non-zero plane normal, positive radii and
-    /// half extents, distinct capsule ends.
+    /// Checks the parameters: finite coordinates, a non-zero plane normal that normalises to a
+    /// finite unit vector, positive radii and half extents, distinct capsule ends whose squared
+    /// distance is positive and finite.
     ///
     /// # Errors
     /// A description of the first problem, naming the shape.
@@ -92,6 +93,9 @@ impl Shape {
         let dim = dim.clamp(1, 3);
         let finite = |v: &[f64; 3]| v[..dim].iter().all(|c| c.is_finite());
         let positive = |v: f64| v > 0.0 && v.is_finite();
+        // The first `dim` components, the others zero.
+        let vector =
+            |v: &[f64; 3]| DVec3::from_array(std::array::from_fn(|i| if i < dim { v[i] } else { 0.0 }));
         match self {
             Shape::Plane { point, normal } => {
                 if !finite(point) || !finite(normal) {
@@ -99,6 +103,12 @@ impl Shape {
                 }
                 if !(normal[..dim].iter().map(|c| c * c).sum::<f64>().sqrt() > 1e-12) {
                     return Err(format!("plane normal must be non-zero, got {normal:?}"));
+                }
+                // A normal whose squared length overflows would normalise to zero.
+                if vector(normal).try_normalize().is_none() {
+                    return Err(format!(
+                        "plane normal {normal:?} is too long to normalise to a finite unit vector"
+                    ));
                 }
             }
             Shape::Sphere { center, radius } => {
@@ -128,6 +138,15 @@ impl Shape {
                 }
                 if a[..dim] == b[..dim] {
                     return Err(format!("capsule ends coincide at {a:?} (use a sphere)"));
+                }
+                // The distance divides by the squared axis length: it must neither underflow to
+                // zero (ends distinct but too close) nor overflow (ends too far apart).
+                let axis_squared = (vector(b) - vector(a)).length_squared();
+                if !positive(axis_squared) {
+                    return Err(format!(
+                        "capsule axis from {a:?} to {b:?} has squared length {axis_squared}: it must be \
+                         positive and finite (ends too close together or too far apart)"
+                    ));
                 }
             }
         }
@@ -171,8 +190,9 @@ impl Shape {
                 let n = if len > 0.0 {
                     d / len
                 } else {
-                    // On the axis: any direction perpendicular to it.
-                    ab.any_orthonormal_vector()
+                    // On the axis: any direction perpendicular to it (glam's construction needs
+                    // the unit axis).
+                    ab.normalize().any_orthonormal_vector()
                 };
                 (len - radius, n)
             }
@@ -218,6 +238,8 @@ mod tests {
         let sphere = Shape::Sphere { center: [1.0, 0.0, 0.0], radius: 0.5 };
         assert!(close(sphere.signed_distance(DVec3::new(1.0, 2.0, 0.0)).0, 1.5));
         assert!(close(sphere.signed_distance(DVec3::new(1.2, 0.0, 0.0)).0, -0.3));
+        let unit = Shape::Sphere { center: [0.0; 3], radius: 1.0 };
+        assert!((unit.signed_distance(DVec3::new(0.0, 0.3, 0.0)).0 + 0.7).abs() < 1e-15);
         assert_eq!(sphere.signed_distance(DVec3::new(1.0, 0.0, 0.0)), (-0.5, DVec3::Z));
         let b = Shape::Box { center: [1.0, 0.0, 0.0], half_extents: [1.0, 0.5, 0.25] };
         // Outside a face, outside an edge, outside a corner, inside.
@@ -226,29 +248,96 @@ mod tests {
         assert!(close(b.signed_distance(DVec3::new(-1.0, -1.5, 1.25)).0, 3f64.sqrt()));
         let (phi, n) = b.signed_distance(DVec3::new(1.1, 0.0, -0.2));
         assert!(close(phi, -0.05) && n == -DVec3::Z);
+        // The normals: outside a face, inside near a face, outside an edge.
+        let (d, n) = b.signed_distance(DVec3::new(1.0, 0.0, 0.5));
+        assert!((d - 0.25).abs() < 1e-15 && n == DVec3::Z);
+        let (d, n) = b.signed_distance(DVec3::new(1.9, 0.0, 0.0));
+        assert!((d + 0.1).abs() < 1e-15 && n == DVec3::X, "{d} {n}");
+        let (d, n) = b.signed_distance(DVec3::new(3.0, 1.5, 0.0));
+        assert!(
+            (d - 2f64.sqrt()).abs() < 1e-15 && (n - DVec3::new(1.0, 1.0, 0.0).normalize()).length() < 1e-15
+        );
         let c = Shape::Capsule { a: [0.0; 3], b: [0.0, 0.0, 2.0], radius: 0.5 };
         assert!(close(c.signed_distance(DVec3::new(2.0, 0.0, 1.0)).0, 1.5));
         assert!(close(c.signed_distance(DVec3::new(0.0, 0.0, 3.0)).0, 0.5));
         assert!(close(c.signed_distance(DVec3::new(0.0, -0.3, -0.4)).0, 0.0));
+        // The normals beside the axis and beyond an end.
+        let (d, n) = c.signed_distance(DVec3::new(1.0, 0.0, 1.0));
+        assert!((d - 0.5).abs() < 1e-15 && n == DVec3::X);
+        let (d, n) = c.signed_distance(DVec3::new(0.0, 0.0, 3.0));
+        assert!((d - 0.5).abs() < 1e-15 && n == DVec3::Z);
         let (phi, n) = c.signed_distance(DVec3::new(0.0, 0.0, 1.0));
         assert!(close(phi, -0.5) && close(n.length(), 1.0) && close(n.z, 0.0));
     }
 
     #[test]
+    fn capsule_normal_on_the_axis_is_unit_and_perpendicular() {
+        // Axis ends and points exactly on the axis (dyadic coordinates, so the closest axis point
+        // is computed without rounding): y-axis capsules both ways, a z-axis one, diagonal ones.
+        type Case = ([f64; 3], [f64; 3], &'static [[f64; 3]]);
+        let cases: [Case; 6] = [
+            (
+                [0.0, -1.0, 0.5],
+                [0.0, 2.0, 0.5],
+                &[[0.0, -1.0, 0.5], [0.0, 0.5, 0.5], [0.0, 1.25, 0.5], [0.0, 2.0, 0.5]],
+            ),
+            ([0.0, 3.0, 0.0], [0.0, 1.0, 0.0], &[[0.0, 3.0, 0.0], [0.0, 2.0, 0.0], [0.0, 1.0, 0.0]]),
+            ([0.0; 3], [0.0, 0.0, 2.0], &[[0.0, 0.0, 1.0]]),
+            ([0.0; 3], [1.0, 2.0, 2.0], &[[0.0; 3], [0.25, 0.5, 0.5], [0.5, 1.0, 1.0], [1.0, 2.0, 2.0]]),
+            ([1.0; 3], [-2.0; 3], &[[1.0; 3], [-0.5; 3], [-2.0; 3]]),
+            ([0.0; 3], [2.0, -1.0, -2.0], &[[1.0, -0.5, -1.0]]),
+        ];
+        for (a, b, points) in cases {
+            let c = Shape::Capsule { a, b, radius: 0.25 };
+            let axis = (DVec3::from_array(b) - DVec3::from_array(a)).normalize();
+            for &p in points {
+                let (phi, n) = c.signed_distance(DVec3::from_array(p));
+                assert_eq!(phi, -0.25, "{c:?} at {p:?} is not on the axis");
+                assert!(close(n.length(), 1.0) && close(n.dot(axis), 0.0), "{c:?} at {p:?}: normal {n}");
+            }
+        }
+    }
+
+    #[test]
     fn normals_are_finite_difference_gradients() {
+        use rand::{Rng, SeedableRng};
+        use rand_chacha::ChaCha8Rng;
+
+        let (capsule_a, capsule_b) = (DVec3::new(-0.3, 0.1, 0.0), DVec3::new(0.4, -0.2, 0.5));
+        let (box_center, box_half) = (DVec3::new(0.1, 0.0, 0.2), DVec3::new(0.6, 0.4, 0.3));
         let shapes = [
             Shape::Plane { point: [0.1, -0.2, 0.3], normal: [1.0, -2.0, 0.5] }.normalized(),
             Shape::Sphere { center: [0.2, 0.1, -0.1], radius: 0.7 },
-            Shape::Box { center: [0.1, 0.0, 0.2], half_extents: [0.6, 0.4, 0.3] },
-            Shape::Capsule { a: [-0.3, 0.1, 0.0], b: [0.4, -0.2, 0.5], radius: 0.35 },
+            Shape::Box { center: box_center.to_array(), half_extents: box_half.to_array() },
+            Shape::Capsule { a: capsule_a.to_array(), b: capsule_b.to_array(), radius: 0.35 },
         ];
+        // A seeded sample of [-1.5, 1.5]^3, then the places where the distance has a kink: points
+        // on the capsule's axis (its ends included), the sphere's centre, and the box's ridges
+        // (edges and corners of its surface, and the inner ridges where two or three faces are
+        // equally near).
+        let mut rng = ChaCha8Rng::seed_from_u64(0x6e6f726d);
+        let mut points: Vec<DVec3> = (0..200)
+            .map(|_| DVec3::from_array(std::array::from_fn(|_| rng.random_range(-1.5..1.5))))
+            .collect();
+        points.extend([0.0, 0.25, 0.5, 0.75, 1.0].map(|t| capsule_a.lerp(capsule_b, t)));
+        points.push(DVec3::new(0.2, 0.1, -0.1));
+        for signs in [DVec3::ONE, DVec3::new(-1.0, 1.0, -1.0), DVec3::new(1.0, -1.0, 1.0)] {
+            for ridge in [
+                box_half,
+                DVec3::new(box_half.x, box_half.y, 0.0),
+                DVec3::new(box_half.x, 0.1, box_half.z),
+                DVec3::new(0.0, box_half.y, box_half.z),
+                DVec3::new(0.5, 0.3, 0.0),
+                DVec3::new(0.5, 0.3, 0.2),
+                DVec3::new(0.4, 0.2, 0.1),
+            ] {
+                points.push(box_center + signs * ridge);
+            }
+        }
         let eps = 1e-6;
         let mut checked = 0;
         for shape in shapes {
-            for i in 0..200 {
-                // A deterministic spread of points in [-1.5, 1.5]^3.
-                let f = |k: u32| ((i * 37 + k as usize * 101) % 97) as f64 / 97.0 * 3.0 - 1.5;
-                let p = DVec3::new(f(1), f(2), f(3));
+            for &p in &points {
                 let (phi, n) = shape.signed_distance(p);
                 assert!(phi.is_finite() && close(n.length(), 1.0), "{shape:?} at {p}");
                 let fd = DVec3::from_array(std::array::from_fn(|a| {
@@ -291,6 +380,41 @@ mod tests {
         assert!(flat.check().is_err() && flat.check_in(2).is_ok());
         let up = Shape::Plane { point: [0.0; 3], normal: [0.0, 0.0, 1.0] };
         assert!(up.check().is_ok() && up.check_in(2).is_err());
+    }
+
+    #[test]
+    fn checks_refuse_what_overflows_or_underflows() {
+        // The squared length of this normal overflows: it would normalise to zero.
+        let huge = Shape::Plane { point: [0.0; 3], normal: [1e200, 0.0, 0.0] };
+        let e = huge.check().unwrap_err();
+        assert!(e.contains("plane normal") && e.contains("unit"), "{e}");
+        assert!(huge.check_in(2).is_err());
+        // Only the first `dim` components count: a huge third one is fine in 2-D.
+        assert!(Shape::Plane { point: [0.0; 3], normal: [0.0, 1.0, 1e200] }.check_in(2).is_ok());
+        assert!(Shape::Plane { point: [0.0; 3], normal: [1e150, 0.0, 0.0] }.check().is_ok());
+        // Capsule ends distinct but so close, or so far apart, that the squared axis length
+        // underflows to zero or overflows: the distance would be NaN.
+        for (a, b) in [
+            ([0.0; 3], [1e-170, 0.0, 0.0]),
+            ([1e-300, -1e-300, 0.0], [0.0; 3]),
+            ([1e200, 0.0, 0.0], [-1e200, 0.0, 0.0]),
+            ([f64::MAX, 0.0, 0.0], [-f64::MAX, 0.0, 0.0]),
+        ] {
+            let capsule = Shape::Capsule { a, b, radius: 0.5 };
+            let e = capsule.check().expect_err(&format!("{capsule:?}"));
+            assert!(e.contains("capsule axis"), "{e}");
+            // Unchecked, its distance would not be a number.
+            let nan = [DVec3::from_array(a), DVec3::new(0.1, 0.2, 0.3)]
+                .into_iter()
+                .any(|p| capsule.signed_distance(p).0.is_nan());
+            assert!(nan, "{capsule:?}");
+        }
+        let e = Shape::Capsule { a: [0.0; 3], b: [0.0, 0.0, 1e-170], radius: 0.5 }.check_in(3).unwrap_err();
+        assert!(e.contains("capsule axis"), "{e}");
+        // In 2-D the ends differ only in the ignored third component: they coincide.
+        let e = Shape::Capsule { a: [0.0; 3], b: [0.0, 0.0, 1.0], radius: 0.5 }.check_in(2).unwrap_err();
+        assert!(e.contains("capsule ends coincide"), "{e}");
+        assert!(Shape::Capsule { a: [0.0; 3], b: [1e-150, 0.0, 0.0], radius: 0.5 }.check().is_ok());
     }
 
     #[test]

@@ -99,6 +99,10 @@ impl Collider {
     }
 
     /// Checks collider `index` in `dim` dimensions and converts its shape to the grid's `f32`.
+    ///
+    /// anim-core's [`Shape::check_in`] checks the shape; this only checks that the conversion to
+    /// `f32` keeps it valid (finite values, positive sizes still > 0, a plane normal that still
+    /// normalises), and normalises the plane normal once, in `f32` as the grid uses it.
     pub(crate) fn compile(&self, index: usize, dim: usize) -> Result<GridCollider, MpmError> {
         let bad = |reason: String| MpmError::BadCollider { index, reason };
         let finite = |v: &[f32]| v.iter().take(dim).all(|c| c.is_finite());
@@ -107,28 +111,43 @@ impl Collider {
         }
         self.shape.check_in(dim).map_err(bad)?;
         let f = |v: [f64; 3]| v.map(|c| c as f32);
+        let positive = |v: &[f32]| v.iter().take(dim).all(|c| *c > 0.0 && c.is_finite());
         let shape = match self.shape {
             Shape::Plane { point, normal } => {
                 let (point, normal) = (f(point), f(normal));
                 if !finite(&point) || !finite(&normal) {
-                    return Err(bad("non-finite plane".into()));
+                    return Err(bad(format!(
+                        "plane point {point:?} and normal {normal:?} must be finite in f32"
+                    )));
                 }
-                if normal.iter().take(dim).map(|c| c * c).sum::<f32>() < 1e-12 {
-                    return Err(bad(format!("plane normal is zero in the first {dim} components")));
-                }
+                let unit = match dim {
+                    1 => unit_normal::<1>(normal),
+                    2 => unit_normal::<2>(normal),
+                    _ => unit_normal::<3>(normal),
+                };
+                let normal = unit.ok_or_else(|| {
+                    bad(format!(
+                        "plane normal {normal:?} does not normalise in f32 (its length is zero or \
+                         overflows)"
+                    ))
+                })?;
                 GridShape::Plane { point, normal }
             }
             Shape::Box { center, half_extents } => {
                 let (center, half) = (f(center), f(half_extents));
-                if !finite(&center) || !half.iter().take(dim).all(|h| *h > 0.0 && h.is_finite()) {
-                    return Err(bad(format!("box needs a finite centre and half extents > 0, got {half:?}")));
+                if !finite(&center) || !positive(&half) {
+                    return Err(bad(format!(
+                        "box centre {center:?} must be finite and half extents {half:?} finite and > 0 in f32"
+                    )));
                 }
                 GridShape::Box { center, half }
             }
             Shape::Sphere { center, radius } => {
                 let (center, radius) = (f(center), radius as f32);
-                if !finite(&center) || !(radius > 0.0) || !radius.is_finite() {
-                    return Err(bad(format!("sphere needs a finite centre and radius > 0, got {radius}")));
+                if !finite(&center) || !positive(&[radius]) {
+                    return Err(bad(format!(
+                        "sphere centre {center:?} must be finite and radius {radius} finite and > 0 in f32"
+                    )));
                 }
                 GridShape::Sphere { center, radius }
             }
@@ -143,10 +162,23 @@ impl Collider {
     }
 }
 
+/// The first `D` components of a plane normal normalised in `f32` (the others zero), or `None`
+/// if their `f32` length is zero or not finite.
+fn unit_normal<const D: usize>(normal: [f32; 3]) -> Option<[f32; 3]> {
+    let v = Vector::<D>::from_fn(|i, _| normal[i]);
+    let len = v.norm();
+    if !(len > 0.0 && len.is_finite()) {
+        return None;
+    }
+    let n = v.normalize();
+    Some(std::array::from_fn(|i| if i < D { n[i] } else { 0.0 }))
+}
+
 /// A collider's shape in `f32`, as the grid kernels use it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum GridShape {
-    /// The half-space behind a plane through `point` with outward normal `normal`.
+    /// The half-space behind a plane through `point` with outward unit normal `normal` (unit in
+    /// its first `D` components, normalised when the collider is compiled).
     Plane { point: [f32; 3], normal: [f32; 3] },
     /// A solid axis-aligned box.
     Box { center: [f32; 3], half: [f32; 3] },
@@ -170,7 +202,7 @@ impl GridCollider {
         let y = x - shift;
         match self.shape {
             GridShape::Plane { point, normal } => {
-                let n = Vector::<D>::from_fn(|i, _| normal[i]).normalize();
+                let n = Vector::<D>::from_fn(|i, _| normal[i]);
                 let p = Vector::<D>::from_fn(|i, _| point[i]);
                 ((y - p).dot(&n), n)
             }
@@ -277,5 +309,43 @@ mod tests {
         assert!(matches!(plane.compile(1, 2), Err(MpmError::BadCollider { index: 1, .. })));
         let huge = Collider::fixed(Shape::Sphere { center: [0.5; 3], radius: 1e300 }, Boundary::Slip);
         assert!(matches!(huge.compile(0, 2), Err(MpmError::BadCollider { index: 0, .. })));
+    }
+
+    #[test]
+    fn f32_conversion_refuses_only_what_it_breaks() {
+        let refused = |shape: Shape, dim| {
+            let err = Collider::fixed(shape, Boundary::Slip).compile(2, dim).unwrap_err();
+            assert!(matches!(err, MpmError::BadCollider { index: 2, .. }), "{err}");
+            let text = err.to_string();
+            assert!(text.starts_with("collider 2: ") && text.contains(shape.name()), "{text}");
+            text
+        };
+        // A short normal anim-core accepts is a plane here too, with a unit normal.
+        let short =
+            Collider::fixed(Shape::Plane { point: [0.0; 3], normal: [0.0, 1e-7, 0.0] }, Boundary::Slip);
+        let (phi, n) = short.compile(0, 2).expect("valid").sdf(&Vector::<2>::new(0.2, -0.25), 0.0);
+        assert!((phi + 0.25).abs() < 1e-7 && n == Vector::<2>::new(0.0, 1.0), "{phi} {n}");
+        let (phi, n) = short.compile(0, 3).expect("valid").sdf(&Vector::<3>::new(0.2, -0.25, 0.1), 0.0);
+        assert!((phi + 0.25).abs() < 1e-7 && n == Vector::<3>::new(0.0, 1.0, 0.0), "{phi} {n}");
+        // A normal whose f32 square overflows, positive sizes that round to zero in f32.
+        let e = refused(Shape::Plane { point: [0.0; 3], normal: [1e20, 0.0, 0.0] }, 3);
+        assert!(e.contains("does not normalise in f32"), "{e}");
+        let e = refused(Shape::Plane { point: [1e40, 0.0, 0.0], normal: [1.0, 0.0, 0.0] }, 2);
+        assert!(e.contains("finite in f32"), "{e}");
+        let e = refused(Shape::Sphere { center: [0.5; 3], radius: 1e-50 }, 2);
+        assert!(e.contains("radius 0"), "{e}");
+        let e = refused(Shape::Box { center: [0.5; 3], half_extents: [0.1, 1e-50, 0.1] }, 3);
+        assert!(e.contains("half extents"), "{e}");
+    }
+
+    #[test]
+    fn plane_normal_is_normalised_once_as_the_grid_did() {
+        let normal = [0.37f64, 1.13, 0.21];
+        let shape = Shape::Plane { point: [0.0, 0.3, 0.0], normal };
+        let c = Collider::fixed(shape, Boundary::Slip);
+        let (_, n2) = c.compile(0, 2).expect("valid").sdf(&Vector::<2>::new(0.1, 0.2), 0.0);
+        assert_eq!(n2, Vector::<2>::new(normal[0] as f32, normal[1] as f32).normalize());
+        let (_, n3) = c.compile(0, 3).expect("valid").sdf(&Vector::<3>::new(0.1, 0.2, 0.3), 0.0);
+        assert_eq!(n3, Vector::<3>::from_fn(|i, _| normal[i] as f32).normalize());
     }
 }

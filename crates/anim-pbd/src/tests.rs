@@ -230,24 +230,6 @@ fn kinetic_and_static_friction() {
     assert!(state.x[0] < -0.1, "did not slide with mu = 0.3 < tan 20 deg: x = {}", state.x[0]);
 }
 
-#[test]
-fn shapes_signed_distances() {
-    let b = Shape::Box { center: [1.0, 0.0, 0.0], half_extents: [1.0, 0.5, 0.25] };
-    let (d, n) = b.signed_distance(DVec3::new(1.0, 0.0, 0.5));
-    assert!((d - 0.25).abs() < 1e-15 && n == DVec3::Z);
-    let (d, n) = b.signed_distance(DVec3::new(1.9, 0.0, 0.0));
-    assert!((d + 0.1).abs() < 1e-15 && n == DVec3::X, "{d} {n}");
-    let (d, n) = b.signed_distance(DVec3::new(3.0, 1.5, 0.0));
-    assert!((d - 2f64.sqrt()).abs() < 1e-15 && (n - DVec3::new(1.0, 1.0, 0.0).normalize()).length() < 1e-15);
-    let c = Shape::Capsule { a: [0.0; 3], b: [0.0, 0.0, 2.0], radius: 0.5 };
-    let (d, n) = c.signed_distance(DVec3::new(1.0, 0.0, 1.0));
-    assert!((d - 0.5).abs() < 1e-15 && n == DVec3::X);
-    let (d, n) = c.signed_distance(DVec3::new(0.0, 0.0, 3.0));
-    assert!((d - 0.5).abs() < 1e-15 && n == DVec3::Z);
-    let s = Shape::Sphere { center: [0.0; 3], radius: 1.0 };
-    assert!((s.signed_distance(DVec3::new(0.0, 0.3, 0.0)).0 + 0.7).abs() < 1e-15);
-}
-
 /// Contacts with every shape, on a moving body too: nothing ends up inside.
 #[test]
 fn particles_stay_outside_every_shape() {
@@ -450,6 +432,20 @@ fn bad_input_is_rejected_naming_the_element() {
     let mut b = two();
     b.collider(Collider::sphere([0.0; 3], -1.0));
     assert!(matches!(b.build(), Err(BuildError::Input(InputError::BadCollider { collider: 0, .. }))));
+    // A non-finite mesh vertex is reported as such (not as a zero-area triangle), numbered after
+    // the particles already there.
+    let mesh = MeshParams {
+        mass: MeshMass::PerVertex(0.01),
+        stretch: ConstraintParams::rigid(),
+        bending: Bending::None,
+    };
+    let nan = [0.0, f64::NAN, 0.0];
+    let e = two().triangle_mesh(&[[0.0; 3], [1.0, 0.0, 0.0], nan], &[[0, 1, 2]], &mesh).unwrap_err();
+    assert!(
+        matches!(e, BuildError::Input(InputError::NonFinitePosition { particle: 4, position })
+            if position[1].is_nan()),
+        "{e}"
+    );
     let mut b = two();
     b.attach(0, AttachTarget::Body { body: 3, local: [0.0; 3] }, 0.0, ConstraintParams::rigid());
     assert!(matches!(b.build(), Err(BuildError::BodyIndex { constraint: 0, body: 3, .. })));

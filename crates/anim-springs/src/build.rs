@@ -27,7 +27,7 @@ use crate::contact::Collider;
 use crate::error::{BuildError, InputError};
 use crate::network::{Particle, Spring, SpringKind, SpringModel, SpringNetwork};
 use anim_core::glam::DVec3;
-use anim_core::input::check_triangle;
+use anim_core::input::{check_particles, check_triangle, check_triangle_indices};
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
@@ -593,25 +593,9 @@ impl NetworkBuilder {
                 max: crate::network::MAX_SPRINGS,
             }));
         }
-        if !self.gravity.iter().all(|g| g.is_finite()) {
-            return Err(BuildError::Input(InputError::NonFiniteGravity { gravity: self.gravity }));
-        }
-        let mut particles = Vec::with_capacity(n);
-        for (particle, (&position, &mass)) in self.positions.iter().zip(&self.masses).enumerate() {
-            if !position.iter().all(|c| c.is_finite()) {
-                return Err(BuildError::Input(InputError::NonFinitePosition { particle, position }));
-            }
-            if !(mass > 0.0 && mass.is_finite()) {
-                return Err(BuildError::Input(InputError::BadMass { particle, mass }));
-            }
-            particles.push(Particle { mass, pinned: false });
-        }
-        for (pin, &index) in self.pins.iter().enumerate() {
-            match particles.get_mut(index) {
-                Some(p) => p.pinned = true,
-                None => return Err(BuildError::Input(InputError::PinIndex { pin, index, particles: n })),
-            }
-        }
+        let pinned = check_particles(&self.positions, &self.masses, &self.pins, self.gravity)?;
+        let particles: Vec<Particle> =
+            self.masses.iter().zip(pinned).map(|(&mass, pinned)| Particle { mass, pinned }).collect();
         let mut springs = Vec::with_capacity(self.springs.len());
         for (spring, s) in self.springs.iter().enumerate() {
             for index in [s.i, s.j] {
@@ -638,15 +622,7 @@ impl NetworkBuilder {
             springs.push(Spring { i: s.i, j: s.j, rest_length, stiffness, damping, kind: s.kind });
         }
         for (triangle, t) in self.triangles.iter().enumerate() {
-            for &index in t {
-                if index >= n {
-                    return Err(BuildError::Input(InputError::TriangleIndex {
-                        triangle,
-                        index,
-                        vertices: n,
-                    }));
-                }
-            }
+            check_triangle_indices(triangle, *t, n)?;
         }
         let mut colliders = Vec::with_capacity(self.colliders.len());
         for (collider, c) in self.colliders.iter().enumerate() {

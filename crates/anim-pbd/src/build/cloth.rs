@@ -129,9 +129,9 @@ impl PbdBuilder {
     /// and wind. Returns the range of its particles.
     ///
     /// # Errors
-    /// [`InputError::TriangleIndex`], [`InputError::DegenerateTriangle`],
-    /// [`InputError::NonManifoldEdge`] (with bending), [`InputError::IsolatedVertex`] (mass by
-    /// density), [`InputError::BadParameter`].
+    /// [`InputError::NonFinitePosition`], [`InputError::TriangleIndex`],
+    /// [`InputError::DegenerateTriangle`], [`InputError::NonManifoldEdge`] (with bending),
+    /// [`InputError::IsolatedVertex`] (mass by density), [`InputError::BadParameter`].
     pub fn triangle_mesh(
         &mut self,
         positions: &[[f64; 3]],
@@ -139,6 +139,16 @@ impl PbdBuilder {
         params: &MeshParams,
     ) -> Result<Range<usize>, BuildError> {
         check_mass("mesh", params.mass)?;
+        // Positions first: a non-finite vertex would otherwise show as a zero-area triangle.
+        let first = self.positions.len();
+        for (k, p) in positions.iter().enumerate() {
+            if !p.iter().all(|c| c.is_finite()) {
+                return Err(BuildError::Input(InputError::NonFinitePosition {
+                    particle: first + k,
+                    position: *p,
+                }));
+            }
+        }
         let nv = positions.len();
         let pos: Vec<DVec3> = positions.iter().map(|&p| DVec3::from_array(p)).collect();
         let mut area = vec![0.0; nv];
@@ -185,7 +195,6 @@ impl PbdBuilder {
                 e.push([a, b, c]);
             }
         }
-        let first = self.positions.len();
         for (p, m) in positions.iter().zip(&masses) {
             self.particle(*p, *m);
         }

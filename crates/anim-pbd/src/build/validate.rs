@@ -15,6 +15,7 @@ use crate::constraint::{
 };
 use crate::model::{Particle, PbdModel, VolumeMesh};
 use anim_core::glam::DVec3;
+use anim_core::input::{check_particles, check_triangle_indices};
 use std::collections::HashMap;
 
 impl PbdBuilder {
@@ -41,25 +42,9 @@ impl PbdBuilder {
                 max: u32::MAX as usize - 1,
             }));
         }
-        if !self.gravity.iter().all(|g| g.is_finite()) {
-            return Err(BuildError::Input(InputError::NonFiniteGravity { gravity: self.gravity }));
-        }
-        let mut particles = Vec::with_capacity(n);
-        for (i, (&m, p)) in self.masses.iter().zip(&self.positions).enumerate() {
-            if !(m > 0.0 && m.is_finite()) {
-                return Err(BuildError::Input(InputError::BadMass { particle: i, mass: m }));
-            }
-            if !p.iter().all(|c| c.is_finite()) {
-                return Err(BuildError::Input(InputError::NonFinitePosition { particle: i, position: *p }));
-            }
-            particles.push(Particle { mass: m, pinned: false });
-        }
-        for (k, &p) in self.pins.iter().enumerate() {
-            if p >= n {
-                return Err(BuildError::Input(InputError::PinIndex { pin: k, index: p, particles: n }));
-            }
-            particles[p].pinned = true;
-        }
+        let pinned = check_particles(&self.positions, &self.masses, &self.pins, self.gravity)?;
+        let particles: Vec<Particle> =
+            self.masses.iter().zip(pinned).map(|(&mass, pinned)| Particle { mass, pinned }).collect();
         let inv_mass: Vec<f64> =
             particles.iter().map(|p| if p.pinned { 0.0 } else { 1.0 / p.mass }).collect();
         for (b, body) in self.bodies.iter().enumerate() {
@@ -106,13 +91,7 @@ impl PbdBuilder {
             ));
         }
         for (t, tri) in self.triangles.iter().enumerate() {
-            if let Some(&i) = tri.iter().find(|&&i| i >= n) {
-                return Err(BuildError::Input(InputError::TriangleIndex {
-                    triangle: t,
-                    index: i,
-                    vertices: n,
-                }));
-            }
+            check_triangle_indices(t, *tri, n)?;
         }
         for e in &self.edges {
             if let Some(&i) = e.iter().find(|&&i| i >= n) {
