@@ -237,6 +237,21 @@ pub struct Registry {
     pub study_uses: Vec<StudyUse>,
 }
 
+/// The larger of `a` and `b`, NaN when either is NaN: a running maximum of errors that keeps a
+/// NaN marking a failed measurement (`f64::max` returns the other operand and drops it).
+///
+/// ```
+/// use anim_core::cases::nan_max;
+/// assert_eq!(nan_max(1.0, 2.0), 2.0);
+/// assert!(nan_max(f64::NAN, 2.0).is_nan());
+/// assert!(nan_max(3.0, f64::NAN).is_nan());
+/// assert!([0.5, f64::NAN, 0.1].into_iter().fold(0.0, nan_max).is_nan());
+/// ```
+#[must_use]
+pub fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) }
+}
+
 /// Median wall time of `f`, in seconds: repeats `f` in batches until each batch lasts at least
 /// `min_batch` seconds, over `batches` batches.
 pub fn median_seconds(batches: usize, min_batch: f64, mut f: impl FnMut()) -> f64 {

@@ -7,10 +7,25 @@ use crate::generate::box_mesh;
 use crate::material::{Material, MaterialModel};
 use crate::model::FemModel;
 use crate::sim::{FemParams, FemSimulation};
-use anim_core::cases::{Check, Ctx, Judge};
+use anim_core::cases::{Check, Ctx, Judge, nan_max};
 use anim_material::nalgebra::{Matrix3, Rotation3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+
+/// A check that could not run: measured NaN (a failure), the error in the metric.
+fn failed(case: String, why: &str) -> Check {
+    eprintln!("{case}: {why}");
+    Check {
+        crate_name: CRATE,
+        case,
+        metric: format!("could not run: {why}"),
+        measured: f64::NAN,
+        reference: 0.0,
+        tolerance: 0.0,
+        judge: Judge::AtMost,
+        source: "-",
+    }
+}
 
 fn random_rotation(rng: &mut ChaCha8Rng) -> Matrix3<f64> {
     let axis =
@@ -38,7 +53,12 @@ pub(super) fn material_derivatives(ctx: &Ctx) -> Vec<Check> {
     let samples = if ctx.quick { 40 } else { 200 };
     let lame = match anim_material::Lame::from_young_poisson(1.0, 0.3) {
         Ok(l) => l,
-        Err(_) => return Vec::new(),
+        Err(e) => {
+            return vec![failed(
+                format!("material derivatives, {samples} random F"),
+                &format!("Lame parameters: {e}"),
+            )];
+        }
     };
     let mut checks = Vec::new();
     for model in MaterialModel::ALL {
@@ -61,18 +81,18 @@ pub(super) fn material_derivatives(ctx: &Ctx) -> Vec<Check> {
                     let mut fm = f;
                     fm[(kk, l)] -= h;
                     let dpsi = (model.energy(&lame, &fp) - model.energy(&lame, &fm)) / (2.0 * h);
-                    num_p = num_p.max((dpsi - p[(kk, l)]).abs());
+                    num_p = nan_max(num_p, (dpsi - p[(kk, l)]).abs());
                     let dp = (model.pk1(&lame, &fp) - model.pk1(&lame, &fm)) / (2.0 * h);
-                    num_c = num_c.max((dp - c.d[kk][l]).abs().max());
+                    num_c = (dp - c.d[kk][l]).iter().fold(num_c, |m, x| nan_max(m, x.abs()));
                 }
             }
-            err_p = err_p.max(num_p / scale_p);
-            err_c = err_c.max(num_c / scale_c);
+            err_p = nan_max(err_p, num_p / scale_p);
+            err_c = nan_max(err_c, num_c / scale_c);
             if model != MaterialModel::Linear {
                 let r = random_rotation(&mut rng);
                 let e0 = model.energy(&lame, &f);
                 let e1 = model.energy(&lame, &(r * f));
-                err_rot = err_rot.max((e1 - e0).abs() / e0.abs().max(1.0));
+                err_rot = nan_max(err_rot, (e1 - e0).abs() / e0.abs().max(1.0));
             }
         }
         let name = model.name();
@@ -117,7 +137,10 @@ pub(super) fn material_derivatives(ctx: &Ctx) -> Vec<Check> {
 
 pub(super) fn patch_and_momentum(_ctx: &Ctx) -> Vec<Check> {
     let mut checks = Vec::new();
-    let Ok(mesh) = box_mesh([0.0; 3], [1.0; 3], [4, 4, 4]) else { return checks };
+    let mesh = match box_mesh([0.0; 3], [1.0; 3], [4, 4, 4]) {
+        Ok(m) => m,
+        Err(e) => return vec![failed("patch test and momentum, 4x4x4 patch".into(), &format!("mesh: {e}"))],
+    };
     let interior = |p: [f64; 3]| p.iter().all(|&c| c > 1e-9 && c < 1.0 - 1e-9);
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let mut distorted = mesh.clone();
@@ -132,12 +155,28 @@ pub(super) fn patch_and_momentum(_ctx: &Ctx) -> Vec<Check> {
     let affine =
         |p: [f64; 3]| [0, 1, 2].map(|i| a[i][0] * p[0] + a[i][1] * p[1] + a[i][2] * p[2] + 0.1 * i as f64);
     for model in MaterialModel::ALL {
-        let Ok(material) = Material::new(model, 1e6, 0.3, 1000.0) else { continue };
-        let Ok(mut m) = FemModel::new(distorted.clone(), material) else { continue };
+        let patch_case =
+            format!("{}: patch test, distorted 4x4x4 patch, u = A X + b on the boundary", model.name());
+        let free_case = format!("{}: internal forces of a randomly deformed free body", model.name());
+        // A setup failure fails the checks it prevents, with the reason, instead of dropping them.
+        let material = match Material::new(model, 1e6, 0.3, 1000.0) {
+            Ok(m) => m,
+            Err(e) => {
+                checks.push(failed(patch_case, &format!("material: {e}")));
+                checks.push(failed(free_case, &format!("material: {e}")));
+                continue;
+            }
+        };
+        let mut m = match FemModel::new(distorted.clone(), material) {
+            Ok(m) => m,
+            Err(e) => {
+                checks.push(failed(patch_case, &format!("model: {e}")));
+                checks.push(failed(free_case, &format!("model: {e}")));
+                continue;
+            }
+        };
         let boundary = m.vertices_where(|p| !interior(p));
-        if m.pin_vertices(&boundary).is_err() {
-            continue;
-        }
+        let pinned = m.pin_vertices(&boundary).map_err(|e| format!("pinning the boundary: {e}"));
         let mut x = Vec::new();
         for v in 0..m.vertices() {
             x.extend_from_slice(&affine(m.mesh().positions[v]));
@@ -150,31 +189,44 @@ pub(super) fn patch_and_momentum(_ctx: &Ctx) -> Vec<Check> {
                 }
             }
         }
-        let Ok(mut sim) = FemSimulation::new(m, FemParams::default().with_newton_tolerance(1e-15)) else {
-            continue;
-        };
-        let solved = sim.solve_static(&mut start, 1);
-        let err = match solved {
-            Ok(_) => start.iter().zip(&x).fold(0.0f64, |e, (a, b)| e.max((a - b).abs())),
-            Err(_) => f64::NAN,
-        };
-        checks.push(Check {
-            crate_name: CRATE,
-            case: format!("{}: patch test, distorted 4x4x4 patch, u = A X + b on the boundary", model.name()),
-            metric: "max |x - (A X + b)| over all vertices (unit cube)".into(),
-            measured: err,
-            reference: 0.0,
-            tolerance: 1e-10,
-            judge: Judge::AtMost,
-            source: "Irons patch test",
+        let sim = pinned.and_then(|()| {
+            FemSimulation::new(m, FemParams::default().with_newton_tolerance(1e-15))
+                .map_err(|e| format!("simulation: {e}"))
         });
+        match sim {
+            Ok(mut sim) => {
+                let err = match sim.solve_static(&mut start, 1) {
+                    Ok(_) => start.iter().zip(&x).fold(0.0f64, |e, (a, b)| nan_max(e, (a - b).abs())),
+                    Err(_) => f64::NAN,
+                };
+                checks.push(Check {
+                    crate_name: CRATE,
+                    case: patch_case,
+                    metric: "max |x - (A X + b)| over all vertices (unit cube)".into(),
+                    measured: err,
+                    reference: 0.0,
+                    tolerance: 1e-10,
+                    judge: Judge::AtMost,
+                    source: "Irons patch test",
+                });
+            }
+            Err(e) => checks.push(failed(patch_case, &e)),
+        }
         // Momentum: internal forces of a randomly deformed free body.
-        let free = FemModel::new(distorted.clone(), material);
-        let Ok(free) = free else { continue };
-        let Ok(mut sim) = FemSimulation::new(free, FemParams::default()) else { continue };
+        let free = FemModel::new(distorted.clone(), material).map_err(|e| format!("model: {e}"));
+        let mut sim = match free.and_then(|free| {
+            FemSimulation::new(free, FemParams::default()).map_err(|e| format!("simulation: {e}"))
+        }) {
+            Ok(sim) => sim,
+            Err(e) => {
+                checks.push(failed(free_case, &e));
+                continue;
+            }
+        };
         let y: Vec<f64> = x.iter().map(|v| v + 0.05 * rng.random_range(-1.0..1.0)).collect();
         let mut f = vec![0.0; y.len()];
-        if sim.internal_forces(&y, &mut f).is_err() {
+        if let Err(e) = sim.internal_forces(&y, &mut f) {
+            checks.push(failed(free_case, &format!("internal forces: {e}")));
             continue;
         }
         let scale: f64 = f.iter().map(|v| v.abs()).sum();
@@ -191,7 +243,7 @@ pub(super) fn patch_and_momentum(_ctx: &Ctx) -> Vec<Check> {
         let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         checks.push(Check {
             crate_name: CRATE,
-            case: format!("{}: internal forces of a randomly deformed free body", model.name()),
+            case: free_case.clone(),
             metric: "|sum f| / sum |f|".into(),
             measured: norm(sum) / scale,
             reference: 0.0,
@@ -202,7 +254,7 @@ pub(super) fn patch_and_momentum(_ctx: &Ctx) -> Vec<Check> {
         if model != MaterialModel::Linear {
             checks.push(Check {
                 crate_name: CRATE,
-                case: format!("{}: internal forces of a randomly deformed free body", model.name()),
+                case: free_case,
                 metric: "|sum x x f| / sum |f|".into(),
                 measured: norm(torque) / scale,
                 reference: 0.0,

@@ -4,10 +4,11 @@
 use crate::{FlipError, FlipParams, FlipSimulation, Particles, Transfer, scenes};
 use anim_core::cases::{Check, Ctx, Outcome, across_threads, fmt_num};
 
-/// A hard case's verdict: non-finite values are a detected divergence, other errors a rejection.
-fn outcome(r: Result<String, FlipError>) -> Outcome {
+/// A hard case's verdict: the run's own (Stable, or Diverged for a broken invariant); non-finite
+/// values are a detected divergence, other errors a rejection.
+fn outcome(r: Result<Outcome, FlipError>) -> Outcome {
     match r {
-        Ok(s) => Outcome::Stable(s),
+        Ok(o) => o,
         Err(e @ FlipError::NonFinite { .. }) => Outcome::Diverged(e.to_string()),
         Err(e) => Outcome::Rejected(e.to_string()),
     }
@@ -31,12 +32,14 @@ pub(super) fn cfl_ten(_ctx: &Ctx) -> Outcome {
         let (lo, hi) = sim.fluid_box();
         let inside = p.x.iter().all(|x| (0..2).all(|a| x[a] >= lo[a] && x[a] <= hi[a]));
         let v1 = sim.volume_estimate(&p, 4.0);
-        Ok(format!(
+        let detail = format!(
             "1 s in 20 steps of 50 ms: {subs} substeps (at most {max_sub} per step), {pushed} wall push-outs, max |div u| after projection {} 1/s, all particles inside: {inside}, volume change {:.2}%, max speed {:.2} m/s",
             fmt_num(max_div),
             100.0 * (v1 - v0) / v0,
             p.max_speed()
-        ))
+        );
+        // A particle outside the box breaks the case's invariant: detected, not stable.
+        Ok(if inside { Outcome::Stable(detail) } else { Outcome::Diverged(format!("{detail}: detected")) })
     })())
 }
 
@@ -58,12 +61,15 @@ pub(super) fn into_obstacle(_ctx: &Ctx) -> Outcome {
         let inside =
             p.x.iter().filter(|x| sim.solid()[(x[0] / h) as usize + n * (x[1] / h) as usize]).count();
         if inside > 0 {
-            return Ok(format!("{inside} particles left inside solid cells"));
+            // The case's invariant is broken: a failure, not a stable run.
+            return Ok(Outcome::Diverged(format!(
+                "{inside} particles left inside solid cells after {pushed} push-outs, detected"
+            )));
         }
-        Ok(format!(
+        Ok(Outcome::Stable(format!(
             "{pushed} push-outs over 0.2 s, no particle left in a solid cell, max speed {:.2} m/s",
             p.max_speed()
-        ))
+        )))
     })())
 }
 

@@ -8,8 +8,8 @@
 //! anim-mpm's weakly compressible fluid, each at several resolutions (why the feature brings in
 //! anim-mpm).
 //!
-//! Run by the crate's tests in quick mode (`tests/cases.rs`) and by `cargo xtask conformance`,
-//! `stability` and `report`.
+//! Run in quick mode by the lib test this module declares (`anim_core::quick_cases_test!`)
+//! and by `cargo xtask conformance`, `stability` and `report`.
 
 mod conformance;
 mod dam_break;

@@ -6,7 +6,7 @@ use crate::mac::{MacFluid, MacParams, MacState};
 use crate::scenes::{self, FluidSim};
 use crate::stam::{StamFluid, StamParams};
 use anim_core::cases::{
-    Budget, Ctx, ENERGY_STRIDE, Outcome, Soak, drive, energy_exceeds, finish, fmt_num, rejected,
+    Budget, Ctx, ENERGY_STRIDE, Outcome, Soak, drive, energy_exceeds, finish, fmt_num, nan_max, rejected,
 };
 use std::f64::consts::PI;
 
@@ -27,7 +27,7 @@ pub(super) fn cfl10(_ctx: &Ctx) -> Outcome {
             return Outcome::Diverged(format!("step {step}: {e}"));
         }
     }
-    let vmax = s.vel.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    let vmax = s.vel.iter().flatten().fold(0.0f64, |m, x| nan_max(m, x.abs()));
     let (lo, hi) = s.density.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
     if vmax <= speed * 1.5 && lo >= -1e-12 && hi <= 1.0 + 1e-12 {
         Outcome::Stable(format!(
@@ -80,11 +80,14 @@ pub(super) fn one_cell(_ctx: &Ctx) -> Outcome {
 
 pub(super) fn non_positive(_ctx: &Ctx) -> Outcome {
     let mut msgs = Vec::new();
-    if let Ok((mut f, mut s)) = MacFluid::new([8, 8, 1], 2, 0.1, MacParams::default()) {
-        match f.advance(&mut s, 0.0) {
-            Err(e) => msgs.push(format!("dt = 0: {e}")),
-            Ok(_) => return Outcome::Stable("accepted dt = 0".into()),
-        }
+    // The case expects Rejected: a fluid that does not build leaves dt = 0 untested, a failure.
+    let (mut f, mut s) = match MacFluid::new([8, 8, 1], 2, 0.1, MacParams::default()) {
+        Ok(x) => x,
+        Err(e) => return Outcome::Stable(format!("setup failed, dt = 0 not tested: {e}")),
+    };
+    match f.advance(&mut s, 0.0) {
+        Err(e) => msgs.push(format!("dt = 0: {e}")),
+        Ok(_) => return Outcome::Stable("accepted dt = 0".into()),
     }
     match MacFluid::new([8, 8, 1], 2, -0.1, MacParams::default()) {
         Err(e) => msgs.push(format!("h < 0: {e}")),
@@ -106,25 +109,31 @@ pub(super) fn non_positive(_ctx: &Ctx) -> Outcome {
 }
 
 pub(super) fn nan_source(_ctx: &Ctx) -> Outcome {
+    // The case expects Diverged: a solver that does not build, or a failed step that does not
+    // leave the state as it was, is Rejected (a failure), not a detected divergence.
     let mut msgs = Vec::new();
-    if let Ok(mut f) = StamFluid::new(16, StamParams::default()) {
-        f.apply_source_pattern();
-        f.sources_mut().1[40] = f32::NAN;
-        match f.step() {
-            Err(e) => msgs.push(format!("Stam: {e}")),
-            Ok(()) => return Outcome::Stable("Stam's solver let NaN pass silently".into()),
-        }
+    let mut stam = match StamFluid::new(16, StamParams::default()) {
+        Ok(f) => f,
+        Err(e) => return Outcome::Rejected(format!("setup failed, Stam not tested: {e}")),
+    };
+    stam.apply_source_pattern();
+    stam.sources_mut().1[40] = f32::NAN;
+    match stam.step() {
+        Err(e) => msgs.push(format!("Stam: {e}")),
+        Ok(()) => return Outcome::Stable("Stam's solver let NaN pass silently".into()),
     }
-    if let Ok((mut f, mut s)) = MacFluid::new([16, 16, 1], 2, 1.0 / 16.0, MacParams::default()) {
-        s.density[100] = f64::NAN;
-        let before = s.clone();
-        match f.advance(&mut s, 0.01) {
-            Err(e) => msgs.push(format!(
-                "MAC: {e}; state restored: {}",
-                s.vel == before.vel && s.steps == before.steps
-            )),
-            Ok(_) => return Outcome::Stable("MAC NaN passed silently".into()),
+    let (mut f, mut s) = match MacFluid::new([16, 16, 1], 2, 1.0 / 16.0, MacParams::default()) {
+        Ok(x) => x,
+        Err(e) => return Outcome::Rejected(format!("setup failed, MAC not tested: {e}")),
+    };
+    s.density[100] = f64::NAN;
+    let before = s.clone();
+    match f.advance(&mut s, 0.01) {
+        Err(e) if s.vel == before.vel && s.steps == before.steps => {
+            msgs.push(format!("MAC: {e}; state restored: true"));
         }
+        Err(e) => return Outcome::Rejected(format!("MAC: {e}, but the state was not restored")),
+        Ok(_) => return Outcome::Stable("MAC NaN passed silently".into()),
     }
     Outcome::Diverged(msgs.join("; "))
 }

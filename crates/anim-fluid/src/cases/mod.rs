@@ -7,8 +7,8 @@
 //! non-positive parameters, NaN sources); the CFL-10 soak run; work-precision studies of the
 //! pressure solvers (divergence residual and Ghia error against wall time).
 //!
-//! Run by the crate's tests in quick mode (`tests/cases.rs`) and by `cargo xtask conformance`,
-//! `stability` and `report`.
+//! Run in quick mode by the lib test this module declares (`anim_core::quick_cases_test!`)
+//! and by `cargo xtask conformance`, `stability` and `report`.
 
 mod conformance;
 mod ghia;

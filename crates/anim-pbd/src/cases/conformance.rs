@@ -11,11 +11,26 @@ use crate::{
     AttachTarget, Bending, BuildError, Cloth, Collider, ConstraintFunction, ConstraintParams, EARTH_GRAVITY,
     Method, PbdBuilder, PbdModel, PbdParams, PbdSimulation, SolverKind,
 };
-use anim_core::cases::{Check, Ctx, Judge, fmt_num};
+use anim_core::cases::{Check, Ctx, Judge, fmt_num, nan_max};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 pub(super) const CRATE: &str = "anim-pbd";
+
+/// A case that could not run: measured NaN (a failure), the error in the metric.
+fn failed(case: &str, why: &str) -> Check {
+    eprintln!("{case}: {why}");
+    Check {
+        crate_name: CRATE,
+        case: case.to_string(),
+        metric: format!("could not run: {why}"),
+        measured: f64::NAN,
+        reference: 0.0,
+        tolerance: 0.0,
+        judge: Judge::AtMost,
+        source: "-",
+    }
+}
 
 const ITERATIONS: [usize; 3] = [5, 20, 100];
 const DTS: [(f64, &str); 3] = [(1.0 / 30.0, "1/30"), (1.0 / 60.0, "1/60"), (1.0 / 240.0, "1/240")];
@@ -37,7 +52,7 @@ pub(super) fn xpbd_chain(_ctx: &Ctx) -> Vec<Check> {
             });
             let (err, steps) = match run {
                 Some((s, steps)) => {
-                    let e = (1..=c.n).map(|j| (s.x[3 * j + 2] - exact[j - 1]).abs()).fold(0.0, f64::max);
+                    let e = (1..=c.n).map(|j| (s.x[3 * j + 2] - exact[j - 1]).abs()).fold(0.0, nan_max);
                     (e / total, steps)
                 }
                 None => (f64::NAN, 0),
@@ -90,8 +105,12 @@ pub(super) fn pbd_stiffness(_ctx: &Ctx) -> Vec<Check> {
             let (lo, hi) = v.iter().fold((f64::MAX, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
             hi / lo
         };
-        let over_dt = (0..3).map(|a| ratio(&k[a])).fold(f64::MAX, f64::min);
-        let over_it = (0..3).map(|b| ratio(&[k[0][b], k[1][b], k[2][b]])).fold(f64::MAX, f64::min);
+        let mut over_dt = (0..3).map(|a| ratio(&k[a])).fold(f64::MAX, f64::min);
+        let mut over_it = (0..3).map(|b| ratio(&[k[0][b], k[1][b], k[2][b]])).fold(f64::MAX, f64::min);
+        if k.iter().flatten().any(|x| x.is_nan()) {
+            // A chain that did not settle (NaN cell) would be dropped by min/max: fail instead.
+            (over_dt, over_it) = (f64::NAN, f64::NAN);
+        }
         let name = if correction { "k = 0.5 with k' = 1 - (1 - k)^(1/n)" } else { "k = 0.5 used raw" };
         checks.push(Check {
             crate_name: CRATE,
@@ -182,20 +201,29 @@ fn single(model: &PbdModel, j: usize, params: ConstraintParams) -> Result<PbdMod
 pub(super) fn momentum(_ctx: &Ctx) -> Vec<Check> {
     let mut checks = Vec::new();
     // (1) Each projection alone: sum m dp and sum m p x dp against the size of the correction.
-    for method in [Method::Pbd, Method::Xpbd] {
+    'methods: for method in [Method::Pbd, Method::Xpbd] {
         let mut worst_lin = 0.0f64;
         let mut worst_ang = 0.0f64;
         let mut kinds = 0;
+        let setup = format!("{method:?}: one projection of each internal constraint");
         for seed in 0..20 {
-            let Ok((zoo, ids)) = zoo_model(seed, ConstraintParams::with_compliance(1e-3)) else {
-                return vec![];
+            let (zoo, ids) = match zoo_model(seed, ConstraintParams::with_compliance(1e-3)) {
+                Ok(x) => x,
+                Err(e) => {
+                    checks.push(failed(&setup, &format!("constraint zoo, seed {seed}: {e}")));
+                    continue 'methods;
+                }
             };
             for &j in &ids {
                 if matches!(zoo.constraints()[j].function, ConstraintFunction::Attachment { .. }) {
                     continue;
                 }
-                let Ok(m) = single(&zoo, j, ConstraintParams::with_compliance(1e-3).stiffness(0.7)) else {
-                    return vec![];
+                let m = match single(&zoo, j, ConstraintParams::with_compliance(1e-3).stiffness(0.7)) {
+                    Ok(m) => m,
+                    Err(e) => {
+                        checks.push(failed(&setup, &format!("constraint {j} alone, seed {seed}: {e}")));
+                        continue 'methods;
+                    }
                 };
                 let mut state = m.rest_state();
                 let mut rng = ChaCha8Rng::seed_from_u64(1000 + seed);
@@ -205,7 +233,13 @@ pub(super) fn momentum(_ctx: &Ctx) -> Vec<Check> {
                 let x0 = state.x.clone();
                 let mut p = PbdParams::new(method, SolverKind::GaussSeidel, 1, 1);
                 p.max_stretch = f64::INFINITY;
-                let Ok(mut sim) = PbdSimulation::new(m.clone(), p) else { return vec![] };
+                let mut sim = match PbdSimulation::new(m.clone(), p) {
+                    Ok(sim) => sim,
+                    Err(e) => {
+                        checks.push(failed(&setup, &format!("simulation, constraint {j}, seed {seed}: {e}")));
+                        continue 'methods;
+                    }
+                };
                 if sim.advance(&mut state, 0.01).is_err() {
                     worst_lin = f64::NAN;
                     continue;
@@ -231,10 +265,14 @@ pub(super) fn momentum(_ctx: &Ctx) -> Vec<Check> {
                     continue;
                 }
                 let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                worst_lin = worst_lin.max(norm(lin) / lin_eps);
-                worst_ang = worst_ang.max(norm(ang) / ang_eps);
+                worst_lin = nan_max(worst_lin, norm(lin) / lin_eps);
+                worst_ang = nan_max(worst_ang, norm(ang) / ang_eps);
                 kinds += 1;
             }
+        }
+        if kinds == 0 {
+            // No projection was measured: nothing bounds the impulses.
+            (worst_lin, worst_ang) = (f64::NAN, f64::NAN);
         }
         for (what, v) in [
             ("linear impulse |sum m dp| / (eps sum m |p|)", worst_lin),
@@ -332,7 +370,13 @@ pub(super) fn gradients(_ctx: &Ctx) -> Vec<Check> {
     let mut worst = 0.0f64;
     let mut count = 0;
     for seed in 0..30 {
-        let Ok((model, ids)) = zoo_model(seed, ConstraintParams::rigid()) else { return vec![] };
+        let (model, ids) = match zoo_model(seed, ConstraintParams::rigid()) {
+            Ok(x) => x,
+            Err(e) => {
+                let why = format!("constraint zoo, seed {seed}: {e}");
+                return vec![failed("constraint gradients at random configurations", &why)];
+            }
+        };
         let mut x = model.rest_state().x;
         let mut rng = ChaCha8Rng::seed_from_u64(500 + seed);
         for c in x.iter_mut() {
@@ -340,7 +384,7 @@ pub(super) fn gradients(_ctx: &Ctx) -> Vec<Check> {
         }
         for &j in &ids {
             let Some((_, grad)) = model.evaluate(j, &x, 0.0) else { continue };
-            let scale = grad.iter().flat_map(|(_, g)| g.iter()).fold(0.0f64, |m, g| m.max(g.abs()));
+            let scale = grad.iter().flat_map(|(_, g)| g.iter()).fold(0.0f64, |m, g| nan_max(m, g.abs()));
             let h = 1e-6;
             for (p, g) in &grad {
                 for a in 0..3 {
@@ -349,11 +393,15 @@ pub(super) fn gradients(_ctx: &Ctx) -> Vec<Check> {
                     xm[3 * p + a] -= h;
                     let cp = model.evaluate(j, &xp, 0.0).map_or(f64::NAN, |r| r.0);
                     let cm = model.evaluate(j, &xm, 0.0).map_or(f64::NAN, |r| r.0);
-                    worst = worst.max(((cp - cm) / (2.0 * h) - g[a]).abs() / scale);
+                    worst = nan_max(worst, ((cp - cm) / (2.0 * h) - g[a]).abs() / scale);
                 }
             }
             count += 1;
         }
+    }
+    if count == 0 {
+        // No constraint was evaluated: nothing was compared.
+        worst = f64::NAN;
     }
     vec![Check {
         crate_name: CRATE,
@@ -390,7 +438,15 @@ pub(super) fn determinism(ctx: &Ctx) -> Vec<Check> {
         b.collider(Collider::ground(-0.3).with_restitution(0.2));
         b.build()
     })();
-    let Ok(model) = model else { return vec![] };
+    let model = match model {
+        Ok(m) => m,
+        Err(e) => {
+            return vec![failed(
+                &format!("{n}x{n} cloth over a sphere, determinism"),
+                &format!("build: {e}"),
+            )];
+        }
+    };
     let steps = if ctx.quick { 10 } else { 30 };
     SolverKind::ALL
         .iter()

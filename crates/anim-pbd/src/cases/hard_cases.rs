@@ -9,7 +9,7 @@ use crate::{
     Bending, Cloth, ConstraintFunction, ConstraintParams, EARTH_GRAVITY, Method, PbdBuilder, PbdError,
     PbdModel, PbdParams, PbdSimulation, SolverKind,
 };
-use anim_core::cases::{Ctx, Outcome, fmt_num};
+use anim_core::cases::{Ctx, Outcome, fmt_num, nan_max};
 use anim_core::integrate::State;
 
 fn finite(s: &State) -> bool {
@@ -27,7 +27,7 @@ fn max_strain(model: &PbdModel, x: &[f64]) -> f64 {
                 + (x[3 * i + 1] - x[3 * j + 1]).powi(2)
                 + (x[3 * i + 2] - x[3 * j + 2]).powi(2))
             .sqrt();
-            worst = worst.max((d - rest_length).abs() / rest_length);
+            worst = nan_max(worst, (d - rest_length).abs() / rest_length);
         }
     }
     worst

@@ -16,7 +16,7 @@ use crate::{
     compute_joint_jacobians_time_variation, frame_jacobian, frame_jacobian_time_variation,
     frames_forward_kinematics,
 };
-use anim_core::cases::{Check, Ctx, Judge};
+use anim_core::cases::{Check, Ctx, Judge, nan_max};
 use anim_core::glam::DVec3;
 use anim_core::lie::{Se3, Twist};
 use rand::{Rng, SeedableRng};
@@ -44,6 +44,8 @@ fn against_pinocchio(model: &Model, json: &Value) -> Result<(f64, f64, f64, usiz
     let mut data = Data::new(model);
     let mut j = Jacobian::zeros(model.nv());
     let (mut ep, mut ej, mut ed) = (0.0_f64, 0.0_f64, 0.0_f64);
+    // Entries compared of each kind: a section missing from every sample compares nothing.
+    let (mut np, mut nj, mut nd) = (0usize, 0usize, 0usize);
     let samples = json["samples"].as_array().ok_or("no samples in the JSON")?;
     for s in samples {
         let q = floats(&s["q"]);
@@ -53,17 +55,21 @@ fn against_pinocchio(model: &Model, json: &Value) -> Result<(f64, f64, f64, usiz
         }
         frames_forward_kinematics(model, &mut data, &q);
         for (i, p) in s["joint_placements"].as_array().into_iter().flatten().enumerate() {
-            ep = ep.max(se3_err(&data.world_placements[i], &se3_of(p)));
+            ep = nan_max(ep, se3_err(&data.world_placements[i], &se3_of(p)));
+            np += 1;
         }
         for (k, p) in s["frame_placements"].as_array().into_iter().flatten().enumerate() {
-            ep = ep.max(se3_err(&data.frame_placements[ids[k]], &se3_of(p)));
+            let Some(&id) = ids.get(k) else { return Err("more frame placements than frames".into()) };
+            ep = nan_max(ep, se3_err(&data.frame_placements[id], &se3_of(p)));
+            np += 1;
         }
         compute_joint_jacobians(model, &mut data, &q);
         for (name, entry) in s["jacobians"].as_object().into_iter().flatten() {
             let fid = model.frame_id(name).ok_or_else(|| format!("frame {name} missing"))?;
             for (rf, reference) in entry.as_object().into_iter().flatten() {
                 frame_jacobian(model, &data, fid, rf_of(rf), &mut j);
-                ej = ej.max(jac_err(&j, reference));
+                ej = nan_max(ej, jac_err(&j, reference));
+                nj += 1;
             }
         }
         compute_joint_jacobians_time_variation(model, &mut data, &q, &v);
@@ -71,11 +77,13 @@ fn against_pinocchio(model: &Model, json: &Value) -> Result<(f64, f64, f64, usiz
             let fid = model.frame_id(name).ok_or_else(|| format!("frame {name} missing"))?;
             for (rf, reference) in entry.as_object().into_iter().flatten() {
                 frame_jacobian_time_variation(model, &data, fid, rf_of(rf), &mut j);
-                ed = ed.max(jac_err(&j, reference));
+                ed = nan_max(ed, jac_err(&j, reference));
+                nd += 1;
             }
         }
     }
-    Ok((ep, ej, ed, samples.len()))
+    let none_is_nan = |e: f64, n: usize| if n == 0 { f64::NAN } else { e };
+    Ok((none_is_nan(ep, np), none_is_nan(ej, nj), none_is_nan(ed, nd), samples.len()))
 }
 
 pub(super) fn pinocchio(_: &Ctx) -> Vec<Check> {
@@ -84,15 +92,24 @@ pub(super) fn pinocchio(_: &Ctx) -> Vec<Check> {
         let case = format!("{robot} vs Pinocchio");
         let model = match model {
             Ok(m) => m,
-            Err(e) => return failed(&case, &e),
+            Err(e) => {
+                out.extend(failed(&case, &e));
+                continue;
+            }
         };
         let text = match std::fs::read_to_string(testdata(&format!("pinocchio_{robot}.json"))) {
             Ok(t) => t,
-            Err(e) => return failed(&case, &e.to_string()),
+            Err(e) => {
+                out.extend(failed(&case, &e.to_string()));
+                continue;
+            }
         };
         let json: Value = match serde_json::from_str(&text) {
             Ok(v) => v,
-            Err(e) => return failed(&case, &e.to_string()),
+            Err(e) => {
+                out.extend(failed(&case, &e.to_string()));
+                continue;
+            }
         };
         match against_pinocchio(&model, &json) {
             Ok((ep, ej, ed, n)) => {
@@ -121,7 +138,7 @@ pub(super) fn pinocchio(_: &Ctx) -> Vec<Check> {
                     PINOCCHIO,
                 ));
             }
-            Err(e) => return failed(&case, &e),
+            Err(e) => out.extend(failed(&case, &e)),
         }
     }
     out
@@ -140,8 +157,14 @@ pub(super) fn jacobian_fd(ctx: &Ctx) -> Vec<Check> {
     let mut rng = ChaCha8Rng::seed_from_u64(61);
     for (name, model, frame) in models {
         let case = format!("{name} Jacobian vs central differences (eps 1e-6)");
-        let Ok(model) = model else { return failed(&case, "model did not load") };
-        let Some(f) = model.frame_id(frame) else { return failed(&case, "no tool frame") };
+        let Ok(model) = model else {
+            out.extend(failed(&case, "model did not load"));
+            continue;
+        };
+        let Some(f) = model.frame_id(frame) else {
+            out.extend(failed(&case, "no tool frame"));
+            continue;
+        };
         let mut data = Data::new(&model);
         let mut j = Jacobian::zeros(model.nv());
         let mut worst = 0.0_f64;
@@ -162,10 +185,10 @@ pub(super) fn jacobian_fd(ctx: &Ctx) -> Vec<Check> {
                 let fd: Twist = ((t.inverse() * plus).log() - (t.inverse() * minus).log()).scale(0.5 / eps);
                 let fd_world = t.adjoint(fd);
                 for (a, b) in local.column(k).to_array().iter().zip(fd.to_array()) {
-                    worst = worst.max((a - b).abs());
+                    worst = nan_max(worst, (a - b).abs());
                 }
                 for (a, b) in world.column(k).to_array().iter().zip(fd_world.to_array()) {
-                    worst = worst.max((a - b).abs());
+                    worst = nan_max(worst, (a - b).abs());
                 }
             }
         }
@@ -187,7 +210,10 @@ pub(super) fn fk_three_ways(ctx: &Ctx) -> Vec<Check> {
     let mut rng = ChaCha8Rng::seed_from_u64(62);
     for (name, model) in [("panda", panda()), ("ur5", ur5()), ("puma-like", puma())] {
         let case = format!("{name} PoE space/body vs joint composition");
-        let Ok(model) = model else { return failed(&case, "model did not load") };
+        let Ok(model) = model else {
+            out.extend(failed(&case, "model did not load"));
+            continue;
+        };
         let chains: Vec<PoeChain> = (0..model.frames().len()).map(|f| PoeChain::new(&model, f)).collect();
         let mut data = Data::new(&model);
         let mut worst = 0.0_f64;
@@ -195,9 +221,8 @@ pub(super) fn fk_three_ways(ctx: &Ctx) -> Vec<Check> {
             let q = random_configuration(&model, &mut || rng.random::<f64>());
             frames_forward_kinematics(&model, &mut data, &q);
             for (f, c) in chains.iter().enumerate() {
-                worst = worst
-                    .max(se3_err(&data.frame_placements[f], &c.forward_space(&q)))
-                    .max(se3_err(&data.frame_placements[f], &c.forward_body(&q)));
+                worst = nan_max(worst, se3_err(&data.frame_placements[f], &c.forward_space(&q)));
+                worst = nan_max(worst, se3_err(&data.frame_placements[f], &c.forward_body(&q)));
             }
         }
         out.push(check(
@@ -294,11 +319,20 @@ pub(super) fn analytic_ik(ctx: &Ctx) -> Vec<Check> {
         [("UR5 (UR type)", ur5(), "tool0"), ("PUMA-like (spherical wrist)", puma(), "tool")]
     {
         let case = format!("{name} analytic IK, {n} random reachable targets");
-        let Ok(model) = model else { return failed(&case, "model did not load") };
-        let Some(f) = model.frame_id(frame) else { return failed(&case, "no tool frame") };
+        let Ok(model) = model else {
+            out.extend(failed(&case, "model did not load"));
+            continue;
+        };
+        let Some(f) = model.frame_id(frame) else {
+            out.extend(failed(&case, "no tool frame"));
+            continue;
+        };
         let ik = match AnalyticIk::new(&model, f) {
             Ok(ik) => ik,
-            Err(e) => return failed(&case, &e.to_string()),
+            Err(e) => {
+                out.extend(failed(&case, &e.to_string()));
+                continue;
+            }
         };
         let mut data = Data::new(&model);
         let (mut worst, mut total, mut found) = (0.0_f64, 0usize, 0usize);
@@ -312,7 +346,7 @@ pub(super) fn analytic_ik(ctx: &Ctx) -> Vec<Check> {
             total += sols.len();
             for s in &sols {
                 let (dp, dr) = pose_error(&frame_at(&model, &mut data, &s.q, f), &target);
-                worst = worst.max(dp).max(dr);
+                worst = nan_max(nan_max(worst, dp), dr);
             }
             if sols.iter().any(|s| s.q.iter().zip(&q).all(|(a, b)| wrap_angle(a - b).abs() < 1e-6)) {
                 found += 1;

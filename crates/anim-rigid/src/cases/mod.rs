@@ -20,7 +20,7 @@ mod soak;
 use std::path::{Path, PathBuf};
 
 use crate::{Jacobian, Model, ReferenceFrame, UrdfOptions, load_urdf};
-use anim_core::cases::{Check, ConformanceCase, Judge, Outcome, Registry, StabilityCase};
+use anim_core::cases::{Check, ConformanceCase, Judge, Outcome, Registry, StabilityCase, nan_max};
 use anim_core::glam::{DMat3, DVec3};
 use anim_core::lie::Se3;
 use serde_json::Value;
@@ -175,9 +175,9 @@ fn se3_of(v: &Value) -> Se3 {
 }
 
 fn se3_err(a: &Se3, b: &Se3) -> f64 {
-    let r = (a.rotation - b.rotation).to_cols_array().iter().fold(0.0_f64, |m, e| m.max(e.abs()));
-    let t = (a.translation - b.translation).abs().max_element();
-    if r.is_nan() || t.is_nan() { f64::NAN } else { r.max(t) }
+    let r = (a.rotation - b.rotation).to_cols_array().iter().fold(0.0_f64, |m, e| nan_max(m, e.abs()));
+    let t = (a.translation - b.translation).to_array().iter().fold(0.0_f64, |m, e| nan_max(m, e.abs()));
+    nan_max(r, t)
 }
 
 fn jac_err(j: &Jacobian, reference: &Value) -> f64 {
@@ -189,7 +189,7 @@ fn jac_err(j: &Jacobian, reference: &Value) -> f64 {
     let mut m = 0.0_f64;
     for row in 0..6 {
         for c in 0..n {
-            m = m.max((j[(row, c)] - r[row * n + c]).abs());
+            m = nan_max(m, (j[(row, c)] - r[row * n + c]).abs());
         }
     }
     m

@@ -5,8 +5,8 @@
 //! twisted cylinder rebound to chains of 2 to 33 twist joints, skinned by LBS and DQS at three
 //! mesh sizes, shape error against the exact twist against the time of one skinning pass.
 //!
-//! Run by the crate's tests in quick mode (`tests/cases.rs`) and by `cargo xtask conformance`,
-//! `stability` and `report`.
+//! Run in quick mode by the lib test this module declares (`anim_core::quick_cases_test!`)
+//! and by `cargo xtask conformance`, `stability` and `report`.
 
 mod conformance;
 mod study;

@@ -3,7 +3,7 @@
 
 use crate::SkinningMethod;
 use crate::scenes::{twisted_cylinder, volume};
-use anim_core::cases::{Budget, Check, Ctx, Soak, across_threads, drive, finish, fmt_num, rejected};
+use anim_core::cases::{Budget, Check, Ctx, Soak, across_threads, drive, finish, fmt_num, nan_max, rejected};
 
 pub(super) fn skin_cylinder(ctx: &Ctx) -> Vec<Check> {
     // 96 segments around: about 11,000 vertices, several parallel chunks.
@@ -46,7 +46,7 @@ pub(super) fn skin_loop(budget: Budget) -> Soak {
             return Err(format!("frame {frame}: non-finite vertex"));
         }
         if k <= frames {
-            worst = worst.max((volume(&scene.character, &data) / rest - 1.0).abs());
+            worst = nan_max(worst, (volume(&scene.character, &data) / rest - 1.0).abs());
             first.push(flat);
         } else if first[frame as usize].iter().zip(&flat).any(|(a, b)| a.to_bits() != b.to_bits()) {
             return Err(format!("step {k}: the pose at t = {t} s differs from its first cycle"));

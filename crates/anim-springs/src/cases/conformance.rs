@@ -7,7 +7,7 @@ use crate::{
     BuildError, Cloth, EARTH_GRAVITY, JacobianMode, NetworkBuilder, SpringNetwork, SpringParams,
     SpringSimulation,
 };
-use anim_core::cases::{Check, Ctx, Judge, fmt_num};
+use anim_core::cases::{Check, Ctx, Judge, fmt_num, nan_max};
 use anim_core::integrate::study::fit_order;
 use anim_core::integrate::{IntegratorKind, MechanicalSystem, NewtonParams, SecondOrderSystem, State};
 use anim_core::linalg::LinearSolverKind;
@@ -19,7 +19,7 @@ pub(super) fn tight() -> NewtonParams {
 }
 
 pub(super) fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, nan_max)
 }
 
 /// Runs the two-particle spring with `kind` for `steps` steps to `t_end`; max error of (x, v).
@@ -38,7 +38,7 @@ pub(super) fn two_particle_run(
         return f64::NAN;
     }
     let (x, v) = case.exact(state.t);
-    max_abs_diff(&state.x, &x).max(max_abs_diff(&state.v, &v))
+    nan_max(max_abs_diff(&state.x, &x), max_abs_diff(&state.v, &v))
 }
 
 pub(super) fn two_particle(_ctx: &Ctx) -> Vec<Check> {
@@ -182,8 +182,24 @@ pub(super) fn jacobian_fd(_ctx: &Ctx) -> Vec<Check> {
         }
         Ok((net, state))
     })();
-    let Ok((mut net, state)) = built else {
-        return vec![];
+    let (mut net, state) = match built {
+        Ok(x) => x,
+        Err(e) => {
+            // Both checks fail, with the reason, instead of vanishing.
+            return ["K = df/dx", "D = df/dv"]
+                .iter()
+                .map(|name| Check {
+                    crate_name: CRATE,
+                    case: format!("5x5 cloth, random perturbation, ground contact: {name}"),
+                    metric: format!("could not run: cloth did not build: {e}"),
+                    measured: f64::NAN,
+                    reference: 0.0,
+                    tolerance: 1e-7,
+                    judge: Judge::AtMost,
+                    source: "central finite differences, h = 1e-6",
+                })
+                .collect();
+        }
     };
     let n = net.dof();
     net.set_jacobian_mode(JacobianMode::Exact);
@@ -210,8 +226,8 @@ pub(super) fn jacobian_fd(_ctx: &Ctx) -> Vec<Check> {
             net.force(0.0, &xm, &vm, &mut fm);
             for r in 0..n {
                 let fd = (fp[r] - fm[r]) / (2.0 * h);
-                errs[which] = errs[which].max((fd - col[r]).abs());
-                scales[which] = scales[which].max(col[r].abs());
+                errs[which] = nan_max(errs[which], (fd - col[r]).abs());
+                scales[which] = nan_max(scales[which], col[r].abs());
             }
         }
     }

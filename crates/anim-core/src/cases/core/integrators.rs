@@ -2,7 +2,7 @@
 //! behaviour over long runs, stability bounds, and the stiff, NaN and zero-step hard cases.
 
 use super::{CRATE, MechanicalDyn, build, kepler_run, oscillator_run, theory_order};
-use crate::cases::{Check, Ctx, Judge, Outcome, fmt_num};
+use crate::cases::{Check, Ctx, Judge, Outcome, fmt_num, nan_max};
 use crate::integrate::study::fit_order;
 use crate::integrate::systems::{HarmonicOscillator, KeplerOrbit};
 use crate::integrate::{IntegrateError, IntegratorKind, SecondOrderSystem, State};
@@ -75,9 +75,9 @@ fn energy_window(
         }
         let err = (sys.energy(state.t, &state.x, &state.v).unwrap_or(f64::NAN) - e0).abs();
         if i < steps / 10 {
-            first = first.max(err);
+            first = nan_max(first, err);
         } else if i >= steps - steps / 10 {
-            last = last.max(err);
+            last = nan_max(last, err);
         }
     }
     (first, last)
@@ -117,7 +117,13 @@ pub(super) fn energy_behaviour(_ctx: &Ctx) -> Vec<Check> {
                 crate_name: CRATE,
                 case: format!("oscillator energy, dt = 0.05 / {}", kind.label()),
                 metric: "max |dE| last tenth / first tenth (must grow)".into(),
-                measured: if last.is_finite() { last / first } else { f64::MAX },
+                measured: if first.is_nan() || last.is_nan() {
+                    f64::NAN
+                } else if last.is_finite() {
+                    last / first
+                } else {
+                    f64::MAX
+                },
                 reference: 1.0,
                 tolerance: 100.0,
                 judge: Judge::AtLeast,

@@ -9,7 +9,7 @@ use crate::{
     crba_world, factor_mass_matrix, forward_dynamics_cholesky, gravity_torques, kinetic_energy, load_urdf,
     nonlinear_effects, potential_energy, rnea,
 };
-use anim_core::cases::{Check, Ctx, Judge};
+use anim_core::cases::{Check, Ctx, Judge, nan_max};
 use anim_core::glam::{DMat3, DVec3};
 use anim_core::lie::Se3;
 use anim_core::solver::Solver;
@@ -41,22 +41,25 @@ fn load_dynamics_reference(name: &str) -> Result<(Model, Value), String> {
     Ok((model, json))
 }
 
-/// `‖ours - reference‖∞ / ‖reference‖∞` (NaN on a length mismatch).
+/// `‖ours - reference‖∞ / ‖reference‖∞` (NaN on a length mismatch or a NaN entry).
 fn rel_err(ours: &[f64], reference: &[f64]) -> f64 {
     if ours.len() != reference.len() {
         return f64::NAN;
     }
-    let scale = reference.iter().fold(0.0_f64, |m, x| m.max(x.abs())).max(f64::MIN_POSITIVE);
-    ours.iter().zip(reference).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs())) / scale
+    let scale = reference.iter().fold(0.0_f64, |m, x| nan_max(m, x.abs())).max(f64::MIN_POSITIVE);
+    ours.iter().zip(reference).fold(0.0_f64, |m, (a, b)| nan_max(m, (a - b).abs())) / scale
 }
 
 pub(super) fn pinocchio_dynamics(_: &Ctx) -> Vec<Check> {
     let mut out = Vec::new();
-    for name in ["panda", "ur5", "chain32", "panda_floating"] {
+    'robots: for name in ["panda", "ur5", "chain32", "panda_floating"] {
         let case = format!("{name} dynamics vs Pinocchio");
         let (model, json) = match load_dynamics_reference(name) {
             Ok(x) => x,
-            Err(e) => return failed(&case, &e),
+            Err(e) => {
+                out.extend(failed(&case, &e));
+                continue;
+            }
         };
         let mut data = Data::new(&model);
         let mut e = [0.0_f64; 6];
@@ -68,20 +71,28 @@ pub(super) fn pinocchio_dynamics(_: &Ctx) -> Vec<Check> {
                 || a.len() != model.nv()
                 || tau.len() != model.nv()
             {
-                return failed(&case, "sample sizes differ from the model");
+                out.extend(failed(&case, "sample sizes differ from the model"));
+                continue 'robots;
             }
-            e[0] = e[0].max(rel_err(rnea(&model, &mut data, &q, &v, &a), &floats(&s["rnea"])));
-            e[1] = e[1].max(rel_err(crba(&model, &mut data, &q).as_slice(), &floats(&s["crba"])));
-            e[2] = e[2].max(rel_err(nonlinear_effects(&model, &mut data, &q, &v), &floats(&s["nle"])));
-            e[3] = e[3].max(rel_err(gravity_torques(&model, &mut data, &q), &floats(&s["gravity"])));
-            e[4] = e[4].max(rel_err(aba(&model, &mut data, &q, &v, &tau), &floats(&s["aba"])));
+            e[0] = nan_max(e[0], rel_err(rnea(&model, &mut data, &q, &v, &a), &floats(&s["rnea"])));
+            e[1] = nan_max(e[1], rel_err(crba(&model, &mut data, &q).as_slice(), &floats(&s["crba"])));
+            e[2] = nan_max(e[2], rel_err(nonlinear_effects(&model, &mut data, &q, &v), &floats(&s["nle"])));
+            e[3] = nan_max(e[3], rel_err(gravity_torques(&model, &mut data, &q), &floats(&s["gravity"])));
+            e[4] = nan_max(e[4], rel_err(aba(&model, &mut data, &q, &v, &tau), &floats(&s["aba"])));
             let ke = kinetic_energy(&model, &mut data, &q, &v);
             let pe = potential_energy(&model, &mut data, &q);
             let rke = s["kinetic_energy"].as_f64().unwrap_or(f64::NAN);
             let rpe = s["potential_energy"].as_f64().unwrap_or(f64::NAN);
-            e[5] = e[5].max((ke - rke).abs() / rke.abs().max(1.0)).max((pe - rpe).abs() / rpe.abs().max(1.0));
+            e[5] = nan_max(
+                nan_max(e[5], (ke - rke).abs() / rke.abs().max(1.0)),
+                (pe - rpe).abs() / rpe.abs().max(1.0),
+            );
         }
         let n = samples.len();
+        if n == 0 {
+            // Nothing was compared: no error bound was measured.
+            e = [f64::NAN; 6];
+        }
         for (k, what) in [
             "RNEA tau",
             "CRBA H (all entries)",
@@ -186,7 +197,10 @@ pub(super) fn cross_checks(_: &Ctx) -> Vec<Check> {
         let case = format!("{name} dynamics cross-checks");
         let model = match model {
             Ok(m) => m,
-            Err(e) => return failed(&case, &e),
+            Err(e) => {
+                out.extend(failed(&case, &e));
+                continue;
+            }
         };
         let nv = model.nv();
         let mut data = Data::new(&model);
@@ -201,26 +215,27 @@ pub(super) fn cross_checks(_: &Ctx) -> Vec<Check> {
             // H q'' + C = tau with q'' from ABA.
             let qdd = aba(&model, &mut data, &q, &v, &tau).to_vec();
             let h = crba(&model, &mut data, &q).clone();
-            asym = asym.max(h.asymmetry());
+            asym = nan_max(asym, h.asymmetry());
             let local = crba_local(&model, &mut data, &q).clone();
-            forms = forms.max(rel_err(crba_world(&model, &mut data, &q).as_slice(), local.as_slice()));
+            forms = nan_max(forms, rel_err(crba_world(&model, &mut data, &q).as_slice(), local.as_slice()));
             let c = nonlinear_effects(&model, &mut data, &q, &v).to_vec();
             let mut hq = vec![0.0; nv];
             h.mul_vec(&qdd, &mut hq);
-            let scale = tau.iter().chain(&c).chain(&hq).fold(0.0_f64, |m, x| m.max(x.abs()));
-            let res = (0..nv).fold(0.0_f64, |m, i| m.max((hq[i] + c[i] - tau[i]).abs()));
-            closure = closure.max(res / scale);
+            let scale = tau.iter().chain(&c).chain(&hq).fold(0.0_f64, |m, x| nan_max(m, x.abs()));
+            let res = (0..nv).fold(0.0_f64, |m, i| nan_max(m, (hq[i] + c[i] - tau[i]).abs()));
+            closure = nan_max(closure, res / scale);
             // ABA(RNEA(a)) = a.
             let t = rnea(&model, &mut data, &q, &v, &a).to_vec();
-            inverse = inverse.max(rel_err(aba(&model, &mut data, &q, &v, &t), &a));
+            inverse = nan_max(inverse, rel_err(aba(&model, &mut data, &q, &v, &t), &a));
             // Cholesky forward dynamics.
             match forward_dynamics_cholesky(&model, &mut data, &q, &v, &tau) {
-                Ok(x) => chol = chol.max(rel_err(x, &qdd)),
+                Ok(x) => chol = nan_max(chol, rel_err(x, &qdd)),
                 Err(_) => chol = f64::NAN,
             }
             if factor_mass_matrix(&model, &mut data).is_ok() {
                 for k in 0..nv {
-                    pivot = pivot.min(data.mass_matrix_factor[(k, k)] / h.max_abs());
+                    // The minimum, kept NaN once a factorisation failed or a pivot is NaN.
+                    pivot = -nan_max(-pivot, -(data.mass_matrix_factor[(k, k)] / h.max_abs()));
                 }
             } else {
                 pivot = f64::NAN;
@@ -232,7 +247,7 @@ pub(super) fn cross_checks(_: &Ctx) -> Vec<Check> {
                 e[k] = 1.0;
                 let col = rnea(&model, &mut data, &q, &zero, &e);
                 for i in 0..nv {
-                    columns = columns.max((h[(i, k)] - (col[i] - g[i])).abs() / h.max_abs());
+                    columns = nan_max(columns, (h[(i, k)] - (col[i] - g[i])).abs() / h.max_abs());
                 }
             }
         }
@@ -357,7 +372,7 @@ pub(super) fn stepper_orders(_: &Ctx) -> Vec<Check> {
                         "the method's theoretical order",
                     )
                 }),
-                Err(e) => return failed(&case, &e),
+                Err(e) => out.extend(failed(&case, &e)),
             }
         }
     }

@@ -6,7 +6,7 @@ use std::time::Instant;
 use crate::scenes::pendulum_chain_model;
 use crate::sim::{RigidIntegrator, RigidSimulation, SimError, SimParams};
 use crate::{Axis, Inertia, JointLimits, JointType, Model, ModelBuilder};
-use anim_core::cases::{Ctx, Outcome};
+use anim_core::cases::{Ctx, Outcome, nan_max};
 use anim_core::glam::{DMat3, DVec3};
 use anim_core::lie::Se3;
 use anim_core::solver::Solver;
@@ -14,9 +14,10 @@ use anim_core::solver::Solver;
 use super::conformance::spinning;
 
 pub(super) fn spinning_drift(integrator: RigidIntegrator) -> Outcome {
+    // A setup failure is Rejected, which no stepper's case expects (some expect Diverged).
     let (mut sim, mut state) = match spinning(integrator) {
         Ok(x) => x,
-        Err(e) => return Outcome::Diverged(e),
+        Err(e) => return Outcome::Rejected(format!("setup failed: {e}")),
     };
     let e0 = sim.energy(&state);
     let l0 = sim.system_mut().momentum_of(&state.q, &state.v).angular;
@@ -31,8 +32,8 @@ pub(super) fn spinning_drift(integrator: RigidIntegrator) -> Outcome {
         if k % 100 == 99 {
             let e = sim.energy(&state);
             let l = sim.system_mut().momentum_of(&state.q, &state.v).angular;
-            de = de.max((e - e0).abs() / e0);
-            dl = dl.max((l - l0).length() / l0.length());
+            de = nan_max(de, (e - e0).abs() / e0);
+            dl = nan_max(dl, (l - l0).length() / l0.length());
         }
     }
     let detail = format!(
@@ -70,14 +71,19 @@ pub(super) fn run_chain(model: Model, integrator: RigidIntegrator, dt: f64, seco
         match sim.step(&mut state, dt) {
             Ok(r) => {
                 iterations += r.iterations;
-                max_drift = max_drift.max((r.energy.unwrap_or(f64::NAN) - e0).abs());
+                max_drift = nan_max(max_drift, (r.energy.unwrap_or(f64::NAN) - e0).abs());
             }
             Err(e) => return Outcome::Diverged(format!("step {k}: {e}")),
         }
-        max_speed = max_speed.max(state.v.iter().fold(0.0_f64, |m, x| m.max(x.abs())));
+        max_speed = nan_max(max_speed, state.v.iter().fold(0.0_f64, |m, x| nan_max(m, x.abs())));
         if k % 10 == 0 {
-            max_kinetic = max_kinetic.max(sim.system_mut().energy_of(&state.q, &state.v).kinetic);
+            max_kinetic = nan_max(max_kinetic, sim.system_mut().energy_of(&state.q, &state.v).kinetic);
         }
+    }
+    if !(max_drift.is_finite() && max_speed.is_finite() && max_kinetic.is_finite()) {
+        return Outcome::Diverged(format!(
+            "not finite (energy missing or NaN): max |E - E0| {max_drift}, max kinetic {max_kinetic}, max joint rate {max_speed}, detected"
+        ));
     }
     // The chain starts at rest at zero potential energy: drift relative to the largest kinetic
     // energy reached.
@@ -135,7 +141,7 @@ pub(super) fn panda_at_limits() -> Outcome {
             return Outcome::Diverged(format!("step {k}: {e}"));
         }
         for (x, (lo, hi)) in state.q.iter().zip(&limits) {
-            worst = worst.max(lo - x).max(x - hi);
+            worst = nan_max(nan_max(worst, lo - x), x - hi);
         }
     }
     let detail = format!(
@@ -160,16 +166,17 @@ pub(super) fn massless_leaf_model() -> Result<Model, crate::ModelError> {
 }
 
 pub(super) fn massless_leaf() -> Outcome {
+    // The case expects Diverged (detected at the first step): a setup failure is Rejected.
     let model = match massless_leaf_model() {
         Ok(m) => m,
-        Err(e) => return Outcome::Diverged(e.to_string()),
+        Err(e) => return Outcome::Rejected(format!("setup failed: model: {e}")),
     };
     let mut sim = match RigidSimulation::new(model, SimParams::default(), RigidIntegrator::SymplecticEuler) {
         Ok(s) => s,
-        Err(e) => return Outcome::Diverged(e.to_string()),
+        Err(e) => return Outcome::Rejected(format!("setup failed: simulation: {e}")),
     };
     let Ok(mut state) = sim.initial_state(vec![0.1, 0.2], vec![0.0, 0.0]) else {
-        return Outcome::Diverged("bad state".into());
+        return Outcome::Rejected("setup failed: bad initial state".into());
     };
     let before = state.clone();
     match sim.step(&mut state, 1e-3) {
