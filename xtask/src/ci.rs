@@ -1,4 +1,4 @@
-//! `cargo xtask ci`: what CI runs, in order; it goes on after a failed lint or doc step (so one run
+//! `cargo ci` (`cargo xtask ci` built in the test profile): what CI runs, in order; it goes on after a failed lint or doc step (so one run
 //! shows every problem) and stops after failed tests.
 
 use crate::registry::Ctx;
@@ -35,7 +35,7 @@ pub fn run() -> bool {
         ("format", &|| cargo(&["fmt", "--all", "--", "--check"], &[])),
         ("clippy", &|| cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"], &[])),
         // The crates' quick-mode case tests are skipped here: the conformance and stability steps
-        // below run the same cases in release, where they take a fraction of the time. The
+        // below run the same cases once more, all crates in one process. The
         // examples are type-checked and linted by clippy above; linking each of them here would
         // add minutes and test nothing more.
         ("tests", &|| {

@@ -375,9 +375,9 @@ pub fn quick_failures(register: fn(&mut Registry)) -> Vec<String> {
 /// The test a crate's `cases` module declares with one line: every conformance and stability
 /// case of `register` passes in quick mode (see [`quick_failures`]).
 ///
-/// `cargo xtask ci` skips this test in the debug test run (`--skip
+/// `cargo ci` skips this test in its test run (`--skip
 /// conformance_and_hard_cases_pass_in_quick_mode`) because its conformance and stability steps
-/// run the same cases right after, in release; `cargo test -p <crate> --features cases` runs it.
+/// run the same cases right after; `cargo test -p <crate> --features cases` runs it.
 #[macro_export]
 macro_rules! quick_cases_test {
     ($register:path) => {
