@@ -1,4 +1,6 @@
-//! Workspace automation for anim: `cargo xtask <suite>`.
+//! Workspace automation for anim: `cargo xtask <suite>`. What CI runs is `cargo ci`
+//! (`xtask/ci`), which runs the quick conformance and stability suites through
+//! `xtask/tests/suites.rs`.
 //!
 //! | suite | what it does |
 //! | --- | --- |
@@ -8,12 +10,10 @@
 //! | `scaling [--quick] [--filter S] [--threads 1,2,...]` | thread scaling of every registered preset (quick params with `--quick`): time per step, speed-up over one thread and the same checkpoint bits as one thread, on 1 and all cores unless `--threads`; exit 1 on a failure or a thread-count dependence |
 //! | `bench [--filter S]` | the criterion benches under `benches/` (with `presets`: one step of every registered preset), printed as a table and written to `target/xtask/bench.csv`; `--peers [--filter S]`: the peer comparisons (springs, rigid, pbd, fem, mpm, fluid, flip), their ratios merged into `docs/report/peers.csv` (a filtered run replaces only its crates' rows) |
 //! | `report [--quick] [--filter S] [--out DIR] [--threads 1,2,...]` | conformance, stability and work-precision studies, the cheapest method per tolerance (also `cheapest.json`), thread scaling (1 and all cores unless `--threads`) and the peer ratios of `docs/report/peers.csv`, written to `docs/report/` (Markdown + SVG, and every measured part in `data.json`); `--filter` re-runs only the parts of matching crates or names and keeps the rest from `data.json`; prints its duration |
-//! | `ci` | what CI runs: format, clippy, tests (with doc tests), docs, quick conformance and stability |
 
 mod architecture;
 mod bench;
 mod cases;
-mod ci;
 mod machine;
 mod peers;
 mod python;
@@ -32,7 +32,7 @@ use std::process::ExitCode;
 pub static ALLOC: anim_core::alloc_count::CountingAllocator =
     anim_core::alloc_count::CountingAllocator::new();
 
-const USAGE: &str = "usage: cargo xtask <conformance|stability|scaling|bench|report|ci> [--quick] [--long] [--filter TEXT] [--out DIR] [--threads 1,2,...]";
+const USAGE: &str = "usage: cargo xtask <conformance|stability|scaling|bench|report> [--quick] [--long] [--filter TEXT] [--out DIR] [--threads 1,2,...]";
 
 #[derive(Debug, Default)]
 struct Args {
@@ -99,7 +99,6 @@ fn main() -> ExitCode {
             &threads(args.threads),
             args.filter.as_deref(),
         ),
-        "ci" => ci::run(),
         "help" | "--help" | "-h" => {
             println!("{USAGE}");
             true

@@ -376,8 +376,8 @@ pub fn quick_failures(register: fn(&mut Registry)) -> Vec<String> {
 /// case of `register` passes in quick mode (see [`quick_failures`]).
 ///
 /// `cargo ci` skips this test in its test run (`--skip
-/// conformance_and_hard_cases_pass_in_quick_mode`) because its conformance and stability steps
-/// run the same cases right after; `cargo test -p <crate> --features cases` runs it.
+/// conformance_and_hard_cases_pass_in_quick_mode`) because its suites step runs the same cases
+/// right after, all crates in one process; `cargo test -p <crate> --features cases` runs it.
 #[macro_export]
 macro_rules! quick_cases_test {
     ($register:path) => {

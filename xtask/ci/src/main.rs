@@ -1,0 +1,89 @@
+//! `cargo ci`: what CI runs, in order. It goes on after a failed lint or doc step (so one run
+//! shows every problem) and stops after failed tests.
+//!
+//! | step | command |
+//! | --- | --- |
+//! | format | `cargo fmt --all -- --check` |
+//! | clippy | `cargo clippy --workspace --all-targets -- -D warnings` |
+//! | tests | `cargo test --workspace --lib --bins --tests`, without the two tests below |
+//! | suites | the same command, running only `xtask/tests/suites.rs`: the quick conformance and stability suites through the `xtask` binary of this build |
+//! | doc tests | `cargo test --workspace --doc` |
+//! | docs | `cargo doc --workspace --no-deps` with warnings denied |
+//!
+//! The runner has no dependencies, so it starts at once, and the suites run in the test build
+//! (one build of the workspace, the features of every member unified) instead of a build of
+//! their own. Each crate's own quick-mode case test
+//! (`anim_core::quick_cases_test!`) is skipped: the suites run the same cases, all crates in
+//! one process; `cargo test -p <crate> --features cases` runs it.
+
+use std::process::{Command, ExitCode};
+use std::time::Instant;
+
+/// The name of the test `anim_core::quick_cases_test!` declares in every crate.
+const QUICK_CASES_TEST: &str = "conformance_and_hard_cases_pass_in_quick_mode";
+
+/// The test of `xtask/tests/suites.rs`.
+const SUITES_TEST: &str = "quick_conformance_and_stability_suites_pass";
+
+/// The test build's command; the tests and suites steps give it the same arguments before
+/// `--`, so the second builds nothing.
+const TEST: [&str; 5] = ["test", "--workspace", "--lib", "--bins", "--tests"];
+
+fn cargo(args: &[&str], env: &[(&str, &str)]) -> bool {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    eprintln!("\n== cargo {}", args.join(" "));
+    let start = Instant::now();
+    let mut cmd = Command::new(cargo);
+    cmd.args(args);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    let ok = match cmd.status() {
+        Ok(status) => status.success(),
+        Err(e) => {
+            eprintln!("could not run cargo: {e}");
+            false
+        }
+    };
+    eprintln!("== {} in {:.0} s", if ok { "ok" } else { "FAILED" }, start.elapsed().as_secs_f64());
+    ok
+}
+
+fn main() -> ExitCode {
+    if let Some(arg) = std::env::args().nth(1) {
+        eprintln!("error: `cargo ci` takes no arguments, got '{arg}'");
+        return ExitCode::from(2);
+    }
+    let start = Instant::now();
+    let tests = [&TEST[..], &["--", "--skip", QUICK_CASES_TEST, "--skip", SUITES_TEST]].concat();
+    let suites = [&TEST[..], &["--", "--exact", SUITES_TEST]].concat();
+    let steps: [(&str, &dyn Fn() -> bool); 6] = [
+        ("format", &|| cargo(&["fmt", "--all", "--", "--check"], &[])),
+        ("clippy", &|| cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"], &[])),
+        // The examples are type-checked and linted by clippy above; linking each of them here
+        // would add minutes and test nothing more.
+        ("tests", &|| cargo(&tests, &[])),
+        ("suites", &|| cargo(&suites, &[])),
+        ("doc tests", &|| cargo(&["test", "--workspace", "--doc"], &[])),
+        ("docs", &|| cargo(&["doc", "--workspace", "--no-deps"], &[("RUSTDOCFLAGS", "-D warnings")])),
+    ];
+    let mut failed = Vec::new();
+    for (name, step) in steps {
+        eprintln!("\n### {name}");
+        if !step() {
+            failed.push(name);
+            // Keep going after lint failures so one run shows every problem; stop on test failures.
+            if name == "tests" || name == "suites" {
+                break;
+            }
+        }
+    }
+    eprintln!("\nci finished in {:.0} s", start.elapsed().as_secs_f64());
+    if failed.is_empty() {
+        eprintln!("ci: all steps passed");
+        ExitCode::SUCCESS
+    } else {
+        eprintln!("ci: FAILED steps: {}", failed.join(", "));
+        ExitCode::FAILURE
+    }
+}
