@@ -60,11 +60,13 @@ impl SceneSpec {
         anim::kind(&self.kind)
     }
 
-    /// `KIND/PRESET` where the parameters name a preset (or a file), else `KIND`.
+    /// `KIND/PRESET` where the parameters name a preset (or a file), `KIND/robot` for a robot
+    /// table, else `KIND`.
     #[must_use]
     pub fn system(&self) -> String {
         match self.params.get("preset").or_else(|| self.params.get("file")).and_then(|v| v.as_str()) {
             Some(p) => format!("{}/{p}", self.kind),
+            None if self.params.contains_key("robot") => format!("{}/robot", self.kind),
             None => self.kind.clone(),
         }
     }
@@ -158,7 +160,7 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
     validate(&scene).map_err(|(field, message)| SceneError::invalid(path, field, message))?;
     if scene.scene.registered().is_none() {
         let kinds: Vec<&str> = anim::kinds().map(|k| k.kind).collect();
-        let at = scene_table(text).and_then(|s| field_offset(text, s, "kind")).unwrap_or(0);
+        let at = table_header(text, "scene").and_then(|s| field_offset(text, s, "kind")).unwrap_or(0);
         let (line, column) = line_col(text, at);
         return Err(SceneError::Parse {
             path: path.to_path_buf(),
@@ -206,9 +208,16 @@ fn build_error(e: BuildError, origin: &Path, text: Option<&str>) -> SceneError {
         BuildError::Invalid { field, message } => (field, message),
         other => (String::new(), other.to_string()),
     };
-    // The first key of the path is the field of `[scene]`.
-    let key = field.split(['.', '[']).next().unwrap_or_default();
-    let at = text.zip(scene_table(text.unwrap_or_default())).and_then(|(t, s)| field_offset(t, s, key));
+    // The first key of the path is the field of `[scene]`; a field of a sub-table written as
+    // its own `[scene.KEY]` table is found under that header.
+    let mut keys = field.split(['.', '[']);
+    let key = keys.next().unwrap_or_default();
+    let at = text.zip(table_header(text.unwrap_or_default(), "scene")).and_then(|(t, s)| {
+        field_offset(t, s, key).or_else(|| {
+            let sub = table_header(t, &format!("scene.{key}"))?;
+            keys.next().and_then(|k| field_offset(t, sub, k)).or(Some(sub))
+        })
+    });
     match (text, at) {
         (Some(t), Some(at)) if !key.is_empty() => {
             let (line, column) = line_col(t, at);
@@ -224,11 +233,12 @@ fn build_error(e: BuildError, origin: &Path, text: Option<&str>) -> SceneError {
     }
 }
 
-/// Byte offset of the `[scene]` header.
-fn scene_table(text: &str) -> Option<usize> {
+/// Byte offset of the `[name]` table header.
+fn table_header(text: &str, name: &str) -> Option<usize> {
+    let header = format!("[{name}]");
     let mut offset = 0;
     for line in text.split_inclusive('\n') {
-        if line.trim_start().starts_with("[scene]") {
+        if line.trim_start().starts_with(&header) {
             return Some(offset);
         }
         offset += line.len();

@@ -8,6 +8,10 @@
 //! | `chain` | [`pendulum_chain`](crate::scenes::pendulum_chain): a 32-link pendulum chain (RK4) | 100 frames of 60 steps of 0.5 ms |
 //! | `t-handle` | [`t_handle`](crate::scenes::t_handle): a spinning T-handle flipping about its intermediate axis (free-body midpoint) | 120 frames of 200 steps of 1 ms |
 //!
+//! A scene file may instead give a `robot` table ([`RobotSpec`](crate::robot::RobotSpec)): a
+//! URDF file of the user's, its base, locked joints, initial joint positions and velocities,
+//! damping, PD servos and a torque schedule.
+//!
 //! A scene is drawn as the line segments its [`RigidScene::segments`] name: frame `k` holds the
 //! two end points of every segment (segment `s` joins points `2 s` and `2 s + 1`) and their
 //! velocities by finite difference over the last step.
@@ -35,6 +39,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::data::Data;
 use crate::model::{FrameIndex, JointType, Model};
+use crate::robot::{RobotSpec, TorqueSchedule};
 use crate::scenes::{self, RigidScene};
 use crate::sim::{RigidSimulation, RigidState, SimError};
 
@@ -48,13 +53,29 @@ pub const KIND: SceneKind = SceneKind {
     tolerance: None,
 };
 
-/// Scene-file parameters of a `rigid` scene (the `[scene]` table without `kind`).
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+/// Scene-file parameters of a `rigid` scene (the `[scene]` table without `kind`): a built-in
+/// `preset`, or a `robot` table ([`RobotSpec`]) bringing the user's URDF.
+///
+/// ```toml
+/// [scene]
+/// kind = "rigid"
+///
+/// [scene.robot]
+/// urdf = "panda.urdf"            # relative to the scene file
+/// locked = { panda_finger_joint1 = 0.0, panda_finger_joint2 = 0.0 }
+/// q0 = { panda_joint2 = 0.5, panda_joint4 = -2.0 }
+/// servo = { kp = 400.0, kd = 40.0, target = { panda_joint1 = 1.0 } }
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RigidParams {
     /// The built-in scene: `"panda-swing"`, `"pendulum-chain"` or `"t-handle"`
-    /// ([`scenes::NAMES`]). Required.
-    pub preset: String,
+    /// ([`scenes::NAMES`]); give this or `robot`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
+    /// A robot from a URDF file; give this or `preset`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robot: Option<RobotSpec>,
 }
 
 fn presets() -> Vec<Preset> {
@@ -87,20 +108,42 @@ fn presets() -> Vec<Preset> {
     ]
 }
 
-fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
+fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
     let p: RigidParams = params(value)?;
-    let scene = match scenes::by_name(&p.preset) {
-        Some(Ok(scene)) => scene,
-        Some(Err(e)) => return Err(BuildError::invalid("preset", e.to_string())),
-        None => {
+    let (scene, schedule) = match (&p.preset, &p.robot) {
+        (Some(name), None) => match scenes::by_name(name) {
+            Some(Ok(scene)) => (scene, TorqueSchedule::default()),
+            Some(Err(e)) => return Err(BuildError::invalid("preset", e.to_string())),
+            None => {
+                return Err(BuildError::invalid(
+                    "preset",
+                    format!("unknown preset `{name}` (one of {})", scenes::NAMES.join(", ")),
+                ));
+            }
+        },
+        (None, Some(robot)) => robot.build(&context.resolve(&robot.urdf)).map_err(|e| {
+            BuildError::invalid(format!("robot.{}", e.field()).trim_end_matches('.'), e.to_string())
+        })?,
+        (Some(_), Some(_)) => {
+            return Err(BuildError::invalid(
+                "robot",
+                "give a built-in `preset` or a `robot` table, not both",
+            ));
+        }
+        (None, None) => {
             return Err(BuildError::invalid(
                 "preset",
-                format!("unknown preset `{}` (one of {})", p.preset, scenes::NAMES.join(", ")),
+                format!(
+                    "give a built-in `preset` (one of {}) or a `robot` table with a `urdf` file",
+                    scenes::NAMES.join(", ")
+                ),
             ));
         }
     };
-    let (solver, state) =
-        RigidSegments::new(scene).map_err(|e| BuildError::invalid("preset", e.to_string()))?;
+    let field = if p.robot.is_some() { "robot" } else { "preset" };
+    let (mut solver, state) =
+        RigidSegments::new(scene).map_err(|e| BuildError::invalid(field, e.to_string()))?;
+    solver.schedule = schedule;
     Ok(Simulated::new(solver, state).boxed())
 }
 
@@ -119,6 +162,8 @@ pub struct RigidSegments {
     points: Vec<[DVec3; 2]>,
     /// End points (flat, 3 per point, two points per segment), their velocities and the time.
     display: State,
+    /// Applied torques over time (empty: the simulation's own constant torques).
+    schedule: TorqueSchedule,
 }
 
 impl RigidSegments {
@@ -140,6 +185,7 @@ impl RigidSegments {
             segments,
             points: Vec::new(),
             display: State::new(vec![0.0; n], vec![0.0; n]),
+            schedule: TorqueSchedule::default(),
         };
         solver.refresh(&state, 0.0);
         Ok((solver, state))
@@ -149,6 +195,25 @@ impl RigidSegments {
     #[must_use]
     pub fn simulation(&self) -> &RigidSimulation {
         &self.sim
+    }
+
+    /// Drives the applied torques by `schedule` from the next step on (see
+    /// [`TorqueSchedule::at`]); an empty schedule leaves the simulation's torques as they are.
+    ///
+    /// # Errors
+    /// [`SimError::BadParameter`] when the schedule's torques are not this model's `nv`.
+    pub fn set_schedule(&mut self, schedule: TorqueSchedule) -> Result<(), SimError> {
+        if let Some(tau) = schedule.at(0.0, 0.0)
+            && tau.len() != self.sim.model().nv()
+        {
+            return Err(SimError::BadParameter {
+                name: "torque schedule",
+                value: format!("{} torques", tau.len()),
+                requirement: "must have one torque per velocity (nv)",
+            });
+        }
+        self.schedule = schedule;
+        Ok(())
     }
 
     /// The display state: segment end points, their velocities, the time.
@@ -213,6 +278,10 @@ impl Solver for RigidSegments {
     /// Steps the simulation, then moves the display to the new end points. A failed step
     /// changes neither the state, the simulation's memory nor the display.
     fn step(&mut self, state: &mut RigidState, dt: f64) -> Result<StepReport, SimError> {
+        if let Some(tau) = self.schedule.at(state.t, dt) {
+            // The torques are a function of time: a failed step leaves them to be set again.
+            self.sim.system_mut().set_torque(tau)?;
+        }
         let report = self.sim.step(state, dt)?;
         self.refresh(state, dt);
         Ok(report)

@@ -67,7 +67,10 @@
 //! [`KIND`] registers them as the `rigid` scene kind of anim-core's
 //! [`scene`](anim_core::scene) contracts, with the presets `panda`, `chain` and `t-handle` (see
 //! [`kind`]): built from the scene-file parameters [`kind::RigidParams`], stepped, checkpointed
-//! and drawn as the end points of their segments by [`kind::RigidSegments`].
+//! and drawn as the end points of their segments by [`kind::RigidSegments`]. A scene file can
+//! bring its own robot instead of a preset: [`robot::RobotSpec`] reads a URDF file and sets the
+//! base, locked joints, initial state, damping, PD servos ([`sim::Servo`]) and a torque
+//! schedule.
 //!
 //! ## Accuracy, measured
 //!
@@ -160,6 +163,7 @@ pub mod matrix6x;
 pub mod model;
 pub mod paden_kahan;
 pub mod poe;
+pub mod robot;
 pub mod scenes;
 pub mod sim;
 pub mod spatial;

@@ -265,7 +265,10 @@ fn bad_parameters_name_their_field() {
         "field `preset`: unknown preset `pendulum` (one of panda-swing, pendulum-chain, t-handle)"
     );
     let err = build_error(serde_json::json!({}));
-    assert!(err.contains("missing field `preset`"), "{err}");
+    assert!(
+        err.starts_with("field `preset`: give a built-in `preset`") && err.contains("`robot` table"),
+        "{err}"
+    );
     let err = build_error(serde_json::json!({ "preset": 3 }));
     assert!(err.contains("invalid type"), "{err}");
 }

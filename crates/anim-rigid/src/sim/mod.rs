@@ -74,6 +74,9 @@
 //!
 //! - applied joint torques `τ` (constant, set between steps);
 //! - viscous joint damping `-d q̇` on every degree of freedom except those of free joints;
+//! - proportional-derivative joint servos `kp (q* - q) - kd q̇` on chosen one-degree-of-freedom
+//!   joints ([`Servo`]), evaluated at every stage like the other forces; their work is outside
+//!   the reported energy, like that of applied torques;
 //! - joint limits as a **stiff one-sided penalty**: beyond a limit by `δ`, the torque
 //!   `-k δ - c q̇` (clamped so that it never pulls the joint further in), with the potential
 //!   `½ k δ²` counted in the energy. A penalty keeps the stepper explicit and the state smooth; it
@@ -83,7 +86,7 @@
 //!
 //! Every step reports the total energy `T + V_gravity + V_limits` and the world linear and angular
 //! momentum in its [`StepReport`](anim_core::solver::StepReport); [`ArticulatedSystem::power`] is
-//! the rate at which applied torques, damping and limits change that energy.
+//! the rate at which applied torques, servos, damping and limits change that energy.
 
 mod error;
 mod free_body;
@@ -93,7 +96,7 @@ mod stepper;
 mod system;
 
 pub use error::SimError;
-pub use params::SimParams;
+pub use params::{Servo, SimParams};
 pub use state::RigidState;
 pub use stepper::{RigidIntegrator, RigidSimulation};
 pub use system::{ArticulatedSystem, Energy};

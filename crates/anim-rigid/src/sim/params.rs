@@ -1,6 +1,6 @@
 //! The forces that are not part of the model (viscous joint damping, the joint-limit penalty,
-//! constant applied torques) and the implicit midpoint's Newton settings; the equations are in
-//! the module docs of `sim`.
+//! constant applied torques, joint servos) and the implicit midpoint's Newton settings; the
+//! equations are in the module docs of `sim`.
 
 use serde::{Deserialize, Serialize};
 
@@ -18,6 +18,9 @@ pub struct SimParams {
     pub limit_damping: f64,
     /// Constant applied joint torques (length `nv`), or empty for none. Default empty.
     pub torque: Vec<f64>,
+    /// Proportional-derivative servos on one-degree-of-freedom joints, at most one per degree of
+    /// freedom. Default none.
+    pub servos: Vec<Servo>,
     /// Implicit midpoint: stop Newton when `‖r‖∞ <= newton_tolerance · (1 + ‖v₀‖∞ + h ‖a₀‖∞)`
     /// (`a₀` the acceleration at the start of the step). When even a freshly formed Jacobian no
     /// longer shrinks the residual (the rounding floor of ABA), a residual up to 1000 times this
@@ -34,6 +37,7 @@ impl Default for SimParams {
             limit_stiffness: 1000.0,
             limit_damping: 5.0,
             torque: Vec::new(),
+            servos: Vec::new(),
             newton_tolerance: 1e-12,
             max_newton_iterations: 30,
         }
@@ -62,4 +66,29 @@ impl SimParams {
         self.torque = torque;
         self
     }
+
+    /// These parameters with the joint servos `servos`.
+    #[must_use]
+    pub fn with_servos(mut self, servos: Vec<Servo>) -> Self {
+        self.servos = servos;
+        self
+    }
+}
+
+/// A proportional-derivative servo on the one-degree-of-freedom joint whose velocity index is
+/// `dof`: the joint torque `kp (target - q) - kd q̇`, added to the applied torques. It is a force
+/// like the others, evaluated at every stage of every stepper (not held over a step), so a stiff
+/// servo limits the stable step as a stiff spring does: the explicit steppers need
+/// `dt` well below `sqrt(m / kp)` for the smallest effective inertia `m` it moves.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Servo {
+    /// Velocity index of the joint (its [`Joint::idx_v`](crate::model::Joint::idx_v)).
+    pub dof: usize,
+    /// Target position (rad or m).
+    pub target: f64,
+    /// Proportional gain `kp` (N·m/rad or N/m), finite and `>= 0`.
+    pub kp: f64,
+    /// Derivative gain `kd` (N·m·s/rad or N·s/m), finite and `>= 0`.
+    pub kd: f64,
 }

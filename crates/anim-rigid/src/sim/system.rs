@@ -7,7 +7,7 @@ use crate::data::Data;
 use crate::dynamics::{aba, kinetic_energy, potential_energy, spatial_momentum};
 use crate::model::{JointType, Model};
 use crate::sim::error::SimError;
-use crate::sim::params::SimParams;
+use crate::sim::params::{Servo, SimParams};
 use crate::spatial::Force;
 
 /// The energy of a state, by part (J).
@@ -30,7 +30,7 @@ impl Energy {
 }
 
 /// A tree with its workspace and the forces of [`SimParams`]; its acceleration is
-/// `ABA(q, v, τ_applied - d v + τ_limits)`.
+/// `ABA(q, v, τ_applied + τ_servos - d v + τ_limits)`.
 ///
 /// Implements anim-core's [`SecondOrderSystem`] (state `x = q`, `dof = nv`), meaningful when the
 /// model is Euclidean ([`Model::is_euclidean`]); for spherical and free joints step it with
@@ -69,6 +69,8 @@ pub struct ArticulatedSystem {
     damped: Vec<bool>,
     /// Per degree of freedom: `(q index, lower, upper)` of bounded one-degree-of-freedom joints.
     limits: Vec<Option<(usize, f64, f64)>>,
+    /// Per degree of freedom: `(q index, servo)` of the servoed ones.
+    servos: Vec<Option<(usize, Servo)>>,
 }
 
 impl ArticulatedSystem {
@@ -76,9 +78,11 @@ impl ArticulatedSystem {
     ///
     /// # Errors
     /// [`SimError::BadParameter`] for a negative or non-finite damping or limit coefficient, a
-    /// torque vector of the wrong length or with non-finite entries, or bad Newton settings.
+    /// torque vector of the wrong length or with non-finite entries, a servo on a degree of
+    /// freedom that is not a one-degree-of-freedom joint's (or servoed twice), with a non-finite
+    /// target or a negative or non-finite gain, or bad Newton settings.
     pub fn new(model: Model, params: SimParams) -> Result<Self, SimError> {
-        validate(&model, &params)?;
+        let servos = validate(&model, &params)?;
         let nv = model.nv();
         let mut damped = vec![true; nv];
         let mut limits = vec![None; nv];
@@ -91,7 +95,7 @@ impl ArticulatedSystem {
             }
         }
         let data = Data::new(&model);
-        Ok(Self { model, data, params, tau: vec![0.0; nv], damped, limits })
+        Ok(Self { model, data, params, tau: vec![0.0; nv], damped, limits, servos })
     }
 
     /// The model.
@@ -127,18 +131,23 @@ impl ArticulatedSystem {
     /// # Errors
     /// As [`new`](Self::new); the parameters are unchanged on error.
     pub fn set_params(&mut self, params: SimParams) -> Result<(), SimError> {
-        validate(&self.model, &params)?;
+        self.servos = validate(&self.model, &params)?;
         self.params = params;
         Ok(())
     }
 
-    /// Sets the constant applied joint torques (length `nv`, or empty for none).
+    /// Sets the constant applied joint torques (length `nv`, or empty for none), in place: no
+    /// allocation once the torque vector has had length `nv`, so a torque schedule can change
+    /// it before every step.
     ///
     /// # Errors
-    /// [`SimError::BadParameter`] for a wrong length or non-finite entries.
+    /// [`SimError::BadParameter`] for a wrong length or non-finite entries; the torques are
+    /// unchanged on error.
     pub fn set_torque(&mut self, torque: &[f64]) -> Result<(), SimError> {
-        let params = SimParams { torque: torque.to_vec(), ..self.params.clone() };
-        self.set_params(params)
+        validate_torque(&self.model, torque)?;
+        self.params.torque.clear();
+        self.params.torque.extend_from_slice(torque);
+        Ok(())
     }
 
     /// The joint forces other than gravity and inertia at `(q, v)`: applied torques, damping and
@@ -166,6 +175,9 @@ impl ArticulatedSystem {
         }
         if let Some((iq, lo, hi)) = self.limits[k] {
             f += limit_force(q[iq], v[k], lo, hi, p.limit_stiffness, p.limit_damping);
+        }
+        if let Some((iq, servo)) = self.servos[k] {
+            f += servo.kp * (servo.target - q[iq]) - servo.kd * v[k];
         }
         f
     }
@@ -214,8 +226,8 @@ impl ArticulatedSystem {
     }
 
     /// The rate of change of the total energy ([`Energy::total`]) at `(q, v)`:
-    /// `Σ_k q̇_k (τ_k - d q̇_k + τ_limit,k + k δ_k)`, the power of applied torques, damping and the
-    /// dissipative part of the limit penalty. Zero for a conservative system.
+    /// `Σ_k q̇_k (τ_k + τ_servo,k - d q̇_k + τ_limit,k + k δ_k)`, the power of applied torques,
+    /// servos, damping and the dissipative part of the limit penalty. Zero for a conservative system.
     ///
     /// # Panics
     /// When a length does not match the model.
@@ -248,6 +260,17 @@ impl SecondOrderSystem for ArticulatedSystem {
     }
 }
 
+impl SimParams {
+    /// Whether these parameters suit `model`: the checks [`ArticulatedSystem::new`] makes,
+    /// without building the system.
+    ///
+    /// # Errors
+    /// As [`ArticulatedSystem::new`].
+    pub fn check(&self, model: &Model) -> Result<(), SimError> {
+        validate(model, self).map(|_| ())
+    }
+}
+
 /// How far `q` is beyond its limits: positive above `hi`, negative below `lo`, zero inside.
 #[inline]
 fn penetration(q: f64, lo: f64, hi: f64) -> f64 {
@@ -273,7 +296,7 @@ fn limit_force(q: f64, v: f64, lo: f64, hi: f64, k: f64, c: f64) -> f64 {
     }
 }
 
-fn validate(model: &Model, p: &SimParams) -> Result<(), SimError> {
+fn validate(model: &Model, p: &SimParams) -> Result<Vec<Option<(usize, Servo)>>, SimError> {
     let bad = |name, value: f64, requirement| SimError::BadParameter {
         name,
         value: value.to_string(),
@@ -294,15 +317,51 @@ fn validate(model: &Model, p: &SimParams) -> Result<(), SimError> {
     if p.max_newton_iterations == 0 {
         return Err(bad("max_newton_iterations", 0.0, "must be at least 1"));
     }
-    if !p.torque.is_empty() && p.torque.len() != model.nv() {
+    validate_torque(model, &p.torque)?;
+    servos_by_dof(model, &p.servos)
+}
+
+fn validate_torque(model: &Model, torque: &[f64]) -> Result<(), SimError> {
+    if !torque.is_empty() && torque.len() != model.nv() {
         return Err(SimError::BadParameter {
             name: "torque",
-            value: format!("{} entries", p.torque.len()),
+            value: format!("{} entries", torque.len()),
             requirement: "must be empty or have nv entries",
         });
     }
-    if let Some(x) = p.torque.iter().find(|x| !x.is_finite()) {
-        return Err(bad("torque", *x, "entries must be finite"));
+    if let Some(x) = torque.iter().find(|x| !x.is_finite()) {
+        return Err(SimError::BadParameter {
+            name: "torque",
+            value: x.to_string(),
+            requirement: "entries must be finite",
+        });
     }
     Ok(())
+}
+
+/// The servos per degree of freedom, with the `q` index of each servoed joint.
+fn servos_by_dof(model: &Model, servos: &[Servo]) -> Result<Vec<Option<(usize, Servo)>>, SimError> {
+    let bad = |value: String, requirement| SimError::BadParameter { name: "servos", value, requirement };
+    let mut out = vec![None; model.nv()];
+    for s in servos {
+        let Some(joint) = model.joints()[1..].iter().find(|j| j.nq() == 1 && j.idx_v == s.dof) else {
+            return Err(bad(
+                format!("dof {}", s.dof),
+                "must be the velocity index of a one-degree-of-freedom joint",
+            ));
+        };
+        if !s.target.is_finite() {
+            return Err(bad(format!("{}: target {}", joint.name, s.target), "targets must be finite"));
+        }
+        if !(s.kp >= 0.0 && s.kp.is_finite() && s.kd >= 0.0 && s.kd.is_finite()) {
+            return Err(bad(
+                format!("{}: kp {}, kd {}", joint.name, s.kp, s.kd),
+                "gains must be finite and >= 0",
+            ));
+        }
+        if out[s.dof].replace((joint.idx_q, *s)).is_some() {
+            return Err(bad(joint.name.clone(), "at most one servo per joint"));
+        }
+    }
+    Ok(out)
 }
