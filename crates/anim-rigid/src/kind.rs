@@ -8,7 +8,7 @@
 //! | `chain` | [`pendulum_chain`](crate::scenes::pendulum_chain): a 32-link pendulum chain (RK4) | 100 frames of 60 steps of 0.5 ms |
 //! | `t-handle` | [`t_handle`](crate::scenes::t_handle): a spinning T-handle flipping about its intermediate axis (free-body midpoint) | 120 frames of 200 steps of 1 ms |
 //!
-//! A scene file may instead give a `robot` table ([`RobotSpec`](crate::robot::RobotSpec)): a
+//! A scene file may instead give a `robot` table ([`RobotSpec`]): a
 //! URDF file of the user's, its base, locked joints, initial joint positions and velocities,
 //! damping, PD servos and a torque schedule.
 //!
