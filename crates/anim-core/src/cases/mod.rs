@@ -57,6 +57,23 @@ pub struct Check {
 }
 
 impl Check {
+    /// A check of `crate_name` that could not run (its model did not build, its reference did
+    /// not load): measured NaN, so it fails, with `why` in the metric and on standard error.
+    pub fn could_not_run(crate_name: &'static str, case: impl Into<String>, why: &str) -> Self {
+        let case = case.into();
+        eprintln!("{case}: {why}");
+        Check {
+            crate_name,
+            case,
+            metric: format!("could not run: {why}"),
+            measured: f64::NAN,
+            reference: 0.0,
+            tolerance: 0.0,
+            judge: Judge::AtMost,
+            source: "-",
+        }
+    }
+
     /// Whether the measurement is finite and meets its rule.
     pub fn passed(&self) -> bool {
         if !self.measured.is_finite() {

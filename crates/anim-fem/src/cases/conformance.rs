@@ -14,17 +14,7 @@ use rand_chacha::ChaCha8Rng;
 
 /// A check that could not run: measured NaN (a failure), the error in the metric.
 fn failed(case: String, why: &str) -> Check {
-    eprintln!("{case}: {why}");
-    Check {
-        crate_name: CRATE,
-        case,
-        metric: format!("could not run: {why}"),
-        measured: f64::NAN,
-        reference: 0.0,
-        tolerance: 0.0,
-        judge: Judge::AtMost,
-        source: "-",
-    }
+    Check::could_not_run(CRATE, case, why)
 }
 
 fn random_rotation(rng: &mut ChaCha8Rng) -> Matrix3<f64> {

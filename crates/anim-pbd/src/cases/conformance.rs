@@ -19,17 +19,7 @@ pub(super) const CRATE: &str = "anim-pbd";
 
 /// A case that could not run: measured NaN (a failure), the error in the metric.
 fn failed(case: &str, why: &str) -> Check {
-    eprintln!("{case}: {why}");
-    Check {
-        crate_name: CRATE,
-        case: case.to_string(),
-        metric: format!("could not run: {why}"),
-        measured: f64::NAN,
-        reference: 0.0,
-        tolerance: 0.0,
-        judge: Judge::AtMost,
-        source: "-",
-    }
+    Check::could_not_run(CRATE, case, why)
 }
 
 const ITERATIONS: [usize; 3] = [5, 20, 100];

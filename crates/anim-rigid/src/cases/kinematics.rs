@@ -8,6 +8,7 @@ use std::f64::consts::PI;
 
 use crate::config::{integrate, random_configuration};
 use crate::ik::pose_error;
+use crate::model::FrameIndex;
 use crate::paden_kahan::{
     DEFAULT_TOL, rotate_about, subproblem_plane, subproblem1, subproblem2, subproblem3, wrap_angle,
 };
@@ -157,13 +158,12 @@ pub(super) fn jacobian_fd(ctx: &Ctx) -> Vec<Check> {
     let mut rng = ChaCha8Rng::seed_from_u64(61);
     for (name, model, frame) in models {
         let case = format!("{name} Jacobian vs central differences (eps 1e-6)");
-        let Ok(model) = model else {
-            out.extend(failed(&case, "model did not load"));
-            continue;
-        };
-        let Some(f) = model.frame_id(frame) else {
-            out.extend(failed(&case, "no tool frame"));
-            continue;
+        let (model, f) = match with_tool(model, frame) {
+            Ok(x) => x,
+            Err(why) => {
+                out.extend(failed(&case, why));
+                continue;
+            }
         };
         let mut data = Data::new(&model);
         let mut j = Jacobian::zeros(model.nv());
@@ -319,13 +319,12 @@ pub(super) fn analytic_ik(ctx: &Ctx) -> Vec<Check> {
         [("UR5 (UR type)", ur5(), "tool0"), ("PUMA-like (spherical wrist)", puma(), "tool")]
     {
         let case = format!("{name} analytic IK, {n} random reachable targets");
-        let Ok(model) = model else {
-            out.extend(failed(&case, "model did not load"));
-            continue;
-        };
-        let Some(f) = model.frame_id(frame) else {
-            out.extend(failed(&case, "no tool frame"));
-            continue;
+        let (model, f) = match with_tool(model, frame) {
+            Ok(x) => x,
+            Err(why) => {
+                out.extend(failed(&case, why));
+                continue;
+            }
         };
         let ik = match AnalyticIk::new(&model, f) {
             Ok(ik) => ik,
@@ -372,4 +371,11 @@ pub(super) fn analytic_ik(ctx: &Ctx) -> Vec<Check> {
         ));
     }
     out
+}
+
+/// A loaded model with its tool frame `frame`, or why the case cannot run.
+fn with_tool(model: Result<Model, String>, frame: &str) -> Result<(Model, FrameIndex), &'static str> {
+    let model = model.map_err(|_| "model did not load")?;
+    let f = model.frame_id(frame).ok_or("no tool frame")?;
+    Ok((model, f))
 }

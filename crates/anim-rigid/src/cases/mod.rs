@@ -153,8 +153,7 @@ fn check(
 }
 
 fn failed(case: &str, why: &str) -> Vec<Check> {
-    eprintln!("{case}: {why}");
-    vec![check(case, &format!("could not run: {why}"), f64::NAN, 0.0, Judge::AtMost, "-")]
+    vec![Check::could_not_run(CRATE, case, why)]
 }
 
 fn floats(v: &Value) -> Vec<f64> {

@@ -83,7 +83,7 @@ fn a_torque_schedule_is_held_over_each_step_and_switches_on_the_step_boundary() 
         "urdf": "hinge.urdf",
         "torque": [ { "from": 0.0, "joints": { "hinge": 2.0 } }, { "from": 0.5, "joints": {} } ],
     }});
-    let mut scene = build_kind(params, &dir).expect("builds");
+    let mut scene = build_kind(params.clone(), &dir).expect("builds");
     for _ in 0..1000 {
         scene.step(1e-3).expect("step");
     }
@@ -92,22 +92,8 @@ fn a_torque_schedule_is_held_over_each_step_and_switches_on_the_step_boundary() 
     assert!((tip_angle(&*scene) - 0.75).abs() < 1e-12, "angle {}", tip_angle(&*scene));
 
     // The torque follows time, so a checkpoint taken before the switch resumes bit for bit.
-    let mut straight = build_kind(
-        serde_json::json!({ "robot": {
-            "urdf": "hinge.urdf",
-            "torque": [ { "from": 0.0, "joints": { "hinge": 2.0 } }, { "from": 0.5, "joints": {} } ],
-        }}),
-        &dir,
-    )
-    .expect("builds");
-    let mut resumed = build_kind(
-        serde_json::json!({ "robot": {
-            "urdf": "hinge.urdf",
-            "torque": [ { "from": 0.0, "joints": { "hinge": 2.0 } }, { "from": 0.5, "joints": {} } ],
-        }}),
-        &dir,
-    )
-    .expect("builds");
+    let mut straight = build_kind(params.clone(), &dir).expect("builds");
+    let mut resumed = build_kind(params, &dir).expect("builds");
     for _ in 0..300 {
         straight.step(1e-3).expect("step");
     }
