@@ -339,3 +339,23 @@ fn a_robot_scene_names_a_missing_urdf_and_an_unknown_joint_on_its_line() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// An `fem` body whose mesh has an inverted element is refused before anything runs, naming the
+/// scene file's line, the mesh file and the element.
+#[test]
+fn a_broken_mesh_is_refused_naming_the_file_and_element() {
+    let dir = temp("broken-mesh");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("tet.node"), "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n").unwrap();
+    std::fs::write(dir.join("tet.ele"), "1 4 0\n1 1 3 2 4\n").unwrap();
+    let scene = dir.join("broken.toml");
+    let text = "name = \"b\"\n[run]\ndt = 0.01\nframes = 2\n[scene]\nkind = \"fem\"\n[scene.body]\n\
+                mesh = \"tet.ele\"\nmaterial = { young = 1e5, poisson = 0.3, density = 1000.0 }\n";
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.join("out");
+    let (ok, err) = anim(&["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"]);
+    assert!(!ok);
+    assert!(err.contains("broken.toml:8:") && err.contains("tet.ele") && err.contains("element 0"), "{err}");
+    assert!(!out.exists(), "a refused run wrote {}", out.display());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -8,6 +8,9 @@
 //! | `cube` | `soft-cube-drop`: a soft cube dropped on the ground, backward Euler with penalty contact | 100 frames of 2 x 5 ms |
 //! | `twisted-bar` | `twisted-bar`: a bar twisted by a half turn at one end | 100 frames of 10 ms |
 //!
+//! A scene file may give a `body` table instead of a preset ([`BodySpec`]): a Gmsh or TetGen
+//! mesh of the user's, its material, placement, initial velocity, pins and obstacles.
+//!
 //! A frame holds every node (for 10-node bodies, the corners then the edge nodes) and its
 //! velocity, in the scenes' own z-up frame; the [`Context`] gives the outward boundary
 //! triangles, the (corner) tetrahedra, the pinned and kinematic nodes as pins, the ground and the
@@ -26,6 +29,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use crate::body::BodySpec;
 use crate::material::MaterialModel;
 use crate::model::ElementOrder;
 use crate::scenes;
@@ -50,12 +54,17 @@ pub const KIND: SceneKind = SceneKind {
 };
 
 /// Scene-file parameters of an `fem` scene (the `[scene]` table without `kind`).
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FemSceneParams {
     /// The scene: `"cantilever-beam"`, `"soft-cube-drop"` or `"twisted-bar"` (see
-    /// [`scenes`]).
-    pub preset: String,
+    /// [`scenes`]); give this or `body`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
+    /// A body of the user's own from a tetrahedral mesh file ([`BodySpec`]); give this or
+    /// `preset`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<BodySpec>,
     /// Cells across the beam or bar (4 by default; the length gets 10 times as many), or along
     /// the cube's side (6 by default); absent: the scene's default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -107,23 +116,46 @@ fn presets() -> Vec<Preset> {
     ]
 }
 
-fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
+fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
     let p: FemSceneParams = params(value)?;
-    let found = scenes::by_name_with_order(&p.preset, p.resolution, p.element.unwrap_or_default())
-        .ok_or_else(|| {
-            BuildError::invalid(
+    let order = p.element.unwrap_or_default();
+    let mut scene = match (&p.preset, &p.body) {
+        (Some(name), None) => scenes::by_name_with_order(name, p.resolution, order)
+            .ok_or_else(|| {
+                BuildError::invalid(
+                    "preset",
+                    format!("unknown preset `{name}` (one of {})", scenes::NAMES.join(", ")),
+                )
+            })?
+            .map_err(|e| BuildError::invalid("resolution", e.to_string()))?,
+        (None, Some(body)) => {
+            if p.resolution.is_some() {
+                return Err(BuildError::invalid("resolution", "a body's resolution is its mesh's"));
+            }
+            body.build(&context.resolve(&body.mesh), order)
+                .map_err(|e| BuildError::invalid(format!("body.{}", e.field), e.message))?
+        }
+        (Some(_), Some(_)) => {
+            return Err(BuildError::invalid("body", "give a built-in `preset` or a `body` table, not both"));
+        }
+        (None, None) => {
+            return Err(BuildError::invalid(
                 "preset",
-                format!("unknown preset `{}` (one of {})", p.preset, scenes::NAMES.join(", ")),
-            )
-        })?;
-    let mut scene = found.map_err(|e| BuildError::invalid("resolution", e.to_string()))?;
+                format!(
+                    "give a built-in `preset` (one of {}) or a `body` table with a `mesh` file",
+                    scenes::NAMES.join(", ")
+                ),
+            ));
+        }
+    };
     if let Some(i) = p.integrator {
         scene.params.integrator = i;
     }
     if let Some(l) = p.linear_solver {
         scene.params.linear_solver = l;
     }
-    let (sim, state) = scene.into_simulation().map_err(|e| BuildError::invalid("preset", e.to_string()))?;
+    let field = if p.body.is_some() { "body" } else { "preset" };
+    let (sim, state) = scene.into_simulation().map_err(|e| BuildError::invalid(field, e.to_string()))?;
     Ok(Simulated::new(sim, state).boxed())
 }
 
@@ -266,8 +298,10 @@ fn tolerance_adapter(
     family: &Family,
 ) -> Result<Box<dyn StudyAdapter>, String> {
     let p: FemSceneParams = params(value).map_err(study::unreadable)?;
-    let scene = scenes::by_name(&p.preset, p.resolution)
-        .ok_or_else(|| format!("--tolerance: unknown fem preset `{}`", p.preset))?
+    let preset =
+        p.preset.as_deref().ok_or("--tolerance: the report's studies cover the fem presets, not a body")?;
+    let scene = scenes::by_name(preset, p.resolution)
+        .ok_or_else(|| format!("--tolerance: unknown fem preset `{preset}`"))?
         .map_err(study::unreadable)?;
     let material = *scene.model.material();
     let mesh = scene.model.mesh();

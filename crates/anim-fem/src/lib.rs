@@ -19,6 +19,7 @@
 //! | [`quadratic`] | bodies of 10-node tetrahedra in both time steppers, and the quasi-static front end [`QuadraticModel`](quadratic::QuadraticModel) | - |
 //! | [`ldlt`] | sparse `L D L^T` (faer) for symmetric indefinite Newton matrices | - |
 //! | [`scenes`] | cantilever beam, soft cube drop, twisted bar | - |
+//! | [`body`] | a body of the user's own from a Gmsh or TetGen mesh: material, placement, velocity, pins, obstacles | - |
 //! | [`kind`] | the `fem` scene kind: presets, scene-file parameters, checkpoints and frames | - |
 //!
 //! **Element order.** [`FemModel::new`](model::FemModel::new) builds linear tetrahedra,
@@ -29,7 +30,8 @@
 //! **Scene kind.** [`KIND`] registers the crate's scenes with the workspace
 //! ([`anim_core::scene::SceneKind`], scene files of `kind = "fem"`): the presets `beam`
 //! (`cantilever-beam`), `cube` (`soft-cube-drop`) and `twisted-bar`, built from
-//! [`kind::FemSceneParams`] (preset, resolution, integrator, linear solver, element);
+//! [`kind::FemSceneParams`] (preset, resolution, integrator, linear solver, element), or a
+//! `body` table ([`body::BodySpec`]) bringing the user's own tetrahedral mesh;
 //! [`FemSimulation`](sim::FemSimulation) is their [`Checkpoint`](anim_core::scene::Checkpoint)
 //! and [`View`](anim_core::scene::View).
 //!
@@ -76,6 +78,7 @@
 //! ```
 
 pub mod assembly;
+pub mod body;
 pub mod boundary;
 #[cfg(feature = "cases")]
 pub mod cases;
