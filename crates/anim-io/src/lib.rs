@@ -13,8 +13,8 @@
 //! | [`gmsh`] | Gmsh `.msh` ASCII 2.2 and 4.1, read: nodes, tetrahedra, triangles, physical tags | written by Gmsh, meshio, many meshers |
 //! | [`tetgen`] | TetGen `.node` + `.ele`, read | written by TetGen, meshio |
 //! | [`frames`] | numbered sequences `frame_00000.vtu ...` in any of the writers' formats | ParaView (with the `.pvd`), Blender and Houdini sequence importers |
-//! | [`preview`] | PNG frames and animated GIFs from a software renderer | any image viewer, a browser |
-//! | [`metrics`] | CSV and JSON of per-step metrics (serde) | spreadsheets, pandas, plotting scripts |
+//! | [`preview`] | PNG frames and animated GIFs from a software renderer (feature `output`, default) | any image viewer, a browser |
+//! | [`metrics`] | CSV and JSON of per-step metrics (serde; feature `output`, default) | spreadsheets, pandas, plotting scripts |
 //!
 //! Readers return plain types ([`TriMesh`], [`TetMesh`], or a format's own struct that keeps
 //! its extra data); indices are 0-based, and the only change from the file is the documented
@@ -67,9 +67,11 @@ mod error;
 pub mod frames;
 pub mod gmsh;
 mod mesh;
+#[cfg(feature = "output")]
 pub mod metrics;
 pub mod obj;
 pub mod ply;
+#[cfg(feature = "output")]
 pub mod preview;
 pub mod tetgen;
 mod text;
