@@ -24,6 +24,7 @@
 use std::path::{Path, PathBuf};
 
 use anim_core::glam::{DMat3, DVec3, EulerRot};
+use anim_core::scene::is_default;
 use serde::{Deserialize, Serialize};
 
 use crate::boundary::Obstacle;
@@ -73,10 +74,6 @@ fn default_contact_stiffness() -> f64 {
     1e7
 }
 
-fn is_zero(v: &[f64; 3]) -> bool {
-    *v == [0.0; 3]
-}
-
 /// A body from a tetrahedral mesh file. Every field but `mesh` and `material` has a default.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -92,13 +89,13 @@ pub struct BodySpec {
     pub scale: f64,
     /// Rotation about the mesh's origin as roll, pitch, yaw (rad): `Rz(yaw) Ry(pitch) Rx(roll)`,
     /// applied after the scale; default none.
-    #[serde(default, skip_serializing_if = "is_zero")]
+    #[serde(default, skip_serializing_if = "is_default")]
     pub rotate: [f64; 3],
     /// Translation (m), applied last; default none.
-    #[serde(default, skip_serializing_if = "is_zero")]
+    #[serde(default, skip_serializing_if = "is_default")]
     pub translate: [f64; 3],
     /// Initial velocity of every vertex (m/s); default at rest.
-    #[serde(default, skip_serializing_if = "is_zero")]
+    #[serde(default, skip_serializing_if = "is_default")]
     pub velocity: [f64; 3],
     /// The vertices held fixed: those in this box (after the placement); default none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -114,19 +111,15 @@ pub struct BodySpec {
     #[serde(default = "default_contact_stiffness")]
     pub contact_stiffness: f64,
     /// Coulomb friction coefficient against the obstacles, `>= 0`; default 0 (frictionless).
-    #[serde(default, skip_serializing_if = "is_zero_f64")]
+    #[serde(default, skip_serializing_if = "is_default")]
     pub friction: f64,
     /// Rayleigh stiffness damping `gamma` (s); default 0.
-    #[serde(default, skip_serializing_if = "is_zero_f64")]
+    #[serde(default, skip_serializing_if = "is_default")]
     pub rayleigh: f64,
 }
 
 fn earth_gravity() -> [f64; 3] {
     EARTH_GRAVITY
-}
-
-fn is_zero_f64(x: &f64) -> bool {
-    *x == 0.0
 }
 
 /// Why a body could not be built: the field of [`BodySpec`] at fault and the cause.

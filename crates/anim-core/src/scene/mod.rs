@@ -54,5 +54,5 @@ pub use checkpoint::{
 };
 pub use dynamic::{DynScene, Simulated, StepError};
 pub use looped::Looped;
-pub use preset::{BuildContext, BuildError, BuildFn, Preset, RunDefaults, SceneKind, params};
+pub use preset::{BuildContext, BuildError, BuildFn, Preset, RunDefaults, SceneKind, is_default, params};
 pub use view::{Context, Field, Frame, ImageGrid, Prop, View, frame_box, ground_height};

@@ -18,6 +18,13 @@ pub struct RunDefaults {
     pub steps_per_frame: usize,
 }
 
+/// Whether `value` is its type's default: for `#[serde(skip_serializing_if = "...")]` on
+/// scene-file parameters, so a saved scene file lists only what was set.
+#[must_use]
+pub fn is_default<T: Default + PartialEq>(value: &T) -> bool {
+    *value == T::default()
+}
+
 fn one() -> usize {
     1
 }

@@ -28,6 +28,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anim_core::glam::{DQuat, DVec3};
+use anim_core::scene::is_default;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -78,10 +79,6 @@ fn default_limit_stiffness() -> f64 {
 
 fn default_limit_damping() -> f64 {
     SimParams::default().limit_damping
-}
-
-fn is_default<T: Default + PartialEq>(value: &T) -> bool {
-    *value == T::default()
 }
 
 /// A robot scene: a URDF file and what to do with it. Every field but `urdf` has a default.
@@ -376,7 +373,7 @@ fn one_dof_joint<'m>(
 
 /// What a robot is drawn as: a segment from each joint to its parent joint, and from each
 /// joint to the frames it carries away from its origin (link origins, tool centres); segments
-/// of zero length are left out.
+/// of zero length are left out, unless nothing else is left to draw.
 fn segments(model: &Model) -> Vec<(FrameIndex, FrameIndex)> {
     // The frame marking each joint's origin: its own joint frame, the universe for joint 0.
     let mut origin = vec![None; model.njoints()];
@@ -407,6 +404,11 @@ fn segments(model: &Model) -> Vec<(FrameIndex, FrameIndex)> {
             drawn.push(key);
             out.push((a, f));
         }
+    }
+    // A robot whose frames all sit on its joints (one free body) is drawn as its joint origins,
+    // so its frames still hold where it is.
+    if out.is_empty() {
+        out.extend(origin.iter().skip(1).flatten().map(|&f| (f, f)));
     }
     out
 }

@@ -253,3 +253,24 @@ fn a_servo_must_sit_on_a_one_degree_of_freedom_joint_once() {
     assert!(check(vec![Servo { kd: f64::INFINITY, ..servo }]).is_err());
     let _ = std::fs::remove_dir_all(dir);
 }
+
+#[test]
+fn a_single_floating_body_is_drawn_at_its_origin_and_falls() {
+    let dir = std::env::temp_dir().join(format!("anim-rigid-robot-{}-ball", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temporary folder");
+    let urdf = r#"<robot name="ball"><link name="ball"><inertial><mass value="1"/>
+        <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link></robot>"#;
+    std::fs::write(dir.join("ball.urdf"), urdf).expect("write the URDF");
+    let params = serde_json::json!({ "robot": { "urdf": "ball.urdf", "base": "floating", "base_position": [0.0, 0.0, 2.0] } });
+    let mut scene = build_kind(params, &dir).expect("builds");
+    let mut frame = Frame::default();
+    scene.frame(&mut frame);
+    assert_eq!(frame.points, [0.0, 0.0, 2.0, 0.0, 0.0, 2.0]);
+    for _ in 0..100 {
+        scene.step(1e-3).expect("step");
+    }
+    scene.frame(&mut frame);
+    // Free fall for 0.1 s: z = 2 - g t^2 / 2 (RK4 is exact on it up to rounding).
+    assert!((frame.points[2] - (2.0 - 0.5 * 9.81 * 0.01)).abs() < 1e-12, "z = {}", frame.points[2]);
+    let _ = std::fs::remove_dir_all(dir);
+}
