@@ -44,6 +44,7 @@
 mod checkpoint;
 mod dynamic;
 mod looped;
+mod placement;
 mod preset;
 pub mod study;
 pub mod systems;
@@ -54,5 +55,6 @@ pub use checkpoint::{
 };
 pub use dynamic::{DynScene, Simulated, StepError};
 pub use looped::Looped;
+pub use placement::Placement;
 pub use preset::{BuildContext, BuildError, BuildFn, Preset, RunDefaults, SceneKind, is_default, params};
 pub use view::{Context, Field, Frame, ImageGrid, Prop, View, frame_box, ground_height};
