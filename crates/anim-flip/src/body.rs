@@ -175,6 +175,11 @@ fn vector<const D: usize>(field: &str, v: [f64; 3]) -> Result<[f64; D], BuildErr
     Ok(std::array::from_fn(|k| v[k]))
 }
 
+/// Coordinates rounded to nanometres, for messages.
+fn rounded(v: &[f64]) -> Vec<f64> {
+    v.iter().map(|x| (x * 1e9).round() / 1e9).collect()
+}
+
 /// A point of a `D`-dimensional scene as a 3D one (z = 0 in 2D).
 fn point3<const D: usize>(p: [f64; D]) -> [f64; 3] {
     std::array::from_fn(|k| if k < D { p[k] } else { 0.0 })
@@ -331,8 +336,8 @@ fn seed<const D: usize>(
                 name,
                 format!(
                     "reaches outside the tank: it spans {:?} to {:?} (m); the tank's inside is 0 to 1 m along each axis",
-                    &region.lo[..D],
-                    &region.hi[..D]
+                    rounded(&region.lo[..D]),
+                    rounded(&region.hi[..D])
                 ),
             ));
         }
