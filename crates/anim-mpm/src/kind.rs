@@ -27,7 +27,7 @@
 //!     "bodies": [
 //!         { "shape": { "box": { "center": [0.5, 0.6, 0.5], "half_extents": [0.1, 0.1, 0.1] } },
 //!           "material": { "snow": {} } },
-//!         { "shape": { "sphere": { "center": [0.25, 0.7, 0.5], "radius": 0.08 } },
+//!         { "shape": { "sphere": { "center": [0.3, 0.7, 0.5], "radius": 0.08 } },
 //!           "material": { "elastic": { "young": 2e4 } }, "velocity": [1.0, 0.0, 0.0] },
 //!     ],
 //! });
