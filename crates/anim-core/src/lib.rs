@@ -44,6 +44,7 @@ pub mod linalg;
 pub mod scalar;
 pub mod scene;
 pub mod solver;
+pub mod surface;
 
 pub use glam;
 

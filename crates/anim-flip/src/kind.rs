@@ -1,6 +1,7 @@
-//! The `flip` scene kind: the presets of [`scenes::by_name`] registered with anim-core's scene
-//! contracts ([`anim_core::scene`]), so the `anim` command line, `cargo xtask` and the Python
-//! bindings build, step, checkpoint and draw them without knowing this crate.
+//! The `flip` scene kind: the presets of [`scenes::by_name`], or fluid bodies of the scene
+//! file's own ([`crate::body`]), registered with anim-core's scene contracts
+//! ([`anim_core::scene`]), so the `anim` command line, `cargo xtask` and the Python bindings
+//! build, step, checkpoint and draw them without knowing this crate.
 //!
 //! | preset | what | cells across the 1 m tank |
 //! | --- | --- | --- |
@@ -9,8 +10,15 @@
 //! | `drop-2d`, `drop-3d` | a disk (ball) of water falling into a pool | 64, 32 |
 //! | `sloshing-tank` | water in a 2D tank shaken at its first sloshing frequency | 64 |
 //!
-//! A scene is the [`FlipSimulation`] itself, a [`Solver`](anim_core::solver::Solver) of its
-//! [`Particles`]. anim-flip has y
+//! Instead of `preset`, a scene file may give `[[scene.bodies]]`: boxes, spheres, capsules or
+//! closed OBJ surfaces (`mesh`) filled with fluid, placed (`scale`, `rotate`, `translate`) and
+//! moving (`velocity`), in a tank whose inside is `[0, 1]` m along each axis, with `dim`,
+//! `resolution`, `transfer`, `gravity`, and solid `obstacles` (shapes) and `obstacle_meshes`
+//! (closed OBJ surfaces). Scene-file coordinates are the crate's own, **y up**. See
+//! [`FlipSceneParams`] and [`crate::body`]; such a scene is a [`body::BodyScene`].
+//!
+//! A preset scene is the [`FlipSimulation`] itself, a [`Solver`](anim_core::solver::Solver) of
+//! its [`Particles`]. anim-flip has y
 //! up; frames have z up like the workspace's other scenes: a fluid point `(x, y, z)` is shown
 //! at `(x, -z, y)`, a 2D one `(x, y)` at `(x, 0, y)` (2D scenes lie in the plane y = 0). The
 //! sloshing tank is simulated in its own frame; its frames are in the world frame, the tank's
@@ -33,10 +41,12 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use crate::body::{self, FluidBody, ObstacleMesh};
 use crate::particles::Particles;
 use crate::scenes::{self, FlipScene};
 use crate::sim::FlipSimulation;
 use crate::transfer::Transfer;
+use anim_core::geometry::Shape;
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
     RunDefaults, SceneKind, Simulated, View, params, saved_field,
@@ -48,44 +58,84 @@ use serde_json::json;
 pub const KIND: SceneKind = SceneKind {
     kind: "flip",
     crate_name: "anim-flip",
-    summary: "an incompressible particle fluid (PIC, FLIP, APIC on a MAC grid) in 2D and 3D: dam breaks, drops, a sloshing tank",
+    summary: "an incompressible particle fluid (PIC, FLIP, APIC on a MAC grid) in 2D and 3D: dam breaks, drops, a sloshing tank, or bodies of fluid from shapes and closed surfaces",
     presets,
     build,
     tolerance: None,
 };
 
 /// Scene-file parameters of a `flip` scene: a preset of [`scenes::NAMES`] and what a file may
-/// change in it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// change in it, or fluid bodies of the file's own in a 1 m tank with obstacles ([`crate::body`]).
+/// Give `preset` or `bodies`; `dim`, `gravity`, `obstacles` and `obstacle_meshes` belong to
+/// bodies only. Coordinates are y up.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FlipSceneParams {
     /// The preset's name: `"dam-break-2d"`, `"dam-break-3d"`, `"drop-2d"`, `"drop-3d"` or
-    /// `"sloshing-tank"`.
-    pub preset: String,
+    /// `"sloshing-tank"`. Give this or `bodies`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
     /// Cells across the 1 m tank: at most 1024 in 2D, 128 in 3D (at least 4, what the
-    /// solid border and the kernel need). Default: the preset's (64 in 2D, 32 in 3D).
+    /// solid border and the kernel need). Default: the preset's (64 in 2D, 32 in 3D); for
+    /// bodies the same, across the tank's inside (the walls are outside it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
     /// Grid-to-particle transfer: `"apic"`, `"pic"`, or `{ flip = 0.97 }` (FLIP blended with
     /// PIC, the blend in `[0, 1]`). Default APIC.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transfer: Option<Transfer>,
+    /// Fluid bodies ([`FluidBody`]: a shape or a closed OBJ mesh, placed, with a velocity), in
+    /// the tank's inside `[0, 1]` m along each axis. Give this or `preset`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bodies: Vec<FluidBody>,
+    /// 2 or 3 (a scene of bodies; a 2D one is the plane z = 0). Default 3.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dim: Option<usize>,
+    /// Gravity (m/s^2; a scene of bodies), y up. Default `[0, -9.81, 0]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<[f64; 3]>,
+    /// Obstacles (a scene of bodies), in the [`Shape`] spelling (plane, sphere, box,
+    /// capsule): the cells whose centres are inside one are solid. Default none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacles: Vec<Shape>,
+    /// Obstacles from closed OBJ surfaces ([`ObstacleMesh`]; a scene of bodies): the cells whose
+    /// centres are inside one are solid. Default none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacle_meshes: Vec<ObstacleMesh>,
 }
 
 impl FlipSceneParams {
     /// The preset at `resolution` cells across (the preset's own when `None`).
     #[must_use]
     pub fn preset(name: &str, resolution: Option<usize>) -> Self {
-        Self { preset: name.into(), resolution, transfer: None }
+        Self { preset: Some(name.into()), resolution, ..Self::default() }
     }
 
     /// Checks the parameters and builds the preset.
     ///
     /// # Errors
-    /// [`BuildError::Invalid`] naming the field: an unknown preset, a FLIP blend outside
-    /// `[0, 1]`, a resolution above the preset's limit or one the simulation refuses.
+    /// [`BuildError::Invalid`] naming the field: no preset or bodies as well, a field of bodies
+    /// only, an unknown preset, a FLIP blend outside `[0, 1]`, a resolution above the preset's
+    /// limit or one the simulation refuses.
     pub fn scene(&self) -> Result<FlipScene, BuildError> {
-        let preset = self.preset.as_str();
+        let Some(preset) = self.preset.as_deref() else {
+            return Err(self.neither());
+        };
+        if !self.bodies.is_empty() {
+            return Err(BuildError::invalid("bodies", "give a built-in `preset` or `bodies`, not both"));
+        }
+        let only_bodies = [
+            ("dim", self.dim.is_some()),
+            ("gravity", self.gravity.is_some()),
+            ("obstacles", !self.obstacles.is_empty()),
+            ("obstacle_meshes", !self.obstacle_meshes.is_empty()),
+        ];
+        if let Some((field, _)) = only_bodies.iter().find(|(_, given)| *given) {
+            return Err(BuildError::invalid(
+                *field,
+                format!("belongs to a scene of `bodies`; the preset `{preset}` sets its own"),
+            ));
+        }
         let unknown = || {
             BuildError::invalid(
                 "preset",
@@ -95,14 +145,7 @@ impl FlipSceneParams {
         if !scenes::NAMES.contains(&preset) {
             return Err(unknown());
         }
-        if let Some(Transfer::Flip(blend)) = self.transfer
-            && !(0.0..=1.0).contains(&blend)
-        {
-            return Err(BuildError::invalid(
-                "transfer",
-                format!("the FLIP blend must lie in [0, 1], got {blend}"),
-            ));
-        }
+        self.check_transfer()?;
         let limit = if preset.ends_with("3d") { 128 } else { 1024 };
         if let Some(r) = self.resolution
             && r > limit
@@ -115,6 +158,56 @@ impl FlipSceneParams {
         scenes::by_name(preset, self.resolution, self.transfer)
             .ok_or_else(unknown)?
             .map_err(|e| BuildError::invalid("resolution", e.to_string()))
+    }
+
+    /// Builds the scene of [`bodies`](Self::bodies) ([`crate::body::build`]), in 2D or 3D as
+    /// [`dim`](Self::dim) says; `context` resolves the mesh files.
+    ///
+    /// # Errors
+    /// [`BuildError::Invalid`] naming the field: no bodies, a preset as well, a `dim` other
+    /// than 2 or 3, a FLIP blend outside `[0, 1]`, and the refusals of [`crate::body`].
+    pub fn bodies_scene(&self, context: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
+        if self.bodies.is_empty() {
+            return Err(self.neither());
+        }
+        if self.preset.is_some() {
+            return Err(BuildError::invalid("bodies", "give a built-in `preset` or `bodies`, not both"));
+        }
+        self.check_transfer()?;
+        Ok(match self.dim.unwrap_or(3) {
+            2 => {
+                let (scene, particles) = body::build::<2>(self, context)?;
+                Simulated::new(scene, particles).boxed()
+            }
+            3 => {
+                let (scene, particles) = body::build::<3>(self, context)?;
+                Simulated::new(scene, particles).boxed()
+            }
+            d => return Err(BuildError::invalid("dim", format!("must be 2 or 3, got {d}"))),
+        })
+    }
+
+    fn check_transfer(&self) -> Result<(), BuildError> {
+        if let Some(Transfer::Flip(blend)) = self.transfer
+            && !(0.0..=1.0).contains(&blend)
+        {
+            return Err(BuildError::invalid(
+                "transfer",
+                format!("the FLIP blend must lie in [0, 1], got {blend}"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The refusal of parameters with neither a preset nor bodies.
+    fn neither(&self) -> BuildError {
+        BuildError::invalid(
+            "preset",
+            format!(
+                "give a built-in `preset` (one of {}) or `[[scene.bodies]]` of fluid",
+                scenes::NAMES.join(", ")
+            ),
+        )
     }
 }
 
@@ -166,8 +259,11 @@ fn presets() -> Vec<Preset> {
     ]
 }
 
-fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
+fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
     let p: FlipSceneParams = params(value)?;
+    if p.preset.is_none() {
+        return p.bodies_scene(context);
+    }
     Ok(match p.scene()? {
         FlipScene::Two(s) => Simulated::new(s.sim, s.particles).boxed(),
         FlipScene::Three(s) => Simulated::new(s.sim, s.particles).boxed(),

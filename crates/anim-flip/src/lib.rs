@@ -60,12 +60,15 @@
 //!   ([`scenes::by_name`]: `dam-break-2d`, `dam-break-3d`, `drop-2d`, `drop-3d`,
 //!   `sloshing-tank`);
 //! - [`kind`]: [`KIND`], the presets as the `flip` scene kind of anim-core's scene contracts;
+//! - [`body`]: fluid bodies (shapes and closed OBJ surfaces, placed, moving) and obstacles of a
+//!   `flip` scene file, seeded on the presets' lattice ([`body::build`], [`body::BodyScene`]);
 //! - [`error`]: the error type [`FlipError`].
 //!
 //! [`KIND`] registers the presets `dam-break-2d`, `dam-break-3d`, `drop-2d`, `drop-3d` and
 //! `sloshing-tank` as the `flip` scene kind ([`kind`]): built from their scene-file parameters
-//! ([`kind::FlipSceneParams`]: preset, resolution, transfer), checkpointed, and drawn as z-up
-//! particles in the world frame with the tank as a prop.
+//! ([`kind::FlipSceneParams`]: preset, resolution, transfer, or bodies of fluid and obstacles
+//! instead of a preset, [`body`]), checkpointed, and drawn as z-up particles in the world frame
+//! with the tank as a prop.
 //!
 //! The sloshing tank's first mode oscillates with the period of linear theory,
 //! `omega^2 = g k tanh(k d)`, to within 3.3% at 64 cells per metre (`tests/scenes.rs`; the
@@ -90,6 +93,7 @@
 //! # Ok::<(), anim_flip::FlipError>(())
 //! ```
 
+pub mod body;
 #[cfg(feature = "cases")]
 pub mod cases;
 pub mod classify;

@@ -160,6 +160,7 @@ pub mod kind;
 pub mod mac;
 pub mod pressure;
 pub mod scenes;
+pub mod smoke;
 pub mod stam;
 
 pub use error::FluidError;

@@ -1,0 +1,389 @@
+//! Fluid bodies and obstacles of a `flip` scene file ([`crate::kind::FlipSceneParams`] with
+//! `[[scene.bodies]]` instead of a preset): each body is a shape or the inside of a closed OBJ
+//! surface, filled with particles; obstacles are solid cells.
+//!
+//! Coordinates are the crate's own, **y up**: the tank's inside is the cube `[0, 1]^3` (the
+//! square `[0, 1]^2` in 2D, the plane `z = 0`), gravity `(0, -9.81, 0)` by default, and its
+//! walls are one cell thick outside it. `resolution` cells span the inside along each axis.
+//!
+//! - **Seeding.** The particles of every body are cut from one lattice, that of the presets
+//!   ([`scenes::fill_box`]): 2 particles per cell and axis at offsets `(k + 1/2) h / 2` from the
+//!   tank's inside corner, no jitter, at the body's `velocity`. A lattice point inside several
+//!   bodies is seeded once, by the first of them in file order (so no cell gets a body's
+//!   particles twice, and a later body fills only what the earlier ones left).
+//! - **Obstacles.** A cell is solid when its centre is inside an obstacle (a [`Shape`] of
+//!   `obstacles` or a closed OBJ surface of `obstacle_meshes`); the particles of a body that
+//!   fall in solid cells are dropped.
+//! - **Refusals**, each naming its field: a body that reaches outside the tank's inside
+//!   (`bodies[k]`), a body with no lattice point inside it at this resolution or none left once
+//!   earlier bodies and solid cells have taken theirs (`bodies[k]`), a mesh that does not read or
+//!   is not a closed, consistently oriented surface (`bodies[k].mesh`, the file and the line,
+//!   triangle or edge), an obstacle that covers no cell centre (`obstacles[k]`), and in 2D any
+//!   motion out of the plane.
+//!
+//! A 2D scene reads the first two components of each shape (a sphere is a disk, a box a
+//! rectangle) and cuts a mesh by the plane `z = 0` after its placement; rotations there are yaw
+//! only, and translations, velocities and gravity have no z.
+//!
+//! ```
+//! use anim_flip::kind::FlipSceneParams;
+//!
+//! let params: FlipSceneParams = serde_json::from_value(serde_json::json!({
+//!     "dim": 2,
+//!     "resolution": 16,
+//!     "bodies": [{ "shape": { "box": { "center": [0.5, 0.25, 0.0], "half_extents": [0.5, 0.25, 0.0] } } }],
+//! }))?;
+//! let (_, particles) = anim_flip::body::build::<2>(&params, &Default::default())?;
+//! // 16 x 8 cells, 4 particles per cell.
+//! assert_eq!(particles.len(), 16 * 8 * 4);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! [`scenes::fill_box`]: crate::scenes::fill_box
+
+mod closed;
+mod region;
+mod scene;
+#[cfg(test)]
+mod tests;
+
+pub use scene::BodyScene;
+
+use crate::kind::FlipSceneParams;
+use crate::mac::{flatten, unflatten};
+use crate::particles::Particles;
+use crate::sim::{FlipParams, FlipSimulation};
+use anim_core::geometry::Shape;
+use anim_core::scene::{BuildContext, BuildError, Placement, is_default};
+use region::Region;
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+fn one() -> f64 {
+    1.0
+}
+
+/// A body of fluid: one `shape` or one closed `mesh`, placed, at an initial velocity.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FluidBody {
+    /// The body's shape, in the [`Shape`] spelling: `{ box = { center, half_extents } }`,
+    /// `{ sphere = { center, radius } }` or `{ capsule = { a, b, radius } }` (a plane is
+    /// unbounded and refused). Give this or `mesh`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<Shape>,
+    /// A closed triangle surface, a Wavefront OBJ file relative to the scene file (polygons are
+    /// fan-triangulated; `l` lines are not part of the surface); the fluid fills its inside. Give
+    /// this or `shape`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<PathBuf>,
+    /// Uniform scale about the origin of the shape's or mesh's coordinates, positive. Default 1.
+    #[serde(default = "one")]
+    pub scale: f64,
+    /// Roll, pitch, yaw (rad) about that origin after the scale: `Rz(yaw) Ry(pitch) Rx(roll)`;
+    /// in 2D, yaw only. Default none.
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub rotate: [f64; 3],
+    /// Translation (m), applied last; in 2D, z is 0. Default none.
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub translate: [f64; 3],
+    /// Initial velocity of the body's particles (m/s); in 2D, z is 0. Default at rest.
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub velocity: [f64; 3],
+}
+
+/// A solid obstacle from a closed OBJ surface: the cells whose centres are inside it are solid.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleMesh {
+    /// The closed triangle surface, a Wavefront OBJ file relative to the scene file.
+    pub mesh: PathBuf,
+    /// Uniform scale about the mesh's origin, positive. Default 1.
+    #[serde(default = "one")]
+    pub scale: f64,
+    /// Roll, pitch, yaw (rad) about the mesh's origin after the scale; in 2D, yaw only.
+    /// Default none.
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub rotate: [f64; 3],
+    /// Translation (m), applied last; in 2D, z is 0. Default none.
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub translate: [f64; 3],
+}
+
+/// Default cells across the tank: as the presets, 64 in 2D and 32 in 3D.
+#[must_use]
+pub fn default_resolution(dim: usize) -> usize {
+    if dim == 3 { 32 } else { 64 }
+}
+
+/// Largest cells across the tank: 1024 in 2D, 128 in 3D (as the presets).
+#[must_use]
+pub fn max_resolution(dim: usize) -> usize {
+    if dim == 3 { 128 } else { 1024 }
+}
+
+/// Default gravity of a scene of bodies (m/s^2), y up.
+pub const GRAVITY: [f64; 3] = [0.0, -9.81, 0.0];
+
+/// Volume correction of a scene of bodies: that of the drop and dam-break presets
+/// ([`FlipParams::volume_correction`]).
+pub const VOLUME_CORRECTION: f64 = 0.5;
+
+fn invalid(field: impl Into<String>, message: impl Into<String>) -> BuildError {
+    BuildError::invalid(field, message)
+}
+
+/// The placement of a body or obstacle mesh, checked (its fields prefixed with `prefix`, like
+/// `bodies[0]`), and in 2D kept in the plane.
+fn placement(
+    prefix: &str,
+    scale: f64,
+    rotate: [f64; 3],
+    translate: [f64; 3],
+    dim: usize,
+) -> Result<Placement, BuildError> {
+    let p = Placement { scale, rotate, translate };
+    p.check().map_err(|e| match e {
+        BuildError::Invalid { field, message } => invalid(format!("{prefix}.{field}"), message),
+        other => other,
+    })?;
+    if dim == 2 {
+        if rotate[0] != 0.0 || rotate[1] != 0.0 {
+            return Err(invalid(
+                format!("{prefix}.rotate"),
+                format!("a 2D scene turns bodies in its plane only: give [0, 0, yaw], got {rotate:?}"),
+            ));
+        }
+        if translate[2] != 0.0 {
+            return Err(invalid(
+                format!("{prefix}.translate"),
+                format!("a 2D scene lies in the plane z = 0: give z = 0, got {translate:?}"),
+            ));
+        }
+    }
+    Ok(p)
+}
+
+/// A vector of the scene file as one of a `dim`-dimensional scene: finite, and in 2D with z 0.
+fn vector<const D: usize>(field: &str, v: [f64; 3]) -> Result<[f64; D], BuildError> {
+    if !v.iter().all(|x| x.is_finite()) {
+        return Err(invalid(field, format!("{v:?} holds a non-finite value")));
+    }
+    if D == 2 && v[2] != 0.0 {
+        return Err(invalid(field, format!("a 2D scene lies in the plane z = 0: give z = 0, got {v:?}")));
+    }
+    Ok(std::array::from_fn(|k| v[k]))
+}
+
+/// Coordinates rounded to nanometres, for messages.
+fn rounded(v: &[f64]) -> Vec<f64> {
+    v.iter().map(|x| (x * 1e9).round() / 1e9).collect()
+}
+
+/// A point of a `D`-dimensional scene as a 3D one (z = 0 in 2D).
+fn point3<const D: usize>(p: [f64; D]) -> [f64; 3] {
+    std::array::from_fn(|k| if k < D { p[k] } else { 0.0 })
+}
+
+/// The scene of `params.bodies` in `D` dimensions (`params.dim`, 3 when absent): the simulation
+/// in its tank of `resolution` cells across, its obstacles marked solid, and the bodies'
+/// particles (in the simulation's frame, whose origin is the outer corner of the walls).
+///
+/// # Errors
+/// [`BuildError::Invalid`] naming the field, as the module documentation lists.
+pub fn build<const D: usize>(
+    params: &FlipSceneParams,
+    context: &BuildContext<'_>,
+) -> Result<(BodyScene<D>, Particles<D>), BuildError> {
+    let res = params.resolution.unwrap_or_else(|| default_resolution(D));
+    let limit = max_resolution(D);
+    if !(4..=limit).contains(&res) {
+        return Err(invalid(
+            "resolution",
+            format!("a {D}D scene takes 4 to {limit} cells across its 1 m tank, got {res}"),
+        ));
+    }
+    let mut flip = FlipParams::<D>::default();
+    if let Some(t) = params.transfer {
+        flip.transfer = t;
+    }
+    flip.volume_correction = VOLUME_CORRECTION;
+    flip.gravity = vector::<D>("gravity", params.gravity.unwrap_or(GRAVITY))?;
+    let h = 1.0 / res as f64;
+    let mut sim =
+        FlipSimulation::new([res + 2; D], h, flip).map_err(|e| invalid("transfer", e.to_string()))?;
+    let (origin, _) = sim.fluid_box();
+    let obstacles = obstacles::<D>(params, context)?;
+    mark_solid(&mut sim, &obstacles)?;
+    let particles = seed(&sim, params, context, origin)?;
+    let shapes = params.obstacles.clone();
+    Ok((BodyScene::new(sim, origin, shapes), particles))
+}
+
+/// The regions of `obstacles` and `obstacle_meshes`, each with its field.
+fn obstacles<const D: usize>(
+    params: &FlipSceneParams,
+    context: &BuildContext<'_>,
+) -> Result<Vec<(String, Region)>, BuildError> {
+    let mut out = Vec::new();
+    for (k, shape) in params.obstacles.iter().enumerate() {
+        let field = format!("obstacles[{k}]");
+        shape.check_in(D).map_err(|e| invalid(&field, e))?;
+        out.push((field, Region::shape(*shape, Placement::default(), D)));
+    }
+    for (k, m) in params.obstacle_meshes.iter().enumerate() {
+        let prefix = format!("obstacle_meshes[{k}]");
+        let place = placement(&prefix, m.scale, m.rotate, m.translate, D)?;
+        let region = Region::mesh(&m.mesh, place, context, &format!("{prefix}.mesh"))?;
+        out.push((prefix, region));
+    }
+    Ok(out)
+}
+
+/// Marks the cells whose centres are inside an obstacle as solid.
+///
+/// # Errors
+/// An obstacle that covers no cell centre of the tank's inside.
+fn mark_solid<const D: usize>(
+    sim: &mut FlipSimulation<D>,
+    obstacles: &[(String, Region)],
+) -> Result<(), BuildError> {
+    let n = sim.grid().cells();
+    let h = sim.grid().h();
+    let mut solid = sim.solid().to_vec();
+    for (field, region) in obstacles {
+        // The inner cells whose centres may lie in the region's bounds.
+        let range: [(usize, usize); D] = std::array::from_fn(|a| {
+            let lo = ((region.lo[a] / h - 0.5).floor().max(0.0) as usize).min(n[a] - 3);
+            let hi = ((region.hi[a] / h - 0.5).ceil().max(0.0) as usize).min(n[a] - 3);
+            (lo, hi)
+        });
+        let mut covered = 0usize;
+        for_each_index(range, |idx| {
+            let centre: [f64; D] = std::array::from_fn(|a| (idx[a] as f64 + 0.5) * h);
+            if region.contains(point3(centre)) {
+                // Inner cell idx is grid cell idx + 1 (past the wall).
+                solid[flatten(n, std::array::from_fn(|a| idx[a] + 1))] = true;
+                covered += 1;
+            }
+        });
+        if covered == 0 {
+            return Err(invalid(
+                field.as_str(),
+                format!(
+                    "covers no cell centre of the tank's inside at resolution {} (cells {h} m): it would have no effect",
+                    n[0] - 2
+                ),
+            ));
+        }
+    }
+    // `set_solid` gives cell centres `(i + 1/2) h`, of cell `i`.
+    sim.set_solid(|x| solid[flatten(n, std::array::from_fn(|a| (x[a] / h) as usize))]);
+    Ok(())
+}
+
+/// Calls `f` with every index of the box `range` (inclusive per axis; empty when a low end
+/// exceeds its high end), x fastest.
+fn for_each_index<const D: usize>(range: [(usize, usize); D], mut f: impl FnMut([usize; D])) {
+    if range.iter().any(|(lo, hi)| lo > hi) {
+        return;
+    }
+    let counts: [usize; D] = std::array::from_fn(|a| range[a].1 - range[a].0 + 1);
+    for i in 0..counts.iter().product() {
+        let local = unflatten(counts, i);
+        f(std::array::from_fn(|a| range[a].0 + local[a]))
+    }
+}
+
+/// The particles of the bodies: the lattice points of the presets inside each body, each point
+/// seeded once (by the first body that holds it), none in solid cells.
+fn seed<const D: usize>(
+    sim: &FlipSimulation<D>,
+    params: &FlipSceneParams,
+    context: &BuildContext<'_>,
+    origin: [f64; D],
+) -> Result<Particles<D>, BuildError> {
+    let n = sim.grid().cells();
+    let h = sim.grid().h();
+    let res = n[0] - 2;
+    let per_axis = 2;
+    let spacing = h / per_axis as f64;
+    let counts = [per_axis * res; D];
+    let mut taken = vec![false; counts.iter().product()];
+    let mut particles = Particles::new();
+    for (k, body) in params.bodies.iter().enumerate() {
+        let name = format!("bodies[{k}]");
+        let place = placement(&name, body.scale, body.rotate, body.translate, D)?;
+        let velocity = vector::<D>(&format!("{name}.velocity"), body.velocity)?;
+        let region = match (&body.shape, &body.mesh) {
+            (Some(shape), None) => {
+                let field = format!("{name}.shape");
+                shape.check_in(D).map_err(|e| invalid(&field, e))?;
+                if let Shape::Plane { .. } = shape {
+                    return Err(invalid(field, "a plane is unbounded: fill a pool with a box"));
+                }
+                Region::shape(*shape, place, D)
+            }
+            (None, Some(mesh)) => Region::mesh(mesh, place, context, &format!("{name}.mesh"))?,
+            (Some(_), Some(_)) => return Err(invalid(name, "give a `shape` or a `mesh`, not both")),
+            (None, None) => {
+                return Err(invalid(name, "give a `shape` (box, sphere, capsule) or a closed OBJ `mesh`"));
+            }
+        };
+        let outside = (0..D).any(|a| !(region.lo[a] >= -1e-9 && region.hi[a] <= 1.0 + 1e-9));
+        if outside {
+            return Err(invalid(
+                name,
+                format!(
+                    "reaches outside the tank: it spans {:?} to {:?} (m); the tank's inside is 0 to 1 m along each axis",
+                    rounded(&region.lo[..D]),
+                    rounded(&region.hi[..D])
+                ),
+            ));
+        }
+        let range: [(usize, usize); D] = std::array::from_fn(|a| {
+            let lo = ((region.lo[a] / spacing - 0.5).floor().max(0.0) as usize).min(counts[a] - 1);
+            let hi = ((region.hi[a] / spacing - 0.5).ceil().max(0.0) as usize).min(counts[a] - 1);
+            (lo, hi)
+        });
+        let (mut inside, mut earlier, mut solid) = (0usize, 0usize, 0usize);
+        let before = particles.len();
+        for_each_index(range, |idx| {
+            let local: [f64; D] = std::array::from_fn(|a| (idx[a] as f64 + 0.5) * spacing);
+            if !region.contains(point3(local)) {
+                return;
+            }
+            inside += 1;
+            let slot = &mut taken[flatten(counts, idx)];
+            if *slot {
+                earlier += 1;
+                return;
+            }
+            *slot = true;
+            let x: [f64; D] = std::array::from_fn(|a| origin[a] + local[a]);
+            let cell: [usize; D] = std::array::from_fn(|a| ((x[a] / h) as usize).min(n[a] - 1));
+            if sim.solid()[flatten(n, cell)] {
+                solid += 1;
+                return;
+            }
+            particles.push(x, velocity);
+        });
+        if inside == 0 {
+            return Err(invalid(
+                name,
+                format!(
+                    "holds no particle at resolution {res} (particles {spacing} m apart): make it larger or raise the resolution"
+                ),
+            ));
+        }
+        if particles.len() == before {
+            return Err(invalid(
+                name,
+                format!(
+                    "none of its {inside} particles is left: {earlier} belong to earlier bodies, {solid} lie in solid cells of obstacles"
+                ),
+            ));
+        }
+    }
+    Ok(particles)
+}

@@ -1,0 +1,135 @@
+//! [`BodyScene`]: a fluid of bodies in its tank, stepped and checkpointed as the
+//! [`FlipSimulation`] it holds, drawn in the scene file's frame (the tank's inside from the
+//! origin) turned z up, with its obstacles.
+
+use crate::particles::Particles;
+use crate::sim::FlipSimulation;
+use anim_core::geometry::Shape;
+use anim_core::scene::{Checkpoint, CheckpointError, Context, Frame, Prop, View};
+use anim_core::solver::{Solver, StepReport};
+
+/// A fluid of bodies: the simulation, whose grid starts at the outer corner of the walls, and
+/// what drawing it needs.
+#[derive(Debug, Clone)]
+pub struct BodyScene<const D: usize> {
+    /// The simulation (obstacle cells solid).
+    pub sim: FlipSimulation<D>,
+    /// The tank's inside corner in the simulation's frame: a particle at `x` there is at
+    /// `x - origin` in the scene file's frame.
+    pub origin: [f64; D],
+    /// The obstacle shapes, in the scene file's frame (drawn as props).
+    pub obstacles: Vec<Shape>,
+}
+
+impl<const D: usize> BodyScene<D> {
+    pub(crate) fn new(sim: FlipSimulation<D>, origin: [f64; D], obstacles: Vec<Shape>) -> Self {
+        Self { sim, origin, obstacles }
+    }
+
+    /// A point of the simulation's frame in the scene file's frame.
+    #[must_use]
+    pub fn to_scene(&self, x: &[f64; D]) -> [f64; D] {
+        std::array::from_fn(|a| x[a] - self.origin[a])
+    }
+}
+
+/// A y-up vector of the scene file as a z-up one: `(x, y, z) -> (x, -z, y)`; in 2D the plane
+/// `z = 0` is drawn as the plane y = 0: `(x, y) -> (x, 0, y)`.
+fn z_up<const D: usize>(p: [f64; 3]) -> [f64; 3] {
+    let z = if D == 3 { -p[2] } else { 0.0 };
+    [p[0], z, p[1]]
+}
+
+/// The corners of a box (y up) as a z-up box.
+fn box_z_up<const D: usize>(lo: [f64; 3], hi: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let (a, b) = (z_up::<D>(lo), z_up::<D>(hi));
+    (std::array::from_fn(|k| a[k].min(b[k])), std::array::from_fn(|k| a[k].max(b[k])))
+}
+
+fn pad<const D: usize>(p: [f64; D]) -> [f64; 3] {
+    std::array::from_fn(|k| if k < D { p[k] } else { 0.0 })
+}
+
+/// The prop an obstacle shape of a `D`-dimensional scene is drawn as, z up; planes none.
+fn prop<const D: usize>(shape: &Shape) -> Option<Prop> {
+    let flat = |v: [f64; 3]| if D == 2 { [v[0], v[1], 0.0] } else { v };
+    match *shape {
+        Shape::Sphere { center, radius } => Some(Prop::Sphere { center: z_up::<D>(flat(center)), radius }),
+        Shape::Capsule { a, b, radius } => {
+            Some(Prop::Capsule { a: z_up::<D>(flat(a)), b: z_up::<D>(flat(b)), radius })
+        }
+        Shape::Box { center, half_extents: e } => {
+            let (c, e) = (flat(center), flat(e));
+            let (lo, hi) =
+                box_z_up::<D>(std::array::from_fn(|k| c[k] - e[k]), std::array::from_fn(|k| c[k] + e[k]));
+            Some(Prop::Cuboid { lo, hi })
+        }
+        Shape::Plane { .. } => None,
+    }
+}
+
+impl<const D: usize> Solver for BodyScene<D> {
+    type State = Particles<D>;
+    type Error = crate::FlipError;
+
+    fn step(&mut self, state: &mut Particles<D>, dt: f64) -> Result<StepReport, crate::FlipError> {
+        self.sim.step(state, dt)
+    }
+}
+
+/// The simulation's checkpoint ([`FlipSimulation`]'s, positions in its frame).
+impl<const D: usize> Checkpoint for BodyScene<D> {
+    const VERSION: u32 = <FlipSimulation<D> as Checkpoint>::VERSION;
+
+    fn time(&self, _: &Particles<D>) -> f64 {
+        self.sim.time()
+    }
+
+    fn save(&self, particles: &Particles<D>) -> serde_json::Value {
+        Checkpoint::save(&self.sim, particles)
+    }
+
+    fn restore(
+        &mut self,
+        particles: &mut Particles<D>,
+        saved: &serde_json::Value,
+    ) -> Result<(), CheckpointError> {
+        Checkpoint::restore(&mut self.sim, particles, saved)
+    }
+
+    fn provoke_overflow(&mut self, particles: &mut Particles<D>) -> Option<String> {
+        self.sim.provoke_overflow(particles)
+    }
+}
+
+impl<const D: usize> View for BodyScene<D> {
+    fn method(&self) -> String {
+        View::method(&self.sim)
+    }
+
+    /// Particles drawn as discs of a quarter cell, the tank's inner walls (from the origin to
+    /// 1 m, z up; they are also the bounds) and the obstacle shapes but planes.
+    fn context(&self, _: &Particles<D>) -> Context {
+        let (lo, hi) = self.sim.fluid_box();
+        let tank = box_z_up::<D>(pad(self.to_scene(&lo)), pad(self.to_scene(&hi)));
+        let mut context = Context::default();
+        context.point_dim = 3;
+        context.point_radius = 0.25 * self.sim.grid().h();
+        context.props.push(Prop::Tank { lo: tank.0, hi: tank.1 });
+        context.props.extend(self.obstacles.iter().filter_map(prop::<D>));
+        context.bounds = Some(tank);
+        context
+    }
+
+    fn frame(&self, particles: &Particles<D>, out: &mut Frame) {
+        out.time = self.sim.time();
+        out.points.clear();
+        for x in &particles.x {
+            out.points.extend(z_up::<D>(pad(self.to_scene(x))));
+        }
+        let velocity = out.field_mut("velocity", 3);
+        for v in &particles.v {
+            velocity.extend(z_up::<D>(pad(*v)));
+        }
+    }
+}
