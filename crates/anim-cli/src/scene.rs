@@ -208,16 +208,8 @@ fn build_error(e: BuildError, origin: &Path, text: Option<&str>) -> SceneError {
         BuildError::Invalid { field, message } => (field, message),
         other => (String::new(), other.to_string()),
     };
-    // The first key of the path is the field of `[scene]`; a field of a sub-table written as
-    // its own `[scene.KEY]` table is found under that header.
-    let mut keys = field.split(['.', '[']);
-    let key = keys.next().unwrap_or_default();
-    let at = text.zip(table_header(text.unwrap_or_default(), "scene")).and_then(|(t, s)| {
-        field_offset(t, s, key).or_else(|| {
-            let sub = table_header(t, &format!("scene.{key}"))?;
-            keys.next().and_then(|k| field_offset(t, sub, k)).or(Some(sub))
-        })
-    });
+    let at = text.and_then(|t| locate(t, &field));
+    let key = field.split(['.', '[']).next().unwrap_or_default();
     match (text, at) {
         (Some(t), Some(at)) if !key.is_empty() => {
             let (line, column) = line_col(t, at);
@@ -233,13 +225,72 @@ fn build_error(e: BuildError, origin: &Path, text: Option<&str>) -> SceneError {
     }
 }
 
+/// Byte offset of the line of `field` (a path like `robot.q0` or `bodies[1].material.young`)
+/// in a scene file's text: the field's line in `[scene]`, or in its own `[scene.KEY]` table, or
+/// in the `[[scene.KEY]]` table of that index; that table's header when the rest of the path is
+/// not written on a line of its own.
+fn locate(text: &str, field: &str) -> Option<usize> {
+    let mut parts = field.splitn(2, '.');
+    let head = parts.next().unwrap_or_default();
+    let rest = parts.next();
+    let (key, index) = match head.split_once('[') {
+        Some((key, i)) => (key, i.trim_end_matches(']').parse::<usize>().ok()),
+        None => (head, None),
+    };
+    if key.is_empty() {
+        return None;
+    }
+    let scene = table_header(text, "scene")?;
+    if let Some(at) = field_in_table(text, scene, key) {
+        return Some(at);
+    }
+    let table = match index {
+        Some(i) => nth_header(text, &format!("[[scene.{key}]]"), i)?,
+        None => table_header(text, &format!("scene.{key}"))?,
+    };
+    let sub = rest.and_then(|r| r.split(['.', '[']).next());
+    Some(sub.and_then(|name| field_in_table(text, table, name)).unwrap_or(table))
+}
+
 /// Byte offset of the `[name]` table header.
 fn table_header(text: &str, name: &str) -> Option<usize> {
-    let header = format!("[{name}]");
+    nth_header(text, &format!("[{name}]"), 0)
+}
+
+/// Byte offset of the `n`-th (0-based) line that starts with `header`.
+fn nth_header(text: &str, header: &str, n: usize) -> Option<usize> {
     let mut offset = 0;
+    let mut seen = 0;
     for line in text.split_inclusive('\n') {
-        if line.trim_start().starts_with(&header) {
-            return Some(offset);
+        if line.trim_start().starts_with(header) {
+            if seen == n {
+                return Some(offset);
+            }
+            seen += 1;
+        }
+        offset += line.len();
+    }
+    None
+}
+
+/// Whether a line opens a table (`[name]` or `[[name]]`), as opposed to continuing an array.
+fn is_header(line: &str) -> bool {
+    let rest = line.trim_start().trim_start_matches('[');
+    line.trim_start().starts_with('[')
+        && rest.starts_with(|c: char| c.is_alphabetic() || c == '"' || c == '\'')
+}
+
+/// Byte offset of the line assigning `name` in the table whose header line starts at `header`,
+/// before the next table.
+fn field_in_table(text: &str, header: usize, name: &str) -> Option<usize> {
+    let mut offset = header;
+    for (n, line) in text[header..].split_inclusive('\n').enumerate() {
+        let trimmed = line.trim_start();
+        if n > 0 && is_header(line) {
+            return None;
+        }
+        if n > 0 && trimmed.strip_prefix(name).is_some_and(|r| r.trim_start().starts_with('=')) {
+            return Some(offset + (line.len() - trimmed.len()));
         }
         offset += line.len();
     }

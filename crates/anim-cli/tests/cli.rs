@@ -289,32 +289,6 @@ fn the_kinds_are_listed_and_any_parameter_can_be_set_from_the_command_line() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// Every scene file under `examples/scenes/` runs from the repository with its committed assets
-/// and writes frames, a preview and metrics.
-#[test]
-fn every_example_scene_runs_with_its_assets() {
-    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
-    let mut scenes: Vec<_> = std::fs::read_dir(&examples)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    scenes.sort();
-    assert!(!scenes.is_empty(), "no scene files in {}", examples.display());
-    for scene in scenes {
-        let name = scene.file_stem().unwrap().to_string_lossy().into_owned();
-        let dir = temp(&format!("example-{name}"));
-        let args = ["run", scene.to_str().unwrap(), "--frames", "2", "--out", dir.to_str().unwrap()];
-        let (ok, err) = anim(&[&args[..], &["--quiet", "--preview-width", "48"]].concat());
-        assert!(ok, "{}: {err}", scene.display());
-        assert!(dir.join("frames").read_dir().unwrap().count() >= 2, "{name}: no frames");
-        for file in ["preview.png", "metrics.json"] {
-            assert!(dir.join(file).exists(), "{name}: no {file}");
-        }
-        std::fs::remove_dir_all(&dir).ok();
-    }
-}
-
 /// A robot scene whose URDF is missing names the URDF; a joint name the robot does not have is
 /// refused on its line of the `[scene.robot]` table, with the robot's joints.
 #[test]

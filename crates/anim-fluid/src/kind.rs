@@ -8,6 +8,11 @@
 //! | `smoke-plume-3d` | hot smoke rising around a sphere, open top | 3D MAC grid, MacCormack + MGPCG |
 //! | `lid-driven-cavity` | the Re = 100 cavity stirring bands of dye | 2D MAC grid, MacCormack + MGPCG |
 //!
+//! Without `preset`, a scene file is a smoke scene of the user's own ([`crate::smoke`]): the MAC
+//! solver on a box of the file's `size` and `resolution` (2D or 3D), smoke from its `sources`
+//! around its `obstacles`, each a collider shape or a closed OBJ surface, with the plume's
+//! settings as defaults ([`FluidSceneParams`] lists every field).
+//!
 //! A scene is the [`FluidScene`] itself stepped as a [`Solver`] whose state is the run's clock:
 //! the sum of the steps' `dt` in `f64` (Stam's solver keeps its own time in sums of the
 //! `f32` step). Its frames have no points: the fields `"density"` (1 per cell) and
@@ -37,6 +42,7 @@ use crate::error::FluidError;
 use crate::mac::{MacFluid, MacState};
 use crate::pressure::PressureMethod;
 use crate::scenes::{self, FluidScene, FluidSim};
+use crate::smoke::{self, ObstacleSpec, SourceSpec};
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, ImageGrid, Preset, Prop,
@@ -61,26 +67,37 @@ pub const KIND: SceneKind = SceneKind {
 pub const PRESSURE_MAX_ITERATIONS: usize = 200_000;
 
 /// Scene-file parameters of a `fluid` scene: a preset of [`scenes::NAMES`] and what a file may
-/// change in it. Unset fields keep the preset's value.
+/// change in it, or, without `preset`, a smoke scene of the user's own ([`crate::smoke`]): the
+/// MAC solver on a box of `size` with buoyant smoke from `sources` around `obstacles`, its
+/// settings defaulting to the `smoke-plume-3d` preset's. Unset fields keep the preset's value.
+///
+/// The fields from `dim` on belong to a smoke scene of the user's own; a preset refuses them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FluidSceneParams {
     /// The preset's name: `"smoke-box-2d"`, `"smoke-plume-3d"` or `"lid-driven-cavity"`.
-    pub preset: String,
+    /// Default: none, a smoke scene of the user's own (which then needs `sources`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
     /// Cells across the domain: 2 to 2048 in 2D, 2 to 128 for `smoke-plume-3d`. Default: the
-    /// preset's (128, 32, 64).
+    /// preset's (128, 32, 64). For a smoke scene of the user's own, the cells along x (the
+    /// other sides take cells of the same size), at most [`smoke::MAX_CELLS`] in all; default
+    /// 32.
+    ///
+    /// [`smoke::MAX_CELLS`]: crate::smoke::MAX_CELLS
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
-    /// Pressure solver of the MAC presets (`"jacobi"`, `"rb-gauss-seidel"`, `"cg"`,
+    /// Pressure solver of the MAC scenes (`"jacobi"`, `"rb-gauss-seidel"`, `"cg"`,
     /// `"mgpcg"`). Default: the preset's (MGPCG). Setting it or the tolerance lets the solve
     /// take up to [`PRESSURE_MAX_ITERATIONS`] iterations.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pressure_solver: Option<PressureMethod>,
-    /// Relative residual `max|b - A p| / max|b|` the pressure solve stops at, > 0 (MAC presets).
-    /// Default: the preset's (1e-5 for the plume, 1e-8 for the cavity).
+    /// Relative residual `max|b - A p| / max|b|` the pressure solve stops at, > 0 (MAC scenes).
+    /// Default: the preset's (1e-5 for the plume and a smoke scene of the user's own, 1e-8 for
+    /// the cavity).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pressure_tolerance: Option<f64>,
-    /// Advection scheme of the MAC presets (`"sl-linear"`, `"sl-monotone-cubic"`, `"bfecc"`,
+    /// Advection scheme of the MAC scenes (`"sl-linear"`, `"sl-monotone-cubic"`, `"bfecc"`,
     /// `"maccormack"`). Default: the preset's (MacCormack).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub advection: Option<Advection>,
@@ -88,29 +105,112 @@ pub struct FluidSceneParams {
     /// or `"reflection"`, advection-reflection). Default: the preset's (advect-project).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub splitting: Option<Splitting>,
+    /// 2 or 3 (a smoke scene of the user's own). Default 3.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dim: Option<usize>,
+    /// The domain's size (m), `[x, y, z]` (`[x, y]` in 2D), from the origin, y up: `resolution`
+    /// cells along x and as many cells of the same size along y and z as cover the size. Default
+    /// the plume's `[1, 1.5, 1]` (`[1, 1.5]` in 2D).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub size: Option<Vec<f64>>,
+    /// Buoyancy weight of density `alpha` in `f = (-alpha rho + beta (T - T_amb)) e_y`, finite.
+    /// Default the plume's 0.05.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub buoyancy_density: Option<f64>,
+    /// Buoyancy weight of temperature `beta`, finite. Default the plume's 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub buoyancy_temperature: Option<f64>,
+    /// Ambient temperature `T_amb`, finite (the initial temperature everywhere). Default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ambient_temperature: Option<f64>,
+    /// Vorticity confinement strength `eps`, >= 0. Default the plume's 2.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vorticity_confinement: Option<f64>,
+    /// Kinematic viscosity (m²/s), >= 0 (an implicit solve per step when positive). Default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub viscosity: Option<f64>,
+    /// Whether the top (the high y side) is open (pressure 0 beyond it, smoke leaves); the other
+    /// walls are no-slip. Default true (the plume's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub open_top: Option<bool>,
+    /// Where smoke comes from: at least one [`SourceSpec`] (a shape or a closed OBJ surface,
+    /// with its density, temperature and velocity).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sources: Option<Vec<SourceSpec>>,
+    /// Solids the smoke flows around: collider shapes and closed OBJ surfaces
+    /// ([`ObstacleSpec`]); each must cover a cell centre. Default none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub obstacles: Option<Vec<ObstacleSpec>>,
 }
 
 impl FluidSceneParams {
     /// The preset at `resolution` cells across (the preset's own when `None`).
     #[must_use]
     pub fn preset(name: &str, resolution: Option<usize>) -> Self {
+        Self { preset: Some(name.into()), resolution, sources: None, ..Self::smoke(Vec::new()) }
+    }
+
+    /// A smoke scene of the user's own from `sources`, every other field at its default.
+    #[must_use]
+    pub fn smoke(sources: Vec<SourceSpec>) -> Self {
         Self {
-            preset: name.into(),
-            resolution,
+            preset: None,
+            resolution: None,
             pressure_solver: None,
             pressure_tolerance: None,
             advection: None,
             splitting: None,
+            dim: None,
+            size: None,
+            buoyancy_density: None,
+            buoyancy_temperature: None,
+            ambient_temperature: None,
+            vorticity_confinement: None,
+            viscosity: None,
+            open_top: None,
+            sources: Some(sources),
+            obstacles: None,
         }
     }
 
-    /// Checks the parameters and builds the scene.
+    /// The fields of a smoke scene of the user's own that are set.
+    fn smoke_fields(&self) -> Vec<&'static str> {
+        [
+            ("dim", self.dim.is_some()),
+            ("size", self.size.is_some()),
+            ("buoyancy_density", self.buoyancy_density.is_some()),
+            ("buoyancy_temperature", self.buoyancy_temperature.is_some()),
+            ("ambient_temperature", self.ambient_temperature.is_some()),
+            ("vorticity_confinement", self.vorticity_confinement.is_some()),
+            ("viscosity", self.viscosity.is_some()),
+            ("open_top", self.open_top.is_some()),
+            ("sources", self.sources.is_some()),
+            ("obstacles", self.obstacles.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(name, set)| set.then_some(name))
+        .collect()
+    }
+
+    /// Checks the parameters and builds the scene (mesh files relative to the working
+    /// directory).
+    ///
+    /// # Errors
+    /// As [`FluidSceneParams::scene_in`].
+    pub fn scene(&self) -> Result<FluidScene, BuildError> {
+        self.scene_in(&BuildContext::default())
+    }
+
+    /// Checks the parameters and builds the scene, reading mesh files relative to `context`.
     ///
     /// # Errors
     /// [`BuildError::Invalid`] naming the field: an unknown preset, a resolution above the
     /// preset's limit or one the solver refuses, a tolerance that is not positive and finite, a
-    /// MAC setting given to Stam's solver.
-    pub fn scene(&self) -> Result<FluidScene, BuildError> {
+    /// MAC setting given to Stam's solver, a smoke scene's field given to a preset; for a smoke
+    /// scene of the user's own, a bad size or setting, a source or obstacle that covers no cell,
+    /// a source inside obstacles, an OBJ file that does not parse or is not a closed surface
+    /// (`sources[k].mesh`, `obstacles[k].mesh`).
+    pub fn scene_in(&self, context: &BuildContext<'_>) -> Result<FluidScene, BuildError> {
         if let Some(tol) = self.pressure_tolerance
             && !(tol > 0.0 && tol.is_finite())
         {
@@ -119,7 +219,20 @@ impl FluidSceneParams {
                 format!("must be a positive finite number, got {tol}"),
             ));
         }
-        let preset = self.preset.as_str();
+        let Some(preset) = self.preset.as_deref() else {
+            let mut scene = smoke::build(self, context)?;
+            self.apply_mac_settings(&mut scene, "a smoke scene")?;
+            return Ok(scene);
+        };
+        if let Some(&field) = self.smoke_fields().first() {
+            return Err(BuildError::invalid(
+                field,
+                format!(
+                    "belongs to a smoke scene of your own; preset `{preset}` keeps its own (remove \
+                     `preset` to build your own scene with `sources` and `obstacles`)"
+                ),
+            ));
+        }
         let unknown = || {
             BuildError::invalid(
                 "preset",
@@ -141,18 +254,25 @@ impl FluidSceneParams {
         let mut scene = scenes::by_name(preset, self.resolution)
             .ok_or_else(unknown)?
             .map_err(|e| BuildError::invalid("resolution", e.to_string()))?;
+        self.apply_mac_settings(&mut scene, preset)?;
+        Ok(scene)
+    }
+
+    /// Sets the pressure solver and tolerance, the advection and the splitting the file gives
+    /// on the MAC solver of `scene` (`what` names the scene in the refusal of Stam's solver).
+    fn apply_mac_settings(&self, scene: &mut FluidScene, what: &str) -> Result<(), BuildError> {
         let fields = [
             ("pressure_solver", self.pressure_solver.is_some()),
             ("pressure_tolerance", self.pressure_tolerance.is_some()),
             ("advection", self.advection.is_some()),
             ("splitting", self.splitting.is_some()),
         ];
-        let Some(&(field, _)) = fields.iter().find(|(_, set)| *set) else { return Ok(scene) };
+        let Some(&(field, _)) = fields.iter().find(|(_, set)| *set) else { return Ok(()) };
         let FluidSim::Mac(fluid, _) = &mut scene.sim else {
             return Err(BuildError::invalid(
                 field,
                 format!(
-                    "{preset} runs Stam's solver (20 Gauss-Seidel sweeps, linear advection), which has no pressure, advection or splitting settings"
+                    "{what} runs Stam's solver (20 Gauss-Seidel sweeps, linear advection), which has no pressure, advection or splitting settings"
                 ),
             ));
         };
@@ -171,7 +291,7 @@ impl FluidSceneParams {
         if let Some(s) = self.splitting {
             fluid.set_splitting(s);
         }
-        Ok(scene)
+        Ok(())
     }
 }
 
@@ -201,9 +321,9 @@ fn presets() -> Vec<Preset> {
     ]
 }
 
-fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
+fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
     let p: FluidSceneParams = params(value)?;
-    Ok(Simulated::new(p.scene()?, 0.0).boxed())
+    Ok(Simulated::new(p.scene_in(context)?, 0.0).boxed())
 }
 
 /// A [`FluidScene`] stepped by `dt` per step (the Stam scene applies its source pattern first),
@@ -281,7 +401,8 @@ impl View for FluidScene {
     }
 
     /// The image grid (origin at 0, the cell size as spacing, the density shown) and, for the
-    /// plume, its sphere in the grid's axes.
+    /// plume, its sphere in the grid's axes; for a smoke scene of the user's own, its shape
+    /// obstacles but planes (meshes have no prop).
     fn context(&self, _: &f64) -> Context {
         // Stam's source adds 10 per step where it sits and the closed box keeps it all: in
         // the 128^2 box after 200 steps the density's median is 17, its 99th percentile 50
@@ -306,6 +427,7 @@ impl View for FluidScene {
                 radius: scenes::PLUME_SPHERE_RADIUS,
             });
         }
+        context.props.extend(self.shapes.iter().filter_map(Prop::of_shape));
         context
     }
 
@@ -445,13 +567,19 @@ fn tolerance_adapter(
             family.study
         ));
     }
-    if p.preset == "lid-driven-cavity" {
+    let Some(preset) = p.preset.as_deref() else {
+        return Err(format!(
+            "is a smoke scene of its own (no `preset`); the {} study measured the presets only",
+            family.study
+        ));
+    };
+    if preset == "lid-driven-cavity" {
         return Ok(Box::new(CavityAdapter {
             pressure_tolerance: study::problem(family, "pressure_tolerance")?,
         }));
     }
-    let scene = scenes::by_name(&p.preset, p.resolution)
-        .ok_or_else(|| format!("--tolerance: unknown fluid preset `{}`", p.preset))?
+    let scene = scenes::by_name(preset, p.resolution)
+        .ok_or_else(|| format!("--tolerance: unknown fluid preset `{preset}`"))?
         .map_err(study::unreadable)?;
     let n = scene.dims().into_iter().max().unwrap_or(1);
     let sizes: Vec<usize> =
@@ -476,7 +604,7 @@ fn tolerance_error(
     max_residual: Option<f64>,
 ) -> Option<f64> {
     let p: FluidSceneParams = params(value).ok()?;
-    if p.preset == "smoke-plume-3d" { max_residual } else { scene.reference_error() }
+    if p.preset.as_deref() == Some("smoke-plume-3d") { max_residual } else { scene.reference_error() }
 }
 
 #[cfg(test)]

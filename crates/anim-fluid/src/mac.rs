@@ -23,8 +23,9 @@
 //! and the scalars are advected once over `dt` by `u'`.
 //!
 //! Walls ([`Wall`]) are no-slip (with a velocity: a moving lid), free-slip or open (`p = 0`,
-//! zero-gradient velocity); obstacles are solid cells ([`MacFluid::set_solid`]); inflow is a
-//! [`Source`] box. Everything is `f64`: the accuracy cases (Taylor-Green decay, Ghia's cavity)
+//! zero-gradient velocity); obstacles are solid cells ([`MacFluid::set_solid`],
+//! [`MacFluid::set_solid_cells`]); inflow is a [`Source`] box or a [`RegionSource`] of any
+//! shape ([`MacFluid::add_region_source`]). Everything is `f64`: the accuracy cases (Taylor-Green decay, Ghia's cavity)
 //! and the tight pressure tolerances of the work-precision study need it.
 //!
 //! 2D grids have `nz = 1` and no `w`; every loop is written once for both, the z terms guarded
@@ -48,7 +49,7 @@ mod tests;
 mod timing;
 mod viscosity;
 
-pub use forces::Source;
+pub use forces::{RegionSource, Source};
 pub use grid::Wall;
 
 use crate::advection::{Advection, Lattice, Splitting};
@@ -160,6 +161,8 @@ pub struct MacFluid {
     /// The warm-start pressure before the current step, restored when the step fails.
     pressure_backup: Vec<f64>,
     last: MacStepInfo,
+    /// Sources of any shape, applied after the boxes of the settings.
+    regions: Vec<RegionSource>,
 }
 
 impl MacFluid {
@@ -217,6 +220,7 @@ impl MacFluid {
             backup: state.clone(),
             pressure_backup: vec![0.0; cells],
             last: MacStepInfo::default(),
+            regions: Vec::new(),
             grid,
             params,
         };
@@ -366,6 +370,49 @@ impl MacFluid {
             self.params.pressure_tolerance,
             self.params.pressure_max_iterations,
         )?);
+        Ok(())
+    }
+
+    /// Marks the cells whose entry of `solid` (one per cell, x fastest) is true as solid
+    /// obstacles, the others as fluid, and rebuilds the pressure operator.
+    ///
+    /// # Errors
+    /// [`FluidError::BadLength`] when `solid` does not have one entry per cell; otherwise only if
+    /// the pressure operator cannot be rebuilt (never for a valid fluid).
+    pub fn set_solid_cells(&mut self, solid: &[bool]) -> Result<(), FluidError> {
+        let cells = self.grid.solid.len();
+        if solid.len() != cells {
+            return Err(FluidError::BadLength { name: "solid", got: solid.len(), expected: cells });
+        }
+        let labels = solid.iter().map(|&s| if s { CellLabel::Solid } else { CellLabel::Fluid }).collect();
+        let solver = projection::pressure_solver(
+            &self.grid,
+            labels,
+            self.params.pressure,
+            self.params.pressure_tolerance,
+            self.params.pressure_max_iterations,
+        )?;
+        self.grid.solid.copy_from_slice(solid);
+        self.projection.set_solver(solver);
+        Ok(())
+    }
+
+    /// Whether each cell is a solid obstacle (x fastest).
+    #[must_use]
+    pub fn solid(&self) -> &[bool] {
+        &self.grid.solid
+    }
+
+    /// Adds a source of any shape, applied every step after the boxes of the settings and the
+    /// region sources added before it.
+    ///
+    /// # Errors
+    /// [`FluidError::BadLength`] for a mask without one entry per cell or per face of its
+    /// component (none for `w` in 2D), [`FluidError::BadParameter`] for a non-finite density,
+    /// temperature or velocity.
+    pub fn add_region_source(&mut self, source: RegionSource) -> Result<(), FluidError> {
+        source.check(&self.grid)?;
+        self.regions.push(source);
         Ok(())
     }
 
@@ -588,10 +635,12 @@ impl MacFluid {
         }
     }
 
-    /// Applies the sources: density, temperature and velocity inside each box.
+    /// Applies the sources: density, temperature and velocity inside each box, then in each
+    /// region.
     fn apply_sources(&self, state: &mut MacState) {
         let MacState { vel, density, temperature, .. } = state;
         forces::apply_sources(&self.grid, &self.params.sources, vel, density, temperature);
+        forces::apply_region_sources(&self.grid, &self.regions, vel, density, temperature);
     }
 
     /// Sets wall-normal and obstacle face velocities; open walls copy their inner neighbour.

@@ -23,6 +23,7 @@ use crate::error::FluidError;
 use crate::mac::{MacFluid, MacParams, MacState, Source, Wall};
 use crate::pressure::PressureMethod;
 use crate::stam::{StamFluid, StamParams, ix};
+use anim_core::geometry::Shape;
 use anim_core::solver::{Solver, StepReport};
 use serde::Deserialize as _;
 
@@ -52,6 +53,9 @@ pub struct FluidScene {
     pub dt: f64,
     /// Suggested duration (s).
     pub duration: f64,
+    /// Obstacle shapes drawn with the scene (a smoke scene's shape obstacles; the plume's
+    /// sphere is drawn by the scene's name).
+    pub shapes: Vec<Shape>,
 }
 
 impl FluidScene {
@@ -273,6 +277,7 @@ pub fn smoke_box_2d(n: usize) -> Result<FluidScene, FluidError> {
         sim: FluidSim::Stam(StamFluid::new(n, params)?),
         dt: f64::from(params.dt),
         duration: 20.0,
+        shapes: Vec::new(),
     })
 }
 
@@ -320,6 +325,7 @@ pub fn smoke_plume_3d(n: usize) -> Result<FluidScene, FluidError> {
         sim: FluidSim::Mac(fluid, state),
         dt: 1.5 * h,
         duration: 3.0,
+        shapes: Vec::new(),
     })
 }
 
@@ -355,6 +361,7 @@ pub fn lid_driven_cavity(n: usize, re: f64, advection: Advection) -> Result<Flui
         sim: FluidSim::Mac(fluid, state),
         dt: h,
         duration: 20.0,
+        shapes: Vec::new(),
     })
 }
 

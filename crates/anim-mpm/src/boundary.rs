@@ -14,8 +14,10 @@
 use crate::{MpmError, Vector};
 use serde::{Deserialize, Serialize};
 
-/// How a grid velocity is constrained at an obstacle.
+/// How a grid velocity is constrained at an obstacle. In a scene file: `"sticky"`, `"slip"`,
+/// `{ separate = { friction = 0.3 } }` or `"separate-frictionless"`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case", deny_unknown_fields)]
 pub enum Boundary {
     /// No relative motion at all.
     Sticky,
@@ -23,7 +25,8 @@ pub enum Boundary {
     Slip,
     /// No approaching normal motion, with Coulomb friction coefficient `friction` (0 = none).
     Separate {
-        /// Coulomb friction coefficient (>= 0).
+        /// Coulomb friction coefficient (>= 0); default 0.
+        #[serde(default)]
         friction: f32,
     },
     /// The default: separating without friction.

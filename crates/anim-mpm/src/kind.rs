@@ -9,6 +9,34 @@
 //! | `dam-break` | `dam-break-3d`: a water column collapsing in a tank, 48^3 cells | 100 frames of 16 x 1 ms |
 //! | `snowball` | `snowball`: a snowball hitting a wall and breaking up, 64^3 cells | 100 frames of 16 x 0.5 ms |
 //!
+//! **Bodies.** Instead of a `preset`, a scene file may bring its own matter: `[[scene.bodies]]`
+//! tables ([`BodySpec`]), each a box, a sphere or a closed OBJ surface filled with particles,
+//! with its material (elastic, snow, fluid or sand), placement and initial velocity, and the
+//! scene-wide `resolution`, `dim`, `particles_per_cell`, `transfer`, `kernel`, `gravity`,
+//! `obstacles` (planes, boxes, spheres), `boundary` (on the obstacles) and `wall` (on the
+//! domain's walls) ([`MpmSceneParams`], [`crate::bodies`]). Such a scene is framed by the
+//! domain's walls.
+//!
+//! ```
+//! use anim_core::scene::BuildContext;
+//!
+//! let params = serde_json::json!({
+//!     "resolution": 16,
+//!     "obstacles": [{ "sphere": { "center": [0.5, 0.3, 0.5], "radius": 0.1 } }],
+//!     "boundary": { "separate": { "friction": 0.3 } },
+//!     "bodies": [
+//!         { "shape": { "box": { "center": [0.5, 0.6, 0.5], "half_extents": [0.1, 0.1, 0.1] } },
+//!           "material": { "snow": {} } },
+//!         { "shape": { "sphere": { "center": [0.3, 0.7, 0.5], "radius": 0.08 } },
+//!           "material": { "elastic": { "young": 2e4 } }, "velocity": [1.0, 0.0, 0.0] },
+//!     ],
+//! });
+//! let mut scene = (anim_mpm::KIND.build)(&params, &BuildContext::default())?;
+//! scene.step(1e-3)?;
+//! assert_eq!(scene.method(), "3D MLS-MPM, quadratic B-splines, CFL substeps");
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! **Frames.** One point per particle in the current (block-sorted) order of the particles,
 //! with its velocity, widened from `f32` to `f64`; 2D scenes lie in the `z = 0` plane. The
 //! scenes keep their own frame, the unit box with **y up** (gravity along `-y`). The
@@ -34,8 +62,9 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use crate::bodies::{self, BodySpec};
 use crate::scenes::{self, MpmScene, SurgeFront};
-use crate::{Kernel, MpmError, MpmParams, MpmSimulation, OutOfDomain, Particles, Shape, Transfer};
+use crate::{Boundary, Kernel, MpmError, MpmParams, MpmSimulation, OutOfDomain, Particles, Shape, Transfer};
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
@@ -54,15 +83,19 @@ pub const KIND: SceneKind = SceneKind {
     tolerance: Some(Tolerance { adapter: tolerance_adapter, error: study::reference_error }),
 };
 
-/// Scene-file parameters of an `mpm` scene (the `[scene]` table without `kind`).
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+/// Scene-file parameters of an `mpm` scene (the `[scene]` table without `kind`): a `preset`, or
+/// `bodies` of the user's own with the scene-wide fields around them (see [`crate::bodies`]).
+/// `resolution`, `transfer`, `kernel` and `particles_per_cell` apply to both; `dim`,
+/// `gravity`, `obstacles`, `boundary` and `wall` only to bodies.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MpmSceneParams {
     /// The scene: `"three-materials"` or `"dam-break-2d"` in 2D, `"dam-break-3d"`,
     /// `"snowball"`, or the peer benchmarks `"benchmark-2d"` and `"benchmark-3d"` (see
-    /// [`scenes`]).
-    pub preset: String,
-    /// Grid cells per axis, at least 8; absent: the scene's default.
+    /// [`scenes`]). Absent when the scene has `bodies`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
+    /// Grid cells per axis, 8 to 16384; absent: the preset's default, 64 for bodies.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
     /// Particle-grid transfer, `"mls-mpm"` or `"apic"`; absent: the scene's (MLS-MPM).
@@ -72,9 +105,32 @@ pub struct MpmSceneParams {
     /// (quadratic).
     #[serde(default, skip_serializing_if = "Option::is_none", with = "kernel_name")]
     pub kernel: Option<Kernel>,
-    /// Particles per cell and axis, 1 to 8 (`dam-break-2d` only; absent: 2).
+    /// Particles per cell and axis, 1 to 8 (of the presets, `dam-break-2d` only; absent: 2).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub particles_per_cell: Option<usize>,
+    /// Bodies: dimension of the scene, 2 (shapes in the x-y plane) or 3; absent: 3.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dim: Option<usize>,
+    /// Bodies: gravity (m/s^2; the first `dim` components are used); absent: `(0, -9.81, 0)`,
+    /// the crate's y up.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<[f64; 3]>,
+    /// Bodies: fixed obstacles, anim-core's [`Shape`] spelling: `plane`, `box` and `sphere`
+    /// (a disk in 2D); a capsule is refused. Absent: none (the domain's walls remain).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacles: Vec<Shape>,
+    /// Bodies: the boundary condition on the obstacles ([`Boundary`]): `"sticky"`, `"slip"`,
+    /// `{ separate = { friction = 0.3 } }` or `"separate-frictionless"`; absent:
+    /// separate-frictionless.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub boundary: Option<Boundary>,
+    /// Bodies: the boundary condition on the domain's walls, as `boundary`; absent:
+    /// separate-frictionless.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wall: Option<Boundary>,
+    /// The bodies (`[[scene.bodies]]` tables), each a [`BodySpec`]; the alternative to `preset`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bodies: Vec<BodySpec>,
 }
 
 /// The scene-file names of the [`Kernel`]s, `"quadratic"` and `"cubic"`, for an optional field.
@@ -148,8 +204,40 @@ fn presets() -> Vec<Preset> {
     ]
 }
 
-fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
+fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
     let p: MpmSceneParams = params(value)?;
+    if !p.bodies.is_empty() {
+        if p.preset.is_some() {
+            return Err(BuildError::invalid("preset", "give a `preset` or `[[scene.bodies]]`, not both"));
+        }
+        return Ok(match bodies::build(&p, context)? {
+            MpmScene::Two(s) => {
+                Simulated::new(MpmRun::new(s.sim, &s.state, None).framed_by_walls(), s.state).boxed()
+            }
+            MpmScene::Three(s) => {
+                Simulated::new(MpmRun::new(s.sim, &s.state, None).framed_by_walls(), s.state).boxed()
+            }
+        });
+    }
+    let Some(preset) = p.preset.as_deref() else {
+        return Err(BuildError::invalid(
+            "preset",
+            format!("give a `preset` (one of {}) or `[[scene.bodies]]` tables", scenes::NAMES.join(", ")),
+        ));
+    };
+    let bodies_only = [
+        ("dim", p.dim.is_some()),
+        ("gravity", p.gravity.is_some()),
+        ("obstacles", !p.obstacles.is_empty()),
+        ("boundary", p.boundary.is_some()),
+        ("wall", p.wall.is_some()),
+    ];
+    if let Some((field, _)) = bodies_only.iter().find(|(_, given)| *given) {
+        return Err(BuildError::invalid(
+            *field,
+            format!("applies to `[[scene.bodies]]`; the preset {preset} sets its own"),
+        ));
+    }
     if let Some(k) = p.particles_per_cell {
         if !(1..=8).contains(&k) {
             return Err(BuildError::invalid(
@@ -157,17 +245,17 @@ fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynS
                 format!("must lie in [1, 8] (per axis), got {k}"),
             ));
         }
-        if p.preset != "dam-break-2d" && scenes::NAMES.contains(&p.preset.as_str()) {
+        if preset != "dam-break-2d" && scenes::NAMES.contains(&preset) {
             return Err(BuildError::invalid(
                 "particles_per_cell",
-                format!("{} places its own particles; only dam-break-2d takes particles_per_cell", p.preset),
+                format!("{preset} places its own particles; only dam-break-2d takes particles_per_cell"),
             ));
         }
     }
-    let found = scenes::by_name_with(&p.preset, p.resolution, p.particles_per_cell).ok_or_else(|| {
+    let found = scenes::by_name_with(preset, p.resolution, p.particles_per_cell).ok_or_else(|| {
         BuildError::invalid(
             "preset",
-            format!("unknown preset `{}` (one of {})", p.preset, scenes::NAMES.join(", ")),
+            format!("unknown preset `{preset}` (one of {})", scenes::NAMES.join(", ")),
         )
     })?;
     let mut scene = found.map_err(|e| BuildError::invalid("resolution", e.to_string()))?;
@@ -200,6 +288,9 @@ pub struct MpmRun<const D: usize> {
     front: Option<SurgeFront>,
     /// Particles of the scene when built, for checking checkpoints.
     particles: usize,
+    /// Whether the view frames the domain between its walls (scenes of bodies) instead of the
+    /// initial particles.
+    walls_framed: bool,
 }
 
 impl<const D: usize> MpmRun<D> {
@@ -207,7 +298,16 @@ impl<const D: usize> MpmRun<D> {
     /// tracker where the scene has one.
     #[must_use]
     pub fn new(sim: MpmSimulation<D>, particles: &Particles<D>, front: Option<SurgeFront>) -> Self {
-        Self { sim, front, particles: particles.len() }
+        Self { sim, front, particles: particles.len(), walls_framed: false }
+    }
+
+    /// The same run viewed as a scene of bodies: framing the domain between its walls, where
+    /// all its matter stays, with the bottom wall drawn as the ground when gravity points down
+    /// along -z (see [`View::context`]).
+    #[must_use]
+    pub fn framed_by_walls(mut self) -> Self {
+        self.walls_framed = true;
+        self
     }
 
     /// The simulation.
@@ -342,7 +442,9 @@ impl<const D: usize> View for MpmRun<D> {
 
     /// Particles as discs of half a cell; the tank of the domain's walls, the colliders; the
     /// region of the particles of `state`, widened sideways by a third of its size and extended
-    /// down along -z by its size.
+    /// down along -z by its size. A scene of bodies ([`MpmRun::framed_by_walls`]) frames the
+    /// tank instead; in 3D with gravity mostly along -z only up to the highest apex a particle
+    /// thrown up reaches (plus a cell), with the bottom wall drawn as the ground.
     fn context(&self, state: &Particles<D>) -> Context {
         let params = self.sim.params();
         let cell = params.size / params.resolution as f64;
@@ -352,8 +454,29 @@ impl<const D: usize> View for MpmRun<D> {
         let mut context = Context::default();
         context.point_dim = 3;
         context.point_radius = 0.5 * cell;
-        context.bounds = Some(anim_core::scene::frame_box(&display.points, None, true));
-        context.props.push(tank(params, D));
+        let tank = tank(params, D);
+        let g = params.gravity;
+        let falls_along_z = D == 3 && -g[2] > g[0].abs().max(g[1].abs());
+        context.bounds = Some(match tank {
+            Prop::Tank { lo, mut hi } if self.walls_framed => {
+                if falls_along_z {
+                    // Nothing rises above the highest apex of a particle thrown up.
+                    let apex = display
+                        .points
+                        .chunks_exact(3)
+                        .zip(state.v.chunks_exact(D))
+                        .map(|(x, v)| x[2] + f64::from(v[D - 1].max(0.0)).powi(2) / (-2.0 * g[2]))
+                        .fold(lo[2], f64::max);
+                    hi[2] = hi[2].min(apex + cell);
+                }
+                (lo, hi)
+            }
+            _ => anim_core::scene::frame_box(&display.points, None, true),
+        });
+        if self.walls_framed && falls_along_z {
+            context.props.push(Prop::Ground { height: params.wall_nodes as f64 * params.h() });
+        }
+        context.props.push(tank);
         context.props.extend(params.colliders.iter().filter_map(|c| collider(c.shape, D)));
         context
     }
@@ -467,5 +590,9 @@ fn tolerance_adapter(
     family: &Family,
 ) -> Result<Box<dyn StudyAdapter>, String> {
     let p: MpmSceneParams = params(value).map_err(study::unreadable)?;
-    if p.preset == "dam-break-2d" { Ok(Box::new(DamBreakAdapter)) } else { Err(study::unmapped(family)) }
+    if p.preset.as_deref() == Some("dam-break-2d") {
+        Ok(Box::new(DamBreakAdapter))
+    } else {
+        Err(study::unmapped(family))
+    }
 }

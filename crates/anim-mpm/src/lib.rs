@@ -40,7 +40,10 @@
 //!   (`three-materials`), `dam-break-2d-mpm` (`dam-break-2d`, with its surge front against
 //!   Martin & Moyce as the reference error), `dam-break` (`dam-break-3d`) and `snowball`, built
 //!   from [`kind::MpmSceneParams`] (preset, resolution, transfer, kernel, particles per cell) and
-//!   run as a [`kind::MpmRun`] (checkpoints and frames).
+//!   run as a [`kind::MpmRun`] (checkpoints and frames);
+//! - [`bodies`]: a scene file's own bodies instead of a preset: boxes, spheres and closed OBJ
+//!   surfaces filled with particles, each with its material and velocity, among plane, box and
+//!   sphere obstacles.
 //!
 //! The G2P affine update is `C_p = D_p^-1 sum ...` with `D_p^-1 = 4/dx^2` for the quadratic
 //! kernel (Jiang et al. 2015; Hu et al. 2018), and snow's plastic update is
@@ -112,6 +115,7 @@
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+pub mod bodies;
 pub mod boundary;
 #[cfg(feature = "cases")]
 pub mod cases;
@@ -128,6 +132,8 @@ mod sim;
 mod simd;
 mod transfer;
 
+#[cfg(test)]
+mod bodies_tests;
 #[cfg(test)]
 mod kind_tests;
 #[cfg(test)]

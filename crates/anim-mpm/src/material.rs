@@ -16,10 +16,12 @@ use crate::{Mat, MpmError};
 use anim_material::{FixedCorotated, Hyperelastic, Lame, NeoHookean};
 use serde::{Deserialize, Serialize};
 
-/// The hyperelastic model of an elastic body (both from `anim-material`).
+/// The hyperelastic model of an elastic body (both from `anim-material`); `"fixed-corotated"`
+/// or `"neo-hookean"` in scene files.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum ElasticModel {
-    /// Fixed corotated (Stomakhin et al. 2012), the MPM standard.
+    /// Fixed corotated (Stomakhin et al. 2012), the MPM standard; the default.
     #[default]
     FixedCorotated,
     /// Compressible Neo-Hookean (undefined for `det F <= 0`).
@@ -28,6 +30,7 @@ pub enum ElasticModel {
 
 /// An elastic body (jelly).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Elastic {
     /// Energy model; default fixed corotated.
     pub model: ElasticModel,
@@ -47,6 +50,7 @@ impl Default for Elastic {
 
 /// Snow (Stomakhin et al. 2013).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Snow {
     /// Young's modulus `E_0`; default `1e4`.
     pub young: f64,
@@ -71,6 +75,7 @@ impl Default for Snow {
 /// A weakly compressible fluid with the `J`-based equation of state
 /// `p(J) = K / gamma (J^-gamma - 1)` (bulk modulus `K` at rest for every `gamma`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Fluid {
     /// Bulk modulus `K` (Pa); default `1e4`.
     pub bulk: f64,
@@ -90,6 +95,7 @@ impl Default for Fluid {
 /// Fu, Schroeder, Jiang & Teran, *Drucker-Prager elastoplasticity for sand animation*, SIGGRAPH
 /// 2016): friction angle `phi_F = h0 + (h1 q - h3) exp(-h2 q)` degrees.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Sand {
     /// Young's modulus; default `3.537e5` (Klár et al.).
     pub young: f64,
@@ -108,8 +114,12 @@ impl Default for Sand {
     }
 }
 
-/// A material of the material table.
+/// A material of the material table. In a scene file (a body's `material`) it is spelled by
+/// its kind with its parameters, each defaulting to the value its doc states:
+/// `{ elastic = { young = 2e4, poisson = 0.3 } }`, `{ snow = {} }`,
+/// `{ fluid = { bulk = 1e5 } }`, `{ sand = { density = 1600.0 } }`; an unknown field is refused.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", deny_unknown_fields)]
 pub enum Material {
     /// Elastic body.
     Elastic(Elastic),
@@ -145,7 +155,16 @@ impl Material {
         };
         positive("density", self.density())?;
         let lame = |e: f64, nu: f64| {
-            Lame::<f32>::from_young_poisson(e, nu).map_err(|e| bad("young/poisson", e.to_string()))
+            let l =
+                Lame::<f32>::from_young_poisson(e, nu).map_err(|e| bad("young/poisson", e.to_string()))?;
+            if l.mu.is_finite() && l.lambda.is_finite() {
+                Ok(l)
+            } else {
+                Err(bad(
+                    "young/poisson",
+                    format!("Young's modulus {e} with Poisson's ratio {nu} overflows f32"),
+                ))
+            }
         };
         let mut c = Compiled {
             kind: Kind::Fluid,

@@ -1,4 +1,5 @@
-//! Colliders: a ground plane and spheres, as penalty forces with their Jacobians.
+//! Colliders: planes, spheres, axis-aligned boxes and capsules, as penalty forces with their
+//! Jacobians.
 //!
 //! # Why penalty forces
 //!
@@ -13,7 +14,10 @@
 //! # The force
 //!
 //! For a collider with signed distance `phi(x)` (positive outside) and outward normal
-//! `n(x) = grad phi`, the penetration is `p = max(0, -phi(x))`. While `p > 0` the particle feels
+//! `n(x) = grad phi` ([`Shape::signed_distance`]), and thickness `t` ([`Collider::thickness`],
+//! usually 0), the penetration is `p = max(0, t - phi(x))`. Inside a box `-phi` is the distance
+//! to the nearest face and `n` that face's normal; inside a capsule the distance to its surface
+//! along the line from the nearest axis point. While `p > 0` the particle feels
 //!
 //! ```text
 //! f = e(p) [ n  -  tau_n (n . v) n  -  tau_t (v - (n . v) n) ]
@@ -43,8 +47,12 @@
 //! semi-definite. The exact `K = df/dx = -e'(p) g n^T + e(p) (dg/dn)(dn/dx)` (with
 //! `g = n + (tau_t - tau_n)(n . v) n - tau_t v` the bracket above) has three parts: the normal
 //! stiffness `-e'(p) (1 - tau_n v_n) n n^T`, the friction coupling `e'(p) tau_t v_t n^T` (not
-//! symmetric), and for a sphere of radius `r` the curvature term `e(p) (dg/dn)(I - n n^T) / |x - c|`
-//! (the normal turns as the particle slides; positive). In the default
+//! symmetric), and the curvature term `e(p) (dg/dn)(dn/dx)` where the normal turns as the particle
+//! slides: `dn/dx = (I - n n^T) / |x - c|` in a sphere (and a capsule's end caps, `c` the end,
+//! and beside a box's corner within the thickness, `c` the corner), `(I - n n^T - a a^T) / r`
+//! beside a capsule's axis (`a` the unit axis, `r` the distance to it) and beside a box's edge
+//! within the thickness, zero in a plane and inside a box or beside its faces (its normal is
+//! constant on each face's side of the inner ridges, where it jumps). In the default
 //! [`JacobianMode::Definite`](crate::JacobianMode::Definite) only the normal stiffness is kept,
 //! with `1 - tau_n v_n` clamped at 0: symmetric and negative semi-definite, as conjugate gradients
 //! and Cholesky need, while the force itself is unchanged (Newton converges to the same step, a
@@ -60,12 +68,34 @@
 
 use crate::geom::{MIN_LENGTH, outer};
 use anim_core::glam::{DMat3, DVec3};
+use anim_core::scene::is_default;
 use serde::{Deserialize, Serialize};
 
-/// The geometry of a collider: anim-core's shared [`Shape`],
-/// re-exported here. The penalty contact handles planes and spheres; a box or capsule is refused
-/// when the network is built ([`NetworkBuilder::build`](crate::NetworkBuilder::build)).
+/// The geometry of a collider: anim-core's shared [`Shape`], re-exported here. The penalty
+/// contact handles all four: plane, sphere, axis-aligned box and capsule.
 pub use anim_core::geometry::Shape;
+
+/// How a collider's outward normal turns as a particle moves inside it:
+/// `dn/dx = curvature (I - n n^T - axis axis^T)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Bend {
+    /// `1 / r`: `r` the distance to a sphere's centre, a capsule's axis, or a box's nearest
+    /// edge or corner (outside it, within the thickness); 0 when the normal is constant (a
+    /// plane, a box's inside or beside a face, a particle at the centre or on the axis).
+    curvature: f64,
+    /// The unit axis of a capsule beside its cylindrical part, or of a box's edge; zero
+    /// otherwise.
+    axis: DVec3,
+}
+
+impl Bend {
+    const NONE: Bend = Bend { curvature: 0.0, axis: DVec3::ZERO };
+
+    /// Turning about a point, as in a sphere.
+    fn round(curvature: f64) -> Self {
+        Bend { curvature, axis: DVec3::ZERO }
+    }
+}
 
 /// A rigid, fixed obstacle acting on every particle through a penalty force (see the
 /// [module docs](self)).
@@ -84,6 +114,13 @@ pub struct Collider {
     /// 0 gives the plain penalty `k_c p`.
     #[serde(default)]
     pub smoothing: f64,
+    /// Distance `t` (m, >= 0) outside the shape at which particles are held: the penalty acts on
+    /// `phi - t`, the signed distance to the shape grown by `t` (a plane moved out along its
+    /// normal, a sphere's or capsule's radius plus `t`, a box with its edges and corners rounded
+    /// to radius `t`). A cloth's thickness: its triangles then lie clear of a curved obstacle
+    /// instead of cutting its surface between their vertices. Default 0.
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub thickness: f64,
 }
 
 impl Collider {
@@ -91,7 +128,14 @@ impl Collider {
     /// damping, friction or smoothing (add them with the `with_` methods).
     #[must_use]
     pub fn ground(height: f64, stiffness: f64) -> Self {
-        Self { shape: Shape::ground(height), stiffness, damping: 0.0, friction: 0.0, smoothing: 0.0 }
+        Self {
+            shape: Shape::ground(height),
+            stiffness,
+            damping: 0.0,
+            friction: 0.0,
+            smoothing: 0.0,
+            thickness: 0.0,
+        }
     }
 
     /// A solid sphere with penalty stiffness `stiffness`, no damping, friction or smoothing.
@@ -103,6 +147,7 @@ impl Collider {
             damping: 0.0,
             friction: 0.0,
             smoothing: 0.0,
+            thickness: 0.0,
         }
     }
 
@@ -127,8 +172,15 @@ impl Collider {
         self
     }
 
-    /// Checks the parameters; returns a description of the first problem. Only planes and
-    /// spheres have a penalty force here: a box or capsule is refused, naming the shape.
+    /// Sets the thickness `t` (m) at which particles are held outside the shape.
+    #[must_use]
+    pub fn with_thickness(mut self, t: f64) -> Self {
+        self.thickness = t;
+        self
+    }
+
+    /// Checks the parameters; returns a description of the first problem (a shape's names the
+    /// shape).
     pub(crate) fn check(&self) -> Result<(), String> {
         if !(self.stiffness > 0.0 && self.stiffness.is_finite()) {
             return Err(format!("stiffness must be positive and finite, got {}", self.stiffness));
@@ -142,14 +194,10 @@ impl Collider {
         if !(self.smoothing >= 0.0 && self.smoothing.is_finite()) {
             return Err(format!("smoothing must be non-negative and finite, got {}", self.smoothing));
         }
-        self.shape.check()?;
-        match self.shape {
-            Shape::Plane { .. } | Shape::Sphere { .. } => Ok(()),
-            Shape::Box { .. } | Shape::Capsule { .. } => Err(format!(
-                "a {} collider has no penalty force in a spring network (planes and spheres only)",
-                self.shape.name()
-            )),
+        if !(self.thickness >= 0.0 && self.thickness.is_finite()) {
+            return Err(format!("thickness must be non-negative and finite, got {}", self.thickness));
         }
+        self.shape.check()
     }
 
     /// A copy with a unit plane normal (called once the parameters are checked).
@@ -158,17 +206,19 @@ impl Collider {
         self
     }
 
-    /// Penetration `p > 0`, outward normal and the normal's rate of turn `1 / |x - c|` (0 for a
-    /// plane), or `None` when the particle is outside.
+    /// Penetration `p > 0` of the shape grown by the thickness, outward normal and how the
+    /// normal turns (see [`Bend`]), or `None` when the particle is outside.
     #[inline]
-    pub(crate) fn probe(&self, x: DVec3) -> Option<(f64, DVec3, f64)> {
+    pub(crate) fn probe(&self, x: DVec3) -> Option<(f64, DVec3, Bend)> {
+        let thickness = self.thickness;
         match self.shape {
             Shape::Plane { point, normal } => {
                 let n = DVec3::from_array(normal);
-                let phi = (x - DVec3::from_array(point)).dot(n);
-                (phi < 0.0).then_some((-phi, n, 0.0))
+                let phi = (x - DVec3::from_array(point)).dot(n) - thickness;
+                (phi < 0.0).then_some((-phi, n, Bend::NONE))
             }
             Shape::Sphere { center, radius } => {
+                let radius = radius + thickness;
                 let d = x - DVec3::from_array(center);
                 let r = d.length();
                 if r >= radius {
@@ -176,13 +226,53 @@ impl Collider {
                 }
                 // At the exact centre the normal is undefined: push out along +z.
                 if r > MIN_LENGTH {
-                    Some((radius - r, d / r, 1.0 / r))
+                    Some((radius - r, d / r, Bend::round(1.0 / r)))
                 } else {
-                    Some((radius - r, DVec3::Z, 0.0))
+                    Some((radius - r, DVec3::Z, Bend::NONE))
                 }
             }
-            // Refused by `check` when the network is built, the only way a collider enters one.
-            Shape::Box { .. } | Shape::Capsule { .. } => None,
+            Shape::Box { center, half_extents } => {
+                let (distance, n) = self.shape.signed_distance(x);
+                let phi = distance - thickness;
+                if phi >= 0.0 {
+                    return None;
+                }
+                // Inside, the nearest face's normal: constant. Outside (within the thickness),
+                // beside a face it is constant too, beside an edge it turns about the edge, beside
+                // a corner about the corner.
+                let q = (x - DVec3::from_array(center)).abs() - DVec3::from_array(half_extents);
+                let out = q.cmpgt(DVec3::ZERO);
+                let bend = match (out.bitmask().count_ones(), distance > MIN_LENGTH) {
+                    (2, true) => {
+                        let along = DVec3::select(out, DVec3::ZERO, DVec3::ONE);
+                        Bend { curvature: 1.0 / distance, axis: along }
+                    }
+                    (3, true) => Bend::round(1.0 / distance),
+                    _ => Bend::NONE,
+                };
+                Some((-phi, n, bend))
+            }
+            Shape::Capsule { a, b, radius } => {
+                let (distance, n) = self.shape.signed_distance(x);
+                let phi = distance - thickness;
+                if phi >= 0.0 {
+                    return None;
+                }
+                // The distance to the axis; on it the normal is any perpendicular, fixed.
+                let r = radius + distance;
+                if !(r > MIN_LENGTH) {
+                    return Some((-phi, n, Bend::NONE));
+                }
+                let (a, b) = (DVec3::from_array(a), DVec3::from_array(b));
+                let ab = b - a;
+                let t = (x - a).dot(ab) / ab.length_squared();
+                let bend = if t > 0.0 && t < 1.0 {
+                    Bend { curvature: 1.0 / r, axis: ab.normalize() }
+                } else {
+                    Bend::round(1.0 / r)
+                };
+                Some((-phi, n, bend))
+            }
         }
     }
 
@@ -221,7 +311,7 @@ impl Collider {
     /// Adds the Jacobians `df/dx` (definite or exact) and `df/dv` at `(x, v)` to `k` and `d`.
     #[inline]
     pub(crate) fn jacobians(&self, x: DVec3, v: DVec3, exact: bool, k: &mut DMat3, d: &mut DMat3) {
-        let Some((p, n, curvature)) = self.probe(x) else {
+        let Some((p, n, bend)) = self.probe(x) else {
             return;
         };
         let (phi, dphi, _) = self.elastic(p);
@@ -240,9 +330,14 @@ impl Collider {
         // df/dx = -phi' g n^T + phi (dg/dn) (dn/dx), dn/dx = curvature (I - n n^T).
         let g = n + (tt - tn) * vn * n - tt * v;
         *k -= dphi * outer(g, n);
-        if curvature > 0.0 {
+        if bend.curvature > 0.0 {
             let dg_dn = DMat3::IDENTITY + (tt - tn) * (vn * DMat3::IDENTITY + outer(n, v));
-            *k += (phi * curvature) * (dg_dn * proj);
+            // dn/dx = curvature (I - n n^T - a a^T); a = 0 but beside a capsule's axis.
+            let turn = if bend.axis == DVec3::ZERO { proj } else { proj - outer(bend.axis, bend.axis) };
+            *k += (phi * bend.curvature) * (dg_dn * turn);
         }
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -8,12 +8,19 @@
 //! | `rope` | [`swinging_rope`](crate::scenes::swinging_rope), velocity Verlet | 120 frames of 40 steps of 0.5 ms |
 //! | `jelly` | [`jelly_drop`](crate::scenes::jelly_drop), backward Euler + sparse Cholesky | 120 frames of 2 steps of 5 ms |
 //!
-//! A scene file's `[scene]` table (`kind = "springs"`) holds the fields of [`SpringsParams`].
-//! The scene is a [`SpringSimulation`] with its [`State`]: it implements
+//! A scene file's `[scene]` table (`kind = "springs"`) holds the fields of [`SpringsParams`]:
+//! a `preset`, or `[[scene.bodies]]` tables ([`BodySpec`]), cloth and shells of the user's own
+//! from OBJ triangle surfaces, each with its material (area density, edge and bending springs),
+//! placement, initial velocity and pinned vertices, among scene-wide `obstacles` (planes,
+//! spheres, boxes and capsules: anim-core's [`Shape`]) with their `contact`, under `gravity`.
+//! Bodies do not collide with each other. The scene is a [`SpringSimulation`] with its [`State`]: it implements
 //! [`Checkpoint`] (the state and the simulation's memory, the integrator's included) and
 //! [`View`] (the particles and their velocities; springs as lines, cloth triangles, pinned
-//! particles, the ground and sphere colliders).
+//! particles, the ground and the sphere, box and capsule colliders).
 
+use crate::EARTH_GRAVITY;
+use crate::body::{BodySpec, ContactSpec, build_bodies};
+use crate::contact::Shape;
 use crate::scenes;
 use crate::sim::SpringSimulation;
 use anim_core::integrate::{IntegratorKind, State};
@@ -38,23 +45,43 @@ pub const KIND: SceneKind = SceneKind {
 };
 
 /// Scene-file parameters of a `springs` scene: a preset of [`scenes`] with its own integrator
-/// and linear solver unless overridden.
+/// and linear solver unless overridden, or bodies of the user's own ([`BodySpec`]) among
+/// obstacles. Give `preset` or `bodies`, not both.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpringsParams {
     /// The preset's name: `hanging-cloth`, `swinging-rope`, `jelly-drop` or `benchmark-cloth`
-    /// ([`scenes::NAMES`]). Required.
-    pub preset: String,
-    /// Particles per side (the preset's default when absent: 32 for the cloth, 40 for the rope,
-    /// 6 for the jelly, 128 for the benchmark cloth); at least 2 (3 for the rope), at most 4096.
+    /// ([`scenes::NAMES`]); give this or `bodies`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
+    /// Particles per side of a preset (the preset's default when absent: 32 for the cloth, 40
+    /// for the rope, 6 for the jelly, 128 for the benchmark cloth); at least 2 (3 for the
+    /// rope), at most 4096. Not with `bodies` (a body's resolution is its mesh's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
-    /// Integrator override (the preset's when absent); a beta-blend's `beta` in `[0, 1]`.
+    /// Integrator override (the preset's when absent; backward Euler for bodies); a
+    /// beta-blend's `beta` in `[0, 1]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub integrator: Option<IntegratorKind>,
-    /// Linear solver override for implicit integrators (the preset's when absent).
+    /// Linear solver override for implicit integrators (the preset's when absent; sparse
+    /// Cholesky for bodies).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub linear_solver: Option<LinearSolverKind>,
+    /// Cloth and shells from OBJ triangle surfaces ([`BodySpec`], `[[scene.bodies]]` tables);
+    /// give this or `preset`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bodies: Vec<BodySpec>,
+    /// With `bodies`: the obstacles every body collides with, anim-core's [`Shape`] (`plane`,
+    /// `sphere`, `box`, `capsule`); default none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacles: Vec<Shape>,
+    /// With `bodies`: gravity (m/s²); default `[0, 0, -9.81]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<[f64; 3]>,
+    /// With `bodies`: the penalty contact against the obstacles ([`ContactSpec`]); default
+    /// its defaults.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact: Option<ContactSpec>,
 }
 
 fn presets() -> Vec<Preset> {
@@ -84,18 +111,52 @@ fn presets() -> Vec<Preset> {
 }
 
 /// Builds a `springs` scene from its parameters ([`SpringsParams`]).
-fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
+fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
     let p: SpringsParams = params(value)?;
     if let Some(integrator) = &p.integrator {
         integrator.validate().map_err(|m| BuildError::invalid("integrator", m))?;
     }
-    let mut scene = match scenes::by_name(&p.preset, p.resolution) {
-        Some(Ok(scene)) => scene,
-        Some(Err(e)) => return Err(BuildError::invalid("resolution", e.to_string())),
-        None => {
+    let mut scene = match (&p.preset, p.bodies.is_empty()) {
+        (Some(name), true) => {
+            for (field, given) in [
+                ("obstacles", !p.obstacles.is_empty()),
+                ("gravity", p.gravity.is_some()),
+                ("contact", p.contact.is_some()),
+            ] {
+                if given {
+                    return Err(BuildError::invalid(
+                        field,
+                        format!("only with `bodies`: the preset `{name}` has its own"),
+                    ));
+                }
+            }
+            preset_scene(name, p.resolution)?
+        }
+        (None, false) => {
+            if p.resolution.is_some() {
+                return Err(BuildError::invalid(
+                    "resolution",
+                    "a preset's field: a body's resolution is its mesh's",
+                ));
+            }
+            build_bodies(
+                &p.bodies,
+                &p.obstacles,
+                p.gravity.unwrap_or(EARTH_GRAVITY),
+                &p.contact.unwrap_or_default(),
+                |mesh| context.resolve(mesh),
+            )?
+        }
+        (Some(_), false) => {
+            return Err(BuildError::invalid("bodies", "give a built-in `preset` or `bodies`, not both"));
+        }
+        (None, true) => {
             return Err(BuildError::invalid(
                 "preset",
-                format!("unknown preset `{}` (one of {})", p.preset, scenes::NAMES.join(", ")),
+                format!(
+                    "give a built-in `preset` (one of {}) or `[[scene.bodies]]`",
+                    scenes::NAMES.join(", ")
+                ),
             ));
         }
     };
@@ -108,6 +169,18 @@ fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynS
     let (sim, state) =
         scene.into_simulation().map_err(|e| BuildError::invalid("integrator", e.to_string()))?;
     Ok(Simulated::new(sim, state).boxed())
+}
+
+/// The preset `name` at `resolution`.
+fn preset_scene(name: &str, resolution: Option<usize>) -> Result<scenes::SpringScene, BuildError> {
+    match scenes::by_name(name, resolution) {
+        Some(Ok(scene)) => Ok(scene),
+        Some(Err(e)) => Err(BuildError::invalid("resolution", e.to_string())),
+        None => Err(BuildError::invalid(
+            "preset",
+            format!("unknown preset `{name}` (one of {})", scenes::NAMES.join(", ")),
+        )),
+    }
 }
 
 impl Checkpoint for SpringSimulation {
@@ -215,8 +288,9 @@ fn tolerance_adapter(
     family: &Family,
 ) -> Result<Box<dyn StudyAdapter>, String> {
     let p: SpringsParams = params(value).map_err(study::unreadable)?;
-    let scene = scenes::by_name(&p.preset, p.resolution)
-        .ok_or_else(|| format!("--tolerance: unknown springs preset `{}`", p.preset))?
+    let preset = p.preset.ok_or("--tolerance: a springs scene of bodies has no study, only the presets")?;
+    let scene = scenes::by_name(&preset, p.resolution)
+        .ok_or_else(|| format!("--tolerance: unknown springs preset `{preset}`"))?
         .map_err(study::unreadable)?;
     let net = &scene.network;
     let k = net.springs().iter().map(|s| s.stiffness).fold(0.0, f64::max);
@@ -474,7 +548,21 @@ mod tests {
         let msg = build_err(&serde_json::json!({ "preset": "hanging-cloth", "resolutoin": 8 }));
         assert!(msg.contains("unknown field `resolutoin`"), "{msg}");
         let msg = build_err(&serde_json::json!({ "resolution": 8 }));
-        assert!(msg.contains("missing field `preset`"), "{msg}");
+        assert_eq!(
+            msg,
+            "field `preset`: give a built-in `preset` (one of hanging-cloth, swinging-rope, jelly-drop, benchmark-cloth) or `[[scene.bodies]]`"
+        );
+        for (field, value) in [
+            ("obstacles", serde_json::json!([{ "sphere": { "center": [0, 0, 0], "radius": 1 } }])),
+            ("gravity", serde_json::json!([0, 0, -1])),
+            ("contact", serde_json::json!({ "stiffness": 1.0 })),
+        ] {
+            let msg = build_err(&serde_json::json!({ "preset": "hanging-cloth", field: value }));
+            assert_eq!(
+                msg,
+                format!("field `{field}`: only with `bodies`: the preset `hanging-cloth` has its own")
+            );
+        }
         let msg = build_err(&serde_json::json!({ "preset": "flying-carpet" }));
         assert_eq!(
             msg,

@@ -16,8 +16,8 @@
 //!   ```
 //!
 //!   (Hooke's law, `f_i = sum_{j != i} f_ij`, `dv_i/dt = f_i / m_i`, `dx_i/dt = v_i`).
-//! - **Gravity** and **colliders** (a ground plane, spheres) as penalty forces with friction
-//!   ([`contact`]).
+//! - **Gravity** and **colliders** (planes, spheres, axis-aligned boxes, capsules) as penalty
+//!   forces with friction ([`contact`]).
 //! - **Builders** ([`NetworkBuilder`]): a chain, a cloth grid with structural, shear and bending
 //!   springs, a 3-D lattice with face and body diagonals, any triangle mesh (an edge spring per
 //!   unique edge, optional bending springs across interior edges; [`TriangleMesh::from_obj`]
@@ -26,7 +26,8 @@
 //!   ground, and the benchmark cloth, each with its suggested integrator, solver and step.
 //! - **Scene kind** ([`KIND`], kind `springs`): the scenes behind anim-core's scene contracts
 //!   ([`anim_core::scene`]), with the presets `cloth` (the 32 x 32 hanging cloth), `rope` (the
-//!   swinging rope) and `jelly` (the jelly drop) that the `anim` command line runs;
+//!   swinging rope) and `jelly` (the jelly drop) that the `anim` command line runs, and scene
+//!   files of the user's own cloth and shells from OBJ surfaces among obstacles ([`body`]);
 //!   [`SpringSimulation`] is a checkpointable, viewable solver ([`kind`]).
 //!
 //! [`SpringNetwork`] implements anim-core's [`SecondOrderSystem`](anim_core::integrate::SecondOrderSystem)
@@ -127,6 +128,7 @@
 //! the benchmark shows the force evaluation is memory-bound, so `f32` would gain little.
 
 pub mod analytic;
+pub mod body;
 mod build;
 #[cfg(feature = "cases")]
 pub mod cases;

@@ -738,10 +738,10 @@ fn builder_errors_name_the_element() {
         ..Collider::ground(0.0, 1.0)
     });
     assert!(matches!(b.build().unwrap_err(), BuildError::Input(InputError::BadCollider { collider: 0, .. })));
-    // Boxes and capsules have no penalty force here: refused, naming the collider and the shape.
+    // A bad box or capsule is refused, naming the collider and the shape.
     for (shape, name) in [
-        (Shape::Box { center: [0.0; 3], half_extents: [1.0; 3] }, "box"),
-        (Shape::Capsule { a: [0.0; 3], b: [0.0, 0.0, 1.0], radius: 0.5 }, "capsule"),
+        (Shape::Box { center: [0.0; 3], half_extents: [1.0, 0.0, 1.0] }, "box"),
+        (Shape::Capsule { a: [0.0; 3], b: [0.0; 3], radius: 0.5 }, "capsule"),
     ] {
         let mut b = two();
         b.collider(Collider::ground(-1.0, 1.0));
@@ -749,7 +749,7 @@ fn builder_errors_name_the_element() {
         let err = b.build().unwrap_err();
         assert!(matches!(err, BuildError::Input(InputError::BadCollider { collider: 1, .. })), "{err:?}");
         let message = err.to_string();
-        assert!(message.starts_with("collider 1: a ") && message.contains(name), "{message}");
+        assert!(message.starts_with("collider 1: ") && message.contains(name), "{message}");
     }
 
     // Shapes.

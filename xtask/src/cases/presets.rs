@@ -84,9 +84,19 @@ fn check(kind: &SceneKind, case: String, metric: &str, measured: f64) -> Check {
 }
 
 fn contracts(kind: &'static SceneKind, preset: &Preset, ctx: &Ctx) -> Vec<Check> {
-    let params = preset.params_for(ctx.quick);
-    let (name, dt) = (preset.name, preset.run.dt);
-    let build = || (kind.build)(params, &BuildContext::default()).map_err(|e| e.to_string());
+    scene_contracts(kind, preset.name, preset.params_for(ctx.quick), &BuildContext::default(), preset.run.dt)
+}
+
+/// The contracts of the scene `kind` builds from `params` (file names relative to `context`),
+/// stepped by `dt`; `name` names it in the checks.
+pub(crate) fn scene_contracts(
+    kind: &'static SceneKind,
+    name: &str,
+    params: &serde_json::Value,
+    context: &BuildContext<'_>,
+    dt: f64,
+) -> Vec<Check> {
+    let build = || (kind.build)(params, context).map_err(|e| e.to_string());
     let run = |steps: usize| -> Result<Vec<f64>, String> {
         let mut scene = build()?;
         for _ in 0..steps {

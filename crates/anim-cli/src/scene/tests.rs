@@ -137,3 +137,41 @@ fn system_names_kind_and_preset() {
     assert_eq!(builtin("cloth").unwrap().scene.system(), "springs/hanging-cloth");
     assert_eq!(builtin("kepler").unwrap().scene.system(), "kepler-orbit");
 }
+
+/// A kind's refusal of a field is placed on the field's line: in `[scene]`, in its own
+/// `[scene.KEY]` table, or in the `[[scene.KEY]]` table of its index, never in a later table.
+#[test]
+fn refused_fields_are_found_in_their_table_and_body() {
+    let text = r#"name = "s"
+[run]
+dt = 0.01
+frames = 2
+[scene]
+kind = "fem"
+obstacles = [
+    { plane = { point = [0, 0, 0], normal = [0, 0, 1] } },
+]
+[scene.robot]
+urdf = "a.urdf"
+q0 = { j = 1.0 }
+[[scene.bodies]]
+mesh = "a.msh"
+material = { young = 1e5, poisson = 0.3, density = 1000.0 }
+[[scene.bodies]]
+material = { young = 1e5, poisson = 0.3, density = 1000.0 }
+mesh = "b.msh"
+[[scene.bodies]]
+mesh = "c.msh"
+"#;
+    let line = |field: &str| locate(text, field).map(|at| line_col(text, at).0);
+    assert_eq!(line("obstacles[0]"), Some(7));
+    assert_eq!(line("robot.q0"), Some(12));
+    assert_eq!(line("robot"), Some(10));
+    assert_eq!(line("bodies[0].mesh"), Some(14));
+    assert_eq!(line("bodies[1].mesh"), Some(18));
+    assert_eq!(line("bodies[1].material.young"), Some(17));
+    // A field the body does not write: its table's header.
+    assert_eq!(line("bodies[2].material"), Some(19));
+    assert_eq!(line("bodies[3].mesh"), None);
+    assert_eq!(line("gravity"), None);
+}

@@ -56,7 +56,7 @@ fn the_presets_are_the_command_lines_scenes_and_their_params_round_trip() {
     for p in &presets {
         for value in [Some(&p.params), p.quick_params.as_ref()].into_iter().flatten() {
             let read: FluidSceneParams = params(value).expect("parameters");
-            assert_eq!(read.preset, p.name);
+            assert_eq!(read.preset.as_deref(), Some(p.name));
             assert_eq!(&serde_json::to_value(&read).expect("json"), value, "{}", p.name);
         }
     }

@@ -12,11 +12,13 @@
 //!   component.
 //! - **Sources** ([`Source`]): inflow boxes that raise the density to theirs, set the
 //!   temperature and optionally the velocity of the cells and faces inside (wall and obstacle
-//!   faces excepted).
+//!   faces excepted). A [`RegionSource`] does the same over cells and faces of any shape, given
+//!   as masks (a sphere's, a mesh's), solid cells excepted; region sources act after the boxes.
 //!
 //! Each force pass writes one row of faces or cells per task from the previous arrays only, so
 //! the result does not depend on the number of threads.
 
+use crate::error::FluidError;
 use crate::mac::grid::{MacGrid, idx};
 use rayon::prelude::*;
 
@@ -34,6 +36,58 @@ pub struct Source {
     pub temperature: f64,
     /// Velocity set on the faces inside, or `None` to leave it.
     pub velocity: Option<[f64; 3]>,
+}
+
+/// An inflow region of any shape, given as masks of the cells and faces whose centres lie
+/// inside it: every step, the density of its cells is raised to `density`, their temperature
+/// set to `temperature` and, when `velocity` is given, the velocity of its faces set to it.
+/// Solid (obstacle) cells and wall and obstacle faces are left alone.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RegionSource {
+    /// Per cell (x fastest, the layout of the cell fields), whether its centre lies inside.
+    pub cells: Vec<bool>,
+    /// Per velocity component `a`, whether each face centre of its lattice
+    /// ([`MacFluid::face_dims`](crate::mac::MacFluid::face_dims)) lies inside; empty for `w` in
+    /// 2D.
+    pub faces: [Vec<bool>; 3],
+    /// Density the cells are raised to.
+    pub density: f64,
+    /// Temperature the cells are set to.
+    pub temperature: f64,
+    /// Velocity set on the faces inside, or `None` to leave it.
+    pub velocity: Option<[f64; 3]>,
+}
+
+impl RegionSource {
+    /// Checks the masks' lengths against `grid` and that the values are finite.
+    pub(super) fn check(&self, grid: &MacGrid) -> Result<(), FluidError> {
+        let cells = grid.cells();
+        if self.cells.len() != cells {
+            return Err(FluidError::BadLength {
+                name: "source cells",
+                got: self.cells.len(),
+                expected: cells,
+            });
+        }
+        for (a, name) in ["source u faces", "source v faces", "source w faces"].into_iter().enumerate() {
+            let expected = grid.face_len(a);
+            if self.faces[a].len() != expected {
+                return Err(FluidError::BadLength { name, got: self.faces[a].len(), expected });
+            }
+        }
+        let scalars = [self.density, self.temperature];
+        if scalars.iter().chain(self.velocity.iter().flatten()).any(|x| !x.is_finite()) {
+            return Err(FluidError::BadParameter {
+                name: "sources",
+                requirement: "must be finite",
+                value: format!(
+                    "density {}, temperature {}, velocity {:?}",
+                    self.density, self.temperature, self.velocity
+                ),
+            });
+        }
+        Ok(())
+    }
 }
 
 /// Buoyancy `v += dt (-alpha rho + beta (T - amb))` on the interior faces of `vy`, the y
@@ -213,6 +267,34 @@ pub(super) fn apply_sources(
                                 vel[a][idx(fd, i, j, k)] = v[a];
                             }
                         }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Applies the region sources, in order: density and temperature on their fluid cells, velocity
+/// on their free faces.
+pub(super) fn apply_region_sources(
+    grid: &MacGrid,
+    sources: &[RegionSource],
+    vel: &mut [Vec<f64>; 3],
+    density: &mut [f64],
+    temperature: &mut [f64],
+) {
+    for s in sources {
+        for (c, _) in s.cells.iter().enumerate().filter(|&(c, &inside)| inside && !grid.solid[c]) {
+            density[c] = density[c].max(s.density);
+            temperature[c] = s.temperature;
+        }
+        if let Some(v) = s.velocity {
+            for a in 0..grid.dim {
+                let fd = grid.face_dims(a);
+                for (f, _) in s.faces[a].iter().enumerate().filter(|&(_, &inside)| inside) {
+                    let (i, j, k) = (f % fd[0], (f / fd[0]) % fd[1], f / (fd[0] * fd[1]));
+                    if !grid.face_fixed(a, i, j, k) {
+                        vel[a][f] = v[a];
                     }
                 }
             }

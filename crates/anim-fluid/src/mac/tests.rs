@@ -161,3 +161,58 @@ fn projection_leaves_divergence_below_tolerance_with_an_obstacle() {
         );
     }
 }
+
+/// A region source raises the density of its fluid cells (never lowers it), sets their
+/// temperature and the velocity of its free faces; solid cells and wall and obstacle faces keep
+/// their values. A bad mask or value is refused.
+#[test]
+fn a_region_source_acts_on_its_fluid_cells_and_free_faces() {
+    let (dims, h) = ([6, 5, 4], 0.25);
+    let (mut fluid, mut state) = MacFluid::new(dims, 3, h, MacParams::default()).unwrap();
+    // Solid: the cells with i = 3.
+    let solid: Vec<bool> = (0..120).map(|c| c % 6 == 3).collect();
+    fluid.set_solid_cells(&solid).unwrap();
+    assert_eq!(fluid.solid(), &solid[..]);
+    // The region: every cell with j <= 1 and every face with j <= 1.
+    let cells: Vec<bool> = (0..120).map(|c| (c / 6) % 5 <= 1).collect();
+    let faces: [Vec<bool>; 3] = std::array::from_fn(|a| {
+        let d = fluid.face_dims(a);
+        (0..d.iter().product()).map(|f| (f / d[0]) % d[1] <= 1).collect()
+    });
+    let v = [0.25, -0.5, 0.75];
+    let source = RegionSource { cells, faces, density: 0.6, temperature: 2.0, velocity: Some(v) };
+    let mut bad = source.clone();
+    bad.cells.pop();
+    assert!(matches!(fluid.add_region_source(bad), Err(FluidError::BadLength { .. })));
+    let mut bad = source.clone();
+    bad.velocity = Some([0.0, f64::NAN, 0.0]);
+    assert!(matches!(fluid.add_region_source(bad), Err(FluidError::BadParameter { .. })));
+    fluid.add_region_source(source.clone()).unwrap();
+    state.density.fill(0.3);
+    state.density[6 * 5 * 2 + 6] = 0.9; // cell (0, 1, 2): above the source's density
+    fluid.apply_sources(&mut state);
+    for c in 0..120 {
+        let (i, j) = (c % 6, (c / 6) % 5);
+        let expected = match (j <= 1, i == 3) {
+            (true, false) if c == 66 => (0.9, 2.0),
+            (true, false) => (0.6, 2.0),
+            _ => (0.3, 0.0),
+        };
+        assert_eq!((state.density[c], state.temperature[c]), expected, "cell {c}");
+    }
+    for a in 0..3 {
+        let d = fluid.face_dims(a);
+        for f in 0..d.iter().product::<usize>() {
+            let (i, j, k) = (f % d[0], (f / d[0]) % d[1], f / (d[0] * d[1]));
+            let n = [i, j, k];
+            let wall = n[a] == 0 || n[a] == dims[a];
+            let obstacle = !wall && {
+                let stride = [1, 6, 30][a];
+                let hi = idx(dims, i, j, k);
+                solid[hi] || solid[hi - stride]
+            };
+            let expected = if j <= 1 && !wall && !obstacle { v[a] } else { 0.0 };
+            assert_eq!(state.vel[a][f], expected, "component {a} face ({i}, {j}, {k})");
+        }
+    }
+}

@@ -1,0 +1,176 @@
+//! The region of a source or an obstacle, and which cell and face centres lie inside it: a
+//! collider shape tested analytically, or a closed OBJ surface tested by its generalized winding
+//! number ([`ClosedSurface::contains`]).
+
+use std::path::Path;
+
+use anim_core::surface::ClosedSurface;
+use anim_core::geometry::Shape;
+use anim_core::scene::{BuildContext, BuildError, Placement};
+use anim_io::obj::{Polygons, read_obj};
+use rayon::prelude::*;
+
+use crate::mac::MacFluid;
+
+/// A region of space (see the [module](self)).
+#[derive(Debug, Clone)]
+pub(super) enum Region {
+    /// A checked collider shape, read in the first `dim` components.
+    Shape { shape: Shape, dim: usize },
+    /// A closed surface, placed.
+    Surface(Box<ClosedSurface>),
+}
+
+impl Region {
+    /// The region of `shape` in a `dim`-dimensional scene, checked.
+    ///
+    /// # Errors
+    /// The shape's problem ([`Shape::check_in`]).
+    pub(super) fn shape(shape: Shape, dim: usize) -> Result<Self, String> {
+        shape.check_in(dim)?;
+        Ok(Region::Shape { shape, dim })
+    }
+
+    /// The closed surface of the OBJ file `mesh` (relative to the scene file), placed by
+    /// `placement`.
+    ///
+    /// # Errors
+    /// [`BuildError::Invalid`] naming `field.scale` (`rotate`, `translate`) for a bad placement
+    /// and `field.mesh` for a file that cannot be read or is not a closed surface (the message
+    /// names the file and the line, triangle, edge or vertex).
+    pub(super) fn mesh(
+        mesh: &Path,
+        placement: Placement,
+        context: &BuildContext<'_>,
+        field: &str,
+    ) -> Result<Self, BuildError> {
+        placement.check().map_err(|e| match e {
+            BuildError::Invalid { field: f, message } => BuildError::invalid(format!("{field}.{f}"), message),
+            other => other,
+        })?;
+        let path = context.resolve(mesh);
+        let obj = read_obj(&path, Polygons::Triangulate)
+            .map_err(|e| BuildError::invalid(format!("{field}.mesh"), e.to_string()))?;
+        let mut positions = obj.positions;
+        placement.apply_all(&mut positions);
+        let surface = ClosedSurface::new(positions, obj.triangles).map_err(|e| {
+            BuildError::invalid(
+                format!("{field}.mesh"),
+                format!(
+                    "{}: {e} (triangles and vertices counted from 0, in file order, polygons split into \
+                     triangles)",
+                    path.display()
+                ),
+            )
+        })?;
+        Ok(Region::Surface(Box::new(surface)))
+    }
+
+    /// Whether `p` lies inside: strictly inside a shape, or inside the surface by its winding
+    /// number.
+    pub(super) fn covers(&self, p: [f64; 3]) -> bool {
+        match self {
+            Region::Shape { shape, dim } => shape_covers(shape, p, *dim),
+            Region::Surface(surface) => surface.contains(p),
+        }
+    }
+
+    /// Per cell of `fluid` (x fastest), whether its centre lies inside.
+    pub(super) fn cell_mask(&self, fluid: &MacFluid) -> Vec<bool> {
+        let d = fluid.dims();
+        self.mask(d, |i, j, k| fluid.cell_centre(i, j, k))
+    }
+
+    /// Per velocity component of `fluid`, whether each face centre lies inside (empty for `w`
+    /// in 2D).
+    pub(super) fn face_masks(&self, fluid: &MacFluid) -> [Vec<bool>; 3] {
+        std::array::from_fn(|a| {
+            if a < fluid.dim() {
+                self.mask(fluid.face_dims(a), |i, j, k| fluid.face_centre(a, i, j, k))
+            } else {
+                Vec::new()
+            }
+        })
+    }
+
+    /// Whether `at(i, j, k)` lies inside, over a lattice of `d` (x fastest); meshes in parallel
+    /// (each point on its own, so the result does not depend on the thread count).
+    fn mask(&self, d: [usize; 3], at: impl Fn(usize, usize, usize) -> [f64; 3] + Sync) -> Vec<bool> {
+        let point = |c: usize| at(c % d[0], (c / d[0]) % d[1], c / (d[0] * d[1]));
+        let n = d[0] * d[1] * d[2];
+        match self {
+            Region::Shape { .. } => (0..n).map(|c| self.covers(point(c))).collect(),
+            Region::Surface(_) => (0..n).into_par_iter().map(|c| self.covers(point(c))).collect(),
+        }
+    }
+
+    /// Why a region that covers no cell centre of the `dim`-dimensional domain `[lo, hi]`
+    /// misses it: it lies outside the domain (or, in 2D, a mesh does not cross `z = 0`), or it
+    /// falls between the cell centres of `grid` (a description of the grid).
+    pub(super) fn misses(&self, (lo, hi): ([f64; 3], [f64; 3]), dim: usize, grid: &str) -> String {
+        let domain: Vec<String> = (0..dim).map(|a| format!("[{}, {}]", lo[a], hi[a])).collect();
+        let domain = domain.join(" x ");
+        match self.bounds() {
+            Some((a, b)) if (0..dim).any(|k| b[k] < lo[k] || a[k] > hi[k]) => {
+                let at: Vec<String> = (0..dim).map(|k| format!("[{:.4}, {:.4}]", a[k], b[k])).collect();
+                format!(
+                    "lies outside the domain {domain} (m, the grid's axes, y up): it spans {}",
+                    at.join(" x ")
+                )
+            }
+            Some((a, b)) if dim == 2 && matches!(self, Region::Surface(_)) && (a[2] > 0.0 || b[2] < 0.0) => {
+                format!("a 2D scene cuts meshes at z = 0, and this one spans z in [{:.4}, {:.4}]", a[2], b[2])
+            }
+            _ => format!(
+                "covers no cell centre of the {grid} in the domain {domain} (m, y up): it falls between \
+                 cell centres; make it larger or raise `resolution`"
+            ),
+        }
+    }
+
+    /// The region's bounding box, if it has one (a plane's half-space has none).
+    fn bounds(&self) -> Option<([f64; 3], [f64; 3])> {
+        match self {
+            Region::Surface(s) => Some(s.bounds()),
+            Region::Shape { shape, .. } => match *shape {
+                Shape::Plane { .. } => None,
+                Shape::Sphere { center, radius } => {
+                    Some((center.map(|c| c - radius), center.map(|c| c + radius)))
+                }
+                Shape::Box { center, half_extents } => Some((
+                    std::array::from_fn(|a| center[a] - half_extents[a]),
+                    std::array::from_fn(|a| center[a] + half_extents[a]),
+                )),
+                Shape::Capsule { a, b, radius } => Some((
+                    std::array::from_fn(|k| a[k].min(b[k]) - radius),
+                    std::array::from_fn(|k| a[k].max(b[k]) + radius),
+                )),
+            },
+        }
+    }
+}
+
+/// Whether `p` lies strictly inside `shape`, reading the first `dim` components of every vector
+/// (in 2D a sphere is a disk, a capsule a stadium, a box a rectangle).
+pub(super) fn shape_covers(shape: &Shape, p: [f64; 3], dim: usize) -> bool {
+    let sub = |x: [f64; 3], y: [f64; 3]| -> [f64; 3] {
+        std::array::from_fn(|a| if a < dim { x[a] - y[a] } else { 0.0 })
+    };
+    let dot = |x: [f64; 3], y: [f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+    match *shape {
+        Shape::Plane { point, normal } => dot(sub(p, point), sub(normal, [0.0; 3])) < 0.0,
+        // The plume preset's expression, term for term, so that a sphere obstacle marks the same
+        // cells as the preset's sphere.
+        Shape::Sphere { center: [cx, cy, cz], radius: r } => {
+            let dz2 = if dim == 3 { (p[2] - cz).powi(2) } else { 0.0 };
+            (p[0] - cx).powi(2) + (p[1] - cy).powi(2) + dz2 < r * r
+        }
+        Shape::Box { center, half_extents } => (0..dim).all(|a| (p[a] - center[a]).abs() < half_extents[a]),
+        Shape::Capsule { a, b, radius } => {
+            let (ab, ap) = (sub(b, a), sub(p, a));
+            let t = (dot(ap, ab) / dot(ab, ab)).clamp(0.0, 1.0);
+            let d: [f64; 3] = std::array::from_fn(|k| ap[k] - t * ab[k]);
+            dot(d, d) < radius * radius
+        }
+    }
+}
