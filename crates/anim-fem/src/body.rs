@@ -1,7 +1,9 @@
 //! A body of the user's own: a tetrahedral mesh file (Gmsh 2.2 or 4.1 `.msh`, TetGen
-//! `.node`/`.ele`) with its material, its placement (scale, rotation, translation), initial
-//! velocity, pinned region, gravity and the obstacles around it. [`BodySpec`] is also the `body`
-//! table of an `fem` scene file (see [`crate::kind`]).
+//! `.node`/`.ele`) or a closed triangle surface (`.obj`, filled with tetrahedra) with its
+//! material, its placement (scale, rotation, translation), initial velocity and pinned region.
+//! [`BodySpec`] is one entry of the `bodies` list of an `fem` scene file (see [`crate::kind`]);
+//! [`crate::bodies`] merges several into one model with the obstacles, gravity and damping they
+//! share.
 //!
 //! ```
 //! use anim_fem::body::BodySpec;
@@ -11,30 +13,24 @@
 //!     "mesh": "cube_v41.msh",
 //!     "material": { "young": 5e4, "poisson": 0.3, "density": 1000.0 },
 //!     "translate": [0.0, 0.0, 0.5],
-//!     "obstacles": [ { "plane": { "point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0] } } ],
 //! }))?;
-//! let scene = spec.build(&dir.join(&spec.mesh), Default::default())?;
-//! assert!(scene.model.mesh().positions.iter().all(|p| p[2] >= 0.5 - 1e-12));
+//! let body = spec.load(&dir.join(&spec.mesh))?;
+//! assert!(body.mesh.positions.iter().all(|p| p[2] >= 0.5 - 1e-12));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Units are SI: metres, kilograms, seconds, pascals. Scenes are z-up; gravity defaults to
-//! `(0, 0, -9.81)`.
+//! Units are SI: metres, kilograms, seconds, pascals. Scenes are z-up.
 
 use std::path::{Path, PathBuf};
 
-use anim_core::glam::{DMat3, DVec3, EulerRot};
-use anim_core::scene::is_default;
+use anim_core::scene::{BuildError, Placement, is_default};
 use serde::{Deserialize, Serialize};
 
-use crate::boundary::Obstacle;
 use crate::error::FemError;
 use crate::material::{Material, MaterialModel};
-use crate::mesh::{TetMesh, read_gmsh, read_tetgen};
-use crate::model::{EARTH_GRAVITY, ElementOrder, FemModel};
-use crate::scenes::FemScene;
-use crate::sim::FemParams;
-use anim_core::integrate::State;
+use crate::mesh::{TetMesh, read_gmsh, read_tetgen, validate};
+
+mod obj;
 
 /// The material of a body.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -55,8 +51,8 @@ fn default_model() -> MaterialModel {
     MaterialModel::StableNeoHookean
 }
 
-/// An axis-aligned box (world coordinates, after the body's placement): the vertices inside or
-/// on it are pinned.
+/// An axis-aligned box (world coordinates, after the body's placement): the vertices of the
+/// body inside or on it are pinned.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PinBox {
@@ -66,26 +62,32 @@ pub struct PinBox {
     pub max: [f64; 3],
 }
 
+impl PinBox {
+    /// Whether `p` is inside or on the box.
+    #[must_use]
+    pub fn contains(&self, p: [f64; 3]) -> bool {
+        (0..3).all(|k| p[k] >= self.min[k] && p[k] <= self.max[k])
+    }
+}
+
 fn one() -> f64 {
     1.0
 }
 
-fn default_contact_stiffness() -> f64 {
-    1e7
-}
-
-/// A body from a tetrahedral mesh file. Every field but `mesh` and `material` has a default.
+/// A body from a mesh file. Every field but `mesh` and `material` has a default; `cell` is
+/// required for an OBJ surface and refused for a tetrahedral mesh.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
     /// The mesh file (in a scene file: relative to the scene file's folder): a Gmsh `.msh`
-    /// (versions 2.2 and 4.1, ASCII; its 4-node tetrahedra) or a TetGen `.node` or `.ele` (the
-    /// pair is read).
+    /// (versions 2.2 and 4.1, ASCII; its 4-node tetrahedra), a TetGen `.node` or `.ele` (the
+    /// pair is read), or a closed, consistently oriented triangle surface `.obj` (polygons are
+    /// split into triangles) whose inside is filled with tetrahedra of edge about `cell`.
     pub mesh: PathBuf,
     /// The material.
     pub material: MaterialSpec,
     /// Uniform scale of the mesh about its origin, positive; default 1.
-    #[serde(default = "one")]
+    #[serde(default = "one", skip_serializing_if = "is_one")]
     pub scale: f64,
     /// Rotation about the mesh's origin as roll, pitch, yaw (rad): `Rz(yaw) Ry(pitch) Rx(roll)`,
     /// applied after the scale; default none.
@@ -94,48 +96,55 @@ pub struct BodySpec {
     /// Translation (m), applied last; default none.
     #[serde(default, skip_serializing_if = "is_default")]
     pub translate: [f64; 3],
-    /// Initial velocity of every vertex (m/s); default at rest.
+    /// Initial velocity of every vertex of the body (m/s); default at rest.
     #[serde(default, skip_serializing_if = "is_default")]
     pub velocity: [f64; 3],
-    /// The vertices held fixed: those in this box (after the placement); default none.
+    /// The vertices of this body held fixed: those in this box (after the placement); default
+    /// none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pin: Option<PinBox>,
-    /// Gravity (m/s²); default `(0, 0, -9.81)`.
-    #[serde(default = "earth_gravity")]
-    pub gravity: [f64; 3],
-    /// Obstacles the body collides with: `plane` and `sphere` shapes (FEM contact takes no box or
-    /// capsule); default none.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub obstacles: Vec<Obstacle>,
-    /// Penalty stiffness of the obstacles (N/m), positive; default `1e7`.
-    #[serde(default = "default_contact_stiffness")]
-    pub contact_stiffness: f64,
-    /// Coulomb friction coefficient against the obstacles, `>= 0`; default 0 (frictionless).
-    #[serde(default, skip_serializing_if = "is_default")]
-    pub friction: f64,
-    /// Rayleigh stiffness damping `gamma` (s); default 0.
-    #[serde(default, skip_serializing_if = "is_default")]
-    pub rayleigh: f64,
+    /// For an `.obj` surface (required there, refused for a tetrahedral mesh): the target edge
+    /// length of its tetrahedra, in the OBJ's own units (before `scale`), positive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cell: Option<f64>,
 }
 
-fn earth_gravity() -> [f64; 3] {
-    EARTH_GRAVITY
+fn is_one(x: &f64) -> bool {
+    *x == 1.0
 }
 
-/// Why a body could not be built: the field of [`BodySpec`] at fault and the cause.
+/// Why a body could not be built: the field at fault and the cause.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{message}")]
 pub struct BodyError {
-    /// The field (`mesh`, `material`, `scale`, `pin`, `obstacles[1]`, ...).
+    /// The field: of a [`BodySpec`] (`mesh`, `material`, `scale`, `pin`, ...) from
+    /// [`BodySpec::load`]; of the `[scene]` table (`bodies[1].mesh`, `obstacles[0]`,
+    /// `gravity`, ...) from [`crate::bodies::build`].
     pub field: String,
     /// What is wrong; for the mesh, the file and line or element.
     pub message: String,
 }
 
 impl BodyError {
-    fn new(field: impl Into<String>, message: impl std::fmt::Display) -> Self {
+    pub(crate) fn new(field: impl Into<String>, message: impl std::fmt::Display) -> Self {
         BodyError { field: field.into(), message: message.to_string() }
     }
+
+    /// The same error with its field inside `prefix` (`bodies[2]` makes `mesh`
+    /// `bodies[2].mesh`).
+    #[must_use]
+    pub fn within(self, prefix: &str) -> Self {
+        BodyError { field: format!("{prefix}.{}", self.field), message: self.message }
+    }
+}
+
+/// A body read, placed and checked: its tetrahedra in world coordinates and its material.
+#[derive(Debug, Clone)]
+pub struct LoadedBody {
+    /// The placed mesh, its elements checked (none degenerate or inverted).
+    pub mesh: TetMesh,
+    /// The material.
+    pub material: Material,
 }
 
 /// Reads a tetrahedral mesh by its extension: `.msh` (Gmsh), `.node` or `.ele` (TetGen).
@@ -148,73 +157,81 @@ pub fn read_mesh(path: &Path) -> Result<TetMesh, FemError> {
         Some("msh") => read_gmsh(path),
         Some("node" | "ele") => read_tetgen(path),
         _ => Err(FemError::MeshInput(format!(
-            "{}: unknown mesh format (a Gmsh .msh or a TetGen .node/.ele)",
+            "{}: unknown mesh format (a Gmsh .msh, a TetGen .node/.ele or an OBJ surface .obj)",
             path.display()
         ))),
     }
 }
 
+/// Whether `path` names an OBJ surface (by its extension).
+fn is_obj(path: &Path) -> bool {
+    path.extension().and_then(|e| e.to_str()) == Some("obj")
+}
+
 impl BodySpec {
-    /// The body of this spec, its mesh read from `mesh` (the caller resolves
-    /// [`mesh`](Self::mesh) against its folder), as a scene with `order` elements.
+    /// The placement of the mesh: [`scale`](Self::scale), [`rotate`](Self::rotate),
+    /// [`translate`](Self::translate).
+    #[must_use]
+    pub fn placement(&self) -> Placement {
+        Placement { scale: self.scale, rotate: self.rotate, translate: self.translate }
+    }
+
+    /// Reads the body's mesh from `mesh` (the caller resolves [`mesh`](Self::mesh) against its
+    /// folder; for an OBJ surface, fills it with tetrahedra of edge about
+    /// [`cell`](Self::cell)), places it and checks it, with the body's material.
     ///
     /// # Errors
-    /// [`BodyError`] naming the field: a mesh that does not read or has a degenerate or
-    /// inverted element (the message names the file or the element), a bad material, a scale
-    /// that is not positive, non-finite values, a pin box that holds no vertex, an obstacle FEM
-    /// contact does not take.
-    pub fn build(&self, mesh: &Path, order: ElementOrder) -> Result<FemScene, BodyError> {
-        let mut tets = read_mesh(mesh).map_err(|e| BodyError::new("mesh", mesh_message(mesh, &e)))?;
-        self.place(&mut tets)?;
+    /// [`BodyError`] naming the field of the spec: a mesh that does not read, an OBJ surface
+    /// that is not closed (the message names the file and the triangle or edge), a degenerate or
+    /// inverted element after the placement (the file and the element), `cell` missing for an
+    /// OBJ or given for a tetrahedral mesh or not positive, a bad material or placement, a
+    /// non-finite velocity or pin box.
+    pub fn load(&self, mesh: &Path) -> Result<LoadedBody, BodyError> {
+        let placement = self.placement();
+        placement.check().map_err(|e| match e {
+            BuildError::Invalid { field, message } => BodyError::new(field, message),
+            other => BodyError::new("scale", other),
+        })?;
         let m = &self.material;
         let material = Material::new(m.model, m.young, m.poisson, m.density)
             .map_err(|e| BodyError::new("material", e))?;
-        finite3("gravity", self.gravity)?;
-        let mut model = FemModel::with_order(tets, material, order)
-            .map_err(|e| BodyError::new("mesh", format!("{}: {e}", mesh.display())))?
-            .with_gravity(self.gravity);
+        finite3("velocity", self.velocity)?;
         if let Some(pin) = self.pin {
             finite3("pin", pin.min)?;
             finite3("pin", pin.max)?;
-            let inside = |p: [f64; 3]| (0..3).all(|k| p[k] >= pin.min[k] && p[k] <= pin.max[k]);
-            let pinned = model.vertices_where(inside);
-            if pinned.is_empty() {
-                return Err(BodyError::new("pin", "the pin box holds no vertex of the placed mesh"));
+        }
+        let (mut tets, source) = if is_obj(mesh) {
+            let Some(cell) = self.cell else {
+                return Err(BodyError::new(
+                    "cell",
+                    format!(
+                        "{} is a surface: give `cell`, the edge length of the tetrahedra that fill it (in the OBJ's units)",
+                        mesh.display()
+                    ),
+                ));
+            };
+            if !(cell > 0.0 && cell.is_finite()) {
+                return Err(BodyError::new("cell", format!("must be positive and finite, got {cell}")));
             }
-            model.pin_vertices(&pinned).map_err(|e| BodyError::new("pin", e))?;
-        }
-        for (k, obstacle) in self.obstacles.iter().enumerate() {
-            model
-                .add_obstacle_with_friction(*obstacle, self.contact_stiffness, self.friction)
-                .map_err(|e| BodyError::new(format!("obstacles[{k}]"), e))?;
-        }
-        finite3("velocity", self.velocity)?;
-        let x = model.rest_positions();
-        let v = self.velocity.iter().copied().cycle().take(x.len()).collect();
-        let params = FemParams::default().with_rayleigh(self.rayleigh);
-        Ok(FemScene {
-            name: "body",
-            description: "a body from a tetrahedral mesh file",
-            model,
-            state: State { t: 0.0, x, v },
-            dt: 1.0 / 120.0,
-            duration: 1.0,
-            params,
-        })
-    }
-
-    /// Scales, rotates and translates the mesh in place.
-    fn place(&self, mesh: &mut TetMesh) -> Result<(), BodyError> {
-        if !(self.scale > 0.0 && self.scale.is_finite()) {
-            return Err(BodyError::new("scale", format!("must be positive and finite, got {}", self.scale)));
-        }
-        let [roll, pitch, yaw] = finite3("rotate", self.rotate)?;
-        let t = DVec3::from_array(finite3("translate", self.translate)?);
-        let r = DMat3::from_euler(EulerRot::ZYX, yaw, pitch, roll);
-        for p in &mut mesh.positions {
-            *p = (r * (self.scale * DVec3::from_array(*p)) + t).to_array();
-        }
-        Ok(())
+            let tets = obj::fill(mesh, cell)?;
+            (tets, format!("{} (filled with tetrahedra of cell {cell})", mesh.display()))
+        } else {
+            if self.cell.is_some() {
+                return Err(BodyError::new(
+                    "cell",
+                    format!(
+                        "`cell` is for OBJ surfaces; {} is a tetrahedral mesh (leave `cell` out)",
+                        mesh.display()
+                    ),
+                ));
+            }
+            let tets = read_mesh(mesh).map_err(|e| BodyError::new("mesh", mesh_message(mesh, &e)))?;
+            (tets, mesh.display().to_string())
+        };
+        placement.apply_all(&mut tets.positions);
+        validate(&tets.positions, &tets.tets)
+            .map_err(|e| BodyError::new("mesh", format!("{source}: {e}")))?;
+        Ok(LoadedBody { mesh: tets, material })
     }
 }
 
@@ -225,7 +242,7 @@ fn mesh_message(path: &Path, e: &FemError) -> String {
     if text.contains(&file) { text } else { format!("{file}: {text}") }
 }
 
-fn finite3(field: &str, v: [f64; 3]) -> Result<[f64; 3], BodyError> {
+pub(crate) fn finite3(field: &str, v: [f64; 3]) -> Result<[f64; 3], BodyError> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(v)
     } else {
@@ -234,4 +251,4 @@ fn finite3(field: &str, v: [f64; 3]) -> Result<[f64; 3], BodyError> {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -1,14 +1,19 @@
 //! Boundary conditions and contact: pinned degrees of freedom, kinematic vertex groups that follow
-//! a prescribed motion, and rigid obstacles (a half-space ground or any plane, a sphere: anim-core's
-//! shared collider [`Shape`](anim_core::geometry::Shape)), each with a Coulomb
+//! a prescribed motion, and rigid obstacles (a half-space ground or any plane, a sphere, an
+//! axis-aligned box, a capsule: anim-core's shared collider
+//! [`Shape`](anim_core::geometry::Shape)), each with a Coulomb
 //! friction coefficient `mu >= 0` given when it is added to a model
 //! ([`FemModel::add_obstacle_with_friction`](crate::model::FemModel::add_obstacle_with_friction);
 //! `mu = 0`, the default of `add_obstacle`, is frictionless).
 //!
 //! Contact is handled per integrator: the explicit step projects penetrating vertices back to the
 //! obstacle surface and removes their approaching normal velocity; the implicit step adds the
-//! penalty energy `kappa/2 min(phi(x), 0)^2` (`phi` the signed distance) to the incremental
-//! potential, so Newton's line search sees it. Friction is velocity-level Coulomb in the explicit
+//! penalty energy `kappa/2 max(-phi(x), 0)^2` (`phi` the signed distance, [`obstacle_distance`])
+//! to the incremental potential, so Newton's line search sees it: its gradient is
+//! `-kappa max(-phi, 0) n` (`n = grad phi`, the outward normal) and its Hessian is taken as
+//! `kappa n n^T` where `phi < 0`, the Gauss-Newton part, which drops the curvature term
+//! `-kappa phi grad n` (zero for a plane and inside a box, where `phi` is linear; positive
+//! semi-definite or not for a sphere or a capsule, so it is left out). Friction is velocity-level Coulomb in the explicit
 //! step and IPC's lagged, smoothed friction potential in the implicit one
 //! ([`crate::friction`]). Contact is vertex against obstacle only: no self-collision, no
 //! body-body contact.
@@ -76,16 +81,18 @@ pub struct KinematicGroup {
 /// A rigid obstacle's geometry: anim-core's shared [`Shape`](anim_core::geometry::Shape),
 /// re-exported under this name (its friction coefficient is stored by the model, see
 /// [`FemModel::obstacle_friction`](crate::model::FemModel::obstacle_friction)). FEM contact
-/// handles planes and spheres; a box or capsule is refused when it is added
-/// ([`FemModel::add_obstacle`](crate::model::FemModel::add_obstacle)).
+/// handles all four shapes: planes, spheres, axis-aligned boxes and capsules.
 pub use anim_core::geometry::Shape as Obstacle;
 
-/// Signed distance `phi(x)` (negative inside) of a plane or sphere obstacle and the unit outward
-/// normal `grad phi`.
+/// Signed distance `phi(x)` (negative inside) of an obstacle and the unit outward normal
+/// `grad phi`.
 ///
 /// A plane is evaluated as `n . x - n . point` with `n` the normalised normal (for the ground
-/// `z >= h`, exactly `z - h`). Boxes and capsules never reach here: the model refuses them, and
-/// they are reported as outside (`+inf`).
+/// `z >= h`, exactly `z - h`). A box and a capsule are
+/// [`Shape::signed_distance`](anim_core::geometry::Shape::signed_distance): inside a box, the
+/// distance to and the normal of the nearest face; outside, the distance to the nearest point
+/// of the box (a face, edge or corner), whose normal turns continuously around edges and
+/// corners; for a capsule, the distance to its axis segment minus the radius.
 #[inline]
 #[must_use]
 pub fn obstacle_distance(obstacle: &Obstacle, x: [f64; 3]) -> (f64, [f64; 3]) {
@@ -101,7 +108,27 @@ pub fn obstacle_distance(obstacle: &Obstacle, x: [f64; 3]) -> (f64, [f64; 3]) {
             let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
             if r > 0.0 { (r - radius, [d[0] / r, d[1] / r, d[2] / r]) } else { (-radius, [0.0, 0.0, 1.0]) }
         }
-        Obstacle::Box { .. } | Obstacle::Capsule { .. } => (f64::INFINITY, [0.0, 0.0, 1.0]),
+        Obstacle::Box { .. } | Obstacle::Capsule { .. } => {
+            let (phi, n) = obstacle.signed_distance(anim_core::glam::DVec3::from_array(x));
+            (phi, n.to_array())
+        }
+    }
+}
+
+/// The penalty contact of a vertex at `x` with `obstacle` at stiffness `k`: `None` outside
+/// (`phi >= 0`); inside, the energy `k/2 phi^2`, its gradient `k phi n` (that is,
+/// `-k max(-phi, 0) n`) and the Gauss-Newton Hessian `k n n^T` (row-major 3 x 3), with `phi` and
+/// `n` of [`obstacle_distance`].
+#[inline]
+#[must_use]
+pub fn penalty(obstacle: &Obstacle, k: f64, x: [f64; 3]) -> Option<(f64, [f64; 3], [f64; 9])> {
+    let (phi, n) = obstacle_distance(obstacle, x);
+    if phi < 0.0 {
+        let grad = [k * phi * n[0], k * phi * n[1], k * phi * n[2]];
+        let hess = std::array::from_fn(|i| k * n[i / 3] * n[i % 3]);
+        Some((0.5 * k * phi * phi, grad, hess))
+    } else {
+        None
     }
 }
 

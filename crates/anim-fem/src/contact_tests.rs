@@ -285,12 +285,12 @@ fn bad_friction_input_is_named() {
     model.add_obstacle_with_friction(Obstacle::ground(0.0), 1e6, 0.4).unwrap();
     model.add_obstacle(Obstacle::Sphere { center: [0.0; 3], radius: 1.0 }, 1e6).unwrap();
     assert_eq!(model.obstacle_friction(), &[0.4, 0.0]);
-    // Invalid shapes, and boxes and capsules (no FEM contact), are refused naming the obstacle.
+    // Invalid shapes are refused naming the obstacle.
     for (shape, words) in [
         (Obstacle::Sphere { center: [0.0; 3], radius: -1.0 }, "sphere radius"),
         (Obstacle::Plane { point: [0.0; 3], normal: [0.0; 3] }, "plane normal"),
-        (Obstacle::Box { center: [0.0; 3], half_extents: [1.0; 3] }, "a box obstacle"),
-        (Obstacle::Capsule { a: [0.0; 3], b: [0.0, 0.0, 1.0], radius: 0.5 }, "a capsule obstacle"),
+        (Obstacle::Box { center: [0.0; 3], half_extents: [1.0, 0.0, 1.0] }, "box half extents"),
+        (Obstacle::Capsule { a: [0.0; 3], b: [0.0; 3], radius: 0.5 }, "capsule ends coincide"),
     ] {
         let err = model.add_obstacle(shape, 1e6).unwrap_err();
         assert!(matches!(err, FemError::BadObstacle { obstacle: 2, .. }), "{err}");

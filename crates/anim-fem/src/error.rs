@@ -99,10 +99,14 @@ pub enum FemError {
         /// The edge's length.
         edge: f64,
     },
+    /// Materials per element that do not fit the mesh: none, a list of indices of the wrong
+    /// length, or an index past the materials.
+    #[error("element materials: {0}")]
+    MaterialIndex(String),
     /// Bad material parameters (Young's modulus, Poisson's ratio).
     #[error("material: {0}")]
     Material(#[from] MaterialError),
-    /// An obstacle's shape is invalid or not one FEM contact handles (planes and spheres).
+    /// An obstacle's shape is invalid (fails [`Shape::check`](anim_core::geometry::Shape::check)).
     #[error("obstacle {obstacle}: {reason}")]
     BadObstacle {
         /// Index of the obstacle in the order added.

@@ -8,13 +8,18 @@
 //! | `cube` | `soft-cube-drop`: a soft cube dropped on the ground, backward Euler with penalty contact | 100 frames of 2 x 5 ms |
 //! | `twisted-bar` | `twisted-bar`: a bar twisted by a half turn at one end | 100 frames of 10 ms |
 //!
-//! A scene file may give a `body` table instead of a preset ([`BodySpec`]): a Gmsh or TetGen
-//! mesh of the user's, its material, placement, initial velocity, pins and obstacles.
+//! A scene file may give a list of `bodies` instead of a preset ([`BodySpec`], one
+//! `[[scene.bodies]]` table each): a Gmsh or TetGen tetrahedral mesh or a closed OBJ surface of
+//! the user's, with its material, placement, initial velocity and pins. The `[scene]` table then
+//! also holds what the bodies share ([`World`]): `gravity`, `obstacles` (planes, spheres, boxes,
+//! capsules), `contact_stiffness`, `friction` and `rayleigh`. The bodies collide with the
+//! obstacles, not with each other. A preset refuses these fields, and `bodies` refuses
+//! `resolution`.
 //!
 //! A frame holds every node (for 10-node bodies, the corners then the edge nodes) and its
 //! velocity, in the scenes' own z-up frame; the [`Context`] gives the outward boundary
 //! triangles, the (corner) tetrahedra, the pinned and kinematic nodes as pins, the ground and the
-//! sphere obstacles.
+//! sphere, box and capsule obstacles.
 //!
 //! ```
 //! use anim_core::scene::{BuildContext, Frame};
@@ -29,9 +34,11 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use crate::bodies::{self, DEFAULT_CONTACT_STIFFNESS, World};
 use crate::body::BodySpec;
+use crate::boundary::Obstacle;
 use crate::material::MaterialModel;
-use crate::model::ElementOrder;
+use crate::model::{EARTH_GRAVITY, ElementOrder};
 use crate::scenes;
 use crate::sim::{FemSimulation, LinearSolverChoice, TimeIntegrator};
 use anim_core::integrate::State;
@@ -58,15 +65,32 @@ pub const KIND: SceneKind = SceneKind {
 #[serde(deny_unknown_fields)]
 pub struct FemSceneParams {
     /// The scene: `"cantilever-beam"`, `"soft-cube-drop"` or `"twisted-bar"` (see
-    /// [`scenes`]); give this or `body`.
+    /// [`scenes`]); give this or `bodies`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub preset: Option<String>,
-    /// A body of the user's own from a tetrahedral mesh file ([`BodySpec`]); give this or
-    /// `preset`.
+    /// Bodies of the user's own, each from a mesh file with its own material ([`BodySpec`]);
+    /// give this (at least one) or `preset`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub body: Option<BodySpec>,
-    /// Cells across the beam or bar (4 by default; the length gets 10 times as many), or along
-    /// the cube's side (6 by default); absent: the scene's default.
+    pub bodies: Option<Vec<BodySpec>>,
+    /// With `bodies`: gravity (m/s²); absent: `(0, 0, -9.81)`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<[f64; 3]>,
+    /// With `bodies`: the obstacles every body collides with (`plane`, `sphere`, `box`,
+    /// `capsule`: [`Obstacle`]); absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub obstacles: Option<Vec<Obstacle>>,
+    /// With `bodies`: penalty stiffness of the obstacles (N/m), positive; absent: `1e7`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_stiffness: Option<f64>,
+    /// With `bodies`: Coulomb friction coefficient against the obstacles, `>= 0`; absent: 0
+    /// (frictionless).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
+    /// With `bodies`: Rayleigh stiffness damping `gamma` (s), `>= 0`; absent: 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rayleigh: Option<f64>,
+    /// With `preset`: cells across the beam or bar (4 by default; the length gets 10 times as
+    /// many), or along the cube's side (6 by default); absent: the scene's default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
     /// Time integrator, `"backward-euler"` or `"symplectic-euler"`; absent: the scene's
@@ -116,33 +140,70 @@ fn presets() -> Vec<Preset> {
     ]
 }
 
+impl FemSceneParams {
+    /// The names of the fields that go with `bodies` only and are given.
+    fn world_fields(&self) -> impl Iterator<Item = &'static str> {
+        [
+            ("gravity", self.gravity.is_some()),
+            ("obstacles", self.obstacles.is_some()),
+            ("contact_stiffness", self.contact_stiffness.is_some()),
+            ("friction", self.friction.is_some()),
+            ("rayleigh", self.rayleigh.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(name, given)| given.then_some(name))
+    }
+
+    /// What the bodies share: the fields given, the defaults for the others.
+    fn world(&self) -> World {
+        World {
+            gravity: self.gravity.unwrap_or(EARTH_GRAVITY),
+            obstacles: self.obstacles.clone().unwrap_or_default(),
+            contact_stiffness: self.contact_stiffness.unwrap_or(DEFAULT_CONTACT_STIFFNESS),
+            friction: self.friction.unwrap_or(0.0),
+            rayleigh: self.rayleigh.unwrap_or(0.0),
+        }
+    }
+}
+
 fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
     let p: FemSceneParams = params(value)?;
     let order = p.element.unwrap_or_default();
-    let mut scene = match (&p.preset, &p.body) {
-        (Some(name), None) => scenes::by_name_with_order(name, p.resolution, order)
-            .ok_or_else(|| {
-                BuildError::invalid(
-                    "preset",
-                    format!("unknown preset `{name}` (one of {})", scenes::NAMES.join(", ")),
-                )
-            })?
-            .map_err(|e| BuildError::invalid("resolution", e.to_string()))?,
-        (None, Some(body)) => {
-            if p.resolution.is_some() {
-                return Err(BuildError::invalid("resolution", "a body's resolution is its mesh's"));
+    let mut scene = match (&p.preset, &p.bodies) {
+        (Some(name), None) => {
+            if let Some(field) = p.world_fields().next() {
+                return Err(BuildError::invalid(
+                    field,
+                    format!("a preset brings its own `{field}`; the field goes with `bodies`"),
+                ));
             }
-            body.build(&context.resolve(&body.mesh), order)
-                .map_err(|e| BuildError::invalid(format!("body.{}", e.field), e.message))?
+            scenes::by_name_with_order(name, p.resolution, order)
+                .ok_or_else(|| {
+                    BuildError::invalid(
+                        "preset",
+                        format!("unknown preset `{name}` (one of {})", scenes::NAMES.join(", ")),
+                    )
+                })?
+                .map_err(|e| BuildError::invalid("resolution", e.to_string()))?
+        }
+        (None, Some(bodies)) => {
+            if p.resolution.is_some() {
+                return Err(BuildError::invalid(
+                    "resolution",
+                    "a preset's field: the resolution of bodies is their meshes' (or `cell` for an OBJ surface)",
+                ));
+            }
+            bodies::build(bodies, &p.world(), order, |path| context.resolve(path))
+                .map_err(|e| BuildError::invalid(e.field, e.message))?
         }
         (Some(_), Some(_)) => {
-            return Err(BuildError::invalid("body", "give a built-in `preset` or a `body` table, not both"));
+            return Err(BuildError::invalid("bodies", "give a built-in `preset` or `bodies`, not both"));
         }
         (None, None) => {
             return Err(BuildError::invalid(
                 "preset",
                 format!(
-                    "give a built-in `preset` (one of {}) or a `body` table with a `mesh` file",
+                    "give a built-in `preset` (one of {}) or `bodies` (`[[scene.bodies]]` tables, each with a `mesh` file)",
                     scenes::NAMES.join(", ")
                 ),
             ));
@@ -154,7 +215,7 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
     if let Some(l) = p.linear_solver {
         scene.params.linear_solver = l;
     }
-    let field = if p.body.is_some() { "body" } else { "preset" };
+    let field = if p.bodies.is_some() { "bodies" } else { "preset" };
     let (sim, state) = scene.into_simulation().map_err(|e| BuildError::invalid(field, e.to_string()))?;
     Ok(Simulated::new(sim, state).boxed())
 }
@@ -198,15 +259,16 @@ impl View for FemSimulation {
     }
 
     /// The boundary triangles, the (corner) tetrahedra, as pins the nodes whose three
-    /// coordinates are held (pinned or moved kinematically), the ground (the last obstacle plane
-    /// `z >= h`) and the sphere obstacles, and the region the body stays in: its bounding box at
+    /// coordinates are held (pinned or moved kinematically), the ground (the first obstacle
+    /// plane `z >= h`) and the sphere, box and capsule obstacles, and the region the body stays
+    /// in: its bounding box at
     /// `state`, widened sideways by a third of its size and extended down by its size or to
     /// the ground.
     fn context(&self, state: &State) -> Context {
         let model = self.model();
         let ground = ground_height(model.obstacles());
-        // A model has no box or capsule obstacles (refused when they are added).
-        let spheres: Vec<Prop> = model.obstacles().iter().filter_map(Prop::of_shape).collect();
+        // Every obstacle but the planes (a ground is drawn as `Prop::Ground`).
+        let solids: Vec<Prop> = model.obstacles().iter().filter_map(Prop::of_shape).collect();
         let fixed = model.fixed();
         // `Context` is non-exhaustive: filled field by field.
         let mut context = Context::default();
@@ -217,7 +279,7 @@ impl View for FemSimulation {
             (0..model.vertices()).filter(|&i| fixed[3 * i..3 * i + 3].iter().all(|&f| f)).collect();
         context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
         context.props.extend(ground.map(|height| Prop::Ground { height }));
-        context.props.extend(spheres);
+        context.props.extend(solids);
         context
     }
 
@@ -299,7 +361,7 @@ fn tolerance_adapter(
 ) -> Result<Box<dyn StudyAdapter>, String> {
     let p: FemSceneParams = params(value).map_err(study::unreadable)?;
     let preset =
-        p.preset.as_deref().ok_or("--tolerance: the report's studies cover the fem presets, not a body")?;
+        p.preset.as_deref().ok_or("--tolerance: the report's studies cover the fem presets, not bodies")?;
     let scene = scenes::by_name(preset, p.resolution)
         .ok_or_else(|| format!("--tolerance: unknown fem preset `{preset}`"))?
         .map_err(study::unreadable)?;

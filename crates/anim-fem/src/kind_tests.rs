@@ -246,10 +246,7 @@ fn bad_parameters_name_their_field() {
     let msg = refused(&json!({ "preset": "cantilever-beam", "element": "tet7" }));
     assert!(msg.contains("tet7") && msg.contains("tet10"), "{msg}");
     let msg = refused(&json!({ "resolution": 2 }));
-    assert!(
-        msg.starts_with("field `preset`: give a built-in `preset`") && msg.contains("`body` table"),
-        "{msg}"
-    );
+    assert!(msg.starts_with("field `preset`: give a built-in `preset`") && msg.contains("`bodies`"), "{msg}");
 }
 
 mod tolerance {

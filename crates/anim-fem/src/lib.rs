@@ -10,8 +10,8 @@
 //! | [`material`] | the six hyperelastic models (linear, StVK, corotated linear, Neo-Hookean, fixed corotated, stable Neo-Hookean) with Lamé parameters from `(E, nu)` | Sifakis & Barbič 2012; Stomakhin et al. 2012 (fixed corotated); Smith et al. 2018 (stable Neo-Hookean) |
 //! | [`element`] | the linear tetrahedron: `Dm^-1`, `W = abs(det Dm)/6`, `F = Ds Dm^-1`, forces `H = -W P(F) Dm^-T`, `f4 = -(f1+f2+f3)`, stiffness | Sifakis & Barbič 2012, Algorithm 1 |
 //! | [`assembly`] | ordered parallel assembly of forces and the sparse stiffness (identical for any thread count) | - |
-//! | [`model`] | a body of linear or 10-node tetrahedra ([`ElementOrder`](model::ElementOrder)): precomputed rest data, lumped or consistent mass, gravity, loads, pinned and kinematic vertices, obstacles with a friction coefficient each | - |
-//! | [`boundary`] | kinematic motions, ground and sphere obstacles | - |
+//! | [`model`] | a body of linear or 10-node tetrahedra ([`ElementOrder`](model::ElementOrder)): precomputed rest data, a material per element, lumped or consistent mass, gravity, loads, pinned and kinematic vertices, obstacles with a friction coefficient each | - |
+//! | [`boundary`] | kinematic motions; plane, sphere, box and capsule obstacles (penalty contact) | - |
 //! | [`friction`] | Coulomb friction at obstacle contacts: velocity-level in explicit steps, IPC's lagged smoothed potential (Li et al. 2020, section 5) in backward Euler | - |
 //! | [`newton`] | Newton on the incremental potential with a backtracking line search, Rayleigh damping `gamma` | backward Euler as an incremental potential |
 //! | [`sim`] | symplectic Euler and backward Euler steps, quasi-static solves, the `Solver` implementation | symplectic and backward Euler |
@@ -19,7 +19,8 @@
 //! | [`quadratic`] | bodies of 10-node tetrahedra in both time steppers, and the quasi-static front end [`QuadraticModel`](quadratic::QuadraticModel) | - |
 //! | [`ldlt`] | sparse `L D L^T` (faer) for symmetric indefinite Newton matrices | - |
 //! | [`scenes`] | cantilever beam, soft cube drop, twisted bar | - |
-//! | [`body`] | a body of the user's own from a Gmsh or TetGen mesh: material, placement, velocity, pins, obstacles | - |
+//! | [`body`] | a body of the user's own from a Gmsh or TetGen mesh or a closed OBJ surface (filled with tetrahedra): material, placement, velocity, pins | - |
+//! | [`bodies`] | several such bodies merged into one model, each element of its body's material, with the gravity, obstacles, friction and damping they share | - |
 //! | [`kind`] | the `fem` scene kind: presets, scene-file parameters, checkpoints and frames | - |
 //!
 //! **Element order.** [`FemModel::new`](model::FemModel::new) builds linear tetrahedra,
@@ -30,8 +31,8 @@
 //! **Scene kind.** [`KIND`] registers the crate's scenes with the workspace
 //! ([`anim_core::scene::SceneKind`], scene files of `kind = "fem"`): the presets `beam`
 //! (`cantilever-beam`), `cube` (`soft-cube-drop`) and `twisted-bar`, built from
-//! [`kind::FemSceneParams`] (preset, resolution, integrator, linear solver, element), or a
-//! `body` table ([`body::BodySpec`]) bringing the user's own tetrahedral mesh;
+//! [`kind::FemSceneParams`] (preset, resolution, integrator, linear solver, element), or a list
+//! of `bodies` ([`body::BodySpec`]) bringing the user's own meshes, with their obstacles;
 //! [`FemSimulation`](sim::FemSimulation) is their [`Checkpoint`](anim_core::scene::Checkpoint)
 //! and [`View`](anim_core::scene::View).
 //!
@@ -78,6 +79,7 @@
 //! ```
 
 pub mod assembly;
+pub mod bodies;
 pub mod body;
 pub mod boundary;
 #[cfg(feature = "cases")]
@@ -100,6 +102,8 @@ pub mod tet10;
 pub use error::FemError;
 pub use kind::KIND;
 
+#[cfg(test)]
+mod contact_shape_tests;
 #[cfg(test)]
 mod contact_tests;
 #[cfg(test)]

@@ -1,6 +1,11 @@
 //! The finite element model: an immutable description of a body (rest mesh, precomputed
-//! `Dm^-1` and `W` per element, material, masses, loads, boundary conditions, obstacles) that
+//! `Dm^-1` and `W` per element, materials, masses, loads, boundary conditions, obstacles) that
 //! algorithms read and never modify.
+//!
+//! Every element has a material: one for the whole body ([`FemModel::new`],
+//! [`FemModel::with_order`]), or one of a list per element ([`FemModel::with_materials`]), which
+//! is how several bodies of different materials are one model (their meshes merged, see
+//! [`body`](crate::body)). Masses, forces, stiffness and energy use each element's own material.
 //!
 //! A body is made of linear (4-node, [`FemModel::new`]) or quadratic (10-node,
 //! [`FemModel::quadratic`], [`tet10`](crate::tet10)) tetrahedra ([`ElementOrder`]).
@@ -83,7 +88,10 @@ pub struct FemModel {
     /// The 10-node elements and their quadrature data (quadratic bodies only).
     tet10: Option<Tet10Elements>,
     surface: Vec<[usize; 3]>,
-    material: Material,
+    /// The materials (at least one).
+    materials: Vec<Material>,
+    /// The index into `materials` of each element.
+    element_material: Vec<u32>,
     dm_inv: Vec<Matrix3<f64>>,
     volume: Vec<f64>,
     shape_grad: Vec<[[f64; 3]; 4]>,
@@ -114,7 +122,8 @@ impl FemModel {
     /// elements named by index).
     pub fn new(mesh: TetMesh, material: Material) -> Result<Self, FemError> {
         validate(&mesh.positions, &mesh.tets)?;
-        Self::build(mesh, None, material)
+        let one = vec![0; mesh.tets.len()];
+        Self::build(mesh, None, vec![material], one)
     }
 
     /// A body of 10-node tetrahedra (from [`generate::quadratic`](crate::generate::quadratic)),
@@ -130,7 +139,8 @@ impl FemModel {
         let corners: Vec<[usize; 4]> = mesh.elements.iter().map(|e| [e[0], e[1], e[2], e[3]]).collect();
         validate(&mesh.positions, &corners)?;
         let tet10 = Tet10Elements::new(&mesh)?;
-        Self::build(TetMesh { positions: mesh.positions, tets: corners }, Some(tet10), material)
+        let one = vec![0; corners.len()];
+        Self::build(TetMesh { positions: mesh.positions, tets: corners }, Some(tet10), vec![material], one)
     }
 
     /// A body of `order` elements on a linear mesh: the mesh itself for
@@ -149,8 +159,54 @@ impl FemModel {
         }
     }
 
-    /// The body from a validated mesh (corner tetrahedra) and the 10-node data if quadratic.
-    fn build(mesh: TetMesh, tet10: Option<Tet10Elements>, material: Material) -> Result<Self, FemError> {
+    /// A body of `order` elements on a linear mesh (as [`with_order`](Self::with_order)) whose
+    /// element `e` is of material `materials[element_material[e]]`. A 10-node element keeps the
+    /// material of the linear element it refines.
+    ///
+    /// # Errors
+    /// As [`FemModel::new`]; [`FemError::MaterialIndex`] for an empty `materials`, an
+    /// `element_material` whose length is not the number of elements, or an index out of range.
+    pub fn with_materials(
+        mesh: TetMesh,
+        materials: Vec<Material>,
+        element_material: Vec<u32>,
+        order: ElementOrder,
+    ) -> Result<Self, FemError> {
+        let elements = mesh.tets.len();
+        if materials.is_empty() || element_material.len() != elements {
+            return Err(FemError::MaterialIndex(format!(
+                "{} materials and {} element materials for {elements} elements",
+                materials.len(),
+                element_material.len()
+            )));
+        }
+        if let Some(e) = element_material.iter().position(|&m| m as usize >= materials.len()) {
+            return Err(FemError::MaterialIndex(format!(
+                "element {e} has material {}, but there are {} materials",
+                element_material[e],
+                materials.len()
+            )));
+        }
+        validate(&mesh.positions, &mesh.tets)?;
+        match order {
+            ElementOrder::Linear => Self::build(mesh, None, materials, element_material),
+            ElementOrder::Quadratic => {
+                let fine = crate::generate::quadratic(&mesh);
+                let tet10 = Tet10Elements::new(&fine)?;
+                let corners = TetMesh { positions: fine.positions, tets: mesh.tets };
+                Self::build(corners, Some(tet10), materials, element_material)
+            }
+        }
+    }
+
+    /// The body from a validated mesh (corner tetrahedra), the 10-node data if quadratic, and
+    /// the materials with each element's index into them (checked by the caller).
+    fn build(
+        mesh: TetMesh,
+        tet10: Option<Tet10Elements>,
+        materials: Vec<Material>,
+        element_material: Vec<u32>,
+    ) -> Result<Self, FemError> {
         let n = mesh.positions.len();
         let m = mesh.tets.len();
         let mut dm_inv = Vec::with_capacity(m);
@@ -168,8 +224,9 @@ impl FemModel {
             volume.push(w);
             shape_grad.push(gradients(&inv));
             if tet10.is_none() {
+                let density = materials[element_material[e] as usize].density;
                 for &v in t {
-                    lumped_mass[v] += 0.25 * material.density * w;
+                    lumped_mass[v] += 0.25 * density * w;
                 }
             }
         }
@@ -180,7 +237,7 @@ impl FemModel {
                 // Consistent mass: per-element 12 x 12 blocks rho W / 20 (1 + delta_ab) I_3.
                 let mut blocks = vec![0.0; m * 144];
                 for e in 0..m {
-                    let c = material.density * volume[e] / 20.0;
+                    let c = materials[element_material[e] as usize].density * volume[e] / 20.0;
                     for a in 0..4 {
                         for b in 0..4 {
                             let v = if a == b { 2.0 * c } else { c };
@@ -203,7 +260,7 @@ impl FemModel {
                 let mut row_sums = vec![0.0; n];
                 let mut blocks = vec![0.0; m * 900];
                 for (e, el) in q.elements.iter().enumerate() {
-                    let c = material.density * volume[e];
+                    let c = materials[element_material[e] as usize].density * volume[e];
                     for a in 0..10 {
                         lumped_mass[el[a]] += c * lumped[a];
                         row_sums[el[a]] += c * coef[a].iter().sum::<f64>();
@@ -224,7 +281,8 @@ impl FemModel {
             mesh,
             tet10,
             surface,
-            material,
+            materials,
+            element_material,
             dm_inv,
             volume,
             shape_grad,
@@ -334,7 +392,7 @@ impl FemModel {
     /// # Errors
     /// [`FemError::BadParameter`] for a non-positive stiffness; [`FemError::BadObstacle`] for a
     /// shape that fails [`Shape::check`](anim_core::geometry::Shape::check) (a non-positive
-    /// sphere radius, a zero plane normal) or a box or capsule, which FEM contact does not handle.
+    /// sphere radius or box half extent, a zero plane normal, a capsule whose ends coincide).
     pub fn add_obstacle(&mut self, obstacle: Obstacle, stiffness: f64) -> Result<(), FemError> {
         self.add_obstacle_with_friction(obstacle, stiffness, 0.0)
     }
@@ -369,12 +427,6 @@ impl FemModel {
         let index = self.obstacles.len();
         let bad = |reason: String| FemError::BadObstacle { obstacle: index, reason };
         obstacle.check().map_err(bad)?;
-        if let Obstacle::Box { .. } | Obstacle::Capsule { .. } = obstacle {
-            return Err(bad(format!(
-                "a {} obstacle has no contact in a finite element model (planes and spheres only)",
-                obstacle.name()
-            )));
-        }
         self.obstacles.push(obstacle);
         self.friction.push(friction);
         self.contact_stiffness = self.contact_stiffness.max(stiffness);
@@ -472,10 +524,31 @@ impl FemModel {
         &self.surface
     }
 
-    /// The material.
+    /// The material of element 0: the body's material when it has one
+    /// ([`FemModel::new`], [`FemModel::with_order`]); see [`materials`](Self::materials) and
+    /// [`element_material`](Self::element_material) for bodies of several.
     #[must_use]
     pub fn material(&self) -> &Material {
-        &self.material
+        &self.materials[0]
+    }
+
+    /// The materials of the elements (one for a single-material body).
+    #[must_use]
+    pub fn materials(&self) -> &[Material] {
+        &self.materials
+    }
+
+    /// The index into [`materials`](Self::materials) of each element's material.
+    #[must_use]
+    pub fn element_material(&self) -> &[u32] {
+        &self.element_material
+    }
+
+    /// The material of element `e`.
+    #[inline]
+    #[must_use]
+    pub fn material_of(&self, e: usize) -> &Material {
+        &self.materials[self.element_material[e] as usize]
     }
 
     /// `Dm^-1` per element (of the corner tetrahedron for 10-node elements).
@@ -632,11 +705,11 @@ impl FemModel {
         out: &mut [f64],
     ) {
         if let Some(q) = &self.tet10 {
-            q.forces(&self.material, e, x, damping, out);
+            q.forces(self.material_of(e), e, x, damping, out);
             return;
         }
         let fd = self.deformation_gradient(e, x);
-        let mat = &self.material;
+        let mat = self.material_of(e);
         let p = mat.model.pk1(&mat.lame, &fd);
         let mut f = nodal_forces(self.volume[e], &p, &self.dm_inv[e]);
         if let Some((gamma, v)) = damping {
@@ -674,11 +747,11 @@ impl ElasticBody for FemModel {
         project: bool,
     ) -> f64 {
         if let Some(q) = &self.tet10 {
-            return q.element(&self.material, e, x, grad, hess, project);
+            return q.element(self.material_of(e), e, x, grad, hess, project);
         }
         let f = self.deformation_gradient(e, x);
         let w = self.volume[e];
-        let mat = &self.material;
+        let mat = self.material_of(e);
         let energy = w * mat.model.energy(&mat.lame, &f);
         if let Some(g) = grad {
             let p = mat.model.pk1(&mat.lame, &f);

@@ -30,7 +30,7 @@
 //! Degrees of freedom marked fixed keep their value: their rows and columns of the matrix are
 //! replaced by the identity and their gradient entries by zero.
 
-use crate::boundary::{Obstacle, obstacle_distance};
+use crate::boundary::{Obstacle, penalty};
 use crate::error::FemError;
 use crate::friction::FrictionContact;
 use anim_core::linalg::{CsrMatrix, LinearSolver, SystemMatrix, dot};
@@ -241,18 +241,15 @@ fn contact_terms(
         let p = [x[3 * i], x[3 * i + 1], x[3 * i + 2]];
         let mut block = [0.0; 9];
         for o in pot.obstacles {
-            let (phi, n) = obstacle_distance(o, p);
-            if phi < 0.0 {
-                energy += 0.5 * k * phi * phi;
+            if let Some((e, g_o, h_o)) = penalty(o, k, p) {
+                energy += e;
                 if let Some(g) = grad.as_deref_mut() {
                     for c in 0..3 {
-                        g[3 * i + c] += k * phi * n[c];
+                        g[3 * i + c] += g_o[c];
                     }
                 }
-                for r in 0..3 {
-                    for c in 0..3 {
-                        block[3 * r + c] += k * n[r] * n[c];
-                    }
+                for (b, h) in block.iter_mut().zip(h_o) {
+                    *b += h;
                 }
             }
         }

@@ -1,12 +1,10 @@
-//! Bodies from mesh files: the placement against the formula, free fall against the exact
-//! momentum balance, pins held, and every refusal naming its field and the file.
+//! One body from a mesh file: the placement against the formula, OBJ surfaces filled with
+//! tetrahedra of the right volume, and every refusal naming its field and the file.
 
 use super::*;
-use crate::kind::KIND;
-use anim_core::scene::{BuildContext, BuildError};
-use anim_core::solver::Solver;
+use crate::mesh::signed_volume6;
 
-fn testdata() -> PathBuf {
+pub(crate) fn testdata() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../anim-io/testdata")
 }
 
@@ -14,6 +12,7 @@ fn spec(value: serde_json::Value) -> BodySpec {
     serde_json::from_value(value).expect("a valid spec")
 }
 
+/// The Gmsh test cube with a material and the `extra` fields.
 fn cube(extra: serde_json::Value) -> BodySpec {
     let mut value = serde_json::json!({
         "mesh": "cube_v41.msh",
@@ -23,14 +22,61 @@ fn cube(extra: serde_json::Value) -> BodySpec {
     spec(value)
 }
 
-/// A folder of this test process with a one-tetrahedron TetGen mesh, positive or inverted.
-fn tetgen(test: &str, inverted: bool) -> PathBuf {
+/// A folder of this test process for `test`.
+pub(crate) fn folder(test: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("anim-fem-body-{}-{test}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temporary folder");
+    dir
+}
+
+/// A folder with a one-tetrahedron TetGen mesh, positive or inverted.
+fn tetgen(test: &str, inverted: bool) -> PathBuf {
+    let dir = folder(test);
     std::fs::write(dir.join("tet.node"), "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n").expect("node");
     let ele = if inverted { "1 4 0\n1 1 3 2 4\n" } else { "1 4 0\n1 1 2 3 4\n" };
     std::fs::write(dir.join("tet.ele"), ele).expect("ele");
     dir
+}
+
+/// The OBJ text of the box `[0, size]^3` as 12 outward triangles, without the triangles listed
+/// in `missing` (0-based).
+pub(crate) fn cube_obj(size: f64, missing: &[usize]) -> String {
+    let mut text = String::from("# a cube\n");
+    for k in 0..8 {
+        let c = [k & 1, (k >> 1) & 1, (k >> 2) & 1].map(|b| size * b as f64);
+        text.push_str(&format!("v {} {} {}\n", c[0], c[1], c[2]));
+    }
+    // Corners numbered by their (x, y, z) bits, from 1.
+    let faces = [
+        [1, 3, 4],
+        [1, 4, 2],
+        [5, 6, 8],
+        [5, 8, 7],
+        [1, 2, 6],
+        [1, 6, 5],
+        [3, 7, 8],
+        [3, 8, 4],
+        [1, 5, 7],
+        [1, 7, 3],
+        [2, 4, 8],
+        [2, 8, 6],
+    ];
+    for (t, f) in faces.iter().enumerate() {
+        if !missing.contains(&t) {
+            text.push_str(&format!("f {} {} {}\n", f[0], f[1], f[2]));
+        }
+    }
+    text
+}
+
+fn volume(mesh: &TetMesh) -> f64 {
+    mesh.tets
+        .iter()
+        .map(|t| {
+            let p = t.map(|v| mesh.positions[v]);
+            signed_volume6(p[0], p[1], p[2], p[3]) / 6.0
+        })
+        .sum()
 }
 
 #[test]
@@ -41,9 +87,9 @@ fn the_placement_scales_then_rotates_then_translates() {
         "rotate": [0.0, 0.0, std::f64::consts::FRAC_PI_2],
         "translate": [1.0, 2.0, 3.0],
     }))
-    .build(&testdata().join("cube_v41.msh"), ElementOrder::Linear)
-    .expect("builds");
-    let positions = &placed.model.mesh().positions;
+    .load(&testdata().join("cube_v41.msh"))
+    .expect("loads");
+    let positions = &placed.mesh.positions;
     assert_eq!(positions.len(), raw.positions.len());
     for (p, q) in raw.positions.iter().zip(positions) {
         // A quarter turn about z takes (x, y) to (-y, x).
@@ -52,66 +98,30 @@ fn the_placement_scales_then_rotates_then_translates() {
     }
 }
 
+/// A closed OBJ cube of side 1 on a lattice of cell 0.25 is filled exactly: 6 x 4^3
+/// tetrahedra of total volume 1, scaled by `scale^3`; the cell is in the file's units.
 #[test]
-fn a_falling_body_keeps_the_exact_momentum_balance() {
-    // The internal forces sum to zero, so backward Euler moves the centre of mass exactly as
-    // V_n = V_0 + n h g and X_n = X_0 + n h V_0 + h^2 g n (n + 1) / 2.
-    let v0 = [0.5, -0.25, 1.0];
-    let body = cube(serde_json::json!({ "velocity": v0 }));
-    let scene = body.build(&testdata().join("cube_v41.msh"), ElementOrder::Linear).expect("builds");
-    let mass = scene.model.lumped_mass().to_vec();
-    let (mut sim, mut state) = scene.into_simulation().expect("simulation");
-    let com = |x: &[f64]| {
-        let total: f64 = mass.iter().sum();
-        let mut c = [0.0; 3];
-        for (i, m) in mass.iter().enumerate() {
-            for k in 0..3 {
-                c[k] += m * x[3 * i + k] / total;
-            }
-        }
-        c
+fn an_obj_cube_is_filled_with_tetrahedra_of_its_volume() {
+    let dir = folder("obj-cube");
+    std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
+    let body = |scale: f64| {
+        cube(serde_json::json!({ "mesh": "cube.obj", "cell": 0.25, "scale": scale }))
+            .load(&dir.join("cube.obj"))
+            .expect("loads")
     };
-    let x0 = com(&state.x);
-    let (h, n) = (0.01, 50);
-    for _ in 0..n {
-        sim.step(&mut state, h).expect("step");
-    }
-    let g = EARTH_GRAVITY;
-    let nf = n as f64;
-    let x = com(&state.x);
-    for k in 0..3 {
-        let want = x0[k] + nf * h * v0[k] + h * h * g[k] * nf * (nf + 1.0) / 2.0;
-        assert!((x[k] - want).abs() < 1e-9, "axis {k}: {} vs {want}", x[k]);
-    }
-}
-
-#[test]
-fn pinned_vertices_stay_where_they_were_placed() {
-    let body = cube(serde_json::json!({
-        "translate": [0.0, 0.0, 1.0],
-        "pin": { "min": [-1.0, -1.0, 1.3], "max": [1.0, 1.0, 1.34] },
-    }));
-    let scene = body.build(&testdata().join("cube_v41.msh"), ElementOrder::Linear).expect("builds");
-    let x0 = scene.state.x.clone();
-    let bottom: Vec<usize> = (0..x0.len() / 3).filter(|&i| x0[3 * i + 2] < 1.34).collect();
-    assert_eq!(bottom.len(), 4, "the cube's four lower corners");
-    let (mut sim, mut state) = scene.into_simulation().expect("simulation");
-    for _ in 0..20 {
-        sim.step(&mut state, 0.01).expect("step");
-    }
-    for i in bottom {
-        assert_eq!(&state.x[3 * i..3 * i + 3], &x0[3 * i..3 * i + 3], "vertex {i} moved");
-    }
-    // The free (upper) corners sag under gravity.
-    for i in (0..x0.len() / 3).filter(|&i| x0[3 * i + 2] > 1.4) {
-        assert!(state.x[3 * i + 2] < x0[3 * i + 2] - 1e-4, "vertex {i} did not sag");
-    }
+    let unit = body(1.0);
+    assert_eq!(unit.mesh.tets.len(), 6 * 4 * 4 * 4);
+    assert!((volume(&unit.mesh) - 1.0).abs() < 1e-12, "{}", volume(&unit.mesh));
+    let half = body(0.5);
+    assert_eq!(half.mesh.tets.len(), 6 * 4 * 4 * 4);
+    assert!((volume(&half.mesh) - 0.125).abs() < 1e-12, "{}", volume(&half.mesh));
+    let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]
 fn refusals_name_the_field_and_the_file() {
     let cube_file = testdata().join("cube_v41.msh");
-    let refuse = |body: BodySpec, file: &Path| body.build(file, ElementOrder::Linear).expect_err("refused");
+    let refuse = |body: BodySpec, file: &Path| body.load(file).expect_err("refused");
     let e = refuse(cube(serde_json::json!({})), Path::new("/nowhere/body.msh"));
     assert_eq!(e.field, "mesh");
     assert!(e.message.contains("/nowhere/body.msh"), "{e}");
@@ -124,65 +134,65 @@ fn refusals_name_the_field_and_the_file() {
     assert!(e.message.contains("tet.ele") && e.message.contains("element 0"), "{e}");
     let e = refuse(cube(serde_json::json!({ "scale": 0.0 })), &cube_file);
     assert_eq!(e.field, "scale");
+    let mut turned = cube(serde_json::json!({}));
+    turned.rotate = [0.0, f64::NAN, 0.0];
+    assert_eq!(refuse(turned, &cube_file).field, "rotate");
     let e = refuse(
         cube(serde_json::json!({ "material": { "young": 1e4, "poisson": 0.5, "density": 1.0 } })),
         &cube_file,
     );
     assert_eq!(e.field, "material");
-    let e = refuse(
-        cube(serde_json::json!({ "pin": { "min": [5.0, 5.0, 5.0], "max": [6.0, 6.0, 6.0] } })),
-        &cube_file,
-    );
-    assert_eq!(e.field, "pin");
-    let boxed = serde_json::json!({ "obstacles": [
-        { "plane": { "point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0] } },
-        { "box": { "center": [0.0, 0.0, 0.0], "half_extents": [1.0, 1.0, 1.0] } },
-    ] });
-    let e = refuse(cube(boxed), &cube_file);
-    assert_eq!(e.field, "obstacles[1]");
+    let mut thrown = cube(serde_json::json!({}));
+    thrown.velocity = [0.0, f64::INFINITY, 0.0];
+    assert_eq!(refuse(thrown, &cube_file).field, "velocity");
+    let mut pinned = cube(serde_json::json!({ "pin": { "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 1.0] } }));
+    if let Some(pin) = &mut pinned.pin {
+        pin.max[2] = f64::NAN;
+    }
+    assert_eq!(refuse(pinned, &cube_file).field, "pin");
+    // `cell` is for surfaces only.
+    let e = refuse(cube(serde_json::json!({ "cell": 0.1 })), &cube_file);
+    assert_eq!(e.field, "cell");
+    assert!(e.message.contains("cube_v41.msh") && e.message.contains("OBJ"), "{e}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// An OBJ surface needs a positive `cell` that leaves a tetrahedron inside; an open surface is
+/// refused naming the file and an edge without a neighbour.
+#[test]
+fn obj_refusals_name_the_cell_or_the_file_and_the_edge() {
+    let dir = folder("obj-refusals");
+    std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
+    std::fs::write(dir.join("holed.obj"), cube_obj(1.0, &[5])).expect("obj");
+    let load = |file: &str, cell: Option<f64>| {
+        let mut extra = serde_json::json!({ "mesh": file });
+        if let Some(cell) = cell {
+            extra["cell"] = serde_json::json!(cell);
+        }
+        cube(extra).load(&dir.join(file)).expect_err("refused")
+    };
+    let e = load("cube.obj", None);
+    assert_eq!(e.field, "cell");
+    assert!(e.message.contains("cube.obj") && e.message.contains("give `cell`"), "{e}");
+    for bad in [0.0, -0.1] {
+        assert_eq!(load("cube.obj", Some(bad)).field, "cell");
+    }
+    let e = load("cube.obj", Some(10.0));
+    assert_eq!(e.field, "cell");
+    assert!(e.message.contains("cube.obj") && e.message.contains("too coarse"), "{e}");
+    let e = load("holed.obj", Some(0.25));
+    assert_eq!(e.field, "mesh");
+    assert!(e.message.contains("holed.obj") && e.message.contains("not closed"), "{e}");
+    assert!(e.message.contains("edge (") && e.message.contains("numbered from 0"), "{e}");
     let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]
-fn a_one_tetrahedron_tetgen_body_builds_from_either_file() {
+fn a_one_tetrahedron_tetgen_body_loads_from_either_file() {
     let dir = tetgen("either", false);
     for file in ["tet.node", "tet.ele"] {
-        let scene = cube(serde_json::json!({})).build(&dir.join(file), ElementOrder::Linear).expect("builds");
-        assert_eq!((scene.model.mesh().positions.len(), scene.model.mesh().tets.len()), (4, 1));
+        let body = cube(serde_json::json!({})).load(&dir.join(file)).expect("loads");
+        assert_eq!((body.mesh.positions.len(), body.mesh.tets.len()), (4, 1));
     }
     let _ = std::fs::remove_dir_all(dir);
-}
-
-#[test]
-fn the_fem_kind_takes_a_preset_or_a_body_and_names_the_field_it_refuses() {
-    let base = testdata();
-    let build = |value: serde_json::Value| (KIND.build)(&value, &BuildContext { base: Some(&base) });
-    let field = |e: BuildError| match e {
-        BuildError::Invalid { field, message } | BuildError::Schema { field, message } => (field, message),
-        other => panic!("unexpected {other}"),
-    };
-    let body = serde_json::json!({
-        "mesh": "cube_v41.msh",
-        "material": { "young": 5e4, "poisson": 0.3, "density": 1000.0 },
-    });
-    assert!(build(serde_json::json!({ "body": body })).is_ok());
-    assert!(build(serde_json::json!({ "body": body, "element": "tet10" })).is_ok());
-    let (f, m) = field(build(serde_json::json!({})).err().expect("refused"));
-    assert_eq!(f, "preset");
-    assert!(m.contains("`body` table"), "{m}");
-    assert_eq!(
-        field(build(serde_json::json!({ "preset": "twisted-bar", "body": body })).err().expect("x")).0,
-        "body"
-    );
-    assert_eq!(
-        field(build(serde_json::json!({ "body": body, "resolution": 3 })).err().expect("x")).0,
-        "resolution"
-    );
-    let missing = serde_json::json!({ "body": { "mesh": "missing.msh", "material": body["material"] } });
-    let (f, m) = field(build(missing).err().expect("x"));
-    assert_eq!(f, "body.mesh");
-    assert!(m.contains("missing.msh"), "{m}");
-    let typo =
-        serde_json::json!({ "body": { "mesh": "cube_v41.msh", "material": body["material"], "scal": 2.0 } });
-    assert!(field(build(typo).err().expect("x")).1.contains("scal"));
 }

@@ -1,0 +1,196 @@
+//! Several bodies of the user's own in one scene: each [`BodySpec`] is loaded, placed and
+//! checked, then the bodies are merged into one [`FemModel`] (the vertices of body `k` after
+//! those of bodies `0..k`, its elements of its own material) that shares the [`World`]: gravity,
+//! the obstacles with their penalty stiffness and friction, and Rayleigh damping.
+//!
+//! Bodies do not collide with each other (contact is vertex against obstacle only): where two
+//! bodies meet, they pass through each other.
+//!
+//! ```
+//! use anim_fem::bodies::{self, World};
+//! use anim_fem::body::BodySpec;
+//! use anim_fem::boundary::Obstacle;
+//! use anim_fem::model::ElementOrder;
+//!
+//! let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../anim-io/testdata");
+//! let body = |young: f64, x: f64| -> BodySpec {
+//!     serde_json::from_value(serde_json::json!({
+//!         "mesh": "cube_v41.msh",
+//!         "material": { "young": young, "poisson": 0.3, "density": 1000.0 },
+//!         "translate": [x, 0.0, 0.5],
+//!     }))
+//!     .expect("a body")
+//! };
+//! let world = World { obstacles: vec![Obstacle::ground(0.0)], ..World::default() };
+//! let scene = bodies::build(&[body(1e5, 0.0), body(1e6, 2.0)], &world, ElementOrder::Linear, |p| dir.join(p))?;
+//! assert_eq!(scene.model.materials().len(), 2);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use crate::body::{BodyError, BodySpec, finite3};
+use crate::boundary::Obstacle;
+use crate::mesh::TetMesh;
+use crate::model::{EARTH_GRAVITY, ElementOrder, FemModel};
+use crate::scenes::FemScene;
+use crate::sim::FemParams;
+use anim_core::integrate::State;
+
+/// What the bodies of a scene share.
+#[derive(Debug, Clone, PartialEq)]
+pub struct World {
+    /// Gravity (m/s²); default `(0, 0, -9.81)`.
+    pub gravity: [f64; 3],
+    /// Obstacles every body collides with (planes, spheres, boxes, capsules); default none.
+    pub obstacles: Vec<Obstacle>,
+    /// Penalty stiffness of the obstacles (N/m), positive; default `1e7`.
+    pub contact_stiffness: f64,
+    /// Coulomb friction coefficient against the obstacles, `>= 0`; default 0 (frictionless).
+    pub friction: f64,
+    /// Rayleigh stiffness damping `gamma` (s), `>= 0`; default 0.
+    pub rayleigh: f64,
+}
+
+/// The default penalty stiffness of the obstacles (N/m).
+pub const DEFAULT_CONTACT_STIFFNESS: f64 = 1e7;
+
+impl Default for World {
+    fn default() -> Self {
+        World {
+            gravity: EARTH_GRAVITY,
+            obstacles: Vec::new(),
+            contact_stiffness: DEFAULT_CONTACT_STIFFNESS,
+            friction: 0.0,
+            rayleigh: 0.0,
+        }
+    }
+}
+
+impl World {
+    /// Checks the scalars and the gravity, naming the field.
+    fn check(&self) -> Result<(), BodyError> {
+        finite3("gravity", self.gravity)?;
+        let positive = |x: f64| x > 0.0 && x.is_finite();
+        let non_negative = |x: f64| x >= 0.0 && x.is_finite();
+        if !positive(self.contact_stiffness) {
+            return Err(BodyError::new(
+                "contact_stiffness",
+                format!("must be positive and finite, got {}", self.contact_stiffness),
+            ));
+        }
+        if !non_negative(self.friction) {
+            return Err(BodyError::new(
+                "friction",
+                format!("must be finite and >= 0, got {}", self.friction),
+            ));
+        }
+        if !non_negative(self.rayleigh) {
+            return Err(BodyError::new(
+                "rayleigh",
+                format!("must be finite and >= 0, got {}", self.rayleigh),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The scene of `bodies` in `world` with `order` elements; `resolve` turns each body's
+/// [`mesh`](BodySpec::mesh) into the file to read (a scene file resolves it against its
+/// folder).
+///
+/// # Errors
+/// [`BodyError`] naming the field of the `[scene]` table: `bodies` for an empty list;
+/// `bodies[k].mesh`, `bodies[k].cell`, `bodies[k].material`, ... for the errors of
+/// [`BodySpec::load`]; `bodies[k].pin` for a pin box that holds no vertex of body `k`;
+/// `gravity`, `contact_stiffness`, `friction`, `rayleigh` for a value out of range;
+/// `obstacles[i]` for an invalid shape.
+pub fn build(
+    bodies: &[BodySpec],
+    world: &World,
+    order: ElementOrder,
+    resolve: impl Fn(&Path) -> PathBuf,
+) -> Result<FemScene, BodyError> {
+    if bodies.is_empty() {
+        return Err(BodyError::new("bodies", "give at least one body (a `[[scene.bodies]]` table)"));
+    }
+    world.check()?;
+    let mut positions = Vec::new();
+    let mut tets = Vec::new();
+    let mut materials = Vec::with_capacity(bodies.len());
+    let mut element_material = Vec::new();
+    // The first corner vertex of each body, and one past the last.
+    let mut starts = vec![0];
+    for (k, body) in bodies.iter().enumerate() {
+        let loaded = body.load(&resolve(&body.mesh)).map_err(|e| e.within(&format!("bodies[{k}]")))?;
+        let offset = positions.len();
+        let id = u32::try_from(k).map_err(|_| BodyError::new("bodies", "too many bodies"))?;
+        element_material.extend(std::iter::repeat_n(id, loaded.mesh.tets.len()));
+        tets.extend(loaded.mesh.tets.iter().map(|t| t.map(|v| v + offset)));
+        positions.extend(loaded.mesh.positions);
+        materials.push(loaded.material);
+        starts.push(positions.len());
+    }
+    let mesh = TetMesh { positions, tets };
+    let mut model = FemModel::with_materials(mesh, materials, element_material, order)
+        .map_err(|e| BodyError::new("bodies", e))?
+        .with_gravity(world.gravity);
+    let owner = node_bodies(&model, &starts);
+    for (k, body) in bodies.iter().enumerate() {
+        if let Some(pin) = body.pin {
+            let pinned: Vec<usize> = (0..model.vertices())
+                .filter(|&i| owner[i] == k && pin.contains(model.mesh().positions[i]))
+                .collect();
+            if pinned.is_empty() {
+                return Err(BodyError::new(
+                    format!("bodies[{k}].pin"),
+                    format!(
+                        "the pin box holds no vertex of body {k} ({}) after its placement",
+                        body.mesh.display()
+                    ),
+                ));
+            }
+            model.pin_vertices(&pinned).map_err(|e| BodyError::new(format!("bodies[{k}].pin"), e))?;
+        }
+    }
+    for (i, obstacle) in world.obstacles.iter().enumerate() {
+        model
+            .add_obstacle_with_friction(*obstacle, world.contact_stiffness, world.friction)
+            .map_err(|e| BodyError::new(format!("obstacles[{i}]"), e))?;
+    }
+    let x = model.rest_positions();
+    let v = owner.iter().flat_map(|&k| bodies[k].velocity).collect();
+    let params = FemParams::default().with_rayleigh(world.rayleigh);
+    Ok(FemScene {
+        name: "bodies",
+        description: "bodies from mesh files",
+        model,
+        state: State { t: 0.0, x, v },
+        dt: 1.0 / 120.0,
+        duration: 1.0,
+        params,
+    })
+}
+
+/// The body of every node of `model`: a corner vertex by the range of its body (`starts[k]..
+/// starts[k + 1]`), an edge node of a 10-node body by an element that holds it.
+fn node_bodies(model: &FemModel, starts: &[usize]) -> Vec<usize> {
+    let corners = starts.last().copied().unwrap_or(0);
+    let mut owner = vec![0; model.vertices()];
+    for k in 0..starts.len() - 1 {
+        owner[starts[k]..starts[k + 1]].fill(k);
+    }
+    if let Some(elements) = model.quadratic_elements() {
+        for (el, &m) in elements.iter().zip(model.element_material()) {
+            for &node in &el[4..] {
+                if node >= corners {
+                    owner[node] = m as usize;
+                }
+            }
+        }
+    }
+    owner
+}
+
+#[cfg(test)]
+mod tests;

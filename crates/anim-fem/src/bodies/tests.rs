@@ -1,0 +1,263 @@
+//! Several bodies in one model: the mass of each is its density times its volume, each element
+//! has its body's material (a soft bar sags more than a stiff one by their Young's ratio), the
+//! bodies move as if alone, pins hold, and every refusal of an `fem` scene names its field.
+
+use super::*;
+use crate::body::tests::{cube_obj, folder, testdata};
+use crate::kind::KIND;
+use crate::sim::{FemSimulation, TimeIntegrator};
+use anim_core::scene::{BuildContext, BuildError};
+use anim_core::solver::Solver;
+
+fn spec(value: serde_json::Value) -> BodySpec {
+    serde_json::from_value(value).expect("a valid spec")
+}
+
+/// The OBJ text of the box `[0, size]` as 12 outward triangles (the unit cube's, stretched).
+fn box_obj(size: [f64; 3]) -> String {
+    cube_obj(1.0, &[])
+        .lines()
+        .map(|line| match line.strip_prefix("v ") {
+            Some(coords) => {
+                let c: Vec<f64> = coords.split(' ').map(|x| x.parse().expect("number")).collect();
+                format!("v {} {} {}\n", c[0] * size[0], c[1] * size[1], c[2] * size[2])
+            }
+            None => format!("{line}\n"),
+        })
+        .collect()
+}
+
+/// The volume of the Gmsh test cube (anim-io's testdata README): 0.1 x 0.7 x 0.123456789 m.
+const TEST_CUBE_VOLUME: f64 = 0.1 * 0.7 * 0.123456789;
+
+/// The total lumped mass is `sum_k rho_k V_k` for 4- and 10-node elements, and each body's
+/// vertices carry its own `rho_k V_k`: a Gmsh box scaled by 2 (volume x 8) at 1000 kg/m³ and an
+/// OBJ cube of side 0.4 (scaled from 1) at 300 kg/m³.
+#[test]
+fn the_mass_of_each_body_is_its_density_times_its_volume() {
+    let dir = folder("bodies-mass");
+    std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
+    std::fs::copy(testdata().join("cube_v41.msh"), dir.join("cube_v41.msh")).expect("msh");
+    let bodies = [
+        spec(serde_json::json!({
+            "mesh": "cube_v41.msh",
+            "material": { "young": 1e5, "poisson": 0.3, "density": 1000.0 },
+            "scale": 2.0,
+        })),
+        spec(serde_json::json!({
+            "mesh": "cube.obj", "cell": 0.25, "scale": 0.4, "translate": [3.0, 0.0, 0.0],
+            "material": { "young": 1e6, "poisson": 0.45, "density": 300.0 },
+        })),
+    ];
+    let want = [1000.0 * 8.0 * TEST_CUBE_VOLUME, 300.0 * 0.4f64.powi(3)];
+    for order in [ElementOrder::Linear, ElementOrder::Quadratic] {
+        let scene = build(&bodies, &World::default(), order, |p| dir.join(p)).expect("builds");
+        let model = &scene.model;
+        let owner = node_bodies(model, &[0, 8, 8 + 125]);
+        let mut mass = [0.0; 2];
+        for (i, m) in model.lumped_mass().iter().enumerate() {
+            mass[owner[i]] += m;
+        }
+        for k in 0..2 {
+            assert!(
+                (mass[k] - want[k]).abs() < 1e-12 * want[k],
+                "{order:?} body {k}: {} vs {}",
+                mass[k],
+                want[k]
+            );
+        }
+        let total: f64 = model.lumped_mass().iter().sum();
+        assert!((total - want[0] - want[1]).abs() < 1e-12 * total, "{order:?}");
+        // The elements keep their body's material, in body order.
+        assert_eq!(model.materials().len(), 2);
+        let split = model.element_material().iter().position(|&m| m == 1).expect("body 1");
+        assert_eq!(split, 6, "the Gmsh cube has 6 tetrahedra");
+        assert!(model.element_material()[split..].iter().all(|&m| m == 1));
+        assert_eq!(model.elements(), 6 + 6 * 64);
+        assert_eq!((model.materials()[0].density, model.materials()[1].density), (1000.0, 300.0));
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// Two bars of the same mesh, clamped at `x = 0`, one four times stiffer, sag under a small load
+/// (g = 0.1 m/s²: deflections of a few millimetres over a metre, the linear regime): the soft
+/// bar's tip deflects four times as far (to 1e-3), solved quasi-statically in one model.
+#[test]
+fn a_soft_bar_sags_more_than_a_stiff_one_by_their_youngs_ratio() {
+    let dir = folder("bodies-bars");
+    std::fs::write(dir.join("bar.obj"), box_obj([1.0, 0.1, 0.1])).expect("obj");
+    let bar = |young: f64, y: f64| {
+        spec(serde_json::json!({
+            "mesh": "bar.obj", "cell": 0.05, "translate": [0.0, y, 1.0],
+            "material": { "young": young, "poisson": 0.3, "density": 1000.0 },
+            "pin": { "min": [-0.01, y - 0.01, 0.99], "max": [0.01, y + 0.11, 1.11] },
+        }))
+    };
+    let world = World { gravity: [0.0, 0.0, -0.1], ..World::default() };
+    let scene = build(&[bar(1e7, 0.0), bar(2.5e6, 0.5)], &world, ElementOrder::Linear, |p| dir.join(p))
+        .expect("builds");
+    let mut sim = FemSimulation::new(scene.model, scene.params.with_newton_tolerance(1e-12)).expect("sim");
+    let mut x = scene.state.x.clone();
+    sim.solve_static(&mut x, 1).expect("static solve");
+    // The sag of the tip (x = 1) of the bar at `y`: the mean downward displacement there.
+    let rest = &scene.state.x;
+    let sag = |y: f64| {
+        let tip: Vec<usize> = (0..rest.len() / 3)
+            .filter(|&i| (rest[3 * i] - 1.0).abs() < 1e-9 && (rest[3 * i + 1] - y).abs() < 0.2)
+            .collect();
+        assert_eq!(tip.len(), 9, "a 3 x 3 tip face");
+        tip.iter().map(|&i| rest[3 * i + 2] - x[3 * i + 2]).sum::<f64>() / tip.len() as f64
+    };
+    let (stiff, soft) = (sag(0.0), sag(0.5));
+    assert!(stiff > 1e-4 && soft < 0.02, "sags {stiff} and {soft}");
+    assert!((soft / stiff - 4.0).abs() < 4e-3, "ratio {} (sags {stiff}, {soft})", soft / stiff);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// Bodies do not touch: two bodies thrown in one model move, step by step and bit for bit, as
+/// each does alone (symplectic Euler, with the ground).
+#[test]
+fn each_body_moves_as_if_it_were_alone() {
+    let dir = testdata();
+    let body = |young: f64, x: f64, v: f64| {
+        spec(serde_json::json!({
+            "mesh": "cube_v41.msh", "translate": [x, 0.0, 0.0], "velocity": [v, 0.0, -1.0],
+            "material": { "young": young, "poisson": 0.3, "density": 1000.0 },
+        }))
+    };
+    let (a, b) = (body(1e5, 0.0, 0.5), body(4e5, 0.05, -0.5));
+    let world = World { obstacles: vec![Obstacle::ground(0.3)], friction: 0.2, ..World::default() };
+    let run = |bodies: &[BodySpec]| {
+        let mut scene = build(bodies, &world, ElementOrder::Linear, |p| dir.join(p)).expect("builds");
+        scene.params.integrator = TimeIntegrator::SymplecticEuler;
+        let (mut sim, mut state) = scene.into_simulation().expect("sim");
+        let mut lowest = f64::INFINITY;
+        for _ in 0..400 {
+            sim.step(&mut state, 2e-4).expect("step");
+            lowest = state.x.chunks(3).map(|p| p[2]).fold(lowest, f64::min);
+        }
+        (state.x, lowest)
+    };
+    let (both, lowest) = run(&[a.clone(), b.clone()]);
+    let ((alone_a, _), (alone_b, _)) = (run(&[a]), run(&[b]));
+    assert!(both[..24].iter().map(|z| z.to_bits()).eq(alone_a.iter().map(|z| z.to_bits())));
+    assert!(both[24..].iter().map(|z| z.to_bits()).eq(alone_b.iter().map(|z| z.to_bits())));
+    // The bodies overlap (they pass through each other) and have landed on the ground.
+    assert!(lowest < 0.3 + 1e-9, "lowest z {lowest}");
+}
+
+/// A pin box holds the vertices of its own body only, where they were placed.
+#[test]
+fn pins_hold_their_own_body() {
+    let dir = testdata();
+    let body = |x: f64, pin: bool| {
+        let mut value = serde_json::json!({
+            "mesh": "cube_v41.msh", "translate": [x, 0.0, 1.0],
+            "material": { "young": 5e4, "poisson": 0.3, "density": 1000.0 },
+        });
+        if pin {
+            // Around both bodies' lower faces (z = 1 + 1/3).
+            value["pin"] = serde_json::json!({ "min": [-1.0, -1.0, 1.3], "max": [2.0, 1.0, 1.34] });
+        }
+        spec(value)
+    };
+    let scene =
+        build(&[body(0.0, false), body(1.0, true)], &World::default(), ElementOrder::Linear, |p| dir.join(p))
+            .expect("builds");
+    let x0 = scene.state.x.clone();
+    let fixed = scene.model.fixed().to_vec();
+    let (mut sim, mut state) = scene.into_simulation().expect("sim");
+    for _ in 0..20 {
+        sim.step(&mut state, 0.01).expect("step");
+    }
+    for i in 0..16 {
+        let lower = x0[3 * i + 2] < 1.34;
+        assert_eq!(fixed[3 * i], i >= 8 && lower, "vertex {i}");
+        if i >= 8 && lower {
+            assert_eq!(&state.x[3 * i..3 * i + 3], &x0[3 * i..3 * i + 3], "vertex {i} moved");
+        } else {
+            assert!(state.x[3 * i + 2] < x0[3 * i + 2] - 1e-4, "vertex {i} did not move down");
+        }
+    }
+}
+
+fn field(e: BuildError) -> (String, String) {
+    match e {
+        BuildError::Invalid { field, message } | BuildError::Schema { field, message } => (field, message),
+        other => panic!("unexpected {other}"),
+    }
+}
+
+/// Through the `fem` kind: each refusal names the field of the `[scene]` table, and the file.
+#[test]
+fn the_fem_kind_names_the_field_it_refuses() {
+    let dir = folder("bodies-kind");
+    std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
+    std::fs::write(dir.join("holed.obj"), cube_obj(1.0, &[7])).expect("obj");
+    std::fs::copy(testdata().join("cube_v41.msh"), dir.join("cube_v41.msh")).expect("msh");
+    let build = |value: serde_json::Value| (KIND.build)(&value, &BuildContext { base: Some(&dir) });
+    let refused = |value: serde_json::Value| field(build(value).err().expect("refused"));
+    let material = serde_json::json!({ "young": 5e4, "poisson": 0.3, "density": 1000.0 });
+    let msh = serde_json::json!({ "mesh": "cube_v41.msh", "material": material });
+    let obj = serde_json::json!({ "mesh": "cube.obj", "cell": 0.5, "material": material });
+    let with = |base: &serde_json::Value, key: &str, value: serde_json::Value| {
+        let mut b = base.clone();
+        b[key] = value;
+        b
+    };
+    assert!(build(serde_json::json!({ "bodies": [msh, obj] })).is_ok());
+    assert!(build(serde_json::json!({ "bodies": [msh, obj], "element": "tet10" })).is_ok());
+    let boxes = serde_json::json!([
+        { "plane": { "point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0] } },
+        { "box": { "center": [0.0, 0.0, 0.0], "half_extents": [1.0, 1.0, 0.1] } },
+        { "capsule": { "a": [0.0, 0.0, 0.0], "b": [1.0, 0.0, 0.0], "radius": 0.1 } },
+    ]);
+    assert!(build(serde_json::json!({ "bodies": [msh], "obstacles": boxes, "friction": 0.3 })).is_ok());
+
+    // A pin box around body 0 only is empty for body 1.
+    let pin = serde_json::json!({ "min": [-0.31, 0.0, 0.3], "max": [-0.19, 0.72, 0.46] });
+    let (f, m) =
+        refused(serde_json::json!({ "bodies": [with(&msh, "pin", pin.clone()), with(&obj, "pin", pin)] }));
+    assert_eq!(f, "bodies[1].pin");
+    assert!(m.contains("body 1") && m.contains("cube.obj"), "{m}");
+    let (f, m) = refused(serde_json::json!({ "bodies": [msh, with(&obj, "mesh", "holed.obj".into())] }));
+    assert_eq!(f, "bodies[1].mesh");
+    assert!(m.contains("holed.obj") && m.contains("edge ("), "{m}");
+    let (f, m) = refused(serde_json::json!({ "bodies": [with(&msh, "cell", 0.1.into())] }));
+    assert_eq!(f, "bodies[0].cell");
+    assert!(m.contains("cube_v41.msh"), "{m}");
+    let mut no_cell = obj.clone();
+    no_cell.as_object_mut().expect("object").remove("cell");
+    let (f, m) = refused(serde_json::json!({ "bodies": [msh, no_cell] }));
+    assert_eq!(f, "bodies[1].cell");
+    assert!(m.contains("cube.obj"), "{m}");
+    let (f, m) = refused(serde_json::json!({ "bodies": [msh, with(&msh, "mesh", "missing.msh".into())] }));
+    assert_eq!(f, "bodies[1].mesh");
+    assert!(m.contains("missing.msh"), "{m}");
+    let bad_box =
+        serde_json::json!([{ "box": { "center": [0.0, 0.0, 0.0], "half_extents": [1.0, 0.0, 1.0] } }]);
+    assert_eq!(refused(serde_json::json!({ "bodies": [msh], "obstacles": bad_box })).0, "obstacles[0]");
+    for (key, value) in [("friction", -0.1), ("contact_stiffness", 0.0), ("rayleigh", -1.0)] {
+        let mut scene = serde_json::json!({ "bodies": [msh] });
+        scene[key] = value.into();
+        assert_eq!(refused(scene).0, key);
+    }
+    assert_eq!(refused(serde_json::json!({ "bodies": [] })).0, "bodies");
+    // Presets and bodies take their own fields.
+    let (f, m) = refused(serde_json::json!({ "preset": "soft-cube-drop", "obstacles": boxes }));
+    assert_eq!(f, "obstacles");
+    assert!(m.contains("goes with `bodies`"), "{m}");
+    assert_eq!(
+        refused(serde_json::json!({ "preset": "soft-cube-drop", "gravity": [0.0, 0.0, -1.0] })).0,
+        "gravity"
+    );
+    assert_eq!(refused(serde_json::json!({ "bodies": [msh], "resolution": 3 })).0, "resolution");
+    assert_eq!(refused(serde_json::json!({ "bodies": [msh], "preset": "twisted-bar" })).0, "bodies");
+    let (f, m) = refused(serde_json::json!({}));
+    assert_eq!(f, "preset");
+    assert!(m.contains("`bodies`"), "{m}");
+    // Unknown fields: a typo in a body, the one-body table of old.
+    assert!(refused(serde_json::json!({ "bodies": [with(&msh, "scal", 2.0.into())] })).1.contains("scal"));
+    assert!(refused(serde_json::json!({ "body": msh })).1.contains("body"));
+    let _ = std::fs::remove_dir_all(dir);
+}
