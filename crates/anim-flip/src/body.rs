@@ -41,7 +41,6 @@
 //!
 //! [`scenes::fill_box`]: crate::scenes::fill_box
 
-mod closed;
 mod region;
 mod scene;
 #[cfg(test)]
@@ -180,11 +179,6 @@ fn rounded(v: &[f64]) -> Vec<f64> {
     v.iter().map(|x| (x * 1e9).round() / 1e9).collect()
 }
 
-/// A point of a `D`-dimensional scene as a 3D one (z = 0 in 2D).
-fn point3<const D: usize>(p: [f64; D]) -> [f64; 3] {
-    std::array::from_fn(|k| if k < D { p[k] } else { 0.0 })
-}
-
 /// The scene of `params.bodies` in `D` dimensions (`params.dim`, 3 when absent): the simulation
 /// in its tank of `resolution` cells across, its obstacles marked solid, and the bodies'
 /// particles (in the simulation's frame, whose origin is the outer corner of the walls).
@@ -211,7 +205,7 @@ pub fn build<const D: usize>(
     flip.gravity = vector::<D>("gravity", params.gravity.unwrap_or(GRAVITY))?;
     let h = 1.0 / res as f64;
     let mut sim =
-        FlipSimulation::new([res + 2; D], h, flip).map_err(|e| invalid("transfer", e.to_string()))?;
+        FlipSimulation::new([res + 2; D], h, flip).map_err(|e| invalid("resolution", e.to_string()))?;
     let (origin, _) = sim.fluid_box();
     let obstacles = obstacles::<D>(params, context)?;
     mark_solid(&mut sim, &obstacles)?;
@@ -253,20 +247,15 @@ fn mark_solid<const D: usize>(
     let mut solid = sim.solid().to_vec();
     for (field, region) in obstacles {
         // The inner cells whose centres may lie in the region's bounds.
-        let range: [(usize, usize); D] = std::array::from_fn(|a| {
-            let lo = ((region.lo[a] / h - 0.5).floor().max(0.0) as usize).min(n[a] - 3);
-            let hi = ((region.hi[a] / h - 0.5).ceil().max(0.0) as usize).min(n[a] - 3);
-            (lo, hi)
-        });
+        let (start, counts) = index_box::<D>(region, h, [n[0] - 2; D]);
+        let inside = region.inside_lattice(start, counts, h).map_err(|e| invalid(field.as_str(), e))?;
         let mut covered = 0usize;
-        for_each_index(range, |idx| {
-            let centre: [f64; D] = std::array::from_fn(|a| (idx[a] as f64 + 0.5) * h);
-            if region.contains(point3(centre)) {
-                // Inner cell idx is grid cell idx + 1 (past the wall).
-                solid[flatten(n, std::array::from_fn(|a| idx[a] + 1))] = true;
-                covered += 1;
-            }
-        });
+        for (f, _) in inside.iter().enumerate().filter(|(_, i)| **i) {
+            let idx = unflatten(counts, f);
+            // Inner cell `start + idx` is grid cell `start + idx + 1` (past the wall).
+            solid[flatten(n, std::array::from_fn(|a| start[a] + idx[a] + 1))] = true;
+            covered += 1;
+        }
         if covered == 0 {
             return Err(invalid(
                 field.as_str(),
@@ -282,17 +271,16 @@ fn mark_solid<const D: usize>(
     Ok(())
 }
 
-/// Calls `f` with every index of the box `range` (inclusive per axis; empty when a low end
-/// exceeds its high end), x fastest.
-fn for_each_index<const D: usize>(range: [(usize, usize); D], mut f: impl FnMut([usize; D])) {
-    if range.iter().any(|(lo, hi)| lo > hi) {
-        return;
-    }
-    let counts: [usize; D] = std::array::from_fn(|a| range[a].1 - range[a].0 + 1);
-    for i in 0..counts.iter().product() {
-        let local = unflatten(counts, i);
-        f(std::array::from_fn(|a| range[a].0 + local[a]))
-    }
+/// The box of lattice points `(i + 1/2) spacing`, `i < len` per axis, that may lie in the
+/// region's bounds: its first index and its extent per axis (at least 1, clamped to the lattice).
+fn index_box<const D: usize>(region: &Region, spacing: f64, len: [usize; D]) -> ([usize; D], [usize; D]) {
+    let start: [usize; D] =
+        std::array::from_fn(|a| ((region.lo[a] / spacing - 0.5).floor().max(0.0) as usize).min(len[a] - 1));
+    let counts = std::array::from_fn(|a| {
+        let end = ((region.hi[a] / spacing - 0.5).ceil().max(0.0) as usize).min(len[a] - 1);
+        end.max(start[a]) - start[a] + 1
+    });
+    (start, counts)
 }
 
 /// The particles of the bodies: the lattice points of the presets inside each body, each point
@@ -341,33 +329,29 @@ fn seed<const D: usize>(
                 ),
             ));
         }
-        let range: [(usize, usize); D] = std::array::from_fn(|a| {
-            let lo = ((region.lo[a] / spacing - 0.5).floor().max(0.0) as usize).min(counts[a] - 1);
-            let hi = ((region.hi[a] / spacing - 0.5).ceil().max(0.0) as usize).min(counts[a] - 1);
-            (lo, hi)
-        });
+        let (start, box_counts) = index_box::<D>(&region, spacing, counts);
+        let lattice = region.inside_lattice(start, box_counts, spacing).map_err(|e| invalid(&name, e))?;
         let (mut inside, mut earlier, mut solid) = (0usize, 0usize, 0usize);
         let before = particles.len();
-        for_each_index(range, |idx| {
-            let local: [f64; D] = std::array::from_fn(|a| (idx[a] as f64 + 0.5) * spacing);
-            if !region.contains(point3(local)) {
-                return;
-            }
+        for (f, _) in lattice.iter().enumerate().filter(|(_, i)| **i) {
             inside += 1;
+            let local = unflatten(box_counts, f);
+            let idx: [usize; D] = std::array::from_fn(|a| start[a] + local[a]);
             let slot = &mut taken[flatten(counts, idx)];
             if *slot {
                 earlier += 1;
-                return;
+                continue;
             }
             *slot = true;
-            let x: [f64; D] = std::array::from_fn(|a| origin[a] + local[a]);
+            // The presets' lattice point, `fill_box`'s arithmetic from the tank's inside corner.
+            let x: [f64; D] = std::array::from_fn(|a| origin[a] + (idx[a] as f64 + 0.5) * spacing);
             let cell: [usize; D] = std::array::from_fn(|a| ((x[a] / h) as usize).min(n[a] - 1));
             if sim.solid()[flatten(n, cell)] {
                 solid += 1;
-                return;
+                continue;
             }
             particles.push(x, velocity);
-        });
+        }
         if inside == 0 {
             return Err(invalid(
                 name,

@@ -8,6 +8,11 @@
 //! | `smoke-plume-3d` | hot smoke rising around a sphere, open top | 3D MAC grid, MacCormack + MGPCG |
 //! | `lid-driven-cavity` | the Re = 100 cavity stirring bands of dye | 2D MAC grid, MacCormack + MGPCG |
 //!
+//! Without `preset`, a scene file is a smoke scene of the user's own ([`crate::smoke`]): the MAC
+//! solver on a box of the file's `size` and `resolution` (2D or 3D), smoke from its `sources`
+//! around its `obstacles`, each a collider shape or a closed OBJ surface, with the plume's
+//! settings as defaults ([`FluidSceneParams`] lists every field).
+//!
 //! A scene is the [`FluidScene`] itself stepped as a [`Solver`] whose state is the run's clock:
 //! the sum of the steps' `dt` in `f64` (Stam's solver keeps its own time in sums of the
 //! `f32` step). Its frames have no points: the fields `"density"` (1 per cell) and

@@ -34,7 +34,9 @@
 //! ([`kind`]): the presets `smoke-box-2d` (Stam's solver), `smoke-plume-3d` and
 //! `lid-driven-cavity` (the MAC solver), built from their scene-file parameters
 //! ([`kind::FluidSceneParams`]: preset, resolution, pressure solver and tolerance, advection,
-//! splitting), checkpointed and drawn as density and velocity fields on an image grid.
+//! splitting), checkpointed and drawn as density and velocity fields on an image grid. Without a
+//! preset, a scene file builds a smoke scene of its own ([`smoke`]): the MAC solver on a box of
+//! its size, with sources and obstacles of collider shapes or closed OBJ surfaces.
 //!
 //! ## Which solver
 //!

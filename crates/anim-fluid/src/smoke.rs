@@ -37,7 +37,6 @@
 //! ```
 
 mod region;
-pub(crate) mod surface_standin;
 #[cfg(test)]
 mod tests;
 

@@ -37,12 +37,12 @@ use std::path::{Path, PathBuf};
 
 use anim_core::glam::DVec3;
 use anim_core::scene::{BuildContext, BuildError, Placement, is_default};
+use anim_core::surface::ClosedSurface;
 use anim_io::obj::{Polygons, read_obj};
 use serde::{Deserialize, Serialize};
 
 use crate::kind::MpmSceneParams;
 use crate::scenes::{MpmScene, Scene};
-use crate::surface::ClosedSurface;
 use crate::{Collider, Material, MpmError, MpmParams, MpmSimulation, Particles, Shape};
 
 /// Grid cells per axis of a scene of bodies without `resolution`.
@@ -334,11 +334,20 @@ impl Region {
 
     /// The lattice points inside the region: the cell centres of the `counts` cells `spacing`
     /// wide from `lo` (first `D` axes) that lie inside.
-    fn points<const D: usize>(&self, lo: [f64; 3], counts: [usize; D], spacing: f64) -> Vec<[f64; D]> {
-        if let Region::Surface(s) = self {
-            return s.sample_inside(spacing).into_iter().map(|p| std::array::from_fn(|a| p[a])).collect();
-        }
-        let Region::Solid { shape, placement } = self else { return Vec::new() };
+    fn points<const D: usize>(
+        &self,
+        lo: [f64; 3],
+        counts: [usize; D],
+        spacing: f64,
+    ) -> Result<Vec<[f64; D]>, String> {
+        let (shape, placement) = match self {
+            Region::Surface(s) => {
+                // The same cells, laid from the lower corner of the surface's bounds.
+                let points = s.sample_inside(spacing).map_err(|e| e.to_string())?;
+                return Ok(points.into_iter().map(|p| std::array::from_fn(|a| p[a])).collect());
+            }
+            Region::Solid { shape, placement } => (shape, placement),
+        };
         // The lattice point in the shape's own frame: the placement undone.
         let r = placement.rotation().transpose();
         let t = DVec3::from_array(placement.translate);
@@ -369,7 +378,7 @@ impl Region {
                 out.push(x);
             }
         }
-        out
+        Ok(out)
     }
 }
 
@@ -440,7 +449,8 @@ impl Lattice {
                 ),
             ));
         }
-        let points = region.points::<D>(lo, counts, self.spacing);
+        let points =
+            region.points::<D>(lo, counts, self.spacing).map_err(|e| BuildError::invalid(body.clone(), e))?;
         if points.is_empty() {
             return Err(BuildError::invalid(
                 body,

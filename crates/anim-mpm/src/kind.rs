@@ -27,7 +27,7 @@
 //!     "bodies": [
 //!         { "shape": { "box": { "center": [0.5, 0.6, 0.5], "half_extents": [0.1, 0.1, 0.1] } },
 //!           "material": { "snow": {} } },
-//!         { "shape": { "sphere": { "center": [0.25, 0.7, 0.5], "radius": 0.08 } },
+//!         { "shape": { "sphere": { "center": [0.3, 0.7, 0.5], "radius": 0.08 } },
 //!           "material": { "elastic": { "young": 2e4 } }, "velocity": [1.0, 0.0, 0.0] },
 //!     ],
 //! });
@@ -443,7 +443,8 @@ impl<const D: usize> View for MpmRun<D> {
     /// Particles as discs of half a cell; the tank of the domain's walls, the colliders; the
     /// region of the particles of `state`, widened sideways by a third of its size and extended
     /// down along -z by its size. A scene of bodies ([`MpmRun::framed_by_walls`]) frames the
-    /// tank instead, and in 3D with gravity mostly along -z has its bottom wall as the ground.
+    /// tank instead; in 3D with gravity mostly along -z only up to the highest apex a particle
+    /// thrown up reaches (plus a cell), with the bottom wall drawn as the ground.
     fn context(&self, state: &Particles<D>) -> Context {
         let params = self.sim.params();
         let cell = params.size / params.resolution as f64;
@@ -454,12 +455,25 @@ impl<const D: usize> View for MpmRun<D> {
         context.point_dim = 3;
         context.point_radius = 0.5 * cell;
         let tank = tank(params, D);
+        let g = params.gravity;
+        let falls_along_z = D == 3 && -g[2] > g[0].abs().max(g[1].abs());
         context.bounds = Some(match tank {
-            Prop::Tank { lo, hi } if self.walls_framed => (lo, hi),
+            Prop::Tank { lo, mut hi } if self.walls_framed => {
+                if falls_along_z {
+                    // Nothing rises above the highest apex of a particle thrown up.
+                    let apex = display
+                        .points
+                        .chunks_exact(3)
+                        .zip(state.v.chunks_exact(D))
+                        .map(|(x, v)| x[2] + f64::from(v[D - 1].max(0.0)).powi(2) / (-2.0 * g[2]))
+                        .fold(lo[2], f64::max);
+                    hi[2] = hi[2].min(apex + cell);
+                }
+                (lo, hi)
+            }
             _ => anim_core::scene::frame_box(&display.points, None, true),
         });
-        let g = params.gravity;
-        if self.walls_framed && D == 3 && -g[2] > g[0].abs().max(g[1].abs()) {
+        if self.walls_framed && falls_along_z {
             context.props.push(Prop::Ground { height: params.wall_nodes as f64 * params.h() });
         }
         context.props.push(tank);

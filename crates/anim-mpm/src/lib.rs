@@ -130,7 +130,6 @@ pub mod plasticity;
 pub mod scenes;
 mod sim;
 mod simd;
-mod surface;
 mod transfer;
 
 #[cfg(test)]

@@ -48,6 +48,14 @@
 //! [`PbdSimulation::set_body_target`](crate::PbdSimulation::set_body_target)). Within a step the
 //! pose moves linearly from its start to its end; substeps see the interpolated pose and friction
 //! acts relative to the body's velocity at the contact point (`x^obs, v^obs`).
+//!
+//! # Contacts between bodies
+//!
+//! Particles do not collide with each other, except across **contact bodies**
+//! ([`PbdBuilder::contact_body`](crate::PbdBuilder::contact_body)): a range of particles with the
+//! triangles of its surface. Every particle of a contact body is tested against the surface
+//! triangles of the other contact bodies (not its own: there is no self-collision), with the
+//! thickness and friction of [`BodyContact`]; `sim/body_contacts.rs` has the constraint.
 
 use anim_core::glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
@@ -276,6 +284,44 @@ impl Collider {
             return Err(format!("body {b} does not exist (the model has {bodies} kinematic bodies)"));
         }
         Ok(c)
+    }
+}
+
+/// The contact parameters between contact bodies
+/// ([`PbdBuilder::contact_body`](crate::PbdBuilder::contact_body)), set with
+/// [`PbdBuilder::body_contact`](crate::PbdBuilder::body_contact).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BodyContact {
+    /// Distance kept between a particle of one body and the surface of another (m, > 0).
+    /// Default `0.005`.
+    pub thickness: f64,
+    /// Static friction coefficient `mu_s >= 0` between bodies. Default 0.
+    pub static_friction: f64,
+    /// Kinetic friction coefficient `mu_k >= 0` between bodies. Default 0.
+    pub kinetic_friction: f64,
+}
+
+impl Default for BodyContact {
+    fn default() -> Self {
+        Self { thickness: 0.005, static_friction: 0.0, kinetic_friction: 0.0 }
+    }
+}
+
+impl BodyContact {
+    /// Checks the parameters; the reason on failure.
+    pub(crate) fn validate(&self) -> Result<(), String> {
+        if !(self.thickness > 0.0 && self.thickness.is_finite()) {
+            return Err(format!("thickness must be positive and finite, got {}", self.thickness));
+        }
+        let nonneg = |v: f64| v >= 0.0 && v.is_finite();
+        if !nonneg(self.static_friction) || !nonneg(self.kinetic_friction) {
+            return Err(format!(
+                "friction coefficients must be non-negative and finite, got {} and {}",
+                self.static_friction, self.kinetic_friction
+            ));
+        }
+        Ok(())
     }
 }
 

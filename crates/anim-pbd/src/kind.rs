@@ -10,8 +10,34 @@
 //! | `pbd-rope` | [`rope`](crate::scenes::rope): 100 links swinging over a capsule onto a box | 120 frames of 1/60 s |
 //! | `pbd-cloth` | [`hanging_cloth`](crate::scenes::hanging_cloth): the report's 14 x 14 cloth | 30 frames of 1/60 s |
 //!
-//! A scene file's `[scene]` table (`kind = "pbd"`) holds the fields of [`PbdSceneParams`]. The
-//! scene is a [`PbdSimulation`] with its [`State`]: it implements [`Checkpoint`] (the state and
+//! A scene file's `[scene]` table (`kind = "pbd"`) holds the fields of [`PbdSceneParams`]: a
+//! `preset` above, or the user's own `bodies` ([`BodySpec`], one `[[scene.bodies]]` table each):
+//! soft bodies from tetrahedral meshes (Gmsh `.msh`, TetGen `.node`/`.ele`, or a closed OBJ
+//! surface filled with tetrahedra) and cloths from OBJ surfaces, each with its material
+//! ([`BodyMaterial`]), placement, initial velocity and pins ([`PinSpec`]), among `obstacles`
+//! (anim-core's [`Shape`](crate::Shape): plane, sphere, box, capsule) with a scene-wide
+//! friction, restitution and thickness. The bodies collide with the obstacles and with each other
+//! (particles against the other bodies' surfaces; a body does not collide with itself).
+//!
+//! ```toml
+//! [scene]
+//! kind = "pbd"
+//! obstacles = [ { plane = { point = [0, 0, 0], normal = [0, 0, 1] } } ]
+//! friction = 0.5
+//!
+//! [[scene.bodies]]
+//! mesh = "assets/torus.msh"                  # soft: a tetrahedral mesh
+//! material = { density = 200.0, stretch = { compliance = 1e-4 } }
+//! translate = [0.0, 0.0, 0.11]
+//!
+//! [[scene.bodies]]
+//! mesh = "assets/cloth.obj"                  # cloth: an OBJ surface
+//! material = { density = 0.2, bending = { isometric = { compliance = 1.0 } } }
+//! translate = [0.0, 0.0, 0.5]
+//! pin = { vertices = [0, 40] }
+//! ```
+//!
+//! The scene is a [`PbdSimulation`] with its [`State`]: it implements [`Checkpoint`] (the state and
 //! the simulation's memory: step count, external forces, pending body targets) and [`View`]
 //! (the particles and their velocities; the model's triangles, or the boundary of its
 //! tetrahedra, its edges and tetrahedra, the particles of zero inverse mass as pins, and the
@@ -28,6 +54,13 @@ use anim_core::scene::{
 };
 use serde::{Deserialize, Serialize};
 
+mod bodies;
+mod body;
+mod surface;
+
+pub use bodies::{DEFAULT_ITERATIONS, DEFAULT_SUBSTEPS, DEFAULT_THICKNESS};
+pub use body::{BodyMaterial, BodySpec, BodyType, PinBox, PinSpec};
+
 /// The `pbd` scene kind of anim-pbd, for the workspace registry.
 pub const KIND: SceneKind = SceneKind {
     kind: "pbd",
@@ -42,28 +75,58 @@ pub const KIND: SceneKind = SceneKind {
 pub const MAX_PBD_COUNT: usize = 100_000;
 
 /// Scene-file parameters of a `pbd` scene: a preset of [`scenes`] with its own solver settings
-/// unless overridden.
+/// unless overridden, or the user's own bodies among obstacles (give `preset` or `bodies`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PbdSceneParams {
     /// The preset's name: `cloth-drape`, `flag`, `rope`, `soft-blob`, `balloon`,
-    /// `hanging-cloth` or `benchmark-cloth` ([`scenes::NAMES`]). Required.
-    pub preset: String,
+    /// `hanging-cloth` or `benchmark-cloth` ([`scenes::NAMES`]). Required unless `bodies` is
+    /// given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
     /// Resolution (the preset's default when absent): the cloth's side (2 to 1024, default 32;
     /// 14 for the hanging cloth; 50 for the benchmark cloth), the flag's width (3 to 512,
     /// default 24), the rope's links (2 to 100,000, default 100), the blob's cells (2 to 40,
-    /// default 6), the balloon's subdivisions (0 to 6, default 3).
+    /// default 6), the balloon's subdivisions (0 to 6, default 3). Presets only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
-    /// `"pbd"` (stiffness) or `"xpbd"` (compliance); the preset's when absent.
+    /// `"pbd"` (stiffness) or `"xpbd"` (compliance); the preset's when absent, `"xpbd"` for
+    /// bodies.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub method: Option<Method>,
-    /// Solver iterations per substep, 1 to [`MAX_PBD_COUNT`] (the preset's when absent).
+    /// Solver iterations per substep, 1 to [`MAX_PBD_COUNT`] (the preset's when absent,
+    /// [`DEFAULT_ITERATIONS`] for bodies).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub iterations: Option<usize>,
-    /// Substeps per step, 1 to [`MAX_PBD_COUNT`] (the preset's when absent).
+    /// Substeps per step, 1 to [`MAX_PBD_COUNT`] (the preset's when absent, [`DEFAULT_SUBSTEPS`]
+    /// for bodies).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub substeps: Option<usize>,
+    /// The user's bodies, instead of a preset: soft bodies and cloths ([`BodySpec`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bodies: Vec<BodySpec>,
+    /// Static obstacles the bodies collide with: anim-core's shapes (`plane`, `sphere`, `box`,
+    /// `capsule`), all of which PBD takes; a plane is a solid half-space. Default none. Bodies
+    /// only.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacles: Vec<crate::Shape>,
+    /// Friction coefficient (static and kinetic) against the obstacles and between bodies,
+    /// `>= 0`. Default 0. Bodies only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
+    /// Coefficient of restitution against the obstacles, in `[0, 1]`. Default 0. Bodies only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub restitution: Option<f64>,
+    /// Distance kept between particles and the obstacles, and between a body's particles and
+    /// another body's surface (m, > 0). Default [`DEFAULT_THICKNESS`]. Bodies only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness: Option<f64>,
+    /// Gravity (m/s^2). Default `[0, 0, -9.81]`. Bodies only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<[f64; 3]>,
+    /// Whether the bodies collide with each other. Default `true`. Bodies only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_contacts: Option<bool>,
 }
 
 /// The step of every preset: 1/60 s.
@@ -93,7 +156,7 @@ fn presets() -> Vec<Preset> {
 }
 
 /// Builds a `pbd` scene from its parameters ([`PbdSceneParams`]).
-fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
+fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dyn DynScene>, BuildError> {
     let p: PbdSceneParams = params(value)?;
     for (field, count) in [("iterations", p.iterations), ("substeps", p.substeps)] {
         if let Some(k) = count
@@ -102,13 +165,33 @@ fn build(value: &serde_json::Value, _: &BuildContext<'_>) -> Result<Box<dyn DynS
             return Err(BuildError::invalid(field, format!("must lie in [1, {MAX_PBD_COUNT}], got {k}")));
         }
     }
-    let mut scene = match scenes::by_name(&p.preset, p.resolution) {
+    let preset = match (&p.preset, p.bodies.is_empty()) {
+        (Some(_), false) => {
+            return Err(BuildError::invalid("preset", "give `preset` or `bodies`, not both"));
+        }
+        (None, true) => {
+            return Err(BuildError::invalid(
+                "preset",
+                format!(
+                    "a pbd scene needs a `preset` (one of {}) or `bodies` ([[scene.bodies]] tables)",
+                    scenes::NAMES.join(", ")
+                ),
+            ));
+        }
+        (None, false) => {
+            let (sim, state) = bodies::build_bodies(&p, context)?;
+            return Ok(Simulated::new(sim, state).boxed());
+        }
+        (Some(preset), true) => preset,
+    };
+    bodies::refuse_body_fields(&p)?;
+    let mut scene = match scenes::by_name(preset, p.resolution) {
         Some(Ok(scene)) => scene,
         Some(Err(e)) => return Err(BuildError::invalid("resolution", e.to_string())),
         None => {
             return Err(BuildError::invalid(
                 "preset",
-                format!("unknown preset `{}` (one of {})", p.preset, scenes::NAMES.join(", ")),
+                format!("unknown preset `{}` (one of {})", preset, scenes::NAMES.join(", ")),
             ));
         }
     };
@@ -318,8 +401,11 @@ fn tolerance_adapter(
     family: &Family,
 ) -> Result<Box<dyn StudyAdapter>, String> {
     let p: PbdSceneParams = params(value).map_err(study::unreadable)?;
-    let scene = scenes::by_name(&p.preset, p.resolution)
-        .ok_or_else(|| format!("--tolerance: unknown pbd preset `{}`", p.preset))?
+    let Some(preset) = &p.preset else {
+        return Err("--tolerance: the pbd studies measured the presets, not a scene of its own bodies".into());
+    };
+    let scene = scenes::by_name(preset, p.resolution)
+        .ok_or_else(|| format!("--tolerance: unknown pbd preset `{preset}`"))?
         .map_err(study::unreadable)?;
     // The cloth's side in particles (the scene and the study's cloths are square).
     let side = ((scene.state.x.len() / 3) as f64).sqrt();
@@ -331,5 +417,7 @@ fn tolerance_adapter(
     }))
 }
 
+#[cfg(test)]
+mod bodies_tests;
 #[cfg(test)]
 mod tests;

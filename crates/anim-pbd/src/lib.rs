@@ -176,10 +176,10 @@ pub use build::{
     Bending, BuildError, Chain, Cloth, ClothHandle, EARTH_GRAVITY, InputError, MeshMass, MeshParams,
     PbdBuilder, TetMeshParams,
 };
-pub use collide::{BodyMotion, Collider, KinematicBody, Pose, Shape};
+pub use collide::{BodyContact, BodyMotion, Collider, KinematicBody, Pose, Shape};
 pub use constraint::{AttachTarget, Constraint, ConstraintFunction, ConstraintParams, ConstraintType};
 pub use kind::KIND;
-pub use model::{Particle, PbdModel, SparseGradient, VolumeMesh, Wind};
+pub use model::{ContactBody, Particle, PbdModel, SparseGradient, VolumeMesh, Wind};
 pub use sim::{Method, PbdError, PbdParams, PbdSimulation, SolverKind, StepInfo};
 
 #[cfg(test)]

@@ -9,7 +9,7 @@
 //! time `t` (which drives the kinematic bodies). The model never holds positions; it reads them
 //! from the state it is handed.
 
-use crate::collide::{Collider, KinematicBody};
+use crate::collide::{BodyContact, Collider, KinematicBody};
 use crate::constraint::{AttachTarget, Constraint, ConstraintFunction, load};
 use anim_core::glam::DVec3;
 use anim_core::integrate::State;
@@ -68,6 +68,20 @@ impl VolumeMesh {
     }
 }
 
+/// A body whose particles collide with the surfaces of the other contact bodies, and whose
+/// surface their particles collide with ([`PbdBuilder::contact_body`](crate::PbdBuilder::contact_body)).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ContactBody {
+    /// Its particles: model indices `particles.0 .. particles.1`.
+    pub particles: (usize, usize),
+    /// Its surface triangles, as model particle indices within its range.
+    pub triangles: Vec<[usize; 3]>,
+    /// A closed surface, oriented outward: a particle is pushed out along the outward normal
+    /// (one-sided, so a particle that went inside comes back out). Otherwise the surface is
+    /// two-sided (cloth): a particle stays on the side it was on at the start of the substep.
+    pub closed: bool,
+}
+
 /// A uniform wind acting on the model's triangles: each triangle of area `A` and unit normal `n`
 /// moving with the mean velocity `u` of its vertices feels `f = drag A ((w - u) . n) n`, shared
 /// equally by its three vertices (the usual cloth wind model; Provot 1995).
@@ -100,6 +114,8 @@ pub struct PbdModel {
     pub(crate) triangles: Vec<[usize; 3]>,
     pub(crate) edges: Vec<[usize; 2]>,
     pub(crate) tets: Vec<[usize; 4]>,
+    pub(crate) contact_bodies: Vec<ContactBody>,
+    pub(crate) body_contact: BodyContact,
     /// Constraints incident to each particle: `inc[inc_ptr[p]..inc_ptr[p + 1]]` as
     /// `(constraint, slot)` in increasing constraint order (slot: position in the index set).
     pub(crate) inc_ptr: Vec<usize>,
@@ -201,6 +217,18 @@ impl PbdModel {
     #[must_use]
     pub fn tets(&self) -> &[[usize; 4]] {
         &self.tets
+    }
+
+    /// The contact bodies, whose particles collide with each other's surfaces.
+    #[must_use]
+    pub fn contact_bodies(&self) -> &[ContactBody] {
+        &self.contact_bodies
+    }
+
+    /// The contact parameters between contact bodies.
+    #[must_use]
+    pub fn body_contact(&self) -> BodyContact {
+        self.body_contact
     }
 
     /// The rest state: rest positions, zero velocities, `t = 0`.

@@ -101,7 +101,7 @@ pub(crate) struct Ctx<'a> {
 
 impl Ctx<'_> {
     #[cold]
-    fn flag(&self, id: u32) {
+    pub(crate) fn flag(&self, id: u32) {
         self.bad.fetch_min(id as usize, Relaxed);
     }
 

@@ -31,7 +31,7 @@
 //! | --- | --- | --- |
 //! | (5), (7) | external forces and wind, predicted positions | `sim/predict.rs` |
 //! | (6), (12)-(16) | velocity damping, velocity update, restitution | `sim/velocity.rs` |
-//! | (8) | collision constraint generation | `sim/contacts.rs` |
+//! | (8) | collision constraint generation | `sim/contacts.rs`, between bodies `sim/body_contacts.rs` |
 //! | (9)-(11) | the constraint sweeps of the three solvers | `sim/solve.rs` |
 //! | after the step | the non-finite and stretch guard, the commit | `sim/check.rs` |
 //!
@@ -40,6 +40,7 @@
 //! loops over threads in `sim/parallel.rs`. Every result is bitwise identical for any number of
 //! rayon threads: parallel loops write disjoint data and every sum runs in one fixed order.
 
+mod body_contacts;
 mod check;
 mod contacts;
 mod error;
@@ -275,13 +276,14 @@ impl PbdSimulation {
         predict::predict_positions(d, h);
         // (8) generateCollisionConstraints.
         contacts::generate_contacts(model, d, params.contact_margin, h);
+        body_contacts::generate_body_contacts(model, d, params.contact_margin);
         // (9)-(11) the solver iterations.
         solve::solve_constraints(model, params, d, h);
         // (12)-(15) v <- (p - x) / h, x <- p.
         velocity::update_velocities(model, d, h);
         // (16) velocityUpdate: restitution.
         velocity::restitution(model, d, h);
-        d.contacts.len()
+        d.contacts.len() + d.bodies.contacts.len()
     }
 
     /// The largest constraint violation at positions `x`: `|C|` for equalities, `max(-C, 0)` for

@@ -106,7 +106,9 @@ impl std::str::FromStr for SkinningChoice {
 }
 
 /// Scene-file parameters of a `skinning` scene (the `[scene]` table without `kind`). Exactly
-/// one of `preset` and `file`.
+/// one of `preset` and `file`. A file must hold at least one skinned triangle mesh (a mesh on a
+/// node with a skin, with `JOINTS_0`/`WEIGHTS_0`); without an animation it is shown in its rest
+/// pose at every frame, and after its first animation's last key it holds the last pose.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SkinParams {
@@ -145,8 +147,26 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
                 format!("unknown preset `{name}` (one of {})", scenes::NAMES.join(", ")),
             ));
         }
-        (None, Some(file)) => scenes::from_gltf(context.resolve(file))
-            .map_err(|e| BuildError::invalid("file", e.to_string()))?,
+        (None, Some(file)) => {
+            let path = context.resolve(file);
+            let scene = scenes::from_gltf(&path).map_err(|e| BuildError::invalid("file", e.to_string()))?;
+            if scene.character.meshes.is_empty() {
+                let skipped = if scene.warnings.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (skipped: {})", scene.warnings.join("; "))
+                };
+                return Err(BuildError::invalid(
+                    "file",
+                    format!(
+                        "{}: no skinned mesh: a skinning scene poses the triangle meshes of nodes \
+                         with a skin{skipped}",
+                        path.display()
+                    ),
+                ));
+            }
+            scene
+        }
         _ => return Err(BuildError::invalid("preset", "give exactly one of `preset` and `file`")),
     };
     let default = if p.preset.is_some() { SkinningChoice::Both } else { SkinningChoice::Dqs };

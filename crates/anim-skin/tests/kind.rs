@@ -151,6 +151,51 @@ fn a_gltf_file_is_read_relative_to_the_scene_folder_with_dqs_by_default() {
     assert!(build_in(&serde_json::json!({ "file": "skin.glb" }), None).is_err());
 }
 
+/// A file whose meshes have no skin has nothing to pose: it is refused naming the file, not run
+/// as an empty scene.
+#[test]
+fn a_file_without_a_skinned_mesh_is_refused() {
+    let text = std::fs::read_to_string(testdata().join("skin_embedded.gltf")).unwrap();
+    let mut gltf: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for node in gltf["nodes"].as_array_mut().unwrap() {
+        node.as_object_mut().unwrap().remove("skin");
+    }
+    gltf.as_object_mut().unwrap().remove("skins");
+    let dir = std::env::temp_dir().join(format!("anim-skin-unskinned-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("unskinned.gltf"), gltf.to_string()).unwrap();
+    let err = build_in(&serde_json::json!({ "file": "unskinned.gltf" }), Some(&dir)).err().unwrap();
+    assert!(
+        err.starts_with("field `file`: ")
+            && err.contains("unskinned.gltf: no skinned mesh")
+            && err.contains("skipped"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A file without an animation is shown in its rest pose: every step leaves the vertices where
+/// they were, at zero velocity.
+#[test]
+fn a_file_without_an_animation_holds_its_rest_pose() {
+    let text = std::fs::read_to_string(testdata().join("skin_embedded.gltf")).unwrap();
+    let mut gltf: serde_json::Value = serde_json::from_str(&text).unwrap();
+    gltf.as_object_mut().unwrap().remove("animations");
+    let dir = std::env::temp_dir().join(format!("anim-skin-still-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("still.gltf"), gltf.to_string()).unwrap();
+    let mut scene = build_in(&serde_json::json!({ "file": "still.gltf" }), Some(&dir)).unwrap();
+    let rest = frame(scene.as_ref()).points;
+    assert!(!rest.is_empty());
+    for _ in 0..3 {
+        scene.step(0.1).unwrap();
+    }
+    let f = frame(scene.as_ref());
+    assert_eq!(f.points, rest);
+    assert!(f.field("velocity").unwrap().values.iter().all(|v| *v == 0.0));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// The embedded asset scales joint 4 on its way to t = 2 s, which DQS refuses: the failing step
 /// names it and leaves the scene (LBS half included) as it was.
 #[test]

@@ -144,8 +144,8 @@ impl BodySpec {
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
     /// Penalty stiffness `k_c` (N/m, > 0); default `1e4`. A vertex of mass `m` rests
-    /// `m g / k_c + smoothing / 2` deep (`sqrt(2 smoothing m g / k_c)` when that is less than
-    /// `smoothing`).
+    /// `m g / k_c + smoothing / 2` deeper than `thickness` (`sqrt(2 smoothing m g / k_c)` when
+    /// that is less than `smoothing`).
     #[serde(default = "default_stiffness")]
     pub stiffness: f64,
     /// Normal damping `tau_n` (s/m, >= 0): the damping force is `tau_n |v_n|` times the elastic
@@ -160,6 +160,11 @@ pub struct ContactSpec {
     /// robust implicit steps; default `1e-3`.
     #[serde(default = "default_smoothing")]
     pub smoothing: f64,
+    /// Distance (m, >= 0) outside the obstacles at which the vertices are held: the cloth's
+    /// thickness. Over a curved obstacle it keeps the triangles clear of the surface between
+    /// their vertices; default 0.
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub thickness: f64,
 }
 
 fn default_stiffness() -> f64 {
@@ -185,6 +190,7 @@ impl Default for ContactSpec {
             damping: default_damping(),
             friction: default_friction(),
             smoothing: default_smoothing(),
+            thickness: 0.0,
         }
     }
 }
@@ -231,6 +237,7 @@ pub fn build_bodies(
             damping: contact.damping,
             friction: contact.friction,
             smoothing: contact.smoothing,
+            thickness: contact.thickness,
         };
         collider.check().map_err(|e| SceneError::invalid(format!("obstacles[{k}]"), e))?;
         b.collider(collider);
@@ -383,7 +390,8 @@ fn check_contact(c: &ContactSpec) -> Result<(), SceneError> {
     positive("contact.stiffness", c.stiffness)?;
     non_negative("contact.damping", c.damping)?;
     non_negative("contact.friction", c.friction)?;
-    non_negative("contact.smoothing", c.smoothing)
+    non_negative("contact.smoothing", c.smoothing)?;
+    non_negative("contact.thickness", c.thickness)
 }
 
 /// A placement error with its field under the body's.

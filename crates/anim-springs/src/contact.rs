@@ -14,10 +14,10 @@
 //! # The force
 //!
 //! For a collider with signed distance `phi(x)` (positive outside) and outward normal
-//! `n(x) = grad phi` ([`Shape::signed_distance`]), the penetration is `p = max(0, -phi(x))`.
-//! Inside a box that is the distance to the nearest face and `n` that face's normal; inside a
-//! capsule the distance to its surface along the line from the nearest axis point. While `p > 0`
-//! the particle feels
+//! `n(x) = grad phi` ([`Shape::signed_distance`]), and thickness `t` ([`Collider::thickness`],
+//! usually 0), the penetration is `p = max(0, t - phi(x))`. Inside a box `-phi` is the distance
+//! to the nearest face and `n` that face's normal; inside a capsule the distance to its surface
+//! along the line from the nearest axis point. While `p > 0` the particle feels
 //!
 //! ```text
 //! f = e(p) [ n  -  tau_n (n . v) n  -  tau_t (v - (n . v) n) ]
@@ -48,10 +48,11 @@
 //! `g = n + (tau_t - tau_n)(n . v) n - tau_t v` the bracket above) has three parts: the normal
 //! stiffness `-e'(p) (1 - tau_n v_n) n n^T`, the friction coupling `e'(p) tau_t v_t n^T` (not
 //! symmetric), and the curvature term `e(p) (dg/dn)(dn/dx)` where the normal turns as the particle
-//! slides: `dn/dx = (I - n n^T) / |x - c|` in a sphere (and a capsule's end caps, `c` the end),
-//! `(I - n n^T - a a^T) / r` beside a capsule's axis (`a` the unit axis, `r` the distance to it),
-//! zero in a plane or a box (whose normal is constant on each face's side of the inner ridges,
-//! where it jumps). In the default
+//! slides: `dn/dx = (I - n n^T) / |x - c|` in a sphere (and a capsule's end caps, `c` the end,
+//! and beside a box's corner within the thickness, `c` the corner), `(I - n n^T - a a^T) / r`
+//! beside a capsule's axis (`a` the unit axis, `r` the distance to it) and beside a box's edge
+//! within the thickness, zero in a plane and inside a box or beside its faces (its normal is
+//! constant on each face's side of the inner ridges, where it jumps). In the default
 //! [`JacobianMode::Definite`](crate::JacobianMode::Definite) only the normal stiffness is kept,
 //! with `1 - tau_n v_n` clamped at 0: symmetric and negative semi-definite, as conjugate gradients
 //! and Cholesky need, while the force itself is unchanged (Newton converges to the same step, a
@@ -67,6 +68,7 @@
 
 use crate::geom::{MIN_LENGTH, outer};
 use anim_core::glam::{DMat3, DVec3};
+use anim_core::scene::is_default;
 use serde::{Deserialize, Serialize};
 
 /// The geometry of a collider: anim-core's shared [`Shape`], re-exported here. The penalty
@@ -77,10 +79,12 @@ pub use anim_core::geometry::Shape;
 /// `dn/dx = curvature (I - n n^T - axis axis^T)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Bend {
-    /// `1 / r`: `r` the distance to a sphere's centre or a capsule's axis; 0 when the normal is
-    /// constant (a plane, a box, a particle at the centre).
+    /// `1 / r`: `r` the distance to a sphere's centre, a capsule's axis, or a box's nearest
+    /// edge or corner (outside it, within the thickness); 0 when the normal is constant (a
+    /// plane, a box's inside or beside a face, a particle at the centre or on the axis).
     curvature: f64,
-    /// The unit axis of a capsule beside its cylindrical part; zero otherwise.
+    /// The unit axis of a capsule beside its cylindrical part, or of a box's edge; zero
+    /// otherwise.
     axis: DVec3,
 }
 
@@ -110,6 +114,13 @@ pub struct Collider {
     /// 0 gives the plain penalty `k_c p`.
     #[serde(default)]
     pub smoothing: f64,
+    /// Distance `t` (m, >= 0) outside the shape at which particles are held: the penalty acts on
+    /// `phi - t`, the signed distance to the shape grown by `t` (a plane moved out along its
+    /// normal, a sphere's or capsule's radius plus `t`, a box with its edges and corners rounded
+    /// to radius `t`). A cloth's thickness: its triangles then lie clear of a curved obstacle
+    /// instead of cutting its surface between their vertices. Default 0.
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub thickness: f64,
 }
 
 impl Collider {
@@ -117,7 +128,14 @@ impl Collider {
     /// damping, friction or smoothing (add them with the `with_` methods).
     #[must_use]
     pub fn ground(height: f64, stiffness: f64) -> Self {
-        Self { shape: Shape::ground(height), stiffness, damping: 0.0, friction: 0.0, smoothing: 0.0 }
+        Self {
+            shape: Shape::ground(height),
+            stiffness,
+            damping: 0.0,
+            friction: 0.0,
+            smoothing: 0.0,
+            thickness: 0.0,
+        }
     }
 
     /// A solid sphere with penalty stiffness `stiffness`, no damping, friction or smoothing.
@@ -129,6 +147,7 @@ impl Collider {
             damping: 0.0,
             friction: 0.0,
             smoothing: 0.0,
+            thickness: 0.0,
         }
     }
 
@@ -153,6 +172,13 @@ impl Collider {
         self
     }
 
+    /// Sets the thickness `t` (m) at which particles are held outside the shape.
+    #[must_use]
+    pub fn with_thickness(mut self, t: f64) -> Self {
+        self.thickness = t;
+        self
+    }
+
     /// Checks the parameters; returns a description of the first problem (a shape's names the
     /// shape).
     pub(crate) fn check(&self) -> Result<(), String> {
@@ -168,6 +194,9 @@ impl Collider {
         if !(self.smoothing >= 0.0 && self.smoothing.is_finite()) {
             return Err(format!("smoothing must be non-negative and finite, got {}", self.smoothing));
         }
+        if !(self.thickness >= 0.0 && self.thickness.is_finite()) {
+            return Err(format!("thickness must be non-negative and finite, got {}", self.thickness));
+        }
         self.shape.check()
     }
 
@@ -177,17 +206,19 @@ impl Collider {
         self
     }
 
-    /// Penetration `p > 0`, outward normal and how the normal turns (see [`Bend`]), or `None`
-    /// when the particle is outside.
+    /// Penetration `p > 0` of the shape grown by the thickness, outward normal and how the
+    /// normal turns (see [`Bend`]), or `None` when the particle is outside.
     #[inline]
     pub(crate) fn probe(&self, x: DVec3) -> Option<(f64, DVec3, Bend)> {
+        let thickness = self.thickness;
         match self.shape {
             Shape::Plane { point, normal } => {
                 let n = DVec3::from_array(normal);
-                let phi = (x - DVec3::from_array(point)).dot(n);
+                let phi = (x - DVec3::from_array(point)).dot(n) - thickness;
                 (phi < 0.0).then_some((-phi, n, Bend::NONE))
             }
             Shape::Sphere { center, radius } => {
+                let radius = radius + thickness;
                 let d = x - DVec3::from_array(center);
                 let r = d.length();
                 if r >= radius {
@@ -200,18 +231,35 @@ impl Collider {
                     Some((radius - r, DVec3::Z, Bend::NONE))
                 }
             }
-            // Inside, the nearest face's normal: constant, so nothing turns.
-            Shape::Box { .. } => {
-                let (phi, n) = self.shape.signed_distance(x);
-                (phi < 0.0).then_some((-phi, n, Bend::NONE))
+            Shape::Box { center, half_extents } => {
+                let (distance, n) = self.shape.signed_distance(x);
+                let phi = distance - thickness;
+                if phi >= 0.0 {
+                    return None;
+                }
+                // Inside, the nearest face's normal: constant. Outside (within the thickness),
+                // beside a face it is constant too, beside an edge it turns about the edge, beside
+                // a corner about the corner.
+                let q = (x - DVec3::from_array(center)).abs() - DVec3::from_array(half_extents);
+                let out = q.cmpgt(DVec3::ZERO);
+                let bend = match (out.bitmask().count_ones(), distance > MIN_LENGTH) {
+                    (2, true) => {
+                        let along = DVec3::select(out, DVec3::ZERO, DVec3::ONE);
+                        Bend { curvature: 1.0 / distance, axis: along }
+                    }
+                    (3, true) => Bend::round(1.0 / distance),
+                    _ => Bend::NONE,
+                };
+                Some((-phi, n, bend))
             }
             Shape::Capsule { a, b, radius } => {
-                let (phi, n) = self.shape.signed_distance(x);
+                let (distance, n) = self.shape.signed_distance(x);
+                let phi = distance - thickness;
                 if phi >= 0.0 {
                     return None;
                 }
                 // The distance to the axis; on it the normal is any perpendicular, fixed.
-                let r = radius + phi;
+                let r = radius + distance;
                 if !(r > MIN_LENGTH) {
                     return Some((-phi, n, Bend::NONE));
                 }

@@ -5,10 +5,10 @@
 //! convention of [`Shape::check_in`]: a sphere is a disk, a box a rectangle) and a mesh is cut
 //! by that plane.
 
-use super::closed::ClosedSurface;
 use anim_core::geometry::Shape;
 use anim_core::glam::{DMat3, DVec3};
 use anim_core::scene::{BuildContext, BuildError, Placement};
+use anim_core::surface::ClosedSurface;
 use std::path::Path;
 
 /// A region of space: the inside of a shape or of a closed surface.
@@ -75,8 +75,41 @@ impl Region {
         Ok(Region { kind: Kind::Surface(Box::new(surface)), lo, hi })
     }
 
+    /// Whether each point `(start + i + 1/2) spacing` of a `D`-dimensional lattice,
+    /// `i < counts` per axis, is inside (z = 0 in 2D), x fastest. Points on a shape's boundary
+    /// are outside; a surface classifies by rows ([`ClosedSurface::inside_lattice`]).
+    ///
+    /// # Errors
+    /// The surface's refusal of the lattice (a spacing that is not positive and finite, more
+    /// than 2^31 points), as a message.
+    pub(crate) fn inside_lattice<const D: usize>(
+        &self,
+        start: [usize; D],
+        counts: [usize; D],
+        spacing: f64,
+    ) -> Result<Vec<bool>, String> {
+        let centre = |i: usize| (i as f64 + 0.5) * spacing;
+        Ok(match &self.kind {
+            Kind::Shape { .. } => {
+                let total: usize = counts.iter().product();
+                (0..total)
+                    .map(|f| {
+                        let idx = crate::mac::unflatten(counts, f);
+                        let p = std::array::from_fn(|a| if a < D { centre(start[a] + idx[a]) } else { 0.0 });
+                        self.contains(p)
+                    })
+                    .collect()
+            }
+            Kind::Surface(surface) => {
+                let origin = std::array::from_fn(|a| if a < D { centre(start[a]) } else { 0.0 });
+                let counts3 = std::array::from_fn(|a| if a < D { counts[a] } else { 1 });
+                surface.inside_lattice(origin, spacing, counts3).map_err(|e| e.to_string())?
+            }
+        })
+    }
+
     /// Whether the point `p` is inside (strictly, for shapes: the boundary is outside).
-    pub(crate) fn contains(&self, p: [f64; 3]) -> bool {
+    fn contains(&self, p: [f64; 3]) -> bool {
         match &self.kind {
             Kind::Shape { shape, inverse } => {
                 let mut x = DVec3::from_array(p);

@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use super::surface_standin::ClosedSurface;
 use anim_core::geometry::Shape;
 use anim_core::scene::{BuildContext, BuildError, Placement};
+use anim_core::surface::ClosedSurface;
 use anim_io::obj::{Polygons, read_obj};
 use rayon::prelude::*;
 

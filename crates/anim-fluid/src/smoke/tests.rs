@@ -192,6 +192,36 @@ fn a_mesh_obstacle_marks_the_cells_inside_its_surface() {
         solid += usize::from(is_solid);
     }
     assert!(band < solid / 10, "{band} of {solid} cells undecided");
+    // A 2D scene cuts the mesh at z = 0: the disk of the sphere's equator (the sphere centred on
+    // z = 0), and a mesh that does not reach z = 0 is refused.
+    let (c, r) = ([0.45, 0.7, 0.0], 0.27);
+    let value = json!({
+        "dim": 2, "resolution": 40,
+        "sources": [ { "shape": { "sphere": { "center": [0.5, 0.0, 0.0], "radius": 0.1 } } } ],
+        "obstacles": [ { "mesh": "ball.obj", "scale": r, "translate": c } ],
+    });
+    let p: FluidSceneParams = params(&value).expect("parameters");
+    let scene = p.scene_in(&BuildContext { base: Some(&dir) }).expect("builds");
+    let (fluid, _) = mac(&scene);
+    let inner = r * (std::f64::consts::PI / segments as f64 * 2.0).cos();
+    let (mut band, mut solid) = (0, 0);
+    for (k, &is_solid) in fluid.solid().iter().enumerate() {
+        let d = distance(centre(k, fluid.dims(), fluid.h(), 2), c);
+        if d < inner {
+            assert!(is_solid, "2D cell {k} at distance {d} is inside the surface");
+        } else if d >= r {
+            assert!(!is_solid, "2D cell {k} at distance {d} is outside the surface");
+        } else {
+            band += 1;
+        }
+        solid += usize::from(is_solid);
+    }
+    assert!(solid > 100 && band < solid / 10, "{band} of {solid} cells undecided");
+    let mut value = value;
+    value["obstacles"][0]["translate"] = json!([0.45, 0.7, 0.5]);
+    let p: FluidSceneParams = params(&value).expect("parameters");
+    let msg = p.scene_in(&BuildContext { base: Some(&dir) }).expect_err("refused").to_string();
+    assert!(msg.starts_with("field `obstacles[0]`: a 2D scene cuts meshes at z = 0"), "{msg}");
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -9,9 +9,9 @@
 //! The helpers below check the shape builders' own parameters and name the offending one.
 
 use super::error::{BuildError, InputError};
-use crate::collide::{Collider, KinematicBody};
+use crate::collide::{BodyContact, Collider, KinematicBody};
 use crate::constraint::{AttachTarget, ConstraintParams};
-use crate::model::Wind;
+use crate::model::{ContactBody, Wind};
 use anim_core::glam::DVec3;
 use serde::{Deserialize, Serialize};
 
@@ -54,6 +54,8 @@ pub struct PbdBuilder {
     pub(super) triangles: Vec<[usize; 3]>,
     pub(super) edges: Vec<[usize; 2]>,
     pub(super) tets: Vec<[usize; 4]>,
+    pub(super) contact_bodies: Vec<ContactBody>,
+    pub(super) body_contact: BodyContact,
 }
 
 /// Standard gravity pointing down the z axis (m/s^2): the scenes' convention is z up.

@@ -148,4 +148,18 @@ pub enum BuildError {
         /// What is wrong.
         reason: String,
     },
+    /// A contact body's particle range or surface is not valid.
+    #[error("contact body {body}: {reason}")]
+    BadContactBody {
+        /// Contact body index.
+        body: usize,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The contact parameters between bodies are not valid.
+    #[error("body contact: {reason}")]
+    BadBodyContact {
+        /// What is wrong.
+        reason: String,
+    },
 }

@@ -98,6 +98,7 @@ impl PbdBuilder {
                 return Err(bad("edge", "vertex", "must be a particle index", i));
             }
         }
+        self.check_contact_bodies(n)?;
         let pos: Vec<DVec3> = self.positions.iter().map(|&p| DVec3::from_array(p)).collect();
         let mut volume_meshes = Vec::with_capacity(self.volume_meshes.len());
         for (tris, c) in &self.volume_meshes {
@@ -164,6 +165,8 @@ impl PbdBuilder {
             triangles: self.triangles.clone(),
             edges: self.edges.clone(),
             tets: self.tets.clone(),
+            contact_bodies: self.contact_bodies.clone(),
+            body_contact: self.body_contact,
             inc_ptr,
             inc,
             tri_ptr,

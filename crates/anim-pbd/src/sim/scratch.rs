@@ -1,8 +1,10 @@
 //! The solver's scratch: every buffer a step writes (positions `x`, velocities `v`, predictions
 //! `p`, the compiled constraints and their multipliers, the sweep order, buffered corrections,
 //! contacts, body poses, wind forces), sized once from the model so that a step allocates nothing.
-//! Contacts are reserved for every particle against every collider.
+//! Contacts are reserved for every particle against every collider, and for every particle of a
+//! contact body against every other contact body.
 
+use super::body_contacts::BodyContactData;
 use crate::collide::{Contact, Pose};
 use crate::model::PbdModel;
 use crate::project::Compiled;
@@ -32,6 +34,8 @@ pub(super) struct Data {
     pub(super) volume_corr: Vec<Vec<DVec3>>,
     pub(super) contacts: Vec<Contact>,
     pub(super) contact_groups: Vec<Range<usize>>,
+    /// The contacts between contact bodies and their search buffers.
+    pub(super) bodies: BodyContactData,
     pub(super) pose_start: Vec<Pose>,
     pub(super) pose_end: Vec<Pose>,
     pub(super) pose_sub: Vec<Pose>,
@@ -64,6 +68,7 @@ impl Data {
             volume_corr: model.volume_meshes.iter().map(|m| vec![DVec3::ZERO; m.vertices.len()]).collect(),
             contacts: Vec::with_capacity(n * nc),
             contact_groups: Vec::with_capacity(nc),
+            bodies: BodyContactData::new(model),
             pose_start: vec![Pose::IDENTITY; nb],
             pose_end: vec![Pose::IDENTITY; nb],
             pose_sub: vec![Pose::IDENTITY; nb],

@@ -22,10 +22,12 @@
 //!   hardware without fast sequential sweeps.
 //!
 //! In the coloured and Jacobi sweeps the contacts form a second group, projected collider by
-//! collider after the internal constraints in every iteration. Every parallel loop writes
+//! collider after the internal constraints in every iteration. Whatever the solver, the contacts
+//! between bodies come last in each iteration, sequentially (`sim/body_contacts.rs`). Every parallel loop writes
 //! disjoint data and every sum runs in one fixed order, so the positions are bitwise the same
 //! for any number of threads.
 
+use super::body_contacts::project_body_contacts;
 use super::parallel::{CHUNK, PARALLEL_MIN, for_each_chunk};
 use super::params::{Method, PbdParams, SolverKind};
 use super::scratch::Data;
@@ -158,6 +160,7 @@ pub(super) fn solve_constraints(model: &PbdModel, params: &PbdParams, d: &mut Da
                 &d.contact_groups,
             ),
         }
+        project_body_contacts(&ctx, model, &mut d.bodies.contacts, &mut d.p);
     }
 }
 

@@ -171,8 +171,8 @@ fn pinned_vertices_start_at_rest_and_do_not_move() {
 }
 
 /// A cloth smaller than a box's top, released just above it, comes to rest on it: no vertex
-/// ever sinks a smoothing width into the box, and at rest each sinks the penalty depth of its
-/// own weight, `e(p) = m g`.
+/// ever sinks a smoothing width into the box (grown by the contact thickness), and at rest each
+/// sinks the penalty depth of its own weight, `e(p) = m g`.
 #[test]
 fn a_cloth_on_a_box_top_rests_above_it_within_the_penalty_depth() {
     let dir = folder("rest-on-box");
@@ -181,30 +181,36 @@ fn a_cloth_on_a_box_top_rests_above_it_within_the_penalty_depth() {
     let mut spec = body(serde_json::json!({
         "mesh": "grid.obj",
         "material": { "density": 0.2, "stiffness": 100.0, "damping": 0.05, "bending": 1.0 },
-        "translate": [-0.2, -0.2, top + 0.005],
+        "translate": [-0.2, -0.2, top + 0.008],
     }));
     spec.rotate = [0.0, 0.0, 0.3];
     let table = Shape::Box { center: [0.0, 0.0, 0.25], half_extents: [0.4, 0.4, 0.25] };
-    let contact = ContactSpec::default();
-    let scene =
-        build_bodies(&[spec], &[table], crate::EARTH_GRAVITY, &contact, |p| dir.join(p)).expect("builds");
-    let masses: Vec<f64> = scene.network.particles().iter().map(|p| p.mass).collect();
-    let (mut sim, mut state) = scene.into_simulation().expect("simulation");
-    let mut lowest = f64::INFINITY;
-    for _ in 0..400 {
-        sim.advance(&mut state, 0.005).expect("step");
-        lowest = lowest.min(state.x.chunks_exact(3).map(|p| p[2]).fold(f64::INFINITY, f64::min));
+    for thickness in [0.0, 0.003] {
+        let contact = ContactSpec { thickness, ..ContactSpec::default() };
+        let scene = build_bodies(&[spec.clone()], &[table], crate::EARTH_GRAVITY, &contact, |p| dir.join(p))
+            .expect("builds");
+        let masses: Vec<f64> = scene.network.particles().iter().map(|p| p.mass).collect();
+        let (mut sim, mut state) = scene.into_simulation().expect("simulation");
+        let surface = top + thickness;
+        let mut lowest = f64::INFINITY;
+        for _ in 0..400 {
+            sim.advance(&mut state, 0.005).expect("step");
+            lowest = lowest.min(state.x.chunks_exact(3).map(|p| p[2]).fold(f64::INFINITY, f64::min));
+        }
+        assert!(lowest > surface - contact.smoothing, "thickness {thickness}: a vertex sank to {lowest}");
+        // At rest: e(p) = k p^2 / (2 delta) = m g below the smoothing width.
+        let (k, delta) = (contact.stiffness, contact.smoothing);
+        for (v, (p, m)) in state.x.chunks_exact(3).zip(&masses).enumerate() {
+            let depth = (2.0 * delta * m * 9.81 / k).sqrt();
+            assert!(depth < delta);
+            let sunk = surface - p[2];
+            assert!(
+                (sunk - depth).abs() < 1e-3 * depth,
+                "thickness {thickness}, vertex {v}: sunk {sunk}, penalty depth {depth}"
+            );
+        }
+        assert!(state.v.iter().all(|v| v.abs() < 1e-6), "thickness {thickness}: still moving");
     }
-    assert!(lowest > top - contact.smoothing, "a vertex sank to {lowest}");
-    // At rest: e(p) = k p^2 / (2 delta) = m g below the smoothing width.
-    let (k, delta) = (contact.stiffness, contact.smoothing);
-    for (v, (p, m)) in state.x.chunks_exact(3).zip(&masses).enumerate() {
-        let depth = (2.0 * delta * m * 9.81 / k).sqrt();
-        assert!(depth < delta);
-        let sunk = top - p[2];
-        assert!((sunk - depth).abs() < 1e-3 * depth, "vertex {v}: sunk {sunk}, penalty depth {depth}");
-    }
-    assert!(state.v.iter().all(|v| v.abs() < 1e-6), "still moving");
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -351,6 +357,13 @@ fn refusals_name_the_field_the_file_and_the_element() {
     let mut bad = scene(cloth());
     bad["contact"] = serde_json::json!({ "friction": -1.0 });
     assert_eq!(refusal(&dir, bad).0, "contact.friction");
+    let mut bad = scene(cloth());
+    bad["contact"] = serde_json::json!({ "thickness": -0.001 });
+    let (field, message) = refusal(&dir, bad);
+    assert_eq!(
+        (field.as_str(), message.as_str()),
+        ("contact.thickness", "must be non-negative and finite, got -0.001")
+    );
     // Preset-only and preset fields.
     let mut bad = scene(cloth());
     bad["resolution"] = serde_json::json!(8);

@@ -11,26 +11,34 @@ const BOX: Shape = Shape::Box { center: [0.1, -0.2, 0.3], half_extents: [0.5, 0.
 const CAPSULE: Shape = Shape::Capsule { a: [-0.3, 0.1, 0.0], b: [0.4, -0.2, 0.5], radius: 0.35 };
 
 fn collider(shape: Shape) -> Collider {
-    Collider { shape, stiffness: 40.0, damping: 0.3, friction: 0.7, smoothing: 0.05 }
+    Collider { shape, stiffness: 40.0, damping: 0.3, friction: 0.7, smoothing: 0.05, thickness: 0.0 }
 }
 
-/// Where a sample sits: inside and away from the places where the force or its derivative has a
-/// kink (the surface, the end of the smoothing zone, a box's inner ridges, a capsule's cap
-/// boundaries and axis), with its region's label.
-fn region(shape: &Shape, x: DVec3, delta: f64) -> Option<&'static str> {
-    let (phi, _) = shape.signed_distance(x);
-    let p = -phi;
+/// Where a sample sits: inside the grown shape and away from the places where the force or its
+/// derivative has a kink (the grown surface, the end of the smoothing zone, a box's inner ridges
+/// and the planes between its face, edge and corner zones, a capsule's cap boundaries and axis),
+/// with its region's label.
+fn region(c: &Collider, x: DVec3) -> Option<&'static str> {
+    let (phi, _) = c.shape.signed_distance(x);
+    let p = c.thickness - phi;
     let margin = 1e-4;
-    if !(p > margin) || (p - delta).abs() < margin {
+    if !(p > margin) || (p - c.smoothing).abs() < margin {
         return None;
     }
-    let zone = if p < delta { "smoothing" } else { "linear" };
-    match *shape {
+    match c.shape {
         Shape::Box { center, half_extents } => {
             let q = (x - DVec3::from_array(center)).abs() - DVec3::from_array(half_extents);
-            let mut q = q.to_array();
-            q.sort_by(f64::total_cmp);
-            (q[2] - q[1] > margin).then_some(zone)
+            if q.to_array().iter().any(|q| q.abs() < margin) {
+                return None;
+            }
+            let mut sorted = q.to_array();
+            sorted.sort_by(f64::total_cmp);
+            match q.cmpgt(DVec3::ZERO).bitmask().count_ones() {
+                0 => (sorted[2] - sorted[1] > margin).then_some("inside"),
+                1 => Some("beside a face"),
+                2 => Some("beside an edge"),
+                _ => Some("beside a corner"),
+            }
         }
         Shape::Capsule { a, b, .. } => {
             let (a, b) = (DVec3::from_array(a), DVec3::from_array(b));
@@ -39,12 +47,12 @@ fn region(shape: &Shape, x: DVec3, delta: f64) -> Option<&'static str> {
             if t.abs() < margin || (t - 1.0).abs() < margin || r < 1e-2 {
                 None
             } else if t > 0.0 && t < 1.0 {
-                Some(if p < delta { "side, smoothing" } else { "side, linear" })
+                Some(if p < c.smoothing { "side, smoothing" } else { "side, linear" })
             } else {
-                Some(if p < delta { "cap, smoothing" } else { "cap, linear" })
+                Some(if p < c.smoothing { "cap, smoothing" } else { "cap, linear" })
             }
         }
-        _ => Some(zone),
+        _ => Some("any"),
     }
 }
 
@@ -76,33 +84,58 @@ fn max_abs(m: DMat3) -> f64 {
 #[test]
 fn box_and_capsule_jacobians_match_central_finite_differences() {
     let mut rng = ChaCha8Rng::seed_from_u64(0x626f78);
-    for shape in [BOX, CAPSULE] {
-        let c = collider(shape);
+    // Without a thickness a box has only its inside; with one, the zones beside its faces, edges
+    // and corners where the grown box is rounded.
+    let cases = [(BOX, 0.0, 1), (BOX, 0.1, 4), (CAPSULE, 0.0, 4), (CAPSULE, 0.1, 4)];
+    for (shape, thickness, regions) in cases {
+        let c = Collider { thickness, ..collider(shape) };
         let mut seen = std::collections::BTreeMap::new();
         while seen.values().sum::<usize>() < 400 {
-            let x = DVec3::from_array(std::array::from_fn(|_| rng.random_range(-0.8..0.9)));
-            let Some(label) = region(&shape, x, c.smoothing) else { continue };
+            // Half the samples anywhere, half near a box's corners or a capsule's ends.
+            let x = if rng.random_bool(0.5) {
+                DVec3::from_array(std::array::from_fn(|_| rng.random_range(-0.8..0.9)))
+            } else {
+                let signs =
+                    DVec3::from_array(std::array::from_fn(|_| if rng.random_bool(0.5) { 1.0 } else { -1.0 }));
+                match shape {
+                    // Mostly in the octant beyond the corner.
+                    Shape::Box { center, half_extents } => {
+                        let out = DVec3::from_array(std::array::from_fn(|_| rng.random_range(-0.02..0.1)));
+                        DVec3::from_array(center) + signs * (DVec3::from_array(half_extents) + out)
+                    }
+                    Shape::Capsule { a, b, .. } => {
+                        let end = DVec3::from_array(if rng.random_bool(0.5) { a } else { b });
+                        end + signs * DVec3::from_array(std::array::from_fn(|_| rng.random_range(0.0..0.4)))
+                    }
+                    _ => DVec3::ZERO,
+                }
+            };
+            let Some(label) = region(&c, x) else { continue };
             *seen.entry(label).or_insert(0) += 1;
             let v = DVec3::from_array(std::array::from_fn(|_| rng.random_range(-1.0..1.0)));
             let (p, n, _) = c.probe(x).expect("inside");
+            let what = format!("{} (thickness {thickness}) {label} at {x}", shape.name());
             // Exact: every term of df/dx and df/dv.
             let (k, d) = jacobians(&c, x, v, true);
             let (k_fd, d_fd) = (finite_differences(&c, x, v, true), finite_differences(&c, x, v, false));
             let scale = max_abs(k_fd).max(max_abs(d_fd)).max(1e-3);
             let (ek, ed) = (max_abs(k - k_fd) / scale, max_abs(d - d_fd) / scale);
-            assert!(ek < 1e-6, "{} {label} at {x}: K off by {ek:e}\n{k}\n{k_fd}", shape.name());
-            assert!(ed < 1e-6, "{} {label} at {x}: D off by {ed:e}", shape.name());
+            assert!(ek < 1e-6, "{what}: K off by {ek:e}\n{k}\n{k_fd}");
+            assert!(ed < 1e-6, "{what}: D off by {ed:e}");
             // Definite: -e'(p) max(1 - tau_n v_n, 0) n n^T, the same D.
             let slope = if p < c.smoothing { c.stiffness * p / c.smoothing } else { c.stiffness };
             let expected = -(slope * (1.0 - c.damping * n.dot(v)).max(0.0)) * crate::geom::outer(n, n);
             let (k_def, d_def) = jacobians(&c, x, v, false);
-            assert!(max_abs(k_def - expected) <= 1e-12 * scale, "{} {label}: definite K", shape.name());
-            assert_eq!(d_def, d, "{} {label}: definite D", shape.name());
+            assert!(max_abs(k_def - expected) <= 1e-12 * scale, "{what}: definite K");
+            assert_eq!(d_def, d, "{what}: definite D");
         }
         // Every region of the shape was sampled, not only the easy one.
-        let regions = if shape == BOX { 2 } else { 4 };
-        assert_eq!(seen.len(), regions, "{}: {seen:?}", shape.name());
-        assert!(seen.values().all(|&count| count >= 10), "{}: {seen:?}", shape.name());
+        assert_eq!(seen.len(), regions, "{} (thickness {thickness}): {seen:?}", shape.name());
+        assert!(
+            seen.values().all(|&count| count >= 10),
+            "{} (thickness {thickness}): {seen:?}",
+            shape.name()
+        );
     }
 }
 
@@ -141,11 +174,18 @@ fn the_force_pushes_out_along_the_nearest_surface_and_vanishes_outside() {
 /// side comes to rest on top of it, with the definite Jacobian and sparse Cholesky.
 #[test]
 fn particles_rest_on_a_box_and_a_capsule_at_the_penalty_depth() {
-    let settle = |shape: Shape, start: [f64; 3]| {
+    let settle = |shape: Shape, thickness: f64, start: [f64; 3]| {
         let mut b = NetworkBuilder::new();
         b.gravity(EARTH_GRAVITY);
         b.particle(start, 0.2);
-        b.collider(Collider { shape, stiffness: 1000.0, damping: 0.5, friction: 1.0, smoothing: 1e-3 });
+        b.collider(Collider {
+            shape,
+            stiffness: 1000.0,
+            damping: 0.5,
+            friction: 1.0,
+            smoothing: 1e-3,
+            thickness,
+        });
         let mut net = b.build().expect("builds");
         let mut state = net.rest_state();
         let mut integ = IntegratorKind::BackwardEuler.build_with::<SpringNetwork>(
@@ -160,13 +200,19 @@ fn particles_rest_on_a_box_and_a_capsule_at_the_penalty_depth() {
     };
     // phi(p) = k_c (p - delta/2) = m g.
     let depth = 0.2 * 9.81 / 1000.0 + 0.5e-3;
-    let (state, _) =
-        settle(Shape::Box { center: [0.0, 0.0, 0.25], half_extents: [0.5, 0.5, 0.25] }, [0.1, 0.2, 0.55]);
-    assert!((state.x[2] - (0.5 - depth)).abs() < 1e-9, "z = {}, expected {}", state.x[2], 0.5 - depth);
-    assert!((state.x[0] - 0.1).abs() < 1e-12 && (state.x[1] - 0.2).abs() < 1e-12);
+    let table = Shape::Box { center: [0.0, 0.0, 0.25], half_extents: [0.5, 0.5, 0.25] };
+    for thickness in [0.0, 0.01] {
+        let (state, _) = settle(table, thickness, [0.1, 0.2, 0.55]);
+        let z = 0.5 + thickness - depth;
+        assert!((state.x[2] - z).abs() < 1e-9, "z = {}, expected {z}", state.x[2]);
+        assert!((state.x[0] - 0.1).abs() < 1e-12 && (state.x[1] - 0.2).abs() < 1e-12);
+    }
     // A horizontal capsule along x: the particle rests on its top line.
-    let (state, f) =
-        settle(Shape::Capsule { a: [-0.5, 0.0, 0.2], b: [0.5, 0.0, 0.2], radius: 0.2 }, [0.1, 0.0, 0.6]);
-    assert!((state.x[2] - (0.4 - depth)).abs() < 1e-9, "z = {}", state.x[2]);
-    assert!(f.iter().all(|c| c.abs() < 1e-9), "net force {f:?}");
+    let bar = Shape::Capsule { a: [-0.5, 0.0, 0.2], b: [0.5, 0.0, 0.2], radius: 0.2 };
+    for thickness in [0.0, 0.01] {
+        let (state, f) = settle(bar, thickness, [0.1, 0.0, 0.6]);
+        let z = 0.4 + thickness - depth;
+        assert!((state.x[2] - z).abs() < 1e-9, "z = {}, expected {z}", state.x[2]);
+        assert!(f.iter().all(|c| c.abs() < 1e-9), "net force {f:?}");
+    }
 }

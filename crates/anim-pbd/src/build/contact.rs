@@ -1,0 +1,99 @@
+//! Contact bodies: ranges of particles that collide with each other's surfaces
+//! ([`crate::collide`], "Contacts between bodies"). A contact body names its particles and its
+//! surface triangles; a closed surface must be closed and consistently oriented outward (its
+//! particles are then pushed out of it along the outward normal), an open one (cloth) is
+//! two-sided. The checks run in [`PbdBuilder::build`]: ranges inside the model and disjoint,
+//! triangles inside their body's range with three distinct corners, a closed surface closed.
+
+use super::builder::PbdBuilder;
+use super::error::BuildError;
+use crate::collide::BodyContact;
+use crate::model::ContactBody;
+use std::collections::HashMap;
+use std::ops::Range;
+
+impl PbdBuilder {
+    /// Makes the particles `particles` a contact body with surface `triangles` (model particle
+    /// indices inside the range); `closed` for a closed surface oriented outward (a soft body's
+    /// boundary, a balloon), else the surface is two-sided (cloth). Returns its index.
+    pub fn contact_body(&mut self, particles: Range<usize>, triangles: &[[usize; 3]], closed: bool) -> usize {
+        self.contact_bodies.push(ContactBody {
+            particles: (particles.start, particles.end),
+            triangles: triangles.to_vec(),
+            closed,
+        });
+        self.contact_bodies.len() - 1
+    }
+
+    /// Sets the thickness and friction of the contacts between contact bodies (default
+    /// [`BodyContact::default`]).
+    pub fn body_contact(&mut self, params: BodyContact) -> &mut Self {
+        self.body_contact = params;
+        self
+    }
+
+    /// Checks the contact bodies and their parameters against `n` particles.
+    pub(super) fn check_contact_bodies(&self, n: usize) -> Result<(), BuildError> {
+        if self.contact_bodies.is_empty() {
+            return Ok(());
+        }
+        self.body_contact.validate().map_err(|reason| BuildError::BadBodyContact { reason })?;
+        let mut ranges: Vec<(usize, usize, usize)> = Vec::new();
+        for (b, body) in self.contact_bodies.iter().enumerate() {
+            let fail = |reason: String| BuildError::BadContactBody { body: b, reason };
+            let (start, end) = body.particles;
+            if !(start < end && end <= n) {
+                return Err(fail(format!(
+                    "particles {start}..{end} are not a non-empty range of the model's {n} particles"
+                )));
+            }
+            if let Some(&(other, s, e)) = ranges.iter().find(|&&(_, s, e)| start < e && s < end) {
+                return Err(fail(format!(
+                    "particles {start}..{end} overlap contact body {other}'s {s}..{e}"
+                )));
+            }
+            ranges.push((b, start, end));
+            for (t, tri) in body.triangles.iter().enumerate() {
+                if let Some(&i) = tri.iter().find(|&&i| !(start..end).contains(&i)) {
+                    return Err(fail(format!("triangle {t} {tri:?}: particle {i} is not in {start}..{end}")));
+                }
+                if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
+                    return Err(fail(format!("triangle {t} {tri:?} repeats a particle")));
+                }
+            }
+            if body.closed {
+                closed_surface(&body.triangles).map_err(fail)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Whether `triangles` are closed and consistently oriented: every directed edge once, with its
+/// opposite; the reason, naming the edge and the triangle, if not.
+pub(crate) fn closed_surface(triangles: &[[usize; 3]]) -> Result<(), String> {
+    let mut directed: HashMap<(usize, usize), usize> = HashMap::new();
+    for (t, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let e = (tri[k], tri[(k + 1) % 3]);
+            if directed.insert(e, t).is_some() {
+                return Err(format!(
+                    "edge {e:?} runs the same way in two triangles (the second is triangle {t}): \
+                     the surface is not consistently oriented or not manifold"
+                ));
+            }
+        }
+    }
+    // In triangle order, so the error names the same edge every time.
+    for (t, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            if !directed.contains_key(&(b, a)) {
+                return Err(format!(
+                    "edge ({a}, {b}) of triangle {t} has no opposite: the surface is not closed"
+                ));
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,362 @@
+//! Contacts between bodies: line (8) and the iterations for the model's contact bodies
+//! ([`PbdBuilder::contact_body`](crate::PbdBuilder::contact_body)). Every particle of a contact
+//! body is tested against the surface triangles of the other contact bodies; it gets at most one
+//! contact per other body, with the triangle closest to its predicted position `p`, when that
+//! distance is below `thickness + margin + |p - x| + max_k |p_k - x_k|` (the triangle's corners
+//! `k`: both sides may move). The constraint, with the closest point's barycentric coordinates
+//! `b_k` and the unit normal `n` frozen for the substep,
+//!
+//! ```text
+//! C = n . (p - sum_k b_k p_k) - thickness >= 0,    grad_p C = n,  grad_{p_k} C = -b_k n
+//! ```
+//!
+//! is projected like a collider's contact (rigid, an inequality; XPBD keeps its multiplier
+//! `>= 0`), both sides weighted by their inverse masses, with positional friction on the relative
+//! tangential motion over the substep (`mu_s`, `mu_k` of [`BodyContact`](crate::BodyContact);
+//! see [`crate::collide`]). There is no restitution between bodies.
+//!
+//! The normal is the triangle's (at `p`): outward for a closed surface, so a particle that went
+//! inside is pushed back out; for an open surface (cloth) it points to the side the particle was
+//! on at the start of the substep.
+//!
+//! The candidates come from a uniform grid hashed by cell and body (a counting sort into a
+//! fixed table), rebuilt every substep from the triangles' boxes grown by the search radius,
+//! with cells at least as large as the largest grown box, so that a particle looks in one
+//! bucket per other body. Particles are visited in increasing order and each bucket's triangles
+//! in increasing order, so the contacts and their order do not depend on the number of threads. The contacts are projected sequentially after the collider contacts in
+//! every iteration, whatever the solver. Buffers are sized when the simulation is made: a step
+//! allocates nothing.
+
+use super::scratch::Data;
+use crate::model::PbdModel;
+use crate::project::{CONTACT_ID, Ctx};
+use anim_core::glam::DVec3;
+
+/// A contact between a particle and a triangle of another body, for one substep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct PairContact {
+    /// The particle.
+    pub particle: u32,
+    /// The triangle's corners.
+    pub tri: [u32; 3],
+    /// Barycentric coordinates of the closest point.
+    pub bary: [f64; 3],
+    /// Unit normal (from the triangle towards the particle's side).
+    pub normal: DVec3,
+    /// Accumulated normal correction (PBD) or multiplier (XPBD) this substep.
+    pub lambda: f64,
+}
+
+/// The buffers of the body contacts: the surface triangles with their bodies, their boxes, the
+/// spatial hash, the closest triangle per other body of the particle being tested, and the
+/// contacts.
+#[derive(Debug, Default)]
+pub(super) struct BodyContactData {
+    /// Every contact body's surface triangles with the body's index.
+    pub surface: Vec<([u32; 3], u32)>,
+    /// Per surface triangle: the box of its predicted corners and their largest motion.
+    pub boxes: Vec<(DVec3, DVec3, f64)>,
+    /// The hash table: bucket `k` holds `entries[start[k]..start[k + 1]]`.
+    pub start: Vec<u32>,
+    /// Surface triangles by bucket, in increasing order within each.
+    pub entries: Vec<u32>,
+    /// Per contact body: `(distance, surface triangle)` of the closest triangle so far.
+    pub best: Vec<(f64, u32)>,
+    /// The contacts of the substep.
+    pub contacts: Vec<PairContact>,
+}
+
+impl BodyContactData {
+    /// Buffers for `model`'s contact bodies (empty without at least two).
+    pub(super) fn new(model: &PbdModel) -> Self {
+        let bodies = &model.contact_bodies;
+        if bodies.len() < 2 {
+            return Self::default();
+        }
+        let surface: Vec<([u32; 3], u32)> = bodies
+            .iter()
+            .enumerate()
+            .flat_map(|(b, body)| body.triangles.iter().map(move |t| (t.map(|i| i as u32), b as u32)))
+            .collect();
+        let particles: usize = bodies.iter().map(|b| b.particles.1 - b.particles.0).sum();
+        // A triangle's grown box spans at most two cells along each axis: at most 8 entries
+        // each, in a table of at least twice as many buckets.
+        let entries = 8 * surface.len();
+        Self {
+            boxes: vec![(DVec3::ZERO, DVec3::ZERO, 0.0); surface.len()],
+            start: vec![0; (2 * entries).next_power_of_two() + 1],
+            entries: vec![0; entries],
+            surface,
+            best: vec![(f64::INFINITY, u32::MAX); bodies.len()],
+            contacts: Vec::with_capacity(particles * (bodies.len() - 1)),
+        }
+    }
+}
+
+/// The bucket of grid cell `c` for body `body` in a table of `mask + 1` buckets.
+#[inline]
+fn bucket(c: [i64; 3], body: u32, mask: usize) -> usize {
+    let h = (c[0] as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ (c[1] as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
+        ^ (c[2] as u64).wrapping_mul(0x1656_67B1_9E37_79F9)
+        ^ u64::from(body).wrapping_mul(0x27D4_EB2F_1656_67C5);
+    (h ^ (h >> 29)) as usize & mask
+}
+
+/// The cell of `p` for cells of size `size`, or `None` if it is out of the grid's range.
+#[inline]
+fn cell(p: DVec3, size: f64) -> Option<[i64; 3]> {
+    let c = (p / size).floor();
+    let lim = 1e15;
+    (c.abs().max_element() < lim).then_some([c.x as i64, c.y as i64, c.z as i64])
+}
+
+/// The cells from `lo` to `hi`, each once.
+fn cells(lo: [i64; 3], hi: [i64; 3]) -> impl Iterator<Item = [i64; 3]> {
+    (lo[0]..=hi[0])
+        .flat_map(move |x| (lo[1]..=hi[1]).flat_map(move |y| (lo[2]..=hi[2]).map(move |z| [x, y, z])))
+}
+
+/// Line (8) for the contact bodies: fills `d.bodies.contacts` for the predicted positions `d.p`
+/// with thickness and speculative margin `margin`.
+pub(super) fn generate_body_contacts(model: &PbdModel, d: &mut Data, margin: f64) {
+    let bc = &mut d.bodies;
+    bc.contacts.clear();
+    if bc.surface.is_empty() {
+        return;
+    }
+    let (x, p, w) = (&d.x, &d.p, &model.inv_mass);
+    let thickness = model.body_contact.thickness;
+    let motion = |i: usize| (p[i] - x[i]).length();
+    let mut most = 0.0f64;
+    for body in &model.contact_bodies {
+        for i in body.particles.0..body.particles.1 {
+            most = most.max(motion(i));
+        }
+    }
+    // A triangle's box grown by `radius` holds every particle that can touch it.
+    let radius = thickness + margin + 2.0 * most;
+    let mut size = 0.0f64;
+    for (&(t, _), b) in bc.surface.iter().zip(bc.boxes.iter_mut()) {
+        let t = t.map(|i| i as usize);
+        let [a, b1, c] = t.map(|i| p[i]);
+        let moved = motion(t[0]).max(motion(t[1])).max(motion(t[2]));
+        *b = (a.min(b1).min(c), a.max(b1).max(c), moved);
+        size = size.max((b.1 - b.0).max_element() + 2.0 * radius);
+    }
+    // A little larger, so that rounding cannot spread a box over a third cell.
+    let size = size * 1.001;
+    if !(size > 0.0 && size.is_finite()) {
+        // Non-finite positions: the step's guard reports them.
+        return;
+    }
+    // Counting sort of the triangles into the buckets of the cells their grown boxes overlap.
+    let mask = bc.start.len() - 2;
+    let grown = |b: &(DVec3, DVec3, f64)| Some((cell(b.0 - radius, size)?, cell(b.1 + radius, size)?));
+    bc.start.iter_mut().for_each(|s| *s = 0);
+    for (&(_, body), b) in bc.surface.iter().zip(&bc.boxes) {
+        if let Some((lo, hi)) = grown(b) {
+            for c in cells(lo, hi) {
+                bc.start[bucket(c, body, mask) + 1] += 1;
+            }
+        }
+    }
+    for k in 1..bc.start.len() {
+        bc.start[k] += bc.start[k - 1];
+    }
+    for (k, (&(_, body), b)) in bc.surface.iter().zip(&bc.boxes).enumerate() {
+        if let Some((lo, hi)) = grown(b) {
+            for c in cells(lo, hi) {
+                let slot = &mut bc.start[bucket(c, body, mask)];
+                bc.entries[*slot as usize] = k as u32;
+                *slot += 1;
+            }
+        }
+    }
+    // The fill moved each bucket's start to the next one's: shift back.
+    for k in (1..bc.start.len()).rev() {
+        bc.start[k] = bc.start[k - 1];
+    }
+    bc.start[0] = 0;
+    let nb = model.contact_bodies.len() as u32;
+    for (body, own) in model.contact_bodies.iter().zip(0u32..) {
+        for i in body.particles.0..body.particles.1 {
+            let Some(c) = cell(p[i], size) else { continue };
+            bc.best.iter_mut().for_each(|b| *b = (f64::INFINITY, u32::MAX));
+            let near = thickness + margin + motion(i);
+            for other in (0..nb).filter(|&o| o != own) {
+                let k = bucket(c, other, mask);
+                for &e in &bc.entries[bc.start[k] as usize..bc.start[k + 1] as usize] {
+                    let (t, from) = bc.surface[e as usize];
+                    let (lo, hi, moved) = bc.boxes[e as usize];
+                    let reach = near + moved;
+                    if from != other
+                        || (p[i] - (lo - reach)).min_element() < 0.0
+                        || ((hi + reach) - p[i]).min_element() < 0.0
+                    {
+                        continue;
+                    }
+                    let t = t.map(|j| j as usize);
+                    if w[i] == 0.0 && t.iter().all(|&j| w[j] == 0.0) {
+                        continue;
+                    }
+                    let (q, _) = closest_on_triangle(p[i], t.map(|j| p[j]));
+                    let dist = (p[i] - q).length();
+                    // Triangles come in increasing order: the first of equally close ones wins.
+                    if dist < reach && dist < bc.best[other as usize].0 {
+                        bc.best[other as usize] = (dist, e);
+                    }
+                }
+            }
+            for &(_, k) in &bc.best {
+                if k == u32::MAX {
+                    continue;
+                }
+                let (t, other) = bc.surface[k as usize];
+                let closed = model.contact_bodies[other as usize].closed;
+                let corners = t.map(|j| j as usize);
+                let (_, bary) = closest_on_triangle(p[i], corners.map(|j| p[j]));
+                let [a, b, c] = corners.map(|j| p[j]);
+                let Some(face) = (b - a).cross(c - a).try_normalize() else { continue };
+                let normal = if closed {
+                    face
+                } else {
+                    let [a0, b0, c0] = corners.map(|j| x[j]);
+                    let q0 = bary[0] * a0 + bary[1] * b0 + bary[2] * c0;
+                    let side = (b0 - a0).cross(c0 - a0).dot(x[i] - q0);
+                    if side > 0.0 {
+                        face
+                    } else if side < 0.0 {
+                        -face
+                    } else {
+                        continue;
+                    }
+                };
+                bc.contacts.push(PairContact { particle: i as u32, tri: t, bary, normal, lambda: 0.0 });
+            }
+        }
+    }
+}
+
+/// The closest point of triangle `t` to `p` and its barycentric coordinates (Ericson, "Real-time
+/// collision detection", 5.1.5).
+fn closest_on_triangle(p: DVec3, t: [DVec3; 3]) -> (DVec3, [f64; 3]) {
+    let [a, b, c] = t;
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, [1.0, 0.0, 0.0]);
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, [0.0, 1.0, 0.0]);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (a + v * ab, [1.0 - v, v, 0.0]);
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (c, [0.0, 0.0, 1.0]);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let v = d2 / (d2 - d6);
+        return (a + v * ac, [1.0 - v, 0.0, v]);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let v = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + v * (c - b), [0.0, 1.0 - v, v]);
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, u) = (vb * denom, vc * denom);
+    (a + ab * v + ac * u, [1.0 - v - u, v, u])
+}
+
+/// One iteration over the body contacts, in order: each projected (rigid inequality) with
+/// positional friction, the corrections applied at once.
+pub(super) fn project_body_contacts(
+    ctx: &Ctx<'_>,
+    model: &PbdModel,
+    contacts: &mut [PairContact],
+    p: &mut [DVec3],
+) {
+    let (mu_s, mu_k) = (model.body_contact.static_friction, model.body_contact.kinetic_friction);
+    let thickness = model.body_contact.thickness;
+    for c in contacts {
+        let i = c.particle as usize;
+        let t = c.tri.map(|j| j as usize);
+        let wt = t.map(|j| ctx.w[j]);
+        let denom =
+            ctx.w[i] + c.bary[0].powi(2) * wt[0] + c.bary[1].powi(2) * wt[1] + c.bary[2].powi(2) * wt[2];
+        if !(denom > 0.0) {
+            continue;
+        }
+        let q = c.bary[0] * p[t[0]] + c.bary[1] * p[t[1]] + c.bary[2] * p[t[2]];
+        let value = c.normal.dot(p[i] - q) - thickness;
+        // The correction of the gap along the normal (m).
+        let dn = if ctx.xpbd {
+            let dl = (-value / denom).max(-c.lambda);
+            c.lambda += dl;
+            dl * denom
+        } else if value < 0.0 {
+            c.lambda += -value;
+            -value
+        } else {
+            0.0
+        };
+        if dn == 0.0 {
+            continue;
+        }
+        // The relative correction `r` of the particle against the surface point is shared as
+        // `w_i r / D` and `-w_k b_k r / D`, which moves the gap by exactly `r`.
+        let mut r = c.normal * dn;
+        if dn > 0.0 && (mu_s > 0.0 || mu_k > 0.0) {
+            let moved = |j: usize| p[j] - ctx.x[j];
+            let rel =
+                moved(i) + r - (c.bary[0] * moved(t[0]) + c.bary[1] * moved(t[1]) + c.bary[2] * moved(t[2]));
+            let tangent = rel - c.normal * rel.dot(c.normal);
+            let tl = tangent.length();
+            if tl > 0.0 {
+                r -= if tl < mu_s * dn { tangent } else { tangent * (mu_k * dn / tl).min(1.0) };
+            }
+        }
+        let scale = r / denom;
+        if !scale.is_finite() {
+            ctx.flag(CONTACT_ID);
+            continue;
+        }
+        p[i] += ctx.w[i] * scale;
+        for k in 0..3 {
+            p[t[k]] -= wt[k] * c.bary[k] * scale;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_closest_point_of_a_triangle_is_found_in_every_region() {
+        let t = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let case = |p: DVec3, q: DVec3, b: [f64; 3]| {
+            let (got, bary) = closest_on_triangle(p, t);
+            assert!((got - q).length() < 1e-15, "{p}: {got}");
+            assert!(bary.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-15), "{p}: {bary:?}");
+            let back = bary[0] * t[0] + bary[1] * t[1] + bary[2] * t[2];
+            assert!((back - q).length() < 1e-15);
+        };
+        case(DVec3::new(0.25, 0.25, 1.0), DVec3::new(0.25, 0.25, 0.0), [0.5, 0.25, 0.25]);
+        case(DVec3::new(-1.0, -1.0, 0.5), DVec3::ZERO, [1.0, 0.0, 0.0]);
+        case(DVec3::new(2.0, -0.5, 0.0), DVec3::X, [0.0, 1.0, 0.0]);
+        case(DVec3::new(-0.5, 3.0, 0.0), DVec3::Y, [0.0, 0.0, 1.0]);
+        case(DVec3::new(0.5, -1.0, 0.0), DVec3::new(0.5, 0.0, 0.0), [0.5, 0.5, 0.0]);
+        case(DVec3::new(-1.0, 0.5, 0.0), DVec3::new(0.0, 0.5, 0.0), [0.5, 0.0, 0.5]);
+        case(DVec3::new(1.0, 1.0, 0.0), DVec3::new(0.5, 0.5, 0.0), [0.0, 0.5, 0.5]);
+    }
+}
