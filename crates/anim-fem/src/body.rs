@@ -51,24 +51,9 @@ fn default_model() -> MaterialModel {
     MaterialModel::StableNeoHookean
 }
 
-/// An axis-aligned box (world coordinates, after the body's placement): the vertices of the
-/// body inside or on it are pinned.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PinBox {
-    /// The lower corner (m).
-    pub min: [f64; 3],
-    /// The upper corner (m).
-    pub max: [f64; 3],
-}
-
-impl PinBox {
-    /// Whether `p` is inside or on the box.
-    #[must_use]
-    pub fn contains(&self, p: [f64; 3]) -> bool {
-        (0..3).all(|k| p[k] >= self.min[k] && p[k] <= self.max[k])
-    }
-}
+/// The `pin` box of a body: the vertices of the body inside or on it, after its placement, are
+/// pinned.
+pub use anim_core::scene::PinBox;
 
 fn one() -> f64 {
     1.0

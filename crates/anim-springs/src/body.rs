@@ -68,30 +68,7 @@ pub struct MaterialSpec {
     pub bending_damping: f64,
 }
 
-/// An axis-aligned box in world coordinates (after the body's placement).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PinBox {
-    /// The lower corner (m).
-    pub min: [f64; 3],
-    /// The upper corner (m).
-    pub max: [f64; 3],
-}
-
-/// The vertices of a body held fixed: those listed, those in the box, or both. Pinned vertices
-/// start at rest (whatever the body's `velocity`) and never move.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PinSpec {
-    /// Vertex indices of the OBJ file, 0-based in the file's order (the first `v` line is 0);
-    /// default none.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub vertices: Vec<usize>,
-    /// The vertices inside or on this box (after the placement); it must hold at least one;
-    /// default none. Written `box` in a scene file.
-    #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
-    pub region: Option<PinBox>,
-}
+pub use anim_core::scene::{PinBox, PinSpec};
 
 fn one() -> f64 {
     1.0
@@ -364,16 +341,16 @@ fn pinned_vertices(
         }
         pins.push(v);
     }
-    if let Some(PinBox { min, max }) = pin.region {
-        if !min.iter().chain(&max).all(|c| c.is_finite()) {
+    if let Some(region) = pin.region {
+        let PinBox { min, max } = region;
+        if !region.is_finite() {
             return Err(SceneError::invalid(
                 format!("{field}.box"),
                 format!("min {min:?} and max {max:?} must be finite"),
             ));
         }
-        let inside = |p: &[f64; 3]| (0..3).all(|k| p[k] >= min[k] && p[k] <= max[k]);
         let before = pins.len();
-        pins.extend(positions.iter().enumerate().filter(|(_, p)| inside(p)).map(|(v, _)| v));
+        pins.extend(positions.iter().enumerate().filter(|(_, p)| region.contains(**p)).map(|(v, _)| v));
         if pins.len() == before {
             return Err(SceneError::invalid(
                 field,

@@ -44,6 +44,7 @@
 mod checkpoint;
 mod dynamic;
 mod looped;
+mod pin;
 mod placement;
 mod preset;
 pub mod study;
@@ -55,6 +56,7 @@ pub use checkpoint::{
 };
 pub use dynamic::{DynScene, Simulated, StepError};
 pub use looped::Looped;
+pub use pin::{PinBox, PinSpec};
 pub use placement::Placement;
 pub use preset::{BuildContext, BuildError, BuildFn, Preset, RunDefaults, SceneKind, is_default, params};
 pub use view::{Context, Field, Frame, ImageGrid, Prop, View, frame_box, ground_height};

@@ -68,30 +68,7 @@ pub struct BodyMaterial {
     pub pressure: Option<f64>,
 }
 
-/// An axis-aligned box in placed coordinates (m).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PinBox {
-    /// The lower corner.
-    pub min: [f64; 3],
-    /// The upper corner (`>= min` on every axis).
-    pub max: [f64; 3],
-}
-
-/// The vertices of a body held fixed: those listed, and those in the box (both when both are
-/// given). Pinned vertices start at rest whatever the body's `velocity`.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PinSpec {
-    /// Vertex indices of the mesh file, 0-based, in range. Default none. Refused on a soft body
-    /// tetrahedralised from an OBJ surface (its vertices are not the file's: pin it by `box`).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub vertices: Vec<usize>,
-    /// The vertices inside or on this box, after the placement; it must hold at least one.
-    /// Default none.
-    #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
-    pub region: Option<PinBox>,
-}
+pub use anim_core::scene::{PinBox, PinSpec};
 
 fn one() -> f64 {
     1.0
@@ -431,16 +408,19 @@ impl BodySpec {
             }
         }
         if let Some(bx) = pin.region {
-            if !bx.min.iter().chain(&bx.max).all(|c| c.is_finite()) || (0..3).any(|a| bx.min[a] > bx.max[a]) {
+            if !bx.is_valid() {
                 return Err(fail(format!(
                     "the box needs finite corners with min <= max on every axis, got min {:?}, max {:?}",
                     bx.min, bx.max
                 )));
             }
-            let inside = |p: &[f64; 3]| (0..3).all(|a| p[a] >= bx.min[a] && p[a] <= bx.max[a]);
             let before = out.len();
             out.extend(
-                positions.iter().zip(map).filter(|(p, m)| m.is_some() && inside(p)).filter_map(|(_, m)| *m),
+                positions
+                    .iter()
+                    .zip(map)
+                    .filter(|(p, m)| m.is_some() && bx.contains(**p))
+                    .filter_map(|(_, m)| *m),
             );
             if out.len() == before {
                 let (lo, hi) = bounds(positions, map);
