@@ -3,7 +3,7 @@
 //! [`ClosedSurface::tetrahedralize`] (Kuhn cubes of a lattice kept by centroid, the boundary
 //! snapped onto the surface).
 
-use anim_core::surface::{ClosedSurface, SurfaceError};
+use anim_core::surface::{ClosedSurface, SurfaceError, Tetrahedra};
 
 /// The tetrahedra filling the closed surface `positions`, `triangles` of `file`, of edge about
 /// `cell`; or the field (under the body: `mesh` for the surface, `cell` for the resolution) and
@@ -13,7 +13,7 @@ pub(super) fn tetrahedralize(
     positions: Vec<[f64; 3]>,
     triangles: Vec<[usize; 3]>,
     cell: f64,
-) -> Result<(Vec<[f64; 3]>, Vec<[usize; 4]>), (&'static str, String)> {
+) -> Result<Tetrahedra, (&'static str, String)> {
     let surface = ClosedSurface::new(positions, triangles)
         .map_err(|e| ("mesh", format!("{file}: a soft body's surface must be closed: {e}")))?;
     surface.tetrahedralize(cell).map_err(|e| match e {
