@@ -22,7 +22,9 @@
 //!   k_pressure V_0` over a closed mesh (balloons);
 //! - **attachment** `|x_i - t| - d` to a fixed point or a point of a moving [`KinematicBody`];
 //! - **contacts**, inequality constraints against [`Collider`]s generated every step (line 8 of
-//!   the loop), with static and kinetic **friction** and **restitution** ([`collide`]).
+//!   the loop), with static and kinetic **friction** and **restitution** ([`collide`]);
+//!   between bodies ([`ContactBody`], [`PbdBuilder::contact_body`]), a particle of one body
+//!   against the closest surface triangle of another, with friction (no self-collision).
 //!
 //! [`PbdBuilder`] makes models from particles and constraints, or from whole shapes: a chain, a
 //! cloth grid, any triangle mesh, any tetrahedral mesh given as `positions` + `tets` arrays
@@ -136,7 +138,8 @@
 //! [`KIND`] (kind `pbd`) puts the scenes behind anim-core's scene contracts
 //! ([`anim_core::scene`]) with the presets the `anim` command line runs: `drape` (cloth on a
 //! sphere), `flag`, `blob` (the soft tetrahedral blob), `pbd-rope` and `pbd-cloth` (the report's
-//! hanging cloth); [`PbdSimulation`] is a checkpointable, viewable solver ([`kind`]).
+//! hanging cloth), or a scene file's own soft bodies and cloths from mesh files
+//! ([`kind::BodySpec`]); [`PbdSimulation`] is a checkpointable, viewable solver ([`kind`]).
 //!
 //! `examples/cloth_drape.rs` runs any built-in scene ([`scenes`]: cloth draped over a sphere, a
 //! flag in the wind on a swaying pole, a rope of 100 links, a soft tetrahedral blob, a balloon)

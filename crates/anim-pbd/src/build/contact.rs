@@ -97,3 +97,51 @@ pub(crate) fn closed_surface(triangles: &[[usize; 3]]) -> Result<(), String> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::{BodyContact, BuildError, PbdBuilder};
+
+    /// Two tetrahedra's worth of particles: 0..4 and 4..8.
+    fn builder() -> PbdBuilder {
+        let mut b = PbdBuilder::new();
+        for k in 0..8 {
+            b.particle([k as f64, (k % 3) as f64, (k % 2) as f64], 1.0);
+        }
+        b
+    }
+
+    const TET: [[usize; 3]; 4] = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+
+    #[test]
+    fn bad_contact_bodies_are_refused_naming_the_body() {
+        let reason = |b: &PbdBuilder| match b.build() {
+            Err(BuildError::BadContactBody { body, reason }) => format!("{body}: {reason}"),
+            other => panic!("{other:?}"),
+        };
+        let mut b = builder();
+        b.contact_body(0..4, &TET, true);
+        b.contact_body(3..8, &[[4, 5, 6]], false);
+        assert_eq!(reason(&b), "1: particles 3..8 overlap contact body 0's 0..4");
+        let mut b = builder();
+        b.contact_body(0..4, &TET, true);
+        b.contact_body(4..9, &[[4, 5, 6]], false);
+        assert_eq!(reason(&b), "1: particles 4..9 are not a non-empty range of the model's 8 particles");
+        let mut b = builder();
+        b.contact_body(4..8, &[[4, 5, 2]], false);
+        assert_eq!(reason(&b), "0: triangle 0 [4, 5, 2]: particle 2 is not in 4..8");
+        let mut b = builder();
+        b.contact_body(0..4, &TET[..3], true);
+        assert_eq!(reason(&b), "0: edge (2, 1) of triangle 0 has no opposite: the surface is not closed");
+        let mut b = builder();
+        b.contact_body(0..4, &TET, true);
+        b.body_contact(BodyContact { thickness: 0.0, ..BodyContact::default() });
+        assert!(matches!(b.build(), Err(BuildError::BadBodyContact { .. })));
+        let mut b = builder();
+        b.contact_body(0..4, &TET, true);
+        b.contact_body(4..8, &[[4, 5, 6]], false);
+        let model = b.build().expect("builds");
+        assert_eq!(model.contact_bodies().len(), 2);
+        assert_eq!(model.body_contact(), BodyContact::default());
+    }
+}

@@ -210,10 +210,11 @@ fn a_cloth_rests_on_a_soft_body_unless_bodies_do_not_collide() {
     let cube = write_tet_box(&dir, "cube", 3, [-0.3, -0.3, 0.0], 0.2);
     let cloth = write_cloth(&dir, "cloth", 11, 0.4);
     let thickness = 0.01;
-    let run = |contacts: bool| {
+    let run = |contacts: bool, method: &str| {
         let (mut sim, mut state) = built(
             &dir,
             serde_json::json!({
+                "method": method,
                 "obstacles": [{ "plane": { "point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0] } }],
                 "friction": 0.5,
                 "thickness": thickness,
@@ -235,12 +236,18 @@ fn a_cloth_rests_on_a_soft_body_unless_bodies_do_not_collide() {
         let top = state.x[..3 * 64].chunks(3).map(|p| p[2]).fold(f64::NEG_INFINITY, f64::max);
         (cloth_z, top)
     };
-    let (cloth, top) = run(true);
-    let lowest = cloth.iter().copied().fold(f64::INFINITY, f64::min);
-    // The box's top is at 0.61; the cloth (0.4 m wide, over a 0.6 m box) lies flat on it.
-    assert!((top - 0.6105).abs() < 0.005, "box top {top}");
-    assert!(lowest > top + 0.9 * thickness && lowest < top + 1.1 * thickness, "cloth {lowest}, top {top}");
-    let (cloth, _) = run(false);
+    // The box's top is at 0.61; the cloth (0.4 m wide, over a 0.6 m box) lies flat on it, with
+    // XPBD's multipliers and with PBD's projections.
+    for method in ["xpbd", "pbd"] {
+        let (cloth, top) = run(true, method);
+        let lowest = cloth.iter().copied().fold(f64::INFINITY, f64::min);
+        assert!((top - 0.6105).abs() < 0.005, "{method}: box top {top}");
+        assert!(
+            lowest > top + 0.9 * thickness && lowest < top + 1.1 * thickness,
+            "{method}: cloth {lowest}, top {top}"
+        );
+    }
+    let (cloth, _) = run(false, "xpbd");
     let highest = cloth.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     assert!(highest < 0.1, "without contacts between bodies the cloth falls through: {highest}");
 }

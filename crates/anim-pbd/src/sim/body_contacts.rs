@@ -25,12 +25,16 @@
 //! bucket per other body. Particles are visited in increasing order and each bucket's triangles
 //! in increasing order, so the contacts and their order do not depend on the number of threads. The contacts are projected sequentially after the collider contacts in
 //! every iteration, whatever the solver. Buffers are sized when the simulation is made: a step
-//! allocates nothing.
+//! allocates nothing unless a particle touches more than four other bodies at once.
 
 use super::scratch::Data;
 use crate::model::PbdModel;
 use crate::project::{CONTACT_ID, Ctx};
 use anim_core::glam::DVec3;
+
+/// Contacts per particle the buffer is sized for: a particle touching more bodies at once
+/// makes the step grow it.
+const MAX_RESERVED: usize = 4;
 
 /// A contact between a particle and a triangle of another body, for one substep.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -80,15 +84,16 @@ impl BodyContactData {
             .collect();
         let particles: usize = bodies.iter().map(|b| b.particles.1 - b.particles.0).sum();
         // A triangle's grown box spans at most two cells along each axis: at most 8 entries
-        // each, in a table of at least twice as many buckets.
+        // each, in a table of at least twice as many buckets as triangles.
         let entries = 8 * surface.len();
         Self {
             boxes: vec![(DVec3::ZERO, DVec3::ZERO, 0.0); surface.len()],
-            start: vec![0; (2 * entries).next_power_of_two() + 1],
+            start: vec![0; (2 * surface.len()).next_power_of_two() + 1],
             entries: vec![0; entries],
             surface,
             best: vec![(f64::INFINITY, u32::MAX); bodies.len()],
-            contacts: Vec::with_capacity(particles * (bodies.len() - 1)),
+            // A particle has at most one contact per other body; room for four of them.
+            contacts: Vec::with_capacity(particles * (bodies.len() - 1).min(MAX_RESERVED)),
         }
     }
 }
