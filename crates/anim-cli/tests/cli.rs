@@ -323,7 +323,7 @@ fn a_broken_mesh_is_refused_naming_the_file_and_element() {
     std::fs::write(dir.join("tet.node"), "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n").unwrap();
     std::fs::write(dir.join("tet.ele"), "1 4 0\n1 1 3 2 4\n").unwrap();
     let scene = dir.join("broken.toml");
-    let text = "name = \"b\"\n[run]\ndt = 0.01\nframes = 2\n[scene]\nkind = \"fem\"\n[scene.body]\n\
+    let text = "name = \"b\"\n[run]\ndt = 0.01\nframes = 2\n[scene]\nkind = \"fem\"\n[[scene.bodies]]\n\
                 mesh = \"tet.ele\"\nmaterial = { young = 1e5, poisson = 0.3, density = 1000.0 }\n";
     std::fs::write(&scene, text).unwrap();
     let out = dir.join("out");

@@ -205,7 +205,7 @@ pub fn build<const D: usize>(
     flip.gravity = vector::<D>("gravity", params.gravity.unwrap_or(GRAVITY))?;
     let h = 1.0 / res as f64;
     let mut sim =
-        FlipSimulation::new([res + 2; D], h, flip).map_err(|e| invalid("transfer", e.to_string()))?;
+        FlipSimulation::new([res + 2; D], h, flip).map_err(|e| invalid("resolution", e.to_string()))?;
     let (origin, _) = sim.fluid_box();
     let obstacles = obstacles::<D>(params, context)?;
     mark_solid(&mut sim, &obstacles)?;

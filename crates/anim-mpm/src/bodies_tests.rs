@@ -450,3 +450,25 @@ fn materials_and_boundaries_read_with_their_defaults() {
         assert_eq!(serde_json::from_value::<Boundary>(serde_json::to_value(want).unwrap()).unwrap(), want);
     }
 }
+
+/// A 2D scene of bodies runs through the kind like the 2D presets: frames in the z = 0 plane,
+/// the method 2D, framed by the domain's walls.
+#[test]
+fn a_2d_scene_of_bodies_steps_through_the_kind() {
+    let params = json!({
+        "dim": 2, "resolution": 32, "transfer": "apic",
+        "obstacles": [{ "box": { "center": [0.5, 0.2, 0.0], "half_extents": [0.3, 0.05, 0.0] } }],
+        "bodies": [
+            { "shape": { "sphere": { "center": [0.3, 0.6, 0.0], "radius": 0.1 } }, "material": { "fluid": {} } },
+            { "shape": cube([0.7, 0.6, 0.0], 0.1), "material": { "sand": {} }, "rotate": [0.0, 0.0, 0.3] },
+        ],
+    });
+    let mut scene = (KIND.build)(&params, &BuildContext::default()).expect("builds");
+    assert_eq!(scene.method(), "2D APIC, quadratic B-splines, CFL substeps");
+    scene.step(1e-3).expect("steps");
+    let mut frame = anim_core::scene::Frame::default();
+    scene.frame(&mut frame);
+    assert!(!frame.points.is_empty() && frame.points.chunks_exact(3).all(|p| p[2] == 0.0));
+    let bounds = scene.context().bounds.expect("bounds");
+    assert_eq!(bounds, ([3.0 / 32.0, 3.0 / 32.0, 0.0], [29.0 / 32.0, 29.0 / 32.0, 0.0]));
+}

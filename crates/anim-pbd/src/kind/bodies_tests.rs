@@ -353,6 +353,21 @@ fn a_missing_or_broken_mesh_file_is_named() {
             dir.join("flat.obj").display()
         )
     );
+    // An inverted tetrahedron names the file, the tetrahedron and its vertices.
+    std::fs::write(dir.join("flip.node"), "5 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n4 1 1 1\n")
+        .expect("write");
+    std::fs::write(dir.join("flip.ele"), "2 4 0\n0 0 1 2 3\n1 1 3 2 4\n").expect("write");
+    let msg = refusal(
+        &dir,
+        serde_json::json!({ "bodies": [{ "mesh": "flip.ele", "material": { "density": 1.0 } }] }),
+    );
+    assert!(
+        msg.starts_with(&format!(
+            "field `bodies[0].mesh`: {}: tetrahedron 1 (vertices 1, 3, 2, 4) is inverted",
+            dir.join("flip.ele").display()
+        )),
+        "{msg}"
+    );
     // A parse error names the file and its line.
     std::fs::write(dir.join("bad.obj"), "v 0 0 0\nv 1 0 zero\n").expect("write");
     let msg = refusal(
@@ -510,4 +525,75 @@ fn a_closed_cloth_with_pressure_inflates() {
     }
     let v = sim.model().volume_mesh(0).volume(&state.x);
     assert!((v / v0 - 1.5).abs() < 0.01, "{}", v / v0);
+}
+
+/// Writes the closed OBJ surface of the unit cube `[0, 1]^3`, twelve outward triangles.
+fn write_cube_obj(dir: &Path) -> String {
+    let mut text = String::new();
+    for i in 0..8 {
+        text += &format!("v {} {} {}\n", i & 1, (i >> 1) & 1, (i >> 2) & 1);
+    }
+    for f in [
+        [0, 2, 3],
+        [0, 3, 1],
+        [4, 5, 7],
+        [4, 7, 6],
+        [0, 1, 5],
+        [0, 5, 4],
+        [1, 3, 7],
+        [1, 7, 5],
+        [3, 2, 6],
+        [3, 6, 7],
+        [2, 0, 4],
+        [2, 4, 6],
+    ] {
+        text += &format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1);
+    }
+    std::fs::write(dir.join("cube.obj"), text).expect("write");
+    "cube.obj".into()
+}
+
+/// A closed OBJ surface with `cell` is a soft body of tetrahedra filling it: its mass is the
+/// density times the enclosed volume, and it stays above the ground.
+#[test]
+fn a_closed_obj_surface_with_a_cell_is_filled_with_tetrahedra() {
+    let dir = folder("obj-soft");
+    let cube = write_cube_obj(&dir);
+    let body = |cell: f64, pin: serde_json::Value| {
+        serde_json::json!({
+            "obstacles": [{ "plane": { "point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0] } }],
+            "thickness": 0.01,
+            "bodies": [{ "mesh": cube, "cell": cell, "scale": 0.4, "translate": [-0.2, -0.2, 0.1],
+                         "material": { "density": 250.0, "stretch": { "compliance": 1e-5 } }, "pin": pin }],
+        })
+    };
+    let (mut sim, mut state) = built(&dir, body(0.1, serde_json::Value::Null));
+    assert!(!sim.model().tets().is_empty());
+    // 0.4^3 m^3 at 250 kg/m^3: 16 kg.
+    let m = total_mass(sim.model());
+    assert!((m - 16.0).abs() < 1e-9, "{m}");
+    for _ in 0..60 {
+        sim.step(&mut state, 1.0 / 60.0).expect("step");
+    }
+    let z = state.x.chunks(3).map(|p| p[2]).fold(f64::INFINITY, f64::min);
+    assert!((z - 0.01).abs() < 1e-3, "{z}");
+    // Its vertices are not the file's: pins by index are refused, pins by box taken.
+    let msg = refusal(&dir, body(0.1, serde_json::json!({ "vertices": [0] })));
+    assert!(msg.starts_with("field `bodies[0].pin`: `vertices` name vertices of the mesh file"), "{msg}");
+    let (sim, _) = built(
+        &dir,
+        body(0.1, serde_json::json!({ "box": { "min": [-1.0, -1.0, 0.45], "max": [1.0, 1.0, 1.0] } })),
+    );
+    let pinned = sim.model().inverse_masses().iter().filter(|&&w| w == 0.0).count();
+    assert_eq!(pinned, 25, "the top face's 5 x 5 lattice vertices");
+    // A cell larger than the body leaves no tetrahedron: refused on `cell`.
+    let msg = refusal(&dir, body(2.0, serde_json::Value::Null));
+    assert!(msg.starts_with("field `bodies[0].cell`: ") && msg.contains("cube.obj"), "{msg}");
+    // An open surface cannot be filled.
+    let cloth = write_cloth(&dir, "cloth", 3, 1.0);
+    let msg = refusal(
+        &dir,
+        serde_json::json!({ "bodies": [{ "mesh": cloth, "cell": 0.1, "material": { "density": 1.0 } }] }),
+    );
+    assert!(msg.starts_with("field `bodies[0].mesh`: ") && msg.contains("must be closed"), "{msg}");
 }

@@ -4,8 +4,9 @@
 //! initial velocity and pinned vertices.
 //!
 //! The mesh is read, placed (scale, rotation, translation: [`Placement`]), checked element by
-//! element in the file's numbering (a repeated vertex, a tetrahedron of zero volume or a triangle
-//! of zero area is refused, naming the file and the element), and added to a [`PbdBuilder`]:
+//! element in the file's numbering (a repeated vertex, an inverted tetrahedron or one of zero
+//! volume, or a triangle of zero area is refused, naming the file and the element), and added to
+//! a [`PbdBuilder`]:
 //!
 //! - **soft**: [`PbdBuilder::tet_mesh`], a distance constraint on every edge (`stretch`) and a
 //!   volume constraint per tetrahedron (`volume`), the masses lumped from `density` (kg/m^3), a
@@ -535,7 +536,7 @@ fn read(path: &Path, format: Format, kind: BodyType) -> Result<(Vec<[f64; 3]>, E
 }
 
 /// Refuses an element with a repeated vertex, a tetrahedron with `|V| <= 1e-12 l^3` (`l` its
-/// longest edge) or a triangle with twice its area `<= 1e-12` times its longer edge at the first
+/// longest edge) or a negative signed volume (inverted), or a triangle with twice its area `<= 1e-12` times its longer edge at the first
 /// corner squared: the builder's own tests, here in the file's numbering.
 fn check_elements(file: &str, positions: &[[f64; 3]], elements: &Elements) -> Result<(), String> {
     let p = |i: usize| DVec3::from_array(positions[i]);
@@ -557,6 +558,12 @@ fn check_elements(file: &str, positions: &[[f64; 3]], elements: &Elements) -> Re
                 if !(v.abs() > 1e-12 * l2 * l2.sqrt()) {
                     return Err(format!(
                         "{file}: tetrahedron {t} (vertices {}) has zero volume (placed: {v:e} m^3)",
+                        list(tet)
+                    ));
+                }
+                if v < 0.0 {
+                    return Err(format!(
+                        "{file}: tetrahedron {t} (vertices {}) is inverted (signed volume {v:e} m^3)",
                         list(tet)
                     ));
                 }

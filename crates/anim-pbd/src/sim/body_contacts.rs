@@ -108,7 +108,7 @@ fn bucket(c: [i64; 3], body: u32, mask: usize) -> usize {
 fn cell(p: DVec3, size: f64) -> Option<[i64; 3]> {
     let c = (p / size).floor();
     let lim = 1e15;
-    (c.abs().max_element() < lim).then(|| [c.x as i64, c.y as i64, c.z as i64])
+    (c.abs().max_element() < lim).then_some([c.x as i64, c.y as i64, c.z as i64])
 }
 
 /// The cells from `lo` to `hi`, each once.
