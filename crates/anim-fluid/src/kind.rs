@@ -10,7 +10,7 @@
 //!
 //! Without `preset`, a scene file is a smoke scene of the user's own ([`crate::smoke`]): the MAC
 //! solver on a box of the file's `size` and `resolution` (2D or 3D), smoke from its `sources`
-//! around its `obstacles`, each a collider shape or a closed OBJ surface, with the plume's
+//! around its `obstacles` (collider shapes) and `obstacle_meshes` (closed OBJ surfaces), with the plume's
 //! settings as defaults ([`FluidSceneParams`] lists every field).
 //!
 //! A scene is the [`FluidScene`] itself stepped as a [`Solver`] whose state is the run's clock:
@@ -42,7 +42,8 @@ use crate::error::FluidError;
 use crate::mac::{MacFluid, MacState};
 use crate::pressure::PressureMethod;
 use crate::scenes::{self, FluidScene, FluidSim};
-use crate::smoke::{self, ObstacleSpec, SourceSpec};
+use crate::smoke::{self, MeshObstacle, SourceSpec};
+use anim_core::geometry::Shape;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, ImageGrid, Preset, Prop,
@@ -137,10 +138,15 @@ pub struct FluidSceneParams {
     /// with its density, temperature and velocity).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sources: Option<Vec<SourceSpec>>,
-    /// Solids the smoke flows around: collider shapes and closed OBJ surfaces
-    /// ([`ObstacleSpec`]); each must cover a cell centre. Default none.
+    /// Solids the smoke flows around, collider shapes in the `anim_core::geometry::Shape`
+    /// spelling (`{ sphere = { center, radius } }`, `box`, `capsule`, `plane`); each must cover
+    /// a cell centre. Default none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub obstacles: Option<Vec<ObstacleSpec>>,
+    pub obstacles: Option<Vec<Shape>>,
+    /// Solids the smoke flows around, closed OBJ surfaces placed by `scale`, `rotate`,
+    /// `translate` ([`MeshObstacle`]); each must cover a cell centre. Default none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub obstacle_meshes: Option<Vec<MeshObstacle>>,
 }
 
 impl FluidSceneParams {
@@ -170,6 +176,7 @@ impl FluidSceneParams {
             open_top: None,
             sources: Some(sources),
             obstacles: None,
+            obstacle_meshes: None,
         }
     }
 
@@ -186,6 +193,7 @@ impl FluidSceneParams {
             ("open_top", self.open_top.is_some()),
             ("sources", self.sources.is_some()),
             ("obstacles", self.obstacles.is_some()),
+            ("obstacle_meshes", self.obstacle_meshes.is_some()),
         ]
         .into_iter()
         .filter_map(|(name, set)| set.then_some(name))
@@ -209,7 +217,7 @@ impl FluidSceneParams {
     /// MAC setting given to Stam's solver, a smoke scene's field given to a preset; for a smoke
     /// scene of the user's own, a bad size or setting, a source or obstacle that covers no cell,
     /// a source inside obstacles, an OBJ file that does not parse or is not a closed surface
-    /// (`sources[k].mesh`, `obstacles[k].mesh`).
+    /// (`sources[k].mesh`, `obstacle_meshes[k].mesh`).
     pub fn scene_in(&self, context: &BuildContext<'_>) -> Result<FluidScene, BuildError> {
         if let Some(tol) = self.pressure_tolerance
             && !(tol > 0.0 && tol.is_finite())
@@ -229,7 +237,7 @@ impl FluidSceneParams {
                 field,
                 format!(
                     "belongs to a smoke scene of your own; preset `{preset}` keeps its own (remove \
-                     `preset` to build your own scene with `sources` and `obstacles`)"
+                     `preset` to build your own scene with `sources` and obstacles)"
                 ),
             ));
         }
@@ -402,7 +410,7 @@ impl View for FluidScene {
 
     /// The image grid (origin at 0, the cell size as spacing, the density shown) and, for the
     /// plume, its sphere in the grid's axes; for a smoke scene of the user's own, its shape
-    /// obstacles but planes (meshes have no prop).
+    /// obstacles but planes (mesh obstacles have no prop).
     fn context(&self, _: &f64) -> Context {
         // Stam's source adds 10 per step where it sits and the closed box keeps it all: in
         // the 128^2 box after 200 steps the density's median is 17, its 99th percentile 50

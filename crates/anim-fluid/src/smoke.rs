@@ -1,8 +1,8 @@
 //! A smoke scene of the user's own: the `fluid` scene kind without `preset`. The domain, its
 //! grid and the solver's settings come from [`FluidSceneParams`], the smoke from its
 //! [`sources`](FluidSceneParams::sources) and the solids from its
-//! [`obstacles`](FluidSceneParams::obstacles): collider shapes ([`Shape`]) or closed OBJ
-//! surfaces.
+//! [`obstacles`](FluidSceneParams::obstacles), collider shapes ([`Shape`]), and its
+//! [`obstacle_meshes`](FluidSceneParams::obstacle_meshes), closed OBJ surfaces.
 //!
 //! **Axes** are the grid's own, as in the presets: the domain is the box from the origin to
 //! `size`, x to the right, **y up** (buoyancy pushes hot smoke along +y, the top is the high y
@@ -139,7 +139,8 @@ pub struct SourceSpec {
     pub velocity: Option<[f64; 3]>,
 }
 
-/// A closed OBJ surface as an obstacle, placed by `scale`, `rotate`, `translate`.
+/// A closed OBJ surface as an obstacle (a table of `obstacle_meshes`), placed by `scale`,
+/// `rotate`, `translate`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshObstacle {
@@ -161,39 +162,6 @@ pub struct MeshObstacle {
 impl MeshObstacle {
     fn placement(&self) -> Placement {
         Placement { scale: self.scale, rotate: self.rotate, translate: self.translate }
-    }
-}
-
-/// An obstacle: a collider shape in the `anim_core::geometry::Shape` spelling
-/// (`{ sphere = { center, radius } }`, `box`, `capsule`, `plane`), or a table with `mesh` (a
-/// [`MeshObstacle`]).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-#[serde(untagged)]
-pub enum ObstacleSpec {
-    /// A collider shape.
-    Shape(Shape),
-    /// A closed OBJ surface.
-    Mesh(MeshObstacle),
-}
-
-impl<'de> Deserialize<'de> for ObstacleSpec {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        use serde::de::Error as _;
-        let value = serde_json::Value::deserialize(d)?;
-        if let Some(table) = value.as_object() {
-            if table.contains_key("mesh") {
-                return serde_json::from_value(value).map(ObstacleSpec::Mesh).map_err(D::Error::custom);
-            }
-            if table.len() != 1 {
-                let keys: Vec<String> = table.keys().map(|k| format!("`{k}`")).collect();
-                return Err(D::Error::custom(format!(
-                    "an obstacle is one shape (`plane`, `sphere`, `box` or `capsule`) or a table with \
-                     `mesh` (and `scale`, `rotate`, `translate`); got {}",
-                    if keys.is_empty() { "an empty table".to_string() } else { keys.join(", ") }
-                )));
-            }
-        }
-        serde_json::from_value(value).map(ObstacleSpec::Shape).map_err(D::Error::custom)
     }
 }
 
@@ -342,18 +310,19 @@ pub(crate) fn build(p: &FluidSceneParams, context: &BuildContext<'_>) -> Result<
 
     // Obstacles: each must cover a cell; the union is solid.
     let mut solid = vec![false; fluid.solid().len()];
-    let mut covered: Vec<Vec<bool>> = Vec::new();
-    let mut shapes = Vec::new();
-    for (k, obstacle) in p.obstacles.iter().flatten().enumerate() {
+    let mut covered: Vec<(String, Vec<bool>)> = Vec::new();
+    let shapes: Vec<Shape> = p.obstacles.iter().flatten().copied().collect();
+    let regions = shapes.iter().enumerate().map(|(k, shape)| {
         let field = format!("obstacles[{k}]");
-        let region = match obstacle {
-            ObstacleSpec::Shape(shape) => {
-                shapes.push(*shape);
-                Region::shape(*shape, grid.dim).map_err(|e| BuildError::invalid(&field, e))?
-            }
-            ObstacleSpec::Mesh(m) => Region::mesh(&m.mesh, m.placement(), context, &field)?,
-        };
-        let cells = region.cell_mask(&fluid);
+        Region::shape(*shape, grid.dim).map(|r| (field.clone(), r)).map_err(|e| BuildError::invalid(field, e))
+    });
+    let meshes = p.obstacle_meshes.iter().flatten().enumerate().map(|(k, m)| {
+        let field = format!("obstacle_meshes[{k}]");
+        Region::mesh(&m.mesh, m.placement(), context, &field).map(|r| (field, r))
+    });
+    for region in regions.chain(meshes) {
+        let (field, region) = region?;
+        let cells = region.cell_mask(&fluid).map_err(|e| BuildError::invalid(&field, e))?;
         if !cells.contains(&true) {
             return Err(BuildError::invalid(
                 &field,
@@ -363,7 +332,7 @@ pub(crate) fn build(p: &FluidSceneParams, context: &BuildContext<'_>) -> Result<
         for (s, c) in solid.iter_mut().zip(&cells) {
             *s |= *c;
         }
-        covered.push(cells);
+        covered.push((field, cells));
     }
     fluid.set_solid_cells(&solid).map_err(|e| BuildError::invalid("obstacles", e.to_string()))?;
 
@@ -371,7 +340,7 @@ pub(crate) fn build(p: &FluidSceneParams, context: &BuildContext<'_>) -> Result<
     for (k, s) in sources.iter().enumerate() {
         let field = format!("sources[{k}]");
         let region = source_region(s, grid.dim, context, &field)?;
-        let cells = region.cell_mask(&fluid);
+        let cells = region.cell_mask(&fluid).map_err(|e| BuildError::invalid(&field, e))?;
         if !cells.contains(&true) {
             return Err(BuildError::invalid(
                 &field,
@@ -379,11 +348,10 @@ pub(crate) fn build(p: &FluidSceneParams, context: &BuildContext<'_>) -> Result<
             ));
         }
         if cells.iter().zip(&solid).all(|(c, s)| !c || *s) {
-            let inside: Vec<String> = covered
+            let inside: Vec<&str> = covered
                 .iter()
-                .enumerate()
-                .filter(|(_, o)| cells.iter().zip(o.iter()).any(|(c, o)| *c && *o))
-                .map(|(j, _)| format!("obstacles[{j}]"))
+                .filter(|(_, o)| cells.iter().zip(o).any(|(c, o)| *c && *o))
+                .map(|(name, _)| name.as_str())
                 .collect();
             return Err(BuildError::invalid(
                 &field,
@@ -403,7 +371,11 @@ pub(crate) fn build(p: &FluidSceneParams, context: &BuildContext<'_>) -> Result<
                 format!("a 2D scene has no z velocity, got {v:?}"),
             ));
         }
-        let faces = if s.velocity.is_some() { region.face_masks(&fluid) } else { empty_faces(&fluid) };
+        let faces = if s.velocity.is_some() {
+            region.face_masks(&fluid).map_err(|e| BuildError::invalid(&field, e))?
+        } else {
+            empty_faces(&fluid)
+        };
         fluid
             .add_region_source(RegionSource {
                 cells,

@@ -1,6 +1,6 @@
 //! The region of a source or an obstacle, and which cell and face centres lie inside it: a
-//! collider shape tested analytically, or a closed OBJ surface tested by its generalized winding
-//! number ([`ClosedSurface::contains`]).
+//! collider shape tested analytically, or a closed OBJ surface tested by its winding number
+//! ([`ClosedSurface::inside_lattice`]).
 
 use std::path::Path;
 
@@ -8,7 +8,6 @@ use anim_core::geometry::Shape;
 use anim_core::scene::{BuildContext, BuildError, Placement};
 use anim_core::surface::ClosedSurface;
 use anim_io::obj::{Polygons, read_obj};
-use rayon::prelude::*;
 
 use crate::mac::MacFluid;
 
@@ -66,41 +65,48 @@ impl Region {
         Ok(Region::Surface(Box::new(surface)))
     }
 
-    /// Whether `p` lies inside: strictly inside a shape, or inside the surface by its winding
-    /// number.
-    pub(super) fn covers(&self, p: [f64; 3]) -> bool {
-        match self {
-            Region::Shape { shape, dim } => shape_covers(shape, p, *dim),
-            Region::Surface(surface) => surface.contains(p),
-        }
-    }
-
     /// Per cell of `fluid` (x fastest), whether its centre lies inside.
-    pub(super) fn cell_mask(&self, fluid: &MacFluid) -> Vec<bool> {
-        let d = fluid.dims();
-        self.mask(d, |i, j, k| fluid.cell_centre(i, j, k))
+    ///
+    /// # Errors
+    /// The surface's refusal of the lattice (never for a grid of at most
+    /// [`MAX_CELLS`](super::MAX_CELLS)).
+    pub(super) fn cell_mask(&self, fluid: &MacFluid) -> Result<Vec<bool>, String> {
+        self.mask(fluid.dims(), fluid.h(), |i, j, k| fluid.cell_centre(i, j, k))
     }
 
     /// Per velocity component of `fluid`, whether each face centre lies inside (empty for `w`
     /// in 2D).
-    pub(super) fn face_masks(&self, fluid: &MacFluid) -> [Vec<bool>; 3] {
-        std::array::from_fn(|a| {
-            if a < fluid.dim() {
-                self.mask(fluid.face_dims(a), |i, j, k| fluid.face_centre(a, i, j, k))
-            } else {
-                Vec::new()
-            }
-        })
+    ///
+    /// # Errors
+    /// As [`Region::cell_mask`].
+    pub(super) fn face_masks(&self, fluid: &MacFluid) -> Result<[Vec<bool>; 3], String> {
+        let mut masks: [Vec<bool>; 3] = Default::default();
+        for (a, mask) in masks.iter_mut().enumerate().take(fluid.dim()) {
+            *mask = self.mask(fluid.face_dims(a), fluid.h(), |i, j, k| fluid.face_centre(a, i, j, k))?;
+        }
+        Ok(masks)
     }
 
-    /// Whether `at(i, j, k)` lies inside, over a lattice of `d` (x fastest); meshes in parallel
-    /// (each point on its own, so the result does not depend on the thread count).
-    fn mask(&self, d: [usize; 3], at: impl Fn(usize, usize, usize) -> [f64; 3] + Sync) -> Vec<bool> {
-        let point = |c: usize| at(c % d[0], (c / d[0]) % d[1], c / (d[0] * d[1]));
-        let n = d[0] * d[1] * d[2];
+    /// Whether each point `at(i, j, k)` of a lattice of `counts` points spaced `h` lies inside
+    /// (x fastest): a shape at each point as the grid computes it, a surface row by row
+    /// ([`ClosedSurface::inside_lattice`] from `at(0, 0, 0)`, the winding number by crossings
+    /// along x).
+    fn mask(
+        &self,
+        counts: [usize; 3],
+        h: f64,
+        at: impl Fn(usize, usize, usize) -> [f64; 3],
+    ) -> Result<Vec<bool>, String> {
         match self {
-            Region::Shape { .. } => (0..n).map(|c| self.covers(point(c))).collect(),
-            Region::Surface(_) => (0..n).into_par_iter().map(|c| self.covers(point(c))).collect(),
+            Region::Shape { shape, dim } => {
+                let n = counts[0] * counts[1] * counts[2];
+                let point =
+                    |c: usize| at(c % counts[0], (c / counts[0]) % counts[1], c / (counts[0] * counts[1]));
+                Ok((0..n).map(|c| shape_covers(shape, point(c), *dim)).collect())
+            }
+            Region::Surface(surface) => {
+                surface.inside_lattice(at(0, 0, 0), h, counts).map_err(|e| e.to_string())
+            }
         }
     }
 

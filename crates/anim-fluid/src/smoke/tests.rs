@@ -171,7 +171,7 @@ fn a_mesh_obstacle_marks_the_cells_inside_its_surface() {
     let value = json!({
         "resolution": 16,
         "sources": [vent()],
-        "obstacles": [ { "mesh": "ball.obj", "scale": r, "translate": c } ],
+        "obstacle_meshes": [ { "mesh": "ball.obj", "scale": r, "translate": c } ],
     });
     let p: FluidSceneParams = params(&value).expect("parameters");
     let scene = p.scene_in(&BuildContext { base: Some(&dir) }).expect("builds");
@@ -198,7 +198,7 @@ fn a_mesh_obstacle_marks_the_cells_inside_its_surface() {
     let value = json!({
         "dim": 2, "resolution": 40,
         "sources": [ { "shape": { "sphere": { "center": [0.5, 0.0, 0.0], "radius": 0.1 } } } ],
-        "obstacles": [ { "mesh": "ball.obj", "scale": r, "translate": c } ],
+        "obstacle_meshes": [ { "mesh": "ball.obj", "scale": r, "translate": c } ],
     });
     let p: FluidSceneParams = params(&value).expect("parameters");
     let scene = p.scene_in(&BuildContext { base: Some(&dir) }).expect("builds");
@@ -218,10 +218,10 @@ fn a_mesh_obstacle_marks_the_cells_inside_its_surface() {
     }
     assert!(solid > 100 && band < solid / 10, "{band} of {solid} cells undecided");
     let mut value = value;
-    value["obstacles"][0]["translate"] = json!([0.45, 0.7, 0.5]);
+    value["obstacle_meshes"][0]["translate"] = json!([0.45, 0.7, 0.5]);
     let p: FluidSceneParams = params(&value).expect("parameters");
     let msg = p.scene_in(&BuildContext { base: Some(&dir) }).expect_err("refused").to_string();
-    assert!(msg.starts_with("field `obstacles[0]`: a 2D scene cuts meshes at z = 0"), "{msg}");
+    assert!(msg.starts_with("field `obstacle_meshes[0]`: a 2D scene cuts meshes at z = 0"), "{msg}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -234,13 +234,16 @@ fn steps_around_obstacles_end_divergence_free_with_no_flow_into_them() {
     let dir = temp_dir("divergence");
     std::fs::write(dir.join("ball.obj"), sphere_obj([0.0; 3], 1.0, 12, 24)).expect("write");
     for (dim, mesh) in [(3, true), (2, false)] {
-        let mut obstacles = vec![json!({ "sphere": { "center": [0.5, 0.45, 0.5], "radius": 0.15 } })];
-        if mesh {
-            obstacles.push(json!({ "mesh": "ball.obj", "scale": 0.12, "translate": [0.25, 0.9, 0.5] }));
-        }
+        let meshes = if mesh {
+            json!([ { "mesh": "ball.obj", "scale": 0.12, "translate": [0.25, 0.9, 0.5] } ])
+        } else {
+            json!([])
+        };
         let value = json!({
             "dim": dim, "resolution": 12, "pressure_tolerance": 1e-10, "open_top": false,
-            "sources": [vent()], "obstacles": obstacles,
+            "sources": [vent()],
+            "obstacles": [ { "sphere": { "center": [0.5, 0.45, 0.5], "radius": 0.15 } } ],
+            "obstacle_meshes": meshes,
         });
         let p: FluidSceneParams = params(&value).expect("parameters");
         let mut scene = p.scene_in(&BuildContext { base: Some(&dir) }).expect("builds");
@@ -401,23 +404,37 @@ fn mesh_problems_name_the_field_and_the_file() {
     let dir = temp_dir("mesh-errors");
     let context = BuildContext { base: Some(&dir) };
     let build = |value: Value| (KIND.build)(&value, &context).err().expect("refused").to_string();
-    let msg = build(json!({ "sources": [vent()], "obstacles": [ { "mesh": "missing.obj" } ] }));
-    assert!(msg.starts_with("field `obstacles[0].mesh`: ") && msg.contains("missing.obj"), "{msg}");
+    let msg = build(json!({ "sources": [vent()], "obstacle_meshes": [ { "mesh": "missing.obj" } ] }));
+    assert!(msg.starts_with("field `obstacle_meshes[0].mesh`: ") && msg.contains("missing.obj"), "{msg}");
     // A cube without its top: open.
     let open = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
                 f 1 3 2\nf 1 4 3\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
     std::fs::write(dir.join("open.obj"), open).expect("write");
-    let msg = build(json!({ "sources": [vent()], "obstacles": [ { "mesh": "open.obj" } ] }));
+    let msg = build(json!({ "sources": [vent()], "obstacle_meshes": [ { "mesh": "open.obj" } ] }));
     assert!(
-        msg.starts_with("field `obstacles[0].mesh`: ") && msg.contains("open.obj: the surface is not closed"),
+        msg.starts_with("field `obstacle_meshes[0].mesh`: ")
+            && msg.contains("open.obj: the surface is not closed"),
         "{msg}"
     );
     std::fs::write(dir.join("bad.obj"), "v 0 0 0\nv 1 0 zero\n").expect("write");
     let msg = build(json!({ "sources": [ { "mesh": "bad.obj" } ] }));
     assert!(msg.starts_with("field `sources[0].mesh`: ") && msg.contains("bad.obj:2:"), "{msg}");
     std::fs::write(dir.join("ball.obj"), sphere_obj([0.0; 3], 1.0, 6, 8)).expect("write");
-    let msg = build(json!({ "sources": [vent()], "obstacles": [ { "mesh": "ball.obj", "scale": 0.0 } ] }));
-    assert!(msg.starts_with("field `obstacles[0].scale`: must be positive"), "{msg}");
+    let msg =
+        build(json!({ "sources": [vent()], "obstacle_meshes": [ { "mesh": "ball.obj", "scale": 0.0 } ] }));
+    assert!(msg.starts_with("field `obstacle_meshes[0].scale`: must be positive"), "{msg}");
+    // A mesh obstacle between cell centres is named with the grid; a source inside it too.
+    let msg = build(json!({ "resolution": 8, "sources": [vent()],
+                            "obstacle_meshes": [ { "mesh": "ball.obj", "scale": 0.03, "translate": [0.5, 0.5, 0.5] } ] }));
+    assert!(
+        msg.starts_with("field `obstacle_meshes[0]`: covers no cell centre of the 8 x 12 x 8 cells"),
+        "{msg}"
+    );
+    let msg = build(json!({ "resolution": 8,
+                            "sources": [vent(), { "shape": { "sphere": { "center": [0.5, 0.8, 0.5], "radius": 0.1 } } }],
+                            "obstacles": [ { "sphere": { "center": [0.1, 0.1, 0.1], "radius": 0.1 } } ],
+                            "obstacle_meshes": [ { "mesh": "ball.obj", "scale": 0.3, "translate": [0.5, 0.8, 0.5] } ] }));
+    assert!(msg.starts_with("field `sources[1]`: lies inside obstacle_meshes[0]: every cell"), "{msg}");
     let msg = build(json!({ "sources": [ { "mesh": "ball.obj", "scale": 0.2, "translate": [0.5, 0.3, 0.5] },
                                          { "mesh": "ball.obj", "scale": 0.2, "translate": [5.0, 0.3, 0.5] } ] }));
     assert!(msg.starts_with("field `sources[1]`: lies outside the domain"), "{msg}");
@@ -478,15 +495,19 @@ fn bad_fields_of_a_smoke_scene_are_named() {
         ),
         (
             json!({ "sources": [vent()], "obstacles": [ { "sphere": { "center": [0.5, 0.5, 0.5], "radiu": 0.1 } } ] }),
-            "field `obstacles[0]`: unknown field `radiu`",
+            "field `obstacles[0].sphere.radiu`: unknown field `radiu`, expected `center` or `radius`",
         ),
         (
-            json!({ "sources": [vent()], "obstacles": [ { "sphere": { "center": [0.5, 0.5, 0.5], "radius": 0.1 }, "scale": 2.0 } ] }),
-            "field `obstacles[0]`: an obstacle is one shape (`plane`, `sphere`, `box` or `capsule`) or a table with `mesh`",
+            json!({ "sources": [vent()], "obstacles": [ { "mesh": "x.obj" } ] }),
+            "field `obstacles[0]`: unknown variant `mesh`",
         ),
         (
-            json!({ "sources": [vent()], "obstacles": [ { "mesh": "x.obj", "scael": 2.0 } ] }),
-            "field `obstacles[0]`: unknown field `scael`",
+            json!({ "sources": [vent()], "obstacle_meshes": [ { "mesh": "x.obj", "scael": 2.0 } ] }),
+            "field `obstacle_meshes[0].scael`: unknown field `scael`, expected one of `mesh`, `scale`",
+        ),
+        (
+            json!({ "preset": "smoke-plume-3d", "obstacle_meshes": [] }),
+            "field `obstacle_meshes`: belongs to a smoke scene of your own",
         ),
         (
             json!({ "sources": [vent()], "pressure_tolerance": 0.0 }),
@@ -520,8 +541,8 @@ fn a_smoke_scene_round_trips_draws_its_shapes_and_resumes() {
         "sources": [vent(), { "mesh": "ball.obj", "scale": 0.1, "rotate": [0.1, 0.0, 0.0],
                               "translate": [0.2, 0.2, 0.3], "density": 0.5, "temperature": 2.0 }],
         "obstacles": [ { "sphere": { "center": [0.5, 0.6, 0.4], "radius": 0.2 } },
-                       { "plane": { "point": [0.0, 1.0, 0.0], "normal": [0.0, -1.0, 1.0] } },
-                       { "mesh": "ball.obj", "scale": 0.1, "translate": [0.8, 0.8, 0.4] } ],
+                       { "plane": { "point": [0.0, 1.0, 0.0], "normal": [0.0, -1.0, 1.0] } } ],
+        "obstacle_meshes": [ { "mesh": "ball.obj", "scale": 0.1, "translate": [0.8, 0.8, 0.4] } ],
     });
     let p: FluidSceneParams = params(&value).expect("parameters");
     assert_eq!(serde_json::to_value(&p).expect("json"), value);
