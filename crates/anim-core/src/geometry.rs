@@ -16,6 +16,9 @@
 //!
 //! A solver that cannot handle a shape refuses it when its model is built, naming the collider
 //! and the shape ([`Shape::name`]).
+//!
+//! [`closest_point_on_triangle`] serves the triangle-mesh queries (contacts between meshed
+//! bodies, the closest point of a closed surface).
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -220,6 +223,55 @@ impl Shape {
             }
         }
     }
+}
+
+/// The closest point of triangle `[a, b, c]` to `p` and its barycentric coordinates `[wa, wb, wc]`
+/// (`q = wa a + wb b + wc c`), by the Voronoi regions of the vertices, edges and face (Ericson,
+/// *Real-Time Collision Detection*, 2005, section 5.1.5). The triangle must have non-zero area.
+///
+/// ```
+/// use anim_core::geometry::closest_point_on_triangle;
+/// use anim_core::glam::DVec3;
+///
+/// let t = [DVec3::ZERO, DVec3::X, DVec3::Y];
+/// let (q, w) = closest_point_on_triangle(DVec3::new(0.25, 0.25, 1.0), t);
+/// assert_eq!((q, w), (DVec3::new(0.25, 0.25, 0.0), [0.5, 0.25, 0.25]));
+/// ```
+#[must_use]
+pub fn closest_point_on_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> (DVec3, [f64; 3]) {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, [1.0, 0.0, 0.0]);
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, [0.0, 1.0, 0.0]);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (a + v * ab, [1.0 - v, v, 0.0]);
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (c, [0.0, 0.0, 1.0]);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let v = d2 / (d2 - d6);
+        return (a + v * ac, [1.0 - v, 0.0, v]);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let v = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + v * (c - b), [0.0, 1.0 - v, v]);
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, u) = (vb * denom, vc * denom);
+    (a + ab * v + ac * u, [1.0 - v - u, v, u])
 }
 
 #[cfg(test)]
@@ -433,5 +485,24 @@ mod tests {
         );
         let json = serde_json::to_string(&Shape::ground(1.0)).unwrap();
         assert_eq!(json, r#"{"plane":{"point":[0.0,0.0,1.0],"normal":[0.0,0.0,1.0]}}"#);
+    }
+
+    #[test]
+    fn the_closest_point_of_a_triangle_is_found_in_every_region() {
+        let t = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let case = |p: DVec3, q: DVec3, b: [f64; 3]| {
+            let (got, bary) = closest_point_on_triangle(p, t);
+            assert!((got - q).length() < 1e-15, "{p}: {got}");
+            assert!(bary.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-15), "{p}: {bary:?}");
+            let back = bary[0] * t[0] + bary[1] * t[1] + bary[2] * t[2];
+            assert!((back - q).length() < 1e-15);
+        };
+        case(DVec3::new(0.25, 0.25, 1.0), DVec3::new(0.25, 0.25, 0.0), [0.5, 0.25, 0.25]);
+        case(DVec3::new(-1.0, -1.0, 0.5), DVec3::ZERO, [1.0, 0.0, 0.0]);
+        case(DVec3::new(2.0, -0.5, 0.0), DVec3::X, [0.0, 1.0, 0.0]);
+        case(DVec3::new(-0.5, 3.0, 0.0), DVec3::Y, [0.0, 0.0, 1.0]);
+        case(DVec3::new(0.5, -1.0, 0.0), DVec3::new(0.5, 0.0, 0.0), [0.5, 0.5, 0.0]);
+        case(DVec3::new(-1.0, 0.5, 0.0), DVec3::new(0.0, 0.5, 0.0), [0.5, 0.0, 0.5]);
+        case(DVec3::new(1.0, 1.0, 0.0), DVec3::new(0.5, 0.5, 0.0), [0.0, 0.5, 0.5]);
     }
 }

@@ -48,6 +48,8 @@
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
+use crate::geometry::closest_point_on_triangle;
+
 use glam::DVec3;
 
 mod lattice;
@@ -302,7 +304,7 @@ impl ClosedSurface {
     pub fn closest_point(&self, p: DVec3) -> DVec3 {
         let mut best = (f64::INFINITY, p);
         for t in &self.triangles {
-            let q = closest_on_triangle(p, t.map(|i| self.positions[i]));
+            let (q, _) = closest_point_on_triangle(p, t.map(|i| self.positions[i]));
             let d = (q - p).length_squared();
             if d < best.0 {
                 best = (d, q);
@@ -343,37 +345,4 @@ fn solid_angle([a, b, c]: [DVec3; 3]) -> f64 {
     let numerator = a.dot(b.cross(c));
     let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
     2.0 * numerator.atan2(denominator)
-}
-
-/// The closest point of triangle `a, b, c` to `p` (Ericson, Real-Time Collision Detection 5.1.5).
-fn closest_on_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> DVec3 {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    a + ab * (vb * denom) + ac * (vc * denom)
 }

@@ -30,6 +30,7 @@
 use super::scratch::Data;
 use crate::model::PbdModel;
 use crate::project::{CONTACT_ID, Ctx};
+use anim_core::geometry::closest_point_on_triangle;
 use anim_core::glam::DVec3;
 
 /// Contacts per particle the buffer is sized for: a particle touching more bodies at once
@@ -205,7 +206,7 @@ pub(super) fn generate_body_contacts(model: &PbdModel, d: &mut Data, margin: f64
                     if w[i] == 0.0 && t.iter().all(|&j| w[j] == 0.0) {
                         continue;
                     }
-                    let (q, _) = closest_on_triangle(p[i], t.map(|j| p[j]));
+                    let (q, _) = closest_point_on_triangle(p[i], t.map(|j| p[j]));
                     let dist = (p[i] - q).length();
                     // Triangles come in increasing order: the first of equally close ones wins.
                     if dist < reach && dist < bc.best[other as usize].0 {
@@ -220,7 +221,7 @@ pub(super) fn generate_body_contacts(model: &PbdModel, d: &mut Data, margin: f64
                 let (t, other) = bc.surface[k as usize];
                 let closed = model.contact_bodies[other as usize].closed;
                 let corners = t.map(|j| j as usize);
-                let (_, bary) = closest_on_triangle(p[i], corners.map(|j| p[j]));
+                let (_, bary) = closest_point_on_triangle(p[i], corners.map(|j| p[j]));
                 let [a, b, c] = corners.map(|j| p[j]);
                 let Some(face) = (b - a).cross(c - a).try_normalize() else { continue };
                 let normal = if closed {
@@ -241,45 +242,6 @@ pub(super) fn generate_body_contacts(model: &PbdModel, d: &mut Data, margin: f64
             }
         }
     }
-}
-
-/// The closest point of triangle `t` to `p` and its barycentric coordinates (Ericson, "Real-time
-/// collision detection", 5.1.5).
-fn closest_on_triangle(p: DVec3, t: [DVec3; 3]) -> (DVec3, [f64; 3]) {
-    let [a, b, c] = t;
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return (a, [1.0, 0.0, 0.0]);
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return (b, [0.0, 1.0, 0.0]);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return (a + v * ab, [1.0 - v, v, 0.0]);
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return (c, [0.0, 0.0, 1.0]);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let v = d2 / (d2 - d6);
-        return (a + v * ac, [1.0 - v, 0.0, v]);
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let v = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (b + v * (c - b), [0.0, 1.0 - v, v]);
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let (v, u) = (vb * denom, vc * denom);
-    (a + ab * v + ac * u, [1.0 - v - u, v, u])
 }
 
 /// One iteration over the body contacts, in order: each projected (rigid inequality) with
@@ -339,29 +301,5 @@ pub(super) fn project_body_contacts(
         for k in 0..3 {
             p[t[k]] -= wt[k] * c.bary[k] * scale;
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_closest_point_of_a_triangle_is_found_in_every_region() {
-        let t = [DVec3::ZERO, DVec3::X, DVec3::Y];
-        let case = |p: DVec3, q: DVec3, b: [f64; 3]| {
-            let (got, bary) = closest_on_triangle(p, t);
-            assert!((got - q).length() < 1e-15, "{p}: {got}");
-            assert!(bary.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-15), "{p}: {bary:?}");
-            let back = bary[0] * t[0] + bary[1] * t[1] + bary[2] * t[2];
-            assert!((back - q).length() < 1e-15);
-        };
-        case(DVec3::new(0.25, 0.25, 1.0), DVec3::new(0.25, 0.25, 0.0), [0.5, 0.25, 0.25]);
-        case(DVec3::new(-1.0, -1.0, 0.5), DVec3::ZERO, [1.0, 0.0, 0.0]);
-        case(DVec3::new(2.0, -0.5, 0.0), DVec3::X, [0.0, 1.0, 0.0]);
-        case(DVec3::new(-0.5, 3.0, 0.0), DVec3::Y, [0.0, 0.0, 1.0]);
-        case(DVec3::new(0.5, -1.0, 0.0), DVec3::new(0.5, 0.0, 0.0), [0.5, 0.5, 0.0]);
-        case(DVec3::new(-1.0, 0.5, 0.0), DVec3::new(0.0, 0.5, 0.0), [0.5, 0.0, 0.5]);
-        case(DVec3::new(1.0, 1.0, 0.0), DVec3::new(0.5, 0.5, 0.0), [0.0, 0.5, 0.5]);
     }
 }
