@@ -167,6 +167,25 @@ impl Shape {
         }
     }
 
+    /// The shape of a 2-D scene, in the plane `z = 0`: the third components dropped (a box's
+    /// depth made 1 m, so that any z lies well inside it) and a plane's normal of unit length.
+    /// Call it on a shape checked in 2-D ([`Shape::check_in`] with `dim = 2`): the components
+    /// it drops are never read again, whatever they held (even NaN).
+    #[must_use]
+    pub fn in_plane(self) -> Self {
+        let flat = |v: [f64; 3]| [v[0], v[1], 0.0];
+        match self {
+            Shape::Plane { point, normal } => {
+                Shape::Plane { point: flat(point), normal: flat(normal) }.normalized()
+            }
+            Shape::Sphere { center, radius } => Shape::Sphere { center: flat(center), radius },
+            Shape::Box { center, half_extents } => {
+                Shape::Box { center: flat(center), half_extents: [half_extents[0], half_extents[1], 1.0] }
+            }
+            Shape::Capsule { a, b, radius } => Shape::Capsule { a: flat(a), b: flat(b), radius },
+        }
+    }
+
     /// Signed distance of point `p` and the outward unit normal of the closest surface point
     /// (`phi < 0` inside; the gradient of `phi` wherever it is differentiable). The plane normal
     /// is used as stored: normalise it first ([`Shape::normalized`]). At a sphere's centre the

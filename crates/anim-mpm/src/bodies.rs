@@ -159,8 +159,9 @@ fn build_in<const D: usize>(p: &MpmSceneParams, context: &BuildContext<'_>) -> R
 /// The simulation parameters of the scene-wide fields, each checked.
 fn sim_params<const D: usize>(p: &MpmSceneParams) -> Result<MpmParams, BuildError> {
     let n = p.resolution.unwrap_or(DEFAULT_RESOLUTION);
-    if !(8..=16384).contains(&n) {
-        return Err(BuildError::invalid("resolution", format!("must lie in [8, 16384], got {n}")));
+    let max = crate::sim::max_resolution(D);
+    if !(8..=max).contains(&n) {
+        return Err(BuildError::invalid("resolution", format!("must lie in [8, {max}] in {D}D, got {n}")));
     }
     let mut params = MpmParams::with_resolution(n);
     if let Some(t) = p.transfer {
@@ -282,7 +283,9 @@ impl Region {
                     }
                 }
                 shape.check_in(D).map_err(|e| BuildError::invalid(at("shape"), e))?;
-                Ok(Region::Solid { shape: *shape, placement })
+                // In 2D the third components are ignored, whatever they hold.
+                let shape = if D == 2 { shape.in_plane() } else { *shape };
+                Ok(Region::Solid { shape, placement })
             }
             (None, Some(mesh)) if D == 3 => {
                 let path = context.resolve(mesh);

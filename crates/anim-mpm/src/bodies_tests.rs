@@ -472,3 +472,45 @@ fn a_2d_scene_of_bodies_steps_through_the_kind() {
     let bounds = scene.context().bounds.expect("bounds");
     assert_eq!(bounds, ([3.0 / 32.0, 3.0 / 32.0, 0.0], [29.0 / 32.0, 29.0 / 32.0, 0.0]));
 }
+
+/// In 2D the third components of a body's shape are ignored, whatever they hold: a sphere at
+/// `z = 1e308` scaled by 10 (its z overflows) gets the particles of the same disk at `z = 0`,
+/// and a box of any depth those of the same rectangle.
+#[test]
+fn a_2d_body_ignores_the_third_components_of_its_shape() {
+    let disk = |z: f64, scale: f64| {
+        two(json!({
+            "dim": 2, "resolution": 32,
+            "bodies": [{
+                "shape": { "sphere": { "center": [0.05, 0.05, z], "radius": 0.01 } },
+                "material": jelly(), "scale": scale,
+            }],
+        }))
+    };
+    let (flat, far) = (disk(0.0, 10.0), disk(1e308, 10.0));
+    assert!(!flat.state.x.is_empty());
+    assert_eq!(far.state.x, flat.state.x);
+    let rectangle = |depth: f64| {
+        two(json!({
+            "dim": 2, "resolution": 32,
+            "bodies": [{
+                "shape": { "box": { "center": [0.25, 0.25, 0.0], "half_extents": [0.05, 0.05, depth] } },
+                "material": jelly(), "scale": 2.0,
+            }],
+        }))
+    };
+    assert_eq!(rectangle(1e308).state.x, rectangle(0.1).state.x);
+}
+
+/// A resolution past the grid's limit in 3D (2048 cells per axis) is refused before anything is
+/// allocated, for bodies and presets alike; 2D takes up to 16384.
+#[test]
+fn a_3d_resolution_past_the_grid_limit_is_refused() {
+    let body = json!([{ "shape": cube([0.5, 0.5, 0.5], 0.1), "material": jelly() }]);
+    let (field, message) = refused(json!({ "bodies": body, "resolution": 4096 }));
+    assert!(field == "resolution" && message.contains("[8, 2048] in 3D"), "{field}: {message}");
+    let (field, message) = refused(json!({ "preset": "snowball", "resolution": 16384 }));
+    assert!(field == "resolution" && message.contains("[8, 2048] in 3D"), "{field}: {message}");
+    let (field, message) = refused(json!({ "preset": "dam-break-2d", "resolution": 16385 }));
+    assert!(field == "resolution" && message.contains("[8, 16384] in 2D"), "{field}: {message}");
+}

@@ -95,7 +95,7 @@ pub struct MpmSceneParams {
     /// [`scenes`]). Absent when the scene has `bodies`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub preset: Option<String>,
-    /// Grid cells per axis, 8 to 16384; absent: the preset's default, 64 for bodies.
+    /// Grid cells per axis, 8 to 16384 in 2D and 8 to 2048 in 3D; absent: the preset's default, 64 for bodies.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
     /// Particle-grid transfer, `"mls-mpm"` or `"apic"`; absent: the scene's (MLS-MPM).

@@ -144,7 +144,7 @@ pub use kernel::Kernel;
 pub use kind::KIND;
 pub use material::{Elastic, ElasticModel, Fluid, Material, Sand, Snow};
 pub use particles::Particles;
-pub use sim::{MpmParams, MpmSimulation, OutOfDomain, StepStats, Totals, Transfer};
+pub use sim::{MpmParams, MpmSimulation, OutOfDomain, StepStats, Totals, Transfer, max_resolution};
 
 /// A `D`-vector of the particle precision.
 pub type Vector<const D: usize> = nalgebra::SVector<f32, D>;

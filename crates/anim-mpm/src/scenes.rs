@@ -207,6 +207,19 @@ impl MpmScene {
 /// cells per axis (`None`: the scene's default).
 #[must_use]
 pub fn by_name(name: &str, resolution: Option<usize>) -> Option<Result<MpmScene, MpmError>> {
+    // A resolution past the grid's limit is refused before the particles are laid out (their
+    // number grows as the resolution to the power of the dimension).
+    let dim = match name {
+        "three-materials" | "dam-break-2d" | "benchmark-2d" => 2,
+        _ if NAMES.contains(&name) => 3,
+        _ => return None,
+    };
+    if let Some(n) = resolution.filter(|&n| n > crate::sim::max_resolution(dim)) {
+        return Some(Err(MpmError::BadParameter {
+            name: "resolution",
+            reason: format!("{n} must lie in [8, {}] in {dim}D", crate::sim::max_resolution(dim)),
+        }));
+    }
     Some(match name {
         "three-materials" => three_materials(resolution.unwrap_or(128)).map(MpmScene::Two),
         "dam-break-2d" => {

@@ -40,7 +40,7 @@ impl Region {
     /// The inside of `shape` moved by `placement` (scale, then rotation, then translation, about
     /// the origin), in a `dim`-dimensional scene.
     pub(crate) fn shape(shape: Shape, placement: Placement, dim: usize) -> Self {
-        let shape = if dim == 2 { in_plane(shape) } else { shape.normalized() };
+        let shape = if dim == 2 { shape.in_plane() } else { shape.normalized() };
         let (lo, hi) = placed_bounds(&shape, &placement);
         let inverse = (placement != Placement::default()).then(|| Inverse {
             rotation_t: placement.rotation().transpose(),
@@ -120,22 +120,6 @@ impl Region {
             }
             Kind::Surface(surface) => surface.contains(p),
         }
-    }
-}
-
-/// A shape of a 2D scene in the plane `z = 0`: the components beyond the first two dropped
-/// (a box's depth and a plane normal's z made irrelevant), the plane normal of unit length.
-fn in_plane(shape: Shape) -> Shape {
-    let flat = |v: [f64; 3]| [v[0], v[1], 0.0];
-    match shape {
-        Shape::Plane { point, normal } => {
-            Shape::Plane { point: flat(point), normal: flat(normal) }.normalized()
-        }
-        Shape::Sphere { center, radius } => Shape::Sphere { center: flat(center), radius },
-        Shape::Box { center, half_extents } => {
-            Shape::Box { center: flat(center), half_extents: [half_extents[0], half_extents[1], 1.0] }
-        }
-        Shape::Capsule { a, b, radius } => Shape::Capsule { a: flat(a), b: flat(b), radius },
     }
 }
 
