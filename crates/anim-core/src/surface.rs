@@ -128,6 +128,18 @@ pub enum SurfaceError {
         /// The two triangles.
         triangles: [usize; 2],
     },
+    /// A surface too large for its volume to be computed in `f64` (the product of its extents
+    /// overflows).
+    #[error(
+        "the surface spans {} x {} x {} m, too large to measure its volume: scale it down",
+        extent[0],
+        extent[1],
+        extent[2]
+    )]
+    TooLarge {
+        /// The extents of its bounding box (m).
+        extent: [f64; 3],
+    },
     /// A closed surface enclosing no volume (a sheet folded onto itself).
     #[error("the surface encloses no volume")]
     ZeroVolume,
@@ -176,7 +188,11 @@ impl ClosedSurface {
                 hi = hi.max(positions[i]);
             }
         }
-        let scale = (hi - lo).length_squared();
+        let extent = hi - lo;
+        let scale = extent.length_squared();
+        if !scale.is_finite() || !(extent.x * extent.y * extent.z).is_finite() {
+            return Err(SurfaceError::TooLarge { extent: extent.to_array() });
+        }
         for (triangle, &t) in triangles.iter().enumerate() {
             let [a, b, c] = t.map(|i| positions[i]);
             let area2 = (b - a).cross(c - a).length();
@@ -192,7 +208,9 @@ impl ClosedSurface {
                 a.dot(b.cross(c)) / 6.0
             })
             .sum();
-        let extent = hi - lo;
+        if !signed.is_finite() {
+            return Err(SurfaceError::TooLarge { extent: extent.to_array() });
+        }
         if signed.abs() <= 1e-12 * extent.x * extent.y * extent.z {
             return Err(SurfaceError::ZeroVolume);
         }

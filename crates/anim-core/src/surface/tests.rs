@@ -169,10 +169,30 @@ fn a_surface_that_is_not_closed_is_refused_naming_the_edge_or_triangle() {
         SurfaceError::NonFinite { vertex: 6, .. }
     ));
     assert_eq!(ClosedSurface::new(p, vec![]).unwrap_err(), SurfaceError::Empty);
-    // A closed surface folded flat: two copies of one square, back to back.
+    // A closed surface folded flat: two copies of one square, back to back (edge (0, 2) is
+    // shared by all four triangles) ...
     let flat = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
     let sheet = vec![[0, 1, 2], [0, 2, 3], [0, 2, 1], [0, 3, 2]];
-    assert!(ClosedSurface::new(flat, sheet).is_err());
+    let e = ClosedSurface::new(flat.clone(), sheet).unwrap_err();
+    assert_eq!(e, SurfaceError::NonManifold { edge: [2, 0], count: 4 });
+    // ... and one triangle back to back with itself: closed, manifold, consistent, no volume.
+    let e = ClosedSurface::new(flat, vec![[0, 1, 2], [0, 2, 1]]).unwrap_err();
+    assert_eq!(e, SurfaceError::ZeroVolume);
+}
+
+/// A surface whose extents multiply past `f64` is refused as too large, not misread as
+/// degenerate or as holding nothing; one just inside the range is measured.
+#[test]
+fn a_surface_too_large_to_measure_is_refused() {
+    let (p, t) = cube();
+    let scaled = |s: f64| p.iter().map(|v| v.map(|x| x * s)).collect::<Vec<_>>();
+    let e = ClosedSurface::new(scaled(1e110), t.clone()).unwrap_err();
+    assert_eq!(e, SurfaceError::TooLarge { extent: [1e110; 3] });
+    assert!(e.to_string().contains("too large"), "{e}");
+    let s = ClosedSurface::new(scaled(1e100), t.clone()).expect("measurable");
+    assert!((s.volume() / 1e300 - 1.0).abs() < 1e-12, "{}", s.volume());
+    let e = ClosedSurface::new(scaled(1e160), t).unwrap_err();
+    assert!(matches!(e, SurfaceError::TooLarge { .. }), "{e}");
 }
 
 #[test]
