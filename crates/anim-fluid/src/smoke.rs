@@ -224,7 +224,16 @@ fn grid(p: &FluidSceneParams) -> Result<Grid, BuildError> {
             ));
         }
         if cells > MAX_CELLS as f64 {
-            return Err(BuildError::invalid("size", format!("size[{a}] = {} m is {cells} cells", size[a])));
+            // The size of the domain or the fineness of its cells, whichever the file gave.
+            let field = if p.size.is_some() { "size" } else { "resolution" };
+            return Err(BuildError::invalid(
+                field,
+                format!(
+                    "size[{a}] = {} m is {cells} cells of {h} m (size[0] / resolution); a smoke scene \
+                     takes at most {MAX_CELLS} cells",
+                    size[a]
+                ),
+            ));
         }
         dims[a] = cells as usize;
     }

@@ -127,6 +127,10 @@ impl Region {
             Some((a, b)) if dim == 2 && matches!(self, Region::Surface(_)) && (a[2] > 0.0 || b[2] < 0.0) => {
                 format!("a 2D scene cuts meshes at z = 0, and this one spans z in [{:.4}, {:.4}]", a[2], b[2])
             }
+            None => format!(
+                "its solid side holds no cell centre of the {grid} in the domain {domain} (m, y up): \
+                 the plane lies beyond the domain; move its `point` or turn its `normal`"
+            ),
             _ => format!(
                 "covers no cell centre of the {grid} in the domain {domain} (m, y up): it falls between \
                  cell centres; make it larger or raise `resolution`"

@@ -397,6 +397,16 @@ fn sources_and_obstacles_that_miss_the_grid_are_named() {
         "obstacles": [ { "box": { "center": [3.0, 0.7, 0.5], "half_extents": [0.5, 0.5, 0.5] } } ],
     }));
     assert!(msg.starts_with("field `obstacles[0]`: lies outside the domain"), "{msg}");
+    // A plane whose solid side (below y = -1) is beyond the domain has no extent to report.
+    let msg = err(json!({
+        "resolution": 8, "sources": [vent()],
+        "obstacles": [ { "plane": { "point": [0.0, -1.0, 0.0], "normal": [0.0, 1.0, 0.0] } } ],
+    }));
+    assert!(
+        msg.starts_with("field `obstacles[0]`: its solid side holds no cell centre")
+            && msg.contains("the plane lies beyond the domain"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -469,6 +479,14 @@ fn bad_fields_of_a_smoke_scene_are_named() {
         (
             json!({ "resolution": 200, "sources": [vent()] }),
             "field `resolution`: 200 x 300 x 200 = 12000000 cells",
+        ),
+        (
+            json!({ "resolution": 3000000, "sources": [vent()] }),
+            "field `resolution`: size[1] = 1.5 m is 4500000 cells",
+        ),
+        (
+            json!({ "size": [1.0, 10.0, 1.0], "resolution": 1000000, "sources": [vent()] }),
+            "field `size`: size[1] = 10 m is 10000000 cells",
         ),
         (json!({ "viscosity": -1.0, "sources": [vent()] }), "field `viscosity`: must be finite and >= 0"),
         (json!({ "vorticity_confinement": -1.0, "sources": [vent()] }), "field `vorticity_confinement`"),
