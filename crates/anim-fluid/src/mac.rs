@@ -350,27 +350,11 @@ impl MacFluid {
     /// Only if the pressure operator cannot be rebuilt (never for a valid fluid).
     pub fn set_solid(&mut self, inside: impl Fn([f64; 3]) -> bool) -> Result<(), FluidError> {
         let [nx, ny, nz] = self.grid.dims;
-        let mut labels = vec![CellLabel::Fluid; self.grid.solid.len()];
-        for k in 0..nz {
-            for j in 0..ny {
-                for i in 0..nx {
-                    let c = idx(self.grid.dims, i, j, k);
-                    let p = self.grid.cell_centre(i, j, k);
-                    self.grid.solid[c] = inside(p);
-                    if self.grid.solid[c] {
-                        labels[c] = CellLabel::Solid;
-                    }
-                }
-            }
-        }
-        self.projection.set_solver(projection::pressure_solver(
-            &self.grid,
-            labels,
-            self.params.pressure,
-            self.params.pressure_tolerance,
-            self.params.pressure_max_iterations,
-        )?);
-        Ok(())
+        let solid: Vec<bool> = (0..nz)
+            .flat_map(|k| (0..ny).flat_map(move |j| (0..nx).map(move |i| (i, j, k))))
+            .map(|(i, j, k)| inside(self.grid.cell_centre(i, j, k)))
+            .collect();
+        self.set_solid_cells(&solid)
     }
 
     /// Marks the cells whose entry of `solid` (one per cell, x fastest) is true as solid
