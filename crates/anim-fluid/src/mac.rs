@@ -162,7 +162,7 @@ pub struct MacFluid {
     pressure_backup: Vec<f64>,
     last: MacStepInfo,
     /// Sources of any shape, applied after the boxes of the settings.
-    regions: Vec<RegionSource>,
+    regions: Vec<forces::CoveredRegion>,
 }
 
 impl MacFluid {
@@ -396,7 +396,7 @@ impl MacFluid {
     /// temperature or velocity.
     pub fn add_region_source(&mut self, source: RegionSource) -> Result<(), FluidError> {
         source.check(&self.grid)?;
-        self.regions.push(source);
+        self.regions.push(forces::CoveredRegion::of(&source));
         Ok(())
     }
 

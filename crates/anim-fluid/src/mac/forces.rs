@@ -274,24 +274,51 @@ pub(super) fn apply_sources(
     }
 }
 
+/// A checked [`RegionSource`] as a step applies it: the indices of the cells and faces it covers
+/// (the masks' true entries), so that a step costs what the source covers, not the grid.
+#[derive(Debug, Clone)]
+pub(super) struct CoveredRegion {
+    cells: Vec<usize>,
+    faces: [Vec<usize>; 3],
+    density: f64,
+    temperature: f64,
+    velocity: Option<[f64; 3]>,
+}
+
+impl CoveredRegion {
+    /// The cells and faces `source` covers (its masks checked against the grid already).
+    pub(super) fn of(source: &RegionSource) -> Self {
+        let covered = |mask: &[bool]| -> Vec<usize> {
+            mask.iter().enumerate().filter(|&(_, &inside)| inside).map(|(c, _)| c).collect()
+        };
+        CoveredRegion {
+            cells: covered(&source.cells),
+            faces: std::array::from_fn(|a| covered(&source.faces[a])),
+            density: source.density,
+            temperature: source.temperature,
+            velocity: source.velocity,
+        }
+    }
+}
+
 /// Applies the region sources, in order: density and temperature on their fluid cells, velocity
 /// on their free faces.
 pub(super) fn apply_region_sources(
     grid: &MacGrid,
-    sources: &[RegionSource],
+    sources: &[CoveredRegion],
     vel: &mut [Vec<f64>; 3],
     density: &mut [f64],
     temperature: &mut [f64],
 ) {
     for s in sources {
-        for (c, _) in s.cells.iter().enumerate().filter(|&(c, &inside)| inside && !grid.solid[c]) {
+        for &c in s.cells.iter().filter(|&&c| !grid.solid[c]) {
             density[c] = density[c].max(s.density);
             temperature[c] = s.temperature;
         }
         if let Some(v) = s.velocity {
             for a in 0..grid.dim {
                 let fd = grid.face_dims(a);
-                for (f, _) in s.faces[a].iter().enumerate().filter(|&(_, &inside)| inside) {
+                for &f in &s.faces[a] {
                     let (i, j, k) = (f % fd[0], (f / fd[0]) % fd[1], f / (fd[0] * fd[1]));
                     if !grid.face_fixed(a, i, j, k) {
                         vel[a][f] = v[a];
