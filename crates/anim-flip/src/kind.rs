@@ -272,13 +272,13 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
 
 /// A y-up fluid vector as a z-up one: `(x, y, z) -> (x, -z, y)` (a rotation about x),
 /// `(x, y) -> (x, 0, y)`.
-fn z_up<const D: usize>(p: &[f64; D]) -> [f64; 3] {
+pub(crate) fn z_up<const D: usize>(p: &[f64; D]) -> [f64; 3] {
     let z = if D == 3 { -p[D - 1] } else { 0.0 };
     [p[0], z, p[1]]
 }
 
 /// The corners of the box with corners `lo` and `hi` (y up), z up.
-fn box_z_up<const D: usize>(lo: &[f64; D], hi: &[f64; D]) -> ([f64; 3], [f64; 3]) {
+pub(crate) fn box_z_up<const D: usize>(lo: &[f64; D], hi: &[f64; D]) -> ([f64; 3], [f64; 3]) {
     let (a, b) = (z_up(lo), z_up(hi));
     (std::array::from_fn(|k| a[k].min(b[k])), std::array::from_fn(|k| a[k].max(b[k])))
 }

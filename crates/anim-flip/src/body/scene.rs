@@ -2,6 +2,7 @@
 //! [`FlipSimulation`] it holds, drawn in the scene file's frame (the tank's inside from the
 //! origin) turned z up, with its obstacles.
 
+use crate::kind::{box_z_up, z_up};
 use crate::particles::Particles;
 use crate::sim::FlipSimulation;
 use anim_core::geometry::Shape;
@@ -33,35 +34,18 @@ impl<const D: usize> BodyScene<D> {
     }
 }
 
-/// A y-up vector of the scene file as a z-up one: `(x, y, z) -> (x, -z, y)`; in 2D the plane
-/// `z = 0` is drawn as the plane y = 0: `(x, y) -> (x, 0, y)`.
-fn z_up<const D: usize>(p: [f64; 3]) -> [f64; 3] {
-    let z = if D == 3 { -p[2] } else { 0.0 };
-    [p[0], z, p[1]]
-}
-
-/// The corners of a box (y up) as a z-up box.
-fn box_z_up<const D: usize>(lo: [f64; 3], hi: [f64; 3]) -> ([f64; 3], [f64; 3]) {
-    let (a, b) = (z_up::<D>(lo), z_up::<D>(hi));
-    (std::array::from_fn(|k| a[k].min(b[k])), std::array::from_fn(|k| a[k].max(b[k])))
-}
-
-fn pad<const D: usize>(p: [f64; D]) -> [f64; 3] {
-    std::array::from_fn(|k| if k < D { p[k] } else { 0.0 })
-}
-
 /// The prop an obstacle shape of a `D`-dimensional scene is drawn as, z up; planes none.
 fn prop<const D: usize>(shape: &Shape) -> Option<Prop> {
-    let flat = |v: [f64; 3]| if D == 2 { [v[0], v[1], 0.0] } else { v };
+    // The first `D` components (in 2D the plane z = 0).
+    let cut = |v: [f64; 3]| -> [f64; D] { std::array::from_fn(|k| v[k]) };
     match *shape {
-        Shape::Sphere { center, radius } => Some(Prop::Sphere { center: z_up::<D>(flat(center)), radius }),
-        Shape::Capsule { a, b, radius } => {
-            Some(Prop::Capsule { a: z_up::<D>(flat(a)), b: z_up::<D>(flat(b)), radius })
-        }
+        Shape::Sphere { center, radius } => Some(Prop::Sphere { center: z_up(&cut(center)), radius }),
+        Shape::Capsule { a, b, radius } => Some(Prop::Capsule { a: z_up(&cut(a)), b: z_up(&cut(b)), radius }),
         Shape::Box { center, half_extents: e } => {
-            let (c, e) = (flat(center), flat(e));
-            let (lo, hi) =
-                box_z_up::<D>(std::array::from_fn(|k| c[k] - e[k]), std::array::from_fn(|k| c[k] + e[k]));
+            let (lo, hi) = box_z_up::<D>(
+                &std::array::from_fn(|k| center[k] - e[k]),
+                &std::array::from_fn(|k| center[k] + e[k]),
+            );
             Some(Prop::Cuboid { lo, hi })
         }
         Shape::Plane { .. } => None,
@@ -111,7 +95,7 @@ impl<const D: usize> View for BodyScene<D> {
     /// 1 m, z up; they are also the bounds) and the obstacle shapes but planes.
     fn context(&self, _: &Particles<D>) -> Context {
         let (lo, hi) = self.sim.fluid_box();
-        let tank = box_z_up::<D>(pad(self.to_scene(&lo)), pad(self.to_scene(&hi)));
+        let tank = box_z_up(&self.to_scene(&lo), &self.to_scene(&hi));
         let mut context = Context::default();
         context.point_dim = 3;
         context.point_radius = 0.25 * self.sim.grid().h();
@@ -125,11 +109,11 @@ impl<const D: usize> View for BodyScene<D> {
         out.time = self.sim.time();
         out.points.clear();
         for x in &particles.x {
-            out.points.extend(z_up::<D>(pad(self.to_scene(x))));
+            out.points.extend(z_up(&self.to_scene(x)));
         }
         let velocity = out.field_mut("velocity", 3);
         for v in &particles.v {
-            velocity.extend(z_up::<D>(pad(*v)));
+            velocity.extend(z_up(v));
         }
     }
 }
