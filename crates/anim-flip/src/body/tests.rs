@@ -143,8 +143,8 @@ fn pool_around_a_sphere(dim: usize) -> Value {
 
 /// Cells whose centres are inside the sphere obstacle are solid and the others (but the walls)
 /// not; no particle is seeded in them or enters them over a second of falling and splashing,
-/// and the density-estimated volume stays within the 3% the crate's volume-correction test
-/// holds a collapsing column to.
+/// and the density-estimated volume stays within 0.1% of its start (0.015% measured: the
+/// volume correction at work).
 #[test]
 fn obstacle_cells_are_solid_no_particle_enters_them_and_the_volume_is_kept() {
     let (mut scene, mut p) = build3(pool_around_a_sphere(3)).expect("builds");
@@ -176,7 +176,7 @@ fn obstacle_cells_are_solid_no_particle_enters_them_and_the_volume_is_kept() {
     }
     assert_eq!(p.len(), count);
     let ratio = scene.sim.volume_estimate(&p, 8.0) / v0;
-    assert!((ratio - 1.0).abs() < 0.03 && lowest > 0.97, "volume ratio {ratio}, lowest {lowest}");
+    assert!((ratio - 1.0).abs() < 1e-3 && lowest > 0.999, "volume ratio {ratio}, lowest {lowest}");
     // Something happened: the blob reached the pool.
     assert!(p.x.iter().all(|x| x[1] - scene.origin[1] < 0.45), "the blob did not fall");
 }
