@@ -1,4 +1,4 @@
-"""Writes blob.obj: a closed, outward-oriented triangle surface of a soft blob about 0.3 m
+"""Writes blob.obj: a closed, outward-oriented triangle surface of a soft blob 0.35 m
 long (a round body with a smaller head bump and a tail bump), an icosphere subdivided three
 times (642 vertices, 1280 triangles) pushed out radially. Needs numpy only.
 

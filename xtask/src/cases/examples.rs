@@ -1,8 +1,11 @@
 //! The example scene files of `examples/scenes/`, each with the user's own assets: every file
 //! gets the scene contracts of the presets (determinism across thread counts, no allocation per
 //! step, checkpoint resume, the non-finite guard; see [`super::presets`]) and a run of the `anim`
-//! command's own run loop that must write its frames, its preview and its metrics. Quick mode
-//! runs two frames of each; the full suite runs the file's own frame count.
+//! command's own run loop that must write its frames, its preview and its metrics. The
+//! contracts step each example at the resolution of its file in both modes (an example has no
+//! smaller quick variant: about 30 steps each, the bulk of the suite's time on the examples); the
+//! `anim run` writes two frames in quick mode and the file's own frame count in the full suite.
+//! A folder without scene files is a failure, not an empty list.
 
 use crate::registry::{Check, ConformanceCase, Ctx, Judge, Registry};
 use anim_core::scene::BuildContext;
@@ -26,7 +29,21 @@ fn files() -> Vec<PathBuf> {
 }
 
 pub fn register(r: &mut Registry) {
-    for file in files() {
+    let files = files();
+    if files.is_empty() {
+        r.conformance.push(ConformanceCase {
+            crate_name: "examples",
+            name: "example scenes",
+            run: Box::new(|_| {
+                failed(
+                    "examples",
+                    "example scenes".into(),
+                    format!("no scene files in {}", folder().display()),
+                )
+            }),
+        });
+    }
+    for file in files {
         let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let crate_name = anim_cli::scene::load(&file)
             .ok()
