@@ -58,14 +58,10 @@ impl Rows {
             let (zlo, zhi) = (p[0].z.min(p[1].z).min(p[2].z), p[0].z.max(p[1].z).max(p[2].z));
             let (ja, jb) = range(ylo, yhi, y0, ny);
             let (ka, kb) = range(zlo, zhi, z0, nz);
-            for k in ka..=kb.max(-1) as usize {
-                if kb < 0 {
-                    break;
-                }
-                for j in ja..=jb.max(-1) as usize {
-                    if jb < 0 {
-                        break;
-                    }
+            // A triangle wholly below the first row or column reaches none.
+            let (Ok(jb), Ok(kb)) = (usize::try_from(jb), usize::try_from(kb)) else { continue };
+            for k in ka..=kb {
+                for j in ja..=jb {
                     buckets[k * ny + j].push(t as u32);
                 }
             }
