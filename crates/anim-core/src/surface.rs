@@ -266,7 +266,7 @@ impl ClosedSurface {
     ///
     /// # Errors
     /// [`SurfaceError::Resolution`] for a spacing that is not positive and finite, a non-finite
-    /// origin or a lattice of more than 2^31 points.
+    /// origin or a lattice of more than 2^27 points.
     pub fn inside_lattice(
         &self,
         origin: [f64; 3],

@@ -8,8 +8,9 @@ use glam::DVec3;
 
 use super::{ClosedSurface, SurfaceError};
 
-/// The largest lattice classified at once.
-const MAX_POINTS: usize = 1 << 31;
+/// The largest lattice classified at once (2^27 points: its answers alone are 128 MiB, and
+/// sampling keeps a 24-byte point for each one inside).
+const MAX_POINTS: usize = 1 << 27;
 
 /// Checks a lattice's origin, spacing and size.
 pub(super) fn check(origin: [f64; 3], spacing: f64, counts: [usize; 3]) -> Result<(), SurfaceError> {

@@ -307,4 +307,9 @@ fn a_bad_cell_is_refused() {
     }
     assert!(matches!(s.tetrahedralize(10.0), Err(SurfaceError::Resolution(m)) if m.contains("too coarse")));
     assert!(s.inside_lattice([0.0; 3], 0.0, [2, 2, 2]).is_err());
+    // One point past 2^27 is refused before anything is allocated; so is a sampling spacing
+    // whose lattice count overflows.
+    let e = s.inside_lattice([0.0; 3], 1e-3, [513, 512, 512]).unwrap_err();
+    assert!(e.to_string().contains("at most 134217728 points"), "{e}");
+    assert!(matches!(s.sample_inside(1e-300), Err(SurfaceError::Resolution(_))));
 }
