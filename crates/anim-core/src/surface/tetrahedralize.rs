@@ -7,6 +7,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 
 use super::{ClosedSurface, SurfaceError, Tetrahedra};
+use crate::geometry::closest_point_on_triangle;
 
 /// The most lattice cubes a mesh may span.
 pub(super) const MAX_CUBES: usize = 1 << 21;
@@ -115,13 +116,14 @@ fn snap_boundary(s: &ClosedSurface, cell: f64, positions: &mut [DVec3], tets: &[
     let floor = MIN_VOLUME_FRACTION * cell.powi(3);
     // Two passes: a vertex held back by a neighbour's move may go once the neighbour has moved.
     let mut pending = boundary;
+    let near = Near::new(s, cell);
+    let mut candidates = Vec::new();
     for _ in 0..2 {
         pending.retain(|&v| {
             let from = positions[v];
-            let target = s.closest_point(from);
-            if (target - from).length() > 2.0 * cell {
+            let Some(target) = near.closest_within(s, from, 2.0 * cell, &mut candidates) else {
                 return false;
-            }
+            };
             for fraction in [1.0, 0.75, 0.5, 0.25] {
                 positions[v] = from.lerp(target, fraction);
                 if around[v].iter().all(|&e| volume6(positions, tets[e as usize]) >= floor) {
@@ -131,5 +133,158 @@ fn snap_boundary(s: &ClosedSurface, cell: f64, positions: &mut [DVec3], tets: &[
             positions[v] = from;
             true
         });
+    }
+}
+
+/// The surface's triangles binned by the lattice cubes their bounding boxes overlap (a
+/// compressed table: `entries[start[c]..start[c + 1]]` for cube `c`), so that the closest point
+/// within a few cells of a vertex is searched among the triangles near it, not among all.
+struct Near {
+    lo: DVec3,
+    cell: f64,
+    n: [usize; 3],
+    start: Vec<usize>,
+    entries: Vec<u32>,
+}
+
+impl Near {
+    fn new(s: &ClosedSurface, cell: f64) -> Self {
+        let extent = s.hi - s.lo;
+        let n = [0, 1, 2].map(|a| ((extent[a] / cell).ceil() as usize).max(1));
+        let mut near = Near { lo: s.lo, cell, n, start: Vec::new(), entries: Vec::new() };
+        let spans: Vec<([usize; 3], [usize; 3])> = s
+            .triangles
+            .iter()
+            .map(|t| {
+                let p = t.map(|i| s.positions[i]);
+                near.span(p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
+            })
+            .collect();
+        let mut start = vec![0usize; n[0] * n[1] * n[2] + 1];
+        for &(a, b) in &spans {
+            near.cubes(a, b, |c| start[c + 1] += 1);
+        }
+        for c in 0..start.len() - 1 {
+            start[c + 1] += start[c];
+        }
+        let mut entries = vec![0u32; start[start.len() - 1]];
+        let mut fill = start.clone();
+        for (t, &(a, b)) in spans.iter().enumerate() {
+            near.cubes(a, b, |c| {
+                entries[fill[c]] = t as u32;
+                fill[c] += 1;
+            });
+        }
+        near.start = start;
+        near.entries = entries;
+        near
+    }
+
+    /// The cubes overlapping the box `[lo, hi]` widened by a millionth of a cube on each side
+    /// (so that rounding cannot drop a cube the box touches), clamped to the table.
+    fn span(&self, lo: DVec3, hi: DVec3) -> ([usize; 3], [usize; 3]) {
+        let index = |x: f64, a: usize, margin: f64| {
+            let i = ((x - self.lo[a]) / self.cell + margin).floor();
+            i.clamp(0.0, (self.n[a] - 1) as f64) as usize
+        };
+        ([0, 1, 2].map(|a| index(lo[a], a, -1e-6)), [0, 1, 2].map(|a| index(hi[a], a, 1e-6)))
+    }
+
+    /// Calls `f` with the index of every cube from `a` to `b` (inclusive).
+    fn cubes(&self, a: [usize; 3], b: [usize; 3], mut f: impl FnMut(usize)) {
+        for k in a[2]..=b[2] {
+            for j in a[1]..=b[1] {
+                for i in a[0]..=b[0] {
+                    f(i + self.n[0] * (j + self.n[1] * k));
+                }
+            }
+        }
+    }
+
+    /// The closest point of the surface to `p` if it lies within `reach` of `p`: the search of
+    /// [`ClosedSurface::closest_point`] over the triangles whose boxes come within `reach`, in
+    /// the triangles' order (the same point, bit for bit). `candidates` is scratch space.
+    fn closest_within(
+        &self,
+        s: &ClosedSurface,
+        p: DVec3,
+        reach: f64,
+        candidates: &mut Vec<u32>,
+    ) -> Option<DVec3> {
+        let (a, b) = self.span(p - DVec3::splat(reach), p + DVec3::splat(reach));
+        candidates.clear();
+        self.cubes(a, b, |c| candidates.extend_from_slice(&self.entries[self.start[c]..self.start[c + 1]]));
+        candidates.sort_unstable();
+        candidates.dedup();
+        let mut best = (f64::INFINITY, p);
+        for &t in candidates.iter() {
+            let (q, _) = closest_point_on_triangle(p, s.triangles[t as usize].map(|i| s.positions[i]));
+            let d = (q - p).length_squared();
+            if d < best.0 {
+                best = (d, q);
+            }
+        }
+        (best.0.sqrt() <= reach).then_some(best.1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The binned search gives `closest_point`'s answer bit for bit whenever that answer is
+    /// within reach, and nothing otherwise, at points in and around a cube of 12 triangles
+    /// binned finely (each face spans many cubes).
+    #[test]
+    fn the_binned_search_equals_the_full_search_within_reach() {
+        let p = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 1.0],
+            [1.0, 1.0, 1.0],
+            [0.0, 1.0, 1.0],
+        ];
+        let t = vec![
+            [0, 2, 1],
+            [0, 3, 2],
+            [4, 5, 6],
+            [4, 6, 7],
+            [0, 1, 5],
+            [0, 5, 4],
+            [1, 2, 6],
+            [1, 6, 5],
+            [2, 3, 7],
+            [2, 7, 6],
+            [3, 0, 4],
+            [3, 4, 7],
+        ];
+        let s = ClosedSurface::new(p, t).unwrap();
+        let cell = 0.07;
+        let near = Near::new(&s, cell);
+        let mut scratch = Vec::new();
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut uniform = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut found, mut missed) = (0, 0);
+        for _ in 0..4000 {
+            let q = DVec3::new(uniform(), uniform(), uniform()) * 1.6 - DVec3::splat(0.3);
+            let full = s.closest_point(q);
+            let got = near.closest_within(&s, q, 2.0 * cell, &mut scratch);
+            if (full - q).length() <= 2.0 * cell {
+                assert_eq!(got, Some(full), "{q}");
+                found += 1;
+            } else {
+                assert_eq!(got, None, "{q}");
+                missed += 1;
+            }
+        }
+        assert!(found > 500 && missed > 500, "{found} within reach, {missed} beyond");
     }
 }
