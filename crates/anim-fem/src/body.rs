@@ -26,9 +26,11 @@ use std::path::{Path, PathBuf};
 use anim_core::scene::{BuildError, Placement, is_default};
 use serde::{Deserialize, Serialize};
 
+use crate::bodies::max_elements;
 use crate::error::FemError;
 use crate::material::{Material, MaterialModel};
 use crate::mesh::{TetMesh, read_gmsh, read_tetgen, validate};
+use crate::model::ElementOrder;
 
 mod obj;
 
@@ -123,6 +125,34 @@ impl BodyError {
     }
 }
 
+/// How many elements a body may still add to its scene.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Budget {
+    /// The most elements of the scene, of `order`.
+    pub(crate) max: usize,
+    /// The elements of the bodies before this one.
+    pub(crate) used: usize,
+    /// The scene's elements.
+    pub(crate) order: ElementOrder,
+}
+
+impl Budget {
+    /// The elements left for this body.
+    pub(crate) fn left(&self) -> usize {
+        self.max.saturating_sub(self.used)
+    }
+
+    /// The limit, for an error message.
+    pub(crate) fn describe(&self) -> String {
+        let before = if self.used > 0 {
+            format!(" ({} of them taken by the bodies before)", self.used)
+        } else {
+            String::new()
+        };
+        format!("a scene takes at most {} {} elements{before}", self.max, self.order.name())
+    }
+}
+
 /// A body read, placed and checked: its tetrahedra in world coordinates and its material.
 #[derive(Debug, Clone)]
 pub struct LoadedBody {
@@ -170,8 +200,16 @@ impl BodySpec {
     /// that is not closed (the message names the file and the triangle or edge), a degenerate or
     /// inverted element after the placement (the file and the element), `cell` missing for an
     /// OBJ or given for a tetrahedral mesh or not positive, a bad material or placement, a
-    /// non-finite velocity or pin box.
+    /// non-finite velocity or pin box; a body of more tetrahedra than a scene of linear
+    /// elements takes ([`max_elements`]): `cell` for an OBJ surface whose lattice could hold
+    /// more (refused before it is filled), `mesh` for a mesh file.
     pub fn load(&self, mesh: &Path) -> Result<LoadedBody, BodyError> {
+        let order = ElementOrder::Linear;
+        self.load_within(mesh, &Budget { max: max_elements(order), used: 0, order })
+    }
+
+    /// As [`load`](Self::load), with at most the elements `budget` leaves.
+    pub(crate) fn load_within(&self, mesh: &Path, budget: &Budget) -> Result<LoadedBody, BodyError> {
         let placement = self.placement();
         placement.check().map_err(|e| match e {
             BuildError::Invalid { field, message } => BodyError::new(field, message),
@@ -198,7 +236,7 @@ impl BodySpec {
             if !(cell > 0.0 && cell.is_finite()) {
                 return Err(BodyError::new("cell", format!("must be positive and finite, got {cell}")));
             }
-            let tets = obj::fill(mesh, cell)?;
+            let tets = obj::fill(mesh, cell, budget)?;
             (tets, format!("{} (filled with tetrahedra of cell {cell})", mesh.display()))
         } else {
             if self.cell.is_some() {
@@ -211,6 +249,17 @@ impl BodySpec {
                 ));
             }
             let tets = read_mesh(mesh).map_err(|e| BodyError::new("mesh", mesh_message(mesh, &e)))?;
+            if tets.tets.len() > budget.left() {
+                return Err(BodyError::new(
+                    "mesh",
+                    format!(
+                        "{} has {} tetrahedra; {}: take a coarser mesh",
+                        mesh.display(),
+                        tets.tets.len(),
+                        budget.describe()
+                    ),
+                ));
+            }
             (tets, mesh.display().to_string())
         };
         placement.apply_all(&mut tets.positions);

@@ -181,6 +181,49 @@ fn pins_hold_their_own_body() {
     }
 }
 
+/// The elements of a scene are counted over its bodies: the body that takes the total past the
+/// limit is refused, naming its `cell` (an OBJ surface, before it is filled) or its `mesh`, with
+/// the elements the bodies before it took.
+#[test]
+fn the_body_past_the_element_limit_is_refused() {
+    let dir = folder("bodies-limit");
+    std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
+    std::fs::copy(testdata().join("cube_v41.msh"), dir.join("cube_v41.msh")).expect("msh");
+    let material = serde_json::json!({ "young": 1e5, "poisson": 0.3, "density": 1000.0 });
+    let msh = spec(serde_json::json!({ "mesh": "cube_v41.msh", "material": material }));
+    // 6 x 4^3 = 384 tetrahedra.
+    let obj = spec(serde_json::json!({ "mesh": "cube.obj", "cell": 0.25, "material": material }));
+    let world = World::default();
+    let within = |bodies: &[BodySpec], max: usize| {
+        build_within(bodies, &world, ElementOrder::Linear, |p| dir.join(p), max)
+    };
+    let scene = within(&[msh.clone(), obj.clone()], 6 + 384).expect("at the limit");
+    assert_eq!(scene.model.elements(), 6 + 384);
+    let e = within(&[msh.clone(), obj.clone()], 6 + 383).err().expect("past the limit");
+    assert_eq!(e.field, "bodies[1].cell");
+    for part in
+        ["cube.obj", "4 x 4 x 4 lattice cubes", "up to 384 tetrahedra", "at most 389 tet4", "6 of them"]
+    {
+        assert!(e.message.contains(part), "{part}: {e}");
+    }
+    let e = within(&[obj, msh], 384 + 5).err().expect("past the limit");
+    assert_eq!(e.field, "bodies[1].mesh");
+    for part in ["cube_v41.msh has 6 tetrahedra", "at most 389 tet4", "384 of them"] {
+        assert!(e.message.contains(part), "{part}: {e}");
+    }
+    // Through the kind, 10-node elements count 16 times: a lattice of 15^3 cubes (up to 20,250
+    // tetrahedra) is refused for tet10 before the fill and built as tet4.
+    let fine = serde_json::json!({ "bodies": [{ "mesh": "cube.obj", "cell": 0.07, "material": material }] });
+    let mut tet10 = fine.clone();
+    tet10["element"] = "tet10".into();
+    let context = BuildContext { base: Some(&dir) };
+    let (f, m) = field((KIND.build)(&tet10, &context).err().expect("refused"));
+    assert_eq!(f, "bodies[0].cell");
+    assert!(m.contains("up to 20250 tetrahedra") && m.contains("at most 16384 tet10"), "{m}");
+    assert!((KIND.build)(&fine, &context).is_ok());
+    let _ = std::fs::remove_dir_all(dir);
+}
+
 fn field(e: BuildError) -> (String, String) {
     match e {
         BuildError::Invalid { field, message } | BuildError::Schema { field, message } => (field, message),

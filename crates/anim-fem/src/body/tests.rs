@@ -187,6 +187,26 @@ fn obj_refusals_name_the_cell_or_the_file_and_the_edge() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
+/// The unit cube at `cell = 0.0084` would lay 120^3 lattice cubes, up to 10,368,000 tetrahedra
+/// (12 GB of mass blocks alone, 75 GB as 10-node elements): refused at once, before the fill,
+/// naming `cell`, the counts and the limit.
+#[test]
+fn a_cell_too_fine_for_the_element_limit_is_refused_before_the_fill() {
+    let dir = folder("obj-too-fine");
+    std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
+    let start = std::time::Instant::now();
+    let e = cube(serde_json::json!({ "mesh": "cube.obj", "cell": 0.0084 }))
+        .load(&dir.join("cube.obj"))
+        .expect_err("refused");
+    assert!(start.elapsed().as_secs_f64() < 20.0, "refused after {:?}", start.elapsed());
+    assert_eq!(e.field, "cell");
+    for part in ["cube.obj", "120 x 120 x 120", "10368000 tetrahedra", "at most 262144 tet4 elements"] {
+        assert!(e.message.contains(part), "{part}: {e}");
+    }
+    assert_eq!(crate::bodies::MAX_ELEMENTS, 262_144);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
 #[test]
 fn a_one_tetrahedron_tetgen_body_loads_from_either_file() {
     let dir = tetgen("either", false);
