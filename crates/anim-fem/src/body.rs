@@ -91,7 +91,8 @@ pub struct BodySpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pin: Option<PinBox>,
     /// For an `.obj` surface (required there, refused for a tetrahedral mesh): the target edge
-    /// length of its tetrahedra, in the OBJ's own units (before `scale`), positive.
+    /// length of its tetrahedra (m) in the placed body, after `scale` (the surface is filled in
+    /// its own coordinates with `cell / scale`, then placed), positive.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cell: Option<f64>,
 }
@@ -228,7 +229,7 @@ impl BodySpec {
                 return Err(BodyError::new(
                     "cell",
                     format!(
-                        "{} is a surface: give `cell`, the edge length of the tetrahedra that fill it (in the OBJ's units)",
+                        "{} is a surface: give `cell`, the edge length (m) of the tetrahedra that fill it as placed",
                         mesh.display()
                     ),
                 ));
@@ -236,8 +237,8 @@ impl BodySpec {
             if !(cell > 0.0 && cell.is_finite()) {
                 return Err(BodyError::new("cell", format!("must be positive and finite, got {cell}")));
             }
-            let tets = obj::fill(mesh, cell, budget)?;
-            (tets, format!("{} (filled with tetrahedra of cell {cell})", mesh.display()))
+            let tets = obj::fill(mesh, cell, self.scale, budget)?;
+            (tets, format!("{} (filled with tetrahedra of cell {cell} m)", mesh.display()))
         } else {
             if self.cell.is_some() {
                 return Err(BodyError::new(

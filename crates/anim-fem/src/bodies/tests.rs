@@ -32,7 +32,7 @@ const TEST_CUBE_VOLUME: f64 = 0.1 * 0.7 * 0.123456789;
 
 /// The total lumped mass is `sum_k rho_k V_k` for 4- and 10-node elements, and each body's
 /// vertices carry its own `rho_k V_k`: a Gmsh box scaled by 2 (volume x 8) at 1000 kg/m³ and an
-/// OBJ cube of side 0.4 (scaled from 1) at 300 kg/m³.
+/// OBJ cube of side 0.4 (scaled from 1, 4 cells of 0.1 m across) at 300 kg/m³.
 #[test]
 fn the_mass_of_each_body_is_its_density_times_its_volume() {
     let dir = folder("bodies-mass");
@@ -45,7 +45,7 @@ fn the_mass_of_each_body_is_its_density_times_its_volume() {
             "scale": 2.0,
         })),
         spec(serde_json::json!({
-            "mesh": "cube.obj", "cell": 0.25, "scale": 0.4, "translate": [3.0, 0.0, 0.0],
+            "mesh": "cube.obj", "cell": 0.1, "scale": 0.4, "translate": [3.0, 0.0, 0.0],
             "material": { "young": 1e6, "poisson": 0.45, "density": 300.0 },
         })),
     ];

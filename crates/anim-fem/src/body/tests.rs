@@ -99,13 +99,13 @@ fn the_placement_scales_then_rotates_then_translates() {
 }
 
 /// A closed OBJ cube of side 1 on a lattice of cell 0.25 is filled exactly: 6 x 4^3
-/// tetrahedra of total volume 1, scaled by `scale^3`; the cell is in the file's units.
+/// tetrahedra of total volume 1, scaled by `scale^3`; the cell is in metres of the placed body.
 #[test]
 fn an_obj_cube_is_filled_with_tetrahedra_of_its_volume() {
     let dir = folder("obj-cube");
     std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
     let body = |scale: f64| {
-        cube(serde_json::json!({ "mesh": "cube.obj", "cell": 0.25, "scale": scale }))
+        cube(serde_json::json!({ "mesh": "cube.obj", "cell": 0.25 * scale, "scale": scale }))
             .load(&dir.join("cube.obj"))
             .expect("loads")
     };
@@ -184,6 +184,39 @@ fn obj_refusals_name_the_cell_or_the_file_and_the_edge() {
     assert_eq!(e.field, "mesh");
     assert!(e.message.contains("holed.obj") && e.message.contains("not closed"), "{e}");
     assert!(e.message.contains("edge (") && e.message.contains("numbered from 0"), "{e}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// `cell` is the edge in metres of the placed body, as in every kind: a body scaled by 2 with cell
+/// `c` is filled with the tetrahedra of the unscaled asset with cell `c / 2` (the same elements,
+/// the positions doubled). The example's blob, scaled by 1.4, gives at `cell = 0.049` the 1,209
+/// tetrahedra that an independent re-implementation of the fill counts in its file at 0.035.
+#[test]
+fn the_cell_is_in_metres_of_the_placed_body() {
+    let dir = folder("obj-cell-metres");
+    std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
+    let cube_body = |cell: f64, scale: f64| {
+        cube(serde_json::json!({ "mesh": "cube.obj", "cell": cell, "scale": scale }))
+            .load(&dir.join("cube.obj"))
+            .expect("loads")
+            .mesh
+    };
+    let (unscaled, scaled) = (cube_body(0.125, 1.0), cube_body(0.25, 2.0));
+    assert_eq!(unscaled.tets.len(), 6 * 8 * 8 * 8);
+    assert_eq!(scaled.tets, unscaled.tets);
+    for (p, q) in scaled.positions.iter().zip(&unscaled.positions) {
+        assert!((0..3).all(|k| (p[k] - 2.0 * q[k]).abs() < 1e-15), "{p:?} vs 2 x {q:?}");
+    }
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/assets");
+    let blob = |cell: f64, scale: f64| {
+        cube(serde_json::json!({ "mesh": "blob.obj", "cell": cell, "scale": scale }))
+            .load(&assets.join("blob.obj"))
+            .expect("loads")
+            .mesh
+            .tets
+            .len()
+    };
+    assert_eq!((blob(0.035, 1.0), blob(0.049, 1.4)), (1209, 1209));
     let _ = std::fs::remove_dir_all(dir);
 }
 
