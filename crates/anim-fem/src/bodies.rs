@@ -193,7 +193,14 @@ fn build_within(
             .map_err(|e| BodyError::new(format!("obstacles[{i}]"), e))?;
     }
     let x = model.rest_positions();
-    let v = owner.iter().flat_map(|&k| bodies[k].velocity).collect();
+    // Pinned vertices start at rest, whatever their body's velocity.
+    let fixed = model.fixed();
+    let v = owner
+        .iter()
+        .flat_map(|&k| bodies[k].velocity)
+        .zip(fixed)
+        .map(|(v, &pinned)| if pinned { 0.0 } else { v })
+        .collect();
     let params = FemParams::default().with_rayleigh(world.rayleigh);
     Ok(FemScene {
         name: "bodies",

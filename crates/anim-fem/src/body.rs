@@ -83,7 +83,8 @@ pub struct BodySpec {
     /// Translation (m), applied last; default none.
     #[serde(default, skip_serializing_if = "is_default")]
     pub translate: [f64; 3],
-    /// Initial velocity of every vertex of the body (m/s); default at rest.
+    /// Initial velocity of every vertex of the body but the pinned ones, which start at rest
+    /// (m/s); default at rest.
     #[serde(default, skip_serializing_if = "is_default")]
     pub velocity: [f64; 3],
     /// The vertices of this body held fixed: those in this box (after the placement); default

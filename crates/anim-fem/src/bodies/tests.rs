@@ -224,6 +224,44 @@ fn the_body_past_the_element_limit_is_refused() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
+/// Pinned vertices start at rest, whatever their body's `velocity` (as anim-core's `PinSpec`
+/// says and pbd and springs do); the others, of either body, start with their body's, for 4- and
+/// 10-node elements (the edge nodes in the pin box pinned too).
+#[test]
+fn pinned_vertices_start_at_rest() {
+    let dir = testdata();
+    let body = |x: f64, v: [f64; 3], pin: bool| {
+        let mut value = serde_json::json!({
+            "mesh": "cube_v41.msh", "translate": [x, 0.0, 1.0], "velocity": v,
+            "material": { "young": 5e4, "poisson": 0.3, "density": 1000.0 },
+        });
+        if pin {
+            // The lower face of the body at x = 1 (z = 1 + 1/3).
+            value["pin"] = serde_json::json!({ "min": [0.5, -1.0, 1.3], "max": [2.0, 1.0, 1.34] });
+        }
+        spec(value)
+    };
+    let velocity = [[0.25, 0.0, -1.0], [0.5, -0.5, 2.0]];
+    let bodies = [body(0.0, velocity[0], false), body(1.0, velocity[1], true)];
+    for order in [ElementOrder::Linear, ElementOrder::Quadratic] {
+        let scene = build(&bodies, &World::default(), order, |p| dir.join(p)).expect("builds");
+        let (x, v) = (&scene.state.x, &scene.state.v);
+        let fixed = scene.model.fixed();
+        let mut pinned = 0;
+        for i in 0..x.len() / 3 {
+            let lower = x[3 * i + 2] < 1.34;
+            let k = usize::from(x[3 * i] > 0.5);
+            assert!((0..3).all(|c| fixed[3 * i + c] == (k == 1 && lower)), "{order:?} vertex {i}");
+            let want = if k == 1 && lower { [0.0; 3] } else { velocity[k] };
+            assert_eq!(&v[3 * i..3 * i + 3], &want, "{order:?} vertex {i}");
+            pinned += usize::from(k == 1 && lower);
+        }
+        // The four lower corners, and for 10-node elements the midpoints of the five edges of
+        // the face's two triangles.
+        assert_eq!(pinned, if order == ElementOrder::Linear { 4 } else { 9 }, "{order:?}");
+    }
+}
+
 fn field(e: BuildError) -> (String, String) {
     match e {
         BuildError::Invalid { field, message } | BuildError::Schema { field, message } => (field, message),
