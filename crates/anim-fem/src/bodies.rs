@@ -123,7 +123,8 @@ impl World {
 /// `bodies[k].mesh`, `bodies[k].cell`, `bodies[k].material`, ... for the errors of
 /// [`BodySpec::load`], and `bodies[k].cell` (an OBJ surface, refused before it is filled) or
 /// `bodies[k].mesh` (a mesh file) for the body that takes the scene past
-/// [`max_elements`]`(order)`; `bodies[k].pin` for a pin box that holds no vertex of body `k`;
+/// [`max_elements`]`(order)`; `bodies[k].pin` for a pin box that holds no vertex of body `k`
+/// (and the pin errors of [`BodySpec::load`]);
 /// `gravity`, `contact_stiffness`, `friction`, `rayleigh` for a value out of range;
 /// `obstacles[i]` for an invalid shape.
 pub fn build(
@@ -153,6 +154,8 @@ fn build_within(
     let mut element_material = Vec::new();
     // The first corner vertex of each body, and one past the last.
     let mut starts = vec![0];
+    // The vertices each body's `pin` lists, numbered in the merged mesh.
+    let mut listed = Vec::with_capacity(bodies.len());
     for (k, body) in bodies.iter().enumerate() {
         let budget = Budget { max, used: tets.len(), order };
         let loaded =
@@ -163,6 +166,7 @@ fn build_within(
         tets.extend(loaded.mesh.tets.iter().map(|t| t.map(|v| v + offset)));
         positions.extend(loaded.mesh.positions);
         materials.push(loaded.material);
+        listed.push(loaded.pinned.iter().map(|v| v + offset).collect::<Vec<_>>());
         starts.push(positions.len());
     }
     let mesh = TetMesh { positions, tets };
@@ -170,21 +174,25 @@ fn build_within(
         .map_err(|e| BodyError::new("bodies", e))?
         .with_gravity(world.gravity);
     let owner = node_bodies(&model, &starts);
-    for (k, body) in bodies.iter().enumerate() {
-        if let Some(pin) = body.pin {
-            let pinned: Vec<usize> = (0..model.vertices())
-                .filter(|&i| owner[i] == k && pin.contains(model.mesh().positions[i]))
+    for (k, (body, listed)) in bodies.iter().zip(&listed).enumerate() {
+        let field = || format!("bodies[{k}].pin");
+        model.pin_vertices(listed).map_err(|e| BodyError::new(field(), e))?;
+        if let Some(region) = body.pin.as_ref().and_then(|p| p.region) {
+            let inside: Vec<usize> = (0..model.vertices())
+                .filter(|&i| owner[i] == k && region.contains(model.mesh().positions[i]))
                 .collect();
-            if pinned.is_empty() {
+            if inside.is_empty() {
                 return Err(BodyError::new(
-                    format!("bodies[{k}].pin"),
+                    field(),
                     format!(
-                        "the pin box holds no vertex of body {k} ({}) after its placement",
+                        "the box from {:?} to {:?} holds no vertex of body {k} ({}) after its placement",
+                        region.min,
+                        region.max,
                         body.mesh.display()
                     ),
                 ));
             }
-            model.pin_vertices(&pinned).map_err(|e| BodyError::new(format!("bodies[{k}].pin"), e))?;
+            model.pin_vertices(&inside).map_err(|e| BodyError::new(field(), e))?;
         }
     }
     for (i, obstacle) in world.obstacles.iter().enumerate() {

@@ -90,7 +90,7 @@ fn a_soft_bar_sags_more_than_a_stiff_one_by_their_youngs_ratio() {
         spec(serde_json::json!({
             "mesh": "bar.obj", "cell": 0.05, "translate": [0.0, y, 1.0],
             "material": { "young": young, "poisson": 0.3, "density": 1000.0 },
-            "pin": { "min": [-0.01, y - 0.01, 0.99], "max": [0.01, y + 0.11, 1.11] },
+            "pin": { "box": { "min": [-0.01, y - 0.01, 0.99], "max": [0.01, y + 0.11, 1.11] } },
         }))
     };
     let world = World { gravity: [0.0, 0.0, -0.1], ..World::default() };
@@ -157,7 +157,8 @@ fn pins_hold_their_own_body() {
         });
         if pin {
             // Around both bodies' lower faces (z = 1 + 1/3).
-            value["pin"] = serde_json::json!({ "min": [-1.0, -1.0, 1.3], "max": [2.0, 1.0, 1.34] });
+            value["pin"] =
+                serde_json::json!({ "box": { "min": [-1.0, -1.0, 1.3], "max": [2.0, 1.0, 1.34] } });
         }
         spec(value)
     };
@@ -224,6 +225,70 @@ fn the_body_past_the_element_limit_is_refused() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
+/// `pin.vertices` are the mesh file's vertex indices, of their own body: vertex `i` of the second
+/// body is the file's vertex `i` as placed, and it alone is held, for 4- and 10-node elements;
+/// with a box too, both are pinned.
+#[test]
+fn listed_vertices_are_pinned_by_their_index_in_the_file() {
+    let dir = testdata();
+    let file = anim_io::gmsh::read_gmsh(dir.join("cube_v41.msh")).expect("reads").tet_mesh();
+    let body = |x: f64, pin: Option<serde_json::Value>| {
+        let mut value = serde_json::json!({
+            "mesh": "cube_v41.msh", "translate": [x, 0.0, 1.0],
+            "material": { "young": 5e4, "poisson": 0.3, "density": 1000.0 },
+        });
+        if let Some(pin) = pin {
+            value["pin"] = pin;
+        }
+        spec(value)
+    };
+    // The lowest and the highest vertex of the file, by z then x.
+    let by_height = |i: &usize, j: &usize| {
+        let (p, q) = (file.positions[*i], file.positions[*j]);
+        (p[2], p[0], p[1]).partial_cmp(&(q[2], q[0], q[1])).expect("finite")
+    };
+    let lowest = (0..8).min_by(by_height).expect("vertices");
+    let highest = (0..8).max_by(by_height).expect("vertices");
+    for order in [ElementOrder::Linear, ElementOrder::Quadratic] {
+        let listed = serde_json::json!({ "vertices": [highest, lowest, highest] });
+        let scene =
+            build(&[body(0.0, None), body(1.0, Some(listed))], &World::default(), order, |p| dir.join(p))
+                .expect("builds");
+        let x0 = scene.state.x.clone();
+        for i in 0..8 {
+            let want = [file.positions[i][0] + 1.0, file.positions[i][1], file.positions[i][2] + 1.0];
+            assert_eq!(&x0[3 * (8 + i)..3 * (8 + i) + 3], &want, "vertex {i} of body 1");
+        }
+        let fixed = scene.model.fixed().to_vec();
+        let held: Vec<usize> = (0..fixed.len() / 3).filter(|&i| fixed[3 * i]).collect();
+        let mut want = vec![8 + lowest, 8 + highest];
+        want.sort_unstable();
+        assert_eq!(held, want, "{order:?}");
+        let (mut sim, mut state) = scene.into_simulation().expect("sim");
+        for _ in 0..10 {
+            sim.step(&mut state, 0.01).expect("step");
+        }
+        for &i in &held {
+            assert_eq!(&state.x[3 * i..3 * i + 3], &x0[3 * i..3 * i + 3], "{order:?} vertex {i} moved");
+        }
+        assert!(state.x[2] < x0[2] - 1e-4, "{order:?}: the free body did not fall");
+        // With a box around the lower face of the second body too, both are held.
+        let both = serde_json::json!({
+            "vertices": [highest], "box": { "min": [0.5, -1.0, 1.3], "max": [2.0, 1.0, 1.34] },
+        });
+        let scene =
+            build(&[body(0.0, None), body(1.0, Some(both))], &World::default(), order, |p| dir.join(p))
+                .expect("builds");
+        let fixed = scene.model.fixed();
+        let x0 = &scene.state.x;
+        for i in 0..fixed.len() / 3 {
+            let body1 = x0[3 * i] > 0.5;
+            let want = body1 && (x0[3 * i + 2] < 1.34 || i == 8 + highest);
+            assert_eq!(fixed[3 * i], want, "{order:?} vertex {i}");
+        }
+    }
+}
+
 /// Pinned vertices start at rest, whatever their body's `velocity` (as anim-core's `PinSpec`
 /// says and pbd and springs do); the others, of either body, start with their body's, for 4- and
 /// 10-node elements (the edge nodes in the pin box pinned too).
@@ -237,7 +302,7 @@ fn pinned_vertices_start_at_rest() {
         });
         if pin {
             // The lower face of the body at x = 1 (z = 1 + 1/3).
-            value["pin"] = serde_json::json!({ "min": [0.5, -1.0, 1.3], "max": [2.0, 1.0, 1.34] });
+            value["pin"] = serde_json::json!({ "box": { "min": [0.5, -1.0, 1.3], "max": [2.0, 1.0, 1.34] } });
         }
         spec(value)
     };
@@ -296,7 +361,7 @@ fn the_fem_kind_names_the_field_it_refuses() {
     assert!(build(serde_json::json!({ "bodies": [msh], "obstacles": boxes, "friction": 0.3 })).is_ok());
 
     // A pin box around body 0 only is empty for body 1.
-    let pin = serde_json::json!({ "min": [-0.31, 0.0, 0.3], "max": [-0.19, 0.72, 0.46] });
+    let pin = serde_json::json!({ "box": { "min": [-0.31, 0.0, 0.3], "max": [-0.19, 0.72, 0.46] } });
     let (f, m) =
         refused(serde_json::json!({ "bodies": [with(&msh, "pin", pin.clone()), with(&obj, "pin", pin)] }));
     assert_eq!(f, "bodies[1].pin");
@@ -340,5 +405,10 @@ fn the_fem_kind_names_the_field_it_refuses() {
     // Unknown fields: a typo in a body, the one-body table of old.
     assert!(refused(serde_json::json!({ "bodies": [with(&msh, "scal", 2.0.into())] })).1.contains("scal"));
     assert!(refused(serde_json::json!({ "body": msh })).1.contains("body"));
+    // The pin box alone, as fem spelled it before every kind shared `pin = { vertices, box }`.
+    let old_pin = serde_json::json!({ "min": [-1.0, -1.0, 0.0], "max": [1.0, 1.0, 1.0] });
+    let (f, m) = refused(serde_json::json!({ "bodies": [with(&msh, "pin", old_pin)] }));
+    assert_eq!(f, "bodies[0].pin");
+    assert!(m.contains("`min`") && m.contains("pin = { box = { min"), "{m}");
     let _ = std::fs::remove_dir_all(dir);
 }

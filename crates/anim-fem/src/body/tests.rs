@@ -145,9 +145,10 @@ fn refusals_name_the_field_and_the_file() {
     let mut thrown = cube(serde_json::json!({}));
     thrown.velocity = [0.0, f64::INFINITY, 0.0];
     assert_eq!(refuse(thrown, &cube_file).field, "velocity");
-    let mut pinned = cube(serde_json::json!({ "pin": { "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 1.0] } }));
-    if let Some(pin) = &mut pinned.pin {
-        pin.max[2] = f64::NAN;
+    let mut pinned =
+        cube(serde_json::json!({ "pin": { "box": { "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 1.0] } } }));
+    if let Some(region) = pinned.pin.as_mut().and_then(|p| p.region.as_mut()) {
+        region.max[2] = f64::NAN;
     }
     assert_eq!(refuse(pinned, &cube_file).field, "pin");
     // `cell` is for surfaces only.
@@ -237,6 +238,57 @@ fn a_cell_too_fine_for_the_element_limit_is_refused_before_the_fill() {
         assert!(e.message.contains(part), "{part}: {e}");
     }
     assert_eq!(crate::bodies::MAX_ELEMENTS, 262_144);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// `pin` is anim-core's `PinSpec`, as in pbd and springs: `vertices` index the mesh file's
+/// vertices and are checked against it, refused for an OBJ surface; the box must have finite
+/// corners in order; an empty table and the old `{ min, max }` spelling are refused.
+#[test]
+fn pin_refusals_name_the_field_and_the_cause() {
+    let dir = folder("pin-refusals");
+    std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
+    let cube_file = testdata().join("cube_v41.msh");
+    let refuse = |pin: serde_json::Value, file: &Path| {
+        let mut extra = serde_json::json!({ "pin": pin });
+        if file.extension().is_some_and(|e| e == "obj") {
+            extra["mesh"] = "cube.obj".into();
+            extra["cell"] = 0.5.into();
+        }
+        let e = cube(extra).load(file).expect_err("refused");
+        assert_eq!(e.field, "pin", "{e}");
+        e.message
+    };
+    let m = refuse(serde_json::json!({ "vertices": [0, 8] }), &cube_file);
+    assert!(
+        m.contains("vertex 8 is out of range") && m.contains("cube_v41.msh has 8 vertices (0 to 7)"),
+        "{m}"
+    );
+    let m = refuse(serde_json::json!({ "vertices": [0] }), &dir.join("cube.obj"));
+    assert!(m.contains("cube.obj") && m.contains("pin them with a `box`"), "{m}");
+    let m =
+        refuse(serde_json::json!({ "box": { "min": [0.0, 1.0, 0.0], "max": [1.0, 0.0, 1.0] } }), &cube_file);
+    assert!(m.contains("min <= max"), "{m}");
+    assert!(refuse(serde_json::json!({}), &cube_file).contains("pins nothing"));
+    // A vertex in no tetrahedron: a fifth, unused vertex in a TetGen mesh.
+    std::fs::write(dir.join("tet.node"), "5 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 2 2 2\n")
+        .expect("node");
+    std::fs::write(dir.join("tet.ele"), "1 4 0\n1 1 2 3 4\n").expect("ele");
+    let m = refuse(serde_json::json!({ "vertices": [4] }), &dir.join("tet.node"));
+    assert!(m.contains("vertex 4 of") && m.contains("tet.node") && m.contains("no tetrahedron"), "{m}");
+    // The box alone, as fem spelled it before: an unknown field.
+    let old = serde_json::json!({
+        "mesh": "cube_v41.msh", "material": { "young": 5e4, "poisson": 0.3, "density": 1000.0 },
+        "pin": { "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 1.0] },
+    });
+    let e = serde_json::from_value::<BodySpec>(old).expect_err("refused").to_string();
+    assert!(e.contains("unknown field `min`") && e.contains("pin = { box = { min = [...]"), "{e}");
+    let typo = serde_json::json!({
+        "mesh": "cube_v41.msh", "material": { "young": 5e4, "poisson": 0.3, "density": 1000.0 },
+        "pin": { "vertex": [0] },
+    });
+    let e = serde_json::from_value::<BodySpec>(typo).expect_err("refused").to_string();
+    assert!(e.contains("unknown field `vertex`, expected `vertices` or `box`"), "{e}");
     let _ = std::fs::remove_dir_all(dir);
 }
 
