@@ -1,6 +1,7 @@
-//! Several bodies in one model: the mass of each is its density times its volume, each element
-//! has its body's material (a soft bar sags more than a stiff one by their Young's ratio), the
-//! bodies move as if alone, pins hold, and every refusal of an `fem` scene names its field.
+//! Several bodies in one model: the mass of each is its density times its volume, a free body
+//! keeps the exact momentum balance of its velocity and gravity, each element has its body's
+//! material (a soft bar sags more than a stiff one by their Young's ratio), the bodies move as
+//! if alone, pins hold, and every refusal of an `fem` scene names its field.
 
 use super::*;
 use crate::body::tests::{cube_obj, folder, testdata};
@@ -77,6 +78,50 @@ fn the_mass_of_each_body_is_its_density_times_its_volume() {
         assert_eq!((model.materials()[0].density, model.materials()[1].density), (1000.0, 300.0));
     }
     let _ = std::fs::remove_dir_all(dir);
+}
+
+/// A free body of a scene keeps the exact momentum balance of its `velocity` and the scene's
+/// gravity: the internal forces sum to zero, so backward Euler gives the total momentum
+/// `P_n = M (V_0 + n h g)` and the centre of mass `X_n = X_0 + n h V_0 + h^2 g n (n + 1) / 2`,
+/// with `M = rho V` from the test cube's volume, for 4- and 10-node elements.
+#[test]
+fn a_falling_body_keeps_the_exact_momentum_balance() {
+    let v0 = [0.5, -0.25, 1.0];
+    let g = [0.3, 0.0, -9.81];
+    let body = spec(serde_json::json!({
+        "mesh": "cube_v41.msh", "velocity": v0,
+        "material": { "young": 5e4, "poisson": 0.3, "density": 1000.0 },
+    }));
+    let world = World { gravity: g, ..World::default() };
+    let total = 1000.0 * TEST_CUBE_VOLUME;
+    for order in [ElementOrder::Linear, ElementOrder::Quadratic] {
+        let scene =
+            build(std::slice::from_ref(&body), &world, order, |p| testdata().join(p)).expect("builds");
+        let mass = scene.model.lumped_mass().to_vec();
+        let (mut sim, mut state) = scene.into_simulation().expect("simulation");
+        let sum = |x: &[f64]| {
+            let mut c = [0.0; 3];
+            for (i, m) in mass.iter().enumerate() {
+                for k in 0..3 {
+                    c[k] += m * x[3 * i + k];
+                }
+            }
+            c
+        };
+        let x0 = sum(&state.x).map(|c| c / total);
+        let (h, n) = (0.01, 50);
+        for _ in 0..n {
+            sim.step(&mut state, h).expect("step");
+        }
+        let nf = f64::from(n);
+        let (x, p) = (sum(&state.x).map(|c| c / total), sum(&state.v));
+        for k in 0..3 {
+            let want = total * (v0[k] + nf * h * g[k]);
+            assert!((p[k] - want).abs() < 1e-11 * total, "{order:?} momentum {k}: {} vs {want}", p[k]);
+            let want = x0[k] + nf * h * v0[k] + h * h * g[k] * nf * (nf + 1.0) / 2.0;
+            assert!((x[k] - want).abs() < 1e-11, "{order:?} centre {k}: {} vs {want}", x[k]);
+        }
+    }
 }
 
 /// Two bars of the same mesh, clamped at `x = 0`, one four times stiffer, sag under a small load
