@@ -63,7 +63,8 @@ pub struct World {
     pub gravity: [f64; 3],
     /// Obstacles every body collides with (planes, spheres, boxes, capsules); default none.
     pub obstacles: Vec<Obstacle>,
-    /// Penalty stiffness of the obstacles (N/m), positive; default `1e7`.
+    /// Penalty stiffness of the obstacles (N/m) in backward Euler steps, positive; default
+    /// `1e7`. Symplectic Euler projects vertices out of the obstacles instead.
     pub contact_stiffness: f64,
     /// Coulomb friction coefficient against the obstacles, `>= 0`; default 0 (frictionless).
     pub friction: f64,

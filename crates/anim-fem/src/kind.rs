@@ -80,7 +80,8 @@ pub struct FemSceneParams {
     /// `capsule`: [`Obstacle`]); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub obstacles: Option<Vec<Obstacle>>,
-    /// With `bodies`: penalty stiffness of the obstacles (N/m), positive; absent: `1e7`.
+    /// With `bodies`: penalty stiffness of the obstacles (N/m) in backward Euler steps (symplectic
+    /// Euler projects instead), positive; absent: `1e7`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contact_stiffness: Option<f64>,
     /// With `bodies`: Coulomb friction coefficient against the obstacles, `>= 0`; absent: 0

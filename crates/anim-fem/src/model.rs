@@ -5,7 +5,7 @@
 //! Every element has a material: one for the whole body ([`FemModel::new`],
 //! [`FemModel::with_order`]), or one of a list per element ([`FemModel::with_materials`]), which
 //! is how several bodies of different materials are one model (their meshes merged, see
-//! [`body`](crate::body)). Masses, forces, stiffness and energy use each element's own material.
+//! [`bodies`](crate::bodies)). Masses, forces, stiffness and energy use each element's own material.
 //!
 //! A body is made of linear (4-node, [`FemModel::new`]) or quadratic (10-node,
 //! [`FemModel::quadratic`], [`tet10`](crate::tet10)) tetrahedra ([`ElementOrder`]).
