@@ -245,14 +245,14 @@ fn the_body_past_the_element_limit_is_refused() {
     };
     let scene = within(&[msh.clone(), obj.clone()], 6 + 384).expect("at the limit");
     assert_eq!(scene.model.elements(), 6 + 384);
-    let e = within(&[msh.clone(), obj.clone()], 6 + 383).err().expect("past the limit");
+    let e = within(&[msh.clone(), obj.clone()], 6 + 383).expect_err("past the limit");
     assert_eq!(e.field, "bodies[1].cell");
     for part in
         ["cube.obj", "4 x 4 x 4 lattice cubes", "up to 384 tetrahedra", "at most 389 tet4", "6 of them"]
     {
         assert!(e.message.contains(part), "{part}: {e}");
     }
-    let e = within(&[obj, msh], 384 + 5).err().expect("past the limit");
+    let e = within(&[obj, msh], 384 + 5).expect_err("past the limit");
     assert_eq!(e.field, "bodies[1].mesh");
     for part in ["cube_v41.msh has 6 tetrahedra", "at most 389 tet4", "384 of them"] {
         assert!(e.message.contains(part), "{part}: {e}");
