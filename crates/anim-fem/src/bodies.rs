@@ -29,13 +29,32 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::body::{BodyError, BodySpec, finite3};
+use crate::body::{BodyError, BodySpec, Budget, finite3};
 use crate::boundary::Obstacle;
 use crate::mesh::TetMesh;
 use crate::model::{EARTH_GRAVITY, ElementOrder, FemModel};
 use crate::scenes::FemScene;
 use crate::sim::FemParams;
 use anim_core::integrate::State;
+
+/// The most linear tetrahedra the bodies of a scene may have together: 2^18 = 262,144. At this
+/// size the model and its simulation take about 0.8 GB, and the first backward-Euler step with
+/// the Cholesky solver about 3.4 GB (its factor grows faster than the mesh).
+pub const MAX_ELEMENTS: usize = 1 << 18;
+
+/// What a 10-node element counts against [`MAX_ELEMENTS`]: its mass blocks, quadrature data and
+/// larger stiffness pattern take about 14 times the memory of a linear element.
+pub const TET10_WEIGHT: usize = 16;
+
+/// The most elements of `order` the bodies of a scene may have together: [`MAX_ELEMENTS`]
+/// linear tetrahedra, or 16,384 10-node ones.
+#[must_use]
+pub fn max_elements(order: ElementOrder) -> usize {
+    match order {
+        ElementOrder::Linear => MAX_ELEMENTS,
+        ElementOrder::Quadratic => MAX_ELEMENTS / TET10_WEIGHT,
+    }
+}
 
 /// What the bodies of a scene share.
 #[derive(Debug, Clone, PartialEq)]
@@ -44,7 +63,8 @@ pub struct World {
     pub gravity: [f64; 3],
     /// Obstacles every body collides with (planes, spheres, boxes, capsules); default none.
     pub obstacles: Vec<Obstacle>,
-    /// Penalty stiffness of the obstacles (N/m), positive; default `1e7`.
+    /// Penalty stiffness of the obstacles (N/m) in backward Euler steps, positive; default
+    /// `1e7`. Symplectic Euler projects vertices out of the obstacles instead.
     pub contact_stiffness: f64,
     /// Coulomb friction coefficient against the obstacles, `>= 0`; default 0 (frictionless).
     pub friction: f64,
@@ -102,7 +122,10 @@ impl World {
 /// # Errors
 /// [`BodyError`] naming the field of the `[scene]` table: `bodies` for an empty list;
 /// `bodies[k].mesh`, `bodies[k].cell`, `bodies[k].material`, ... for the errors of
-/// [`BodySpec::load`]; `bodies[k].pin` for a pin box that holds no vertex of body `k`;
+/// [`BodySpec::load`], and `bodies[k].cell` (an OBJ surface, refused before it is filled) or
+/// `bodies[k].mesh` (a mesh file) for the body that takes the scene past
+/// [`max_elements`]`(order)`; `bodies[k].pin` for a pin box that holds no vertex of body `k`
+/// (and the pin errors of [`BodySpec::load`]);
 /// `gravity`, `contact_stiffness`, `friction`, `rayleigh` for a value out of range;
 /// `obstacles[i]` for an invalid shape.
 pub fn build(
@@ -110,6 +133,17 @@ pub fn build(
     world: &World,
     order: ElementOrder,
     resolve: impl Fn(&Path) -> PathBuf,
+) -> Result<FemScene, BodyError> {
+    build_within(bodies, world, order, resolve, max_elements(order))
+}
+
+/// As [`build`], with at most `max` elements.
+fn build_within(
+    bodies: &[BodySpec],
+    world: &World,
+    order: ElementOrder,
+    resolve: impl Fn(&Path) -> PathBuf,
+    max: usize,
 ) -> Result<FemScene, BodyError> {
     if bodies.is_empty() {
         return Err(BodyError::new("bodies", "give at least one body (a `[[scene.bodies]]` table)"));
@@ -121,14 +155,19 @@ pub fn build(
     let mut element_material = Vec::new();
     // The first corner vertex of each body, and one past the last.
     let mut starts = vec![0];
+    // The vertices each body's `pin` lists, numbered in the merged mesh.
+    let mut listed = Vec::with_capacity(bodies.len());
     for (k, body) in bodies.iter().enumerate() {
-        let loaded = body.load(&resolve(&body.mesh)).map_err(|e| e.within(&format!("bodies[{k}]")))?;
+        let budget = Budget { max, used: tets.len(), order };
+        let loaded =
+            body.load_within(&resolve(&body.mesh), &budget).map_err(|e| e.within(&format!("bodies[{k}]")))?;
         let offset = positions.len();
         let id = u32::try_from(k).map_err(|_| BodyError::new("bodies", "too many bodies"))?;
         element_material.extend(std::iter::repeat_n(id, loaded.mesh.tets.len()));
         tets.extend(loaded.mesh.tets.iter().map(|t| t.map(|v| v + offset)));
         positions.extend(loaded.mesh.positions);
         materials.push(loaded.material);
+        listed.push(loaded.pinned.iter().map(|v| v + offset).collect::<Vec<_>>());
         starts.push(positions.len());
     }
     let mesh = TetMesh { positions, tets };
@@ -136,21 +175,25 @@ pub fn build(
         .map_err(|e| BodyError::new("bodies", e))?
         .with_gravity(world.gravity);
     let owner = node_bodies(&model, &starts);
-    for (k, body) in bodies.iter().enumerate() {
-        if let Some(pin) = body.pin {
-            let pinned: Vec<usize> = (0..model.vertices())
-                .filter(|&i| owner[i] == k && pin.contains(model.mesh().positions[i]))
+    for (k, (body, listed)) in bodies.iter().zip(&listed).enumerate() {
+        let field = || format!("bodies[{k}].pin");
+        model.pin_vertices(listed).map_err(|e| BodyError::new(field(), e))?;
+        if let Some(region) = body.pin.as_ref().and_then(|p| p.region) {
+            let inside: Vec<usize> = (0..model.vertices())
+                .filter(|&i| owner[i] == k && region.contains(model.mesh().positions[i]))
                 .collect();
-            if pinned.is_empty() {
+            if inside.is_empty() {
                 return Err(BodyError::new(
-                    format!("bodies[{k}].pin"),
+                    field(),
                     format!(
-                        "the pin box holds no vertex of body {k} ({}) after its placement",
+                        "the box from {:?} to {:?} holds no vertex of body {k} ({}) after its placement",
+                        region.min,
+                        region.max,
                         body.mesh.display()
                     ),
                 ));
             }
-            model.pin_vertices(&pinned).map_err(|e| BodyError::new(format!("bodies[{k}].pin"), e))?;
+            model.pin_vertices(&inside).map_err(|e| BodyError::new(field(), e))?;
         }
     }
     for (i, obstacle) in world.obstacles.iter().enumerate() {
@@ -159,7 +202,14 @@ pub fn build(
             .map_err(|e| BodyError::new(format!("obstacles[{i}]"), e))?;
     }
     let x = model.rest_positions();
-    let v = owner.iter().flat_map(|&k| bodies[k].velocity).collect();
+    // Pinned vertices start at rest, whatever their body's velocity.
+    let fixed = model.fixed();
+    let v = owner
+        .iter()
+        .flat_map(|&k| bodies[k].velocity)
+        .zip(fixed)
+        .map(|(v, &pinned)| if pinned { 0.0 } else { v })
+        .collect();
     let params = FemParams::default().with_rayleigh(world.rayleigh);
     Ok(FemScene {
         name: "bodies",

@@ -1,6 +1,6 @@
 //! A body of the user's own: a tetrahedral mesh file (Gmsh 2.2 or 4.1 `.msh`, TetGen
 //! `.node`/`.ele`) or a closed triangle surface (`.obj`, filled with tetrahedra) with its
-//! material, its placement (scale, rotation, translation), initial velocity and pinned region.
+//! material, its placement (scale, rotation, translation), initial velocity and pinned vertices.
 //! [`BodySpec`] is one entry of the `bodies` list of an `fem` scene file (see [`crate::kind`]);
 //! [`crate::bodies`] merges several into one model with the obstacles, gravity and damping they
 //! share.
@@ -24,11 +24,13 @@
 use std::path::{Path, PathBuf};
 
 use anim_core::scene::{BuildError, Placement, is_default};
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize};
 
+use crate::bodies::max_elements;
 use crate::error::FemError;
 use crate::material::{Material, MaterialModel};
 use crate::mesh::{TetMesh, read_gmsh, read_tetgen, validate};
+use crate::model::ElementOrder;
 
 mod obj;
 
@@ -51,9 +53,9 @@ fn default_model() -> MaterialModel {
     MaterialModel::StableNeoHookean
 }
 
-/// The `pin` box of a body: the vertices of the body inside or on it, after its placement, are
-/// pinned.
-pub use anim_core::scene::PinBox;
+/// The pinned vertices of a body, spelled as in every kind: `vertices` (indices of the mesh
+/// file's vertices) and a `box` (the vertices inside or on it, after the placement).
+pub use anim_core::scene::{PinBox, PinSpec};
 
 fn one() -> f64 {
     1.0
@@ -81,21 +83,39 @@ pub struct BodySpec {
     /// Translation (m), applied last; default none.
     #[serde(default, skip_serializing_if = "is_default")]
     pub translate: [f64; 3],
-    /// Initial velocity of every vertex of the body (m/s); default at rest.
+    /// Initial velocity of every vertex of the body but the pinned ones, which start at rest
+    /// (m/s); default at rest.
     #[serde(default, skip_serializing_if = "is_default")]
     pub velocity: [f64; 3],
-    /// The vertices of this body held fixed: those in this box (after the placement); default
-    /// none.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub pin: Option<PinBox>,
+    /// The vertices of this body held fixed: `vertices`, indices of the mesh file's vertices
+    /// (0-based in file order; not for an OBJ surface, whose tetrahedra's vertices are made by the
+    /// fill), and those inside or on `box` after the placement (with 10-node elements, edge nodes
+    /// too; the box must hold one); either or both. Default none.
+    #[serde(default, deserialize_with = "pin_spec", skip_serializing_if = "Option::is_none")]
+    pub pin: Option<PinSpec>,
     /// For an `.obj` surface (required there, refused for a tetrahedral mesh): the target edge
-    /// length of its tetrahedra, in the OBJ's own units (before `scale`), positive.
+    /// length of its tetrahedra (m) in the placed body, after `scale` (the surface is filled in
+    /// its own coordinates with `cell / scale`, then placed), positive.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cell: Option<f64>,
 }
 
 fn is_one(x: &f64) -> bool {
     *x == 1.0
+}
+
+/// A [`PinSpec`], with the box alone (`pin = { min, max }`, fem's spelling before every kind
+/// shared one) refused naming the spelling to use.
+fn pin_spec<'de, D: Deserializer<'de>>(d: D) -> Result<Option<PinSpec>, D::Error> {
+    use serde::de::Error;
+    let value = serde_json::Value::deserialize(d)?;
+    if ["min", "max"].iter().any(|k| value.get(k).is_some()) {
+        return Err(D::Error::custom(
+            "unknown field `min`/`max`: a pin box is written `pin = { box = { min = [...], max = [...] } }`, \
+             beside or instead of `vertices = [...]`",
+        ));
+    }
+    PinSpec::deserialize(value).map(Some).map_err(D::Error::custom)
 }
 
 /// Why a body could not be built: the field at fault and the cause.
@@ -123,6 +143,34 @@ impl BodyError {
     }
 }
 
+/// How many elements a body may still add to its scene.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Budget {
+    /// The most elements of the scene, of `order`.
+    pub(crate) max: usize,
+    /// The elements of the bodies before this one.
+    pub(crate) used: usize,
+    /// The scene's elements.
+    pub(crate) order: ElementOrder,
+}
+
+impl Budget {
+    /// The elements left for this body.
+    pub(crate) fn left(&self) -> usize {
+        self.max.saturating_sub(self.used)
+    }
+
+    /// The limit, for an error message.
+    pub(crate) fn describe(&self) -> String {
+        let before = if self.used > 0 {
+            format!(" ({} of them taken by the bodies before)", self.used)
+        } else {
+            String::new()
+        };
+        format!("a scene takes at most {} {} elements{before}", self.max, self.order.name())
+    }
+}
+
 /// A body read, placed and checked: its tetrahedra in world coordinates and its material.
 #[derive(Debug, Clone)]
 pub struct LoadedBody {
@@ -130,6 +178,9 @@ pub struct LoadedBody {
     pub mesh: TetMesh,
     /// The material.
     pub material: Material,
+    /// The vertices of [`PinSpec::vertices`], checked in range and in an element (the box is
+    /// applied to the merged model's nodes, see [`crate::bodies`]).
+    pub pinned: Vec<usize>,
 }
 
 /// Reads a tetrahedral mesh by its extension: `.msh` (Gmsh), `.node` or `.ele` (TetGen).
@@ -170,8 +221,17 @@ impl BodySpec {
     /// that is not closed (the message names the file and the triangle or edge), a degenerate or
     /// inverted element after the placement (the file and the element), `cell` missing for an
     /// OBJ or given for a tetrahedral mesh or not positive, a bad material or placement, a
-    /// non-finite velocity or pin box.
+    /// non-finite velocity; a `pin` with neither `vertices` nor `box`, a box that is not finite
+    /// with `min <= max`, `vertices` on an OBJ surface or out of range or in no element; a body of more tetrahedra than a scene of linear
+    /// elements takes ([`max_elements`]): `cell` for an OBJ surface whose lattice could hold
+    /// more (refused before it is filled), `mesh` for a mesh file.
     pub fn load(&self, mesh: &Path) -> Result<LoadedBody, BodyError> {
+        let order = ElementOrder::Linear;
+        self.load_within(mesh, &Budget { max: max_elements(order), used: 0, order })
+    }
+
+    /// As [`load`](Self::load), with at most the elements `budget` leaves.
+    pub(crate) fn load_within(&self, mesh: &Path, budget: &Budget) -> Result<LoadedBody, BodyError> {
         let placement = self.placement();
         placement.check().map_err(|e| match e {
             BuildError::Invalid { field, message } => BodyError::new(field, message),
@@ -181,16 +241,15 @@ impl BodySpec {
         let material = Material::new(m.model, m.young, m.poisson, m.density)
             .map_err(|e| BodyError::new("material", e))?;
         finite3("velocity", self.velocity)?;
-        if let Some(pin) = self.pin {
-            finite3("pin", pin.min)?;
-            finite3("pin", pin.max)?;
+        if let Some(pin) = &self.pin {
+            check_pin(pin)?;
         }
         let (mut tets, source) = if is_obj(mesh) {
             let Some(cell) = self.cell else {
                 return Err(BodyError::new(
                     "cell",
                     format!(
-                        "{} is a surface: give `cell`, the edge length of the tetrahedra that fill it (in the OBJ's units)",
+                        "{} is a surface: give `cell`, the edge length (m) of the tetrahedra that fill it as placed",
                         mesh.display()
                     ),
                 ));
@@ -198,8 +257,18 @@ impl BodySpec {
             if !(cell > 0.0 && cell.is_finite()) {
                 return Err(BodyError::new("cell", format!("must be positive and finite, got {cell}")));
             }
-            let tets = obj::fill(mesh, cell)?;
-            (tets, format!("{} (filled with tetrahedra of cell {cell})", mesh.display()))
+            if self.pin.as_ref().is_some_and(|p| !p.vertices.is_empty()) {
+                return Err(BodyError::new(
+                    "pin",
+                    format!(
+                        "`vertices` name vertices of a mesh file, but the tetrahedra filling {} have vertices of \
+                         their own: pin them with a `box`",
+                        mesh.display()
+                    ),
+                ));
+            }
+            let tets = obj::fill(mesh, cell, self.scale, budget)?;
+            (tets, format!("{} (filled with tetrahedra of cell {cell} m)", mesh.display()))
         } else {
             if self.cell.is_some() {
                 return Err(BodyError::new(
@@ -211,13 +280,72 @@ impl BodySpec {
                 ));
             }
             let tets = read_mesh(mesh).map_err(|e| BodyError::new("mesh", mesh_message(mesh, &e)))?;
+            if tets.tets.len() > budget.left() {
+                return Err(BodyError::new(
+                    "mesh",
+                    format!(
+                        "{} has {} tetrahedra; {}: take a coarser mesh",
+                        mesh.display(),
+                        tets.tets.len(),
+                        budget.describe()
+                    ),
+                ));
+            }
             (tets, mesh.display().to_string())
+        };
+        let pinned = match &self.pin {
+            Some(pin) => pinned_vertices(&pin.vertices, &tets, &mesh.display().to_string())?,
+            None => Vec::new(),
         };
         placement.apply_all(&mut tets.positions);
         validate(&tets.positions, &tets.tets)
             .map_err(|e| BodyError::new("mesh", format!("{source}: {e}")))?;
-        Ok(LoadedBody { mesh: tets, material })
+        Ok(LoadedBody { mesh: tets, material, pinned })
     }
+}
+
+/// Checks a `pin` table on its own: something to pin, a box with finite corners and `min <= max`.
+fn check_pin(pin: &PinSpec) -> Result<(), BodyError> {
+    match pin.region {
+        None if pin.vertices.is_empty() => {
+            Err(BodyError::new("pin", "pins nothing: give `vertices`, a `box` or both"))
+        }
+        Some(b) if !b.is_valid() => Err(BodyError::new(
+            "pin",
+            format!(
+                "the box needs finite corners with min <= max on every axis, got min {:?}, max {:?}",
+                b.min, b.max
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The vertices `listed` of the mesh read from `file`, checked in range and in an element.
+fn pinned_vertices(listed: &[usize], mesh: &TetMesh, file: &str) -> Result<Vec<usize>, BodyError> {
+    if listed.is_empty() {
+        return Ok(Vec::new());
+    }
+    let n = mesh.positions.len();
+    let mut used = vec![false; n];
+    for &v in mesh.tets.iter().flatten() {
+        used[v] = true;
+    }
+    let mut pinned = listed.to_vec();
+    for &i in &pinned {
+        if i >= n {
+            return Err(BodyError::new(
+                "pin",
+                format!("vertex {i} is out of range: {file} has {n} vertices (0 to {})", n.saturating_sub(1)),
+            ));
+        }
+        if !used[i] {
+            return Err(BodyError::new("pin", format!("vertex {i} of {file} belongs to no tetrahedron")));
+        }
+    }
+    pinned.sort_unstable();
+    pinned.dedup();
+    Ok(pinned)
 }
 
 /// A mesh error with the file named once.

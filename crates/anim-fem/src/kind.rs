@@ -10,10 +10,11 @@
 //!
 //! A scene file may give a list of `bodies` instead of a preset ([`BodySpec`], one
 //! `[[scene.bodies]]` table each): a Gmsh or TetGen tetrahedral mesh or a closed OBJ surface of
-//! the user's, with its material, placement, initial velocity and pins. The `[scene]` table then
-//! also holds what the bodies share ([`World`]): `gravity`, `obstacles` (planes, spheres, boxes,
-//! capsules), `contact_stiffness`, `friction` and `rayleigh`. The bodies collide with the
-//! obstacles, not with each other. A preset refuses these fields, and `bodies` refuses
+//! the user's, with its material, placement, initial velocity and pins (anim-core's `PinSpec`:
+//! `vertices` of the mesh file and a `box`). The `[scene]` table then also holds what the
+//! bodies share ([`World`]): `gravity`, `obstacles` (planes, spheres, boxes, capsules),
+//! `contact_stiffness`, `friction` and `rayleigh`. The bodies collide with the obstacles, not
+//! with each other. A preset refuses these fields, and `bodies` refuses
 //! `resolution`.
 //!
 //! A frame holds every node (for 10-node bodies, the corners then the edge nodes) and its
@@ -79,7 +80,8 @@ pub struct FemSceneParams {
     /// `capsule`: [`Obstacle`]); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub obstacles: Option<Vec<Obstacle>>,
-    /// With `bodies`: penalty stiffness of the obstacles (N/m), positive; absent: `1e7`.
+    /// With `bodies`: penalty stiffness of the obstacles (N/m) in backward Euler steps (symplectic
+    /// Euler projects instead), positive; absent: `1e7`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contact_stiffness: Option<f64>,
     /// With `bodies`: Coulomb friction coefficient against the obstacles, `>= 0`; absent: 0

@@ -5,7 +5,7 @@
 //! Every element has a material: one for the whole body ([`FemModel::new`],
 //! [`FemModel::with_order`]), or one of a list per element ([`FemModel::with_materials`]), which
 //! is how several bodies of different materials are one model (their meshes merged, see
-//! [`body`](crate::body)). Masses, forces, stiffness and energy use each element's own material.
+//! [`bodies`](crate::bodies)). Masses, forces, stiffness and energy use each element's own material.
 //!
 //! A body is made of linear (4-node, [`FemModel::new`]) or quadratic (10-node,
 //! [`FemModel::quadratic`], [`tet10`](crate::tet10)) tetrahedra ([`ElementOrder`]).
@@ -121,9 +121,7 @@ impl FemModel {
     /// The mesh errors of [`validate`] (degenerate or inverted rest
     /// elements named by index).
     pub fn new(mesh: TetMesh, material: Material) -> Result<Self, FemError> {
-        validate(&mesh.positions, &mesh.tets)?;
-        let one = vec![0; mesh.tets.len()];
-        Self::build(mesh, None, vec![material], one)
+        Self::with_order(mesh, material, ElementOrder::Linear)
     }
 
     /// A body of 10-node tetrahedra (from [`generate::quadratic`](crate::generate::quadratic)),
@@ -150,13 +148,8 @@ impl FemModel {
     /// # Errors
     /// As [`FemModel::new`].
     pub fn with_order(mesh: TetMesh, material: Material, order: ElementOrder) -> Result<Self, FemError> {
-        match order {
-            ElementOrder::Linear => Self::new(mesh, material),
-            ElementOrder::Quadratic => {
-                validate(&mesh.positions, &mesh.tets)?;
-                Self::quadratic(crate::generate::quadratic(&mesh), material)
-            }
-        }
+        let one = vec![0; mesh.tets.len()];
+        Self::with_materials(mesh, vec![material], one, order)
     }
 
     /// A body of `order` elements on a linear mesh (as [`with_order`](Self::with_order)) whose

@@ -1,6 +1,7 @@
-//! Several bodies in one model: the mass of each is its density times its volume, each element
-//! has its body's material (a soft bar sags more than a stiff one by their Young's ratio), the
-//! bodies move as if alone, pins hold, and every refusal of an `fem` scene names its field.
+//! Several bodies in one model: the mass of each is its density times its volume, a free body
+//! keeps the exact momentum balance of its velocity and gravity, each element has its body's
+//! material (a soft bar sags more than a stiff one by their Young's ratio), the bodies move as
+//! if alone, pins hold, and every refusal of an `fem` scene names its field.
 
 use super::*;
 use crate::body::tests::{cube_obj, folder, testdata};
@@ -32,7 +33,7 @@ const TEST_CUBE_VOLUME: f64 = 0.1 * 0.7 * 0.123456789;
 
 /// The total lumped mass is `sum_k rho_k V_k` for 4- and 10-node elements, and each body's
 /// vertices carry its own `rho_k V_k`: a Gmsh box scaled by 2 (volume x 8) at 1000 kg/m³ and an
-/// OBJ cube of side 0.4 (scaled from 1) at 300 kg/m³.
+/// OBJ cube of side 0.4 (scaled from 1, 4 cells of 0.1 m across) at 300 kg/m³.
 #[test]
 fn the_mass_of_each_body_is_its_density_times_its_volume() {
     let dir = folder("bodies-mass");
@@ -45,7 +46,7 @@ fn the_mass_of_each_body_is_its_density_times_its_volume() {
             "scale": 2.0,
         })),
         spec(serde_json::json!({
-            "mesh": "cube.obj", "cell": 0.25, "scale": 0.4, "translate": [3.0, 0.0, 0.0],
+            "mesh": "cube.obj", "cell": 0.1, "scale": 0.4, "translate": [3.0, 0.0, 0.0],
             "material": { "young": 1e6, "poisson": 0.45, "density": 300.0 },
         })),
     ];
@@ -79,6 +80,50 @@ fn the_mass_of_each_body_is_its_density_times_its_volume() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
+/// A free body of a scene keeps the exact momentum balance of its `velocity` and the scene's
+/// gravity: the internal forces sum to zero, so backward Euler gives the total momentum
+/// `P_n = M (V_0 + n h g)` and the centre of mass `X_n = X_0 + n h V_0 + h^2 g n (n + 1) / 2`,
+/// with `M = rho V` from the test cube's volume, for 4- and 10-node elements.
+#[test]
+fn a_falling_body_keeps_the_exact_momentum_balance() {
+    let v0 = [0.5, -0.25, 1.0];
+    let g = [0.3, 0.0, -9.81];
+    let body = spec(serde_json::json!({
+        "mesh": "cube_v41.msh", "velocity": v0,
+        "material": { "young": 5e4, "poisson": 0.3, "density": 1000.0 },
+    }));
+    let world = World { gravity: g, ..World::default() };
+    let total = 1000.0 * TEST_CUBE_VOLUME;
+    for order in [ElementOrder::Linear, ElementOrder::Quadratic] {
+        let scene =
+            build(std::slice::from_ref(&body), &world, order, |p| testdata().join(p)).expect("builds");
+        let mass = scene.model.lumped_mass().to_vec();
+        let (mut sim, mut state) = scene.into_simulation().expect("simulation");
+        let sum = |x: &[f64]| {
+            let mut c = [0.0; 3];
+            for (i, m) in mass.iter().enumerate() {
+                for k in 0..3 {
+                    c[k] += m * x[3 * i + k];
+                }
+            }
+            c
+        };
+        let x0 = sum(&state.x).map(|c| c / total);
+        let (h, n) = (0.01, 50);
+        for _ in 0..n {
+            sim.step(&mut state, h).expect("step");
+        }
+        let nf = f64::from(n);
+        let (x, p) = (sum(&state.x).map(|c| c / total), sum(&state.v));
+        for k in 0..3 {
+            let want = total * (v0[k] + nf * h * g[k]);
+            assert!((p[k] - want).abs() < 1e-11 * total, "{order:?} momentum {k}: {} vs {want}", p[k]);
+            let want = x0[k] + nf * h * v0[k] + h * h * g[k] * nf * (nf + 1.0) / 2.0;
+            assert!((x[k] - want).abs() < 1e-11, "{order:?} centre {k}: {} vs {want}", x[k]);
+        }
+    }
+}
+
 /// Two bars of the same mesh, clamped at `x = 0`, one four times stiffer, sag under a small load
 /// (g = 0.1 m/s²: deflections of a few millimetres over a metre, the linear regime): the soft
 /// bar's tip deflects four times as far (to 1e-3), solved quasi-statically in one model.
@@ -90,7 +135,7 @@ fn a_soft_bar_sags_more_than_a_stiff_one_by_their_youngs_ratio() {
         spec(serde_json::json!({
             "mesh": "bar.obj", "cell": 0.05, "translate": [0.0, y, 1.0],
             "material": { "young": young, "poisson": 0.3, "density": 1000.0 },
-            "pin": { "min": [-0.01, y - 0.01, 0.99], "max": [0.01, y + 0.11, 1.11] },
+            "pin": { "box": { "min": [-0.01, y - 0.01, 0.99], "max": [0.01, y + 0.11, 1.11] } },
         }))
     };
     let world = World { gravity: [0.0, 0.0, -0.1], ..World::default() };
@@ -157,7 +202,8 @@ fn pins_hold_their_own_body() {
         });
         if pin {
             // Around both bodies' lower faces (z = 1 + 1/3).
-            value["pin"] = serde_json::json!({ "min": [-1.0, -1.0, 1.3], "max": [2.0, 1.0, 1.34] });
+            value["pin"] =
+                serde_json::json!({ "box": { "min": [-1.0, -1.0, 1.3], "max": [2.0, 1.0, 1.34] } });
         }
         spec(value)
     };
@@ -178,6 +224,151 @@ fn pins_hold_their_own_body() {
         } else {
             assert!(state.x[3 * i + 2] < x0[3 * i + 2] - 1e-4, "vertex {i} did not move down");
         }
+    }
+}
+
+/// The elements of a scene are counted over its bodies: the body that takes the total past the
+/// limit is refused, naming its `cell` (an OBJ surface, before it is filled) or its `mesh`, with
+/// the elements the bodies before it took.
+#[test]
+fn the_body_past_the_element_limit_is_refused() {
+    let dir = folder("bodies-limit");
+    std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
+    std::fs::copy(testdata().join("cube_v41.msh"), dir.join("cube_v41.msh")).expect("msh");
+    let material = serde_json::json!({ "young": 1e5, "poisson": 0.3, "density": 1000.0 });
+    let msh = spec(serde_json::json!({ "mesh": "cube_v41.msh", "material": material }));
+    // 6 x 4^3 = 384 tetrahedra.
+    let obj = spec(serde_json::json!({ "mesh": "cube.obj", "cell": 0.25, "material": material }));
+    let world = World::default();
+    let within = |bodies: &[BodySpec], max: usize| {
+        build_within(bodies, &world, ElementOrder::Linear, |p| dir.join(p), max)
+    };
+    let scene = within(&[msh.clone(), obj.clone()], 6 + 384).expect("at the limit");
+    assert_eq!(scene.model.elements(), 6 + 384);
+    let e = within(&[msh.clone(), obj.clone()], 6 + 383).expect_err("past the limit");
+    assert_eq!(e.field, "bodies[1].cell");
+    for part in
+        ["cube.obj", "4 x 4 x 4 lattice cubes", "up to 384 tetrahedra", "at most 389 tet4", "6 of them"]
+    {
+        assert!(e.message.contains(part), "{part}: {e}");
+    }
+    let e = within(&[obj, msh], 384 + 5).expect_err("past the limit");
+    assert_eq!(e.field, "bodies[1].mesh");
+    for part in ["cube_v41.msh has 6 tetrahedra", "at most 389 tet4", "384 of them"] {
+        assert!(e.message.contains(part), "{part}: {e}");
+    }
+    // Through the kind, 10-node elements count 16 times: a lattice of 15^3 cubes (up to 20,250
+    // tetrahedra) is refused for tet10 before the fill and built as tet4.
+    let fine = serde_json::json!({ "bodies": [{ "mesh": "cube.obj", "cell": 0.07, "material": material }] });
+    let mut tet10 = fine.clone();
+    tet10["element"] = "tet10".into();
+    let context = BuildContext { base: Some(&dir) };
+    let (f, m) = field((KIND.build)(&tet10, &context).err().expect("refused"));
+    assert_eq!(f, "bodies[0].cell");
+    assert!(m.contains("up to 20250 tetrahedra") && m.contains("at most 16384 tet10"), "{m}");
+    assert!((KIND.build)(&fine, &context).is_ok());
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// `pin.vertices` are the mesh file's vertex indices, of their own body: vertex `i` of the second
+/// body is the file's vertex `i` as placed, and it alone is held, for 4- and 10-node elements;
+/// with a box too, both are pinned.
+#[test]
+fn listed_vertices_are_pinned_by_their_index_in_the_file() {
+    let dir = testdata();
+    let file = anim_io::gmsh::read_gmsh(dir.join("cube_v41.msh")).expect("reads").tet_mesh();
+    let body = |x: f64, pin: Option<serde_json::Value>| {
+        let mut value = serde_json::json!({
+            "mesh": "cube_v41.msh", "translate": [x, 0.0, 1.0],
+            "material": { "young": 5e4, "poisson": 0.3, "density": 1000.0 },
+        });
+        if let Some(pin) = pin {
+            value["pin"] = pin;
+        }
+        spec(value)
+    };
+    // The lowest and the highest vertex of the file, by z then x.
+    let by_height = |i: &usize, j: &usize| {
+        let (p, q) = (file.positions[*i], file.positions[*j]);
+        (p[2], p[0], p[1]).partial_cmp(&(q[2], q[0], q[1])).expect("finite")
+    };
+    let lowest = (0..8).min_by(by_height).expect("vertices");
+    let highest = (0..8).max_by(by_height).expect("vertices");
+    for order in [ElementOrder::Linear, ElementOrder::Quadratic] {
+        let listed = serde_json::json!({ "vertices": [highest, lowest, highest] });
+        let scene =
+            build(&[body(0.0, None), body(1.0, Some(listed))], &World::default(), order, |p| dir.join(p))
+                .expect("builds");
+        let x0 = scene.state.x.clone();
+        for i in 0..8 {
+            let want = [file.positions[i][0] + 1.0, file.positions[i][1], file.positions[i][2] + 1.0];
+            assert_eq!(&x0[3 * (8 + i)..3 * (8 + i) + 3], &want, "vertex {i} of body 1");
+        }
+        let fixed = scene.model.fixed().to_vec();
+        let held: Vec<usize> = (0..fixed.len() / 3).filter(|&i| fixed[3 * i]).collect();
+        let mut want = vec![8 + lowest, 8 + highest];
+        want.sort_unstable();
+        assert_eq!(held, want, "{order:?}");
+        let (mut sim, mut state) = scene.into_simulation().expect("sim");
+        for _ in 0..10 {
+            sim.step(&mut state, 0.01).expect("step");
+        }
+        for &i in &held {
+            assert_eq!(&state.x[3 * i..3 * i + 3], &x0[3 * i..3 * i + 3], "{order:?} vertex {i} moved");
+        }
+        assert!(state.x[2] < x0[2] - 1e-4, "{order:?}: the free body did not fall");
+        // With a box around the lower face of the second body too, both are held.
+        let both = serde_json::json!({
+            "vertices": [highest], "box": { "min": [0.5, -1.0, 1.3], "max": [2.0, 1.0, 1.34] },
+        });
+        let scene =
+            build(&[body(0.0, None), body(1.0, Some(both))], &World::default(), order, |p| dir.join(p))
+                .expect("builds");
+        let fixed = scene.model.fixed();
+        let x0 = &scene.state.x;
+        for i in 0..fixed.len() / 3 {
+            let body1 = x0[3 * i] > 0.5;
+            let want = body1 && (x0[3 * i + 2] < 1.34 || i == 8 + highest);
+            assert_eq!(fixed[3 * i], want, "{order:?} vertex {i}");
+        }
+    }
+}
+
+/// Pinned vertices start at rest, whatever their body's `velocity` (as anim-core's `PinSpec`
+/// says and pbd and springs do); the others, of either body, start with their body's, for 4- and
+/// 10-node elements (the edge nodes in the pin box pinned too).
+#[test]
+fn pinned_vertices_start_at_rest() {
+    let dir = testdata();
+    let body = |x: f64, v: [f64; 3], pin: bool| {
+        let mut value = serde_json::json!({
+            "mesh": "cube_v41.msh", "translate": [x, 0.0, 1.0], "velocity": v,
+            "material": { "young": 5e4, "poisson": 0.3, "density": 1000.0 },
+        });
+        if pin {
+            // The lower face of the body at x = 1 (z = 1 + 1/3).
+            value["pin"] = serde_json::json!({ "box": { "min": [0.5, -1.0, 1.3], "max": [2.0, 1.0, 1.34] } });
+        }
+        spec(value)
+    };
+    let velocity = [[0.25, 0.0, -1.0], [0.5, -0.5, 2.0]];
+    let bodies = [body(0.0, velocity[0], false), body(1.0, velocity[1], true)];
+    for order in [ElementOrder::Linear, ElementOrder::Quadratic] {
+        let scene = build(&bodies, &World::default(), order, |p| dir.join(p)).expect("builds");
+        let (x, v) = (&scene.state.x, &scene.state.v);
+        let fixed = scene.model.fixed();
+        let mut pinned = 0;
+        for i in 0..x.len() / 3 {
+            let lower = x[3 * i + 2] < 1.34;
+            let k = usize::from(x[3 * i] > 0.5);
+            assert!((0..3).all(|c| fixed[3 * i + c] == (k == 1 && lower)), "{order:?} vertex {i}");
+            let want = if k == 1 && lower { [0.0; 3] } else { velocity[k] };
+            assert_eq!(&v[3 * i..3 * i + 3], &want, "{order:?} vertex {i}");
+            pinned += usize::from(k == 1 && lower);
+        }
+        // The four lower corners, and for 10-node elements the midpoints of the five edges of
+        // the face's two triangles.
+        assert_eq!(pinned, if order == ElementOrder::Linear { 4 } else { 9 }, "{order:?}");
     }
 }
 
@@ -215,7 +406,7 @@ fn the_fem_kind_names_the_field_it_refuses() {
     assert!(build(serde_json::json!({ "bodies": [msh], "obstacles": boxes, "friction": 0.3 })).is_ok());
 
     // A pin box around body 0 only is empty for body 1.
-    let pin = serde_json::json!({ "min": [-0.31, 0.0, 0.3], "max": [-0.19, 0.72, 0.46] });
+    let pin = serde_json::json!({ "box": { "min": [-0.31, 0.0, 0.3], "max": [-0.19, 0.72, 0.46] } });
     let (f, m) =
         refused(serde_json::json!({ "bodies": [with(&msh, "pin", pin.clone()), with(&obj, "pin", pin)] }));
     assert_eq!(f, "bodies[1].pin");
@@ -259,5 +450,10 @@ fn the_fem_kind_names_the_field_it_refuses() {
     // Unknown fields: a typo in a body, the one-body table of old.
     assert!(refused(serde_json::json!({ "bodies": [with(&msh, "scal", 2.0.into())] })).1.contains("scal"));
     assert!(refused(serde_json::json!({ "body": msh })).1.contains("body"));
+    // The pin box alone, as fem spelled it before every kind shared `pin = { vertices, box }`.
+    let old_pin = serde_json::json!({ "min": [-1.0, -1.0, 0.0], "max": [1.0, 1.0, 1.0] });
+    let (f, m) = refused(serde_json::json!({ "bodies": [with(&msh, "pin", old_pin)] }));
+    assert_eq!(f, "bodies[0].pin");
+    assert!(m.contains("`min`") && m.contains("pin = { box = { min"), "{m}");
     let _ = std::fs::remove_dir_all(dir);
 }

@@ -99,13 +99,13 @@ fn the_placement_scales_then_rotates_then_translates() {
 }
 
 /// A closed OBJ cube of side 1 on a lattice of cell 0.25 is filled exactly: 6 x 4^3
-/// tetrahedra of total volume 1, scaled by `scale^3`; the cell is in the file's units.
+/// tetrahedra of total volume 1, scaled by `scale^3`; the cell is in metres of the placed body.
 #[test]
 fn an_obj_cube_is_filled_with_tetrahedra_of_its_volume() {
     let dir = folder("obj-cube");
     std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
     let body = |scale: f64| {
-        cube(serde_json::json!({ "mesh": "cube.obj", "cell": 0.25, "scale": scale }))
+        cube(serde_json::json!({ "mesh": "cube.obj", "cell": 0.25 * scale, "scale": scale }))
             .load(&dir.join("cube.obj"))
             .expect("loads")
     };
@@ -145,9 +145,10 @@ fn refusals_name_the_field_and_the_file() {
     let mut thrown = cube(serde_json::json!({}));
     thrown.velocity = [0.0, f64::INFINITY, 0.0];
     assert_eq!(refuse(thrown, &cube_file).field, "velocity");
-    let mut pinned = cube(serde_json::json!({ "pin": { "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 1.0] } }));
-    if let Some(pin) = &mut pinned.pin {
-        pin.max[2] = f64::NAN;
+    let mut pinned =
+        cube(serde_json::json!({ "pin": { "box": { "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 1.0] } } }));
+    if let Some(region) = pinned.pin.as_mut().and_then(|p| p.region.as_mut()) {
+        region.max[2] = f64::NAN;
     }
     assert_eq!(refuse(pinned, &cube_file).field, "pin");
     // `cell` is for surfaces only.
@@ -184,6 +185,110 @@ fn obj_refusals_name_the_cell_or_the_file_and_the_edge() {
     assert_eq!(e.field, "mesh");
     assert!(e.message.contains("holed.obj") && e.message.contains("not closed"), "{e}");
     assert!(e.message.contains("edge (") && e.message.contains("numbered from 0"), "{e}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// `cell` is the edge in metres of the placed body, as in every kind: a body scaled by 2 with cell
+/// `c` is filled with the tetrahedra of the unscaled asset with cell `c / 2` (the same elements,
+/// the positions doubled). The example's blob, scaled by 1.4, gives at `cell = 0.049` the 1,209
+/// tetrahedra that an independent re-implementation of the fill counts in its file at 0.035.
+#[test]
+fn the_cell_is_in_metres_of_the_placed_body() {
+    let dir = folder("obj-cell-metres");
+    std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
+    let cube_body = |cell: f64, scale: f64| {
+        cube(serde_json::json!({ "mesh": "cube.obj", "cell": cell, "scale": scale }))
+            .load(&dir.join("cube.obj"))
+            .expect("loads")
+            .mesh
+    };
+    let (unscaled, scaled) = (cube_body(0.125, 1.0), cube_body(0.25, 2.0));
+    assert_eq!(unscaled.tets.len(), 6 * 8 * 8 * 8);
+    assert_eq!(scaled.tets, unscaled.tets);
+    for (p, q) in scaled.positions.iter().zip(&unscaled.positions) {
+        assert!((0..3).all(|k| (p[k] - 2.0 * q[k]).abs() < 1e-15), "{p:?} vs 2 x {q:?}");
+    }
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/assets");
+    let blob = |cell: f64, scale: f64| {
+        cube(serde_json::json!({ "mesh": "blob.obj", "cell": cell, "scale": scale }))
+            .load(&assets.join("blob.obj"))
+            .expect("loads")
+            .mesh
+            .tets
+            .len()
+    };
+    assert_eq!((blob(0.035, 1.0), blob(0.049, 1.4)), (1209, 1209));
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// The unit cube at `cell = 0.0084` would lay 120^3 lattice cubes, up to 10,368,000 tetrahedra
+/// (12 GB of mass blocks alone, 75 GB as 10-node elements): refused at once, before the fill,
+/// naming `cell`, the counts and the limit.
+#[test]
+fn a_cell_too_fine_for_the_element_limit_is_refused_before_the_fill() {
+    let dir = folder("obj-too-fine");
+    std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
+    let start = std::time::Instant::now();
+    let e = cube(serde_json::json!({ "mesh": "cube.obj", "cell": 0.0084 }))
+        .load(&dir.join("cube.obj"))
+        .expect_err("refused");
+    assert!(start.elapsed().as_secs_f64() < 20.0, "refused after {:?}", start.elapsed());
+    assert_eq!(e.field, "cell");
+    for part in ["cube.obj", "120 x 120 x 120", "10368000 tetrahedra", "at most 262144 tet4 elements"] {
+        assert!(e.message.contains(part), "{part}: {e}");
+    }
+    assert_eq!(crate::bodies::MAX_ELEMENTS, 262_144);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// `pin` is anim-core's `PinSpec`, as in pbd and springs: `vertices` index the mesh file's
+/// vertices and are checked against it, refused for an OBJ surface; the box must have finite
+/// corners in order; an empty table and the old `{ min, max }` spelling are refused.
+#[test]
+fn pin_refusals_name_the_field_and_the_cause() {
+    let dir = folder("pin-refusals");
+    std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
+    let cube_file = testdata().join("cube_v41.msh");
+    let refuse = |pin: serde_json::Value, file: &Path| {
+        let mut extra = serde_json::json!({ "pin": pin });
+        if file.extension().is_some_and(|e| e == "obj") {
+            extra["mesh"] = "cube.obj".into();
+            extra["cell"] = 0.5.into();
+        }
+        let e = cube(extra).load(file).expect_err("refused");
+        assert_eq!(e.field, "pin", "{e}");
+        e.message
+    };
+    let m = refuse(serde_json::json!({ "vertices": [0, 8] }), &cube_file);
+    assert!(
+        m.contains("vertex 8 is out of range") && m.contains("cube_v41.msh has 8 vertices (0 to 7)"),
+        "{m}"
+    );
+    let m = refuse(serde_json::json!({ "vertices": [0] }), &dir.join("cube.obj"));
+    assert!(m.contains("cube.obj") && m.contains("pin them with a `box`"), "{m}");
+    let m =
+        refuse(serde_json::json!({ "box": { "min": [0.0, 1.0, 0.0], "max": [1.0, 0.0, 1.0] } }), &cube_file);
+    assert!(m.contains("min <= max"), "{m}");
+    assert!(refuse(serde_json::json!({}), &cube_file).contains("pins nothing"));
+    // A vertex in no tetrahedron: a fifth, unused vertex in a TetGen mesh.
+    std::fs::write(dir.join("tet.node"), "5 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 2 2 2\n")
+        .expect("node");
+    std::fs::write(dir.join("tet.ele"), "1 4 0\n1 1 2 3 4\n").expect("ele");
+    let m = refuse(serde_json::json!({ "vertices": [4] }), &dir.join("tet.node"));
+    assert!(m.contains("vertex 4 of") && m.contains("tet.node") && m.contains("no tetrahedron"), "{m}");
+    // The box alone, as fem spelled it before: an unknown field.
+    let old = serde_json::json!({
+        "mesh": "cube_v41.msh", "material": { "young": 5e4, "poisson": 0.3, "density": 1000.0 },
+        "pin": { "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 1.0] },
+    });
+    let e = serde_json::from_value::<BodySpec>(old).expect_err("refused").to_string();
+    assert!(e.contains("unknown field `min`") && e.contains("pin = { box = { min = [...]"), "{e}");
+    let typo = serde_json::json!({
+        "mesh": "cube_v41.msh", "material": { "young": 5e4, "poisson": 0.3, "density": 1000.0 },
+        "pin": { "vertex": [0] },
+    });
+    let e = serde_json::from_value::<BodySpec>(typo).expect_err("refused").to_string();
+    assert!(e.contains("unknown field `vertex`, expected `vertices` or `box`"), "{e}");
     let _ = std::fs::remove_dir_all(dir);
 }
 
