@@ -5,8 +5,8 @@
 //! pin = { vertices = [0, 40], box = { min = [-0.6, 0.49, 0.0], max = [0.6, 0.51, 2.0] } }
 //! ```
 //!
-//! (the `fem` kind takes the box alone: `pin = { min = [...], max = [...] }`). Each kind checks
-//! the indices against its mesh and refuses a box that holds no vertex of the placed body.
+//! Each kind checks the indices against its mesh and refuses a box that holds no vertex of the
+//! placed body.
 //!
 //! ```
 //! use anim_core::scene::PinBox;
