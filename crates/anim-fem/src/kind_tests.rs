@@ -314,3 +314,19 @@ mod tolerance {
         assert_eq!(c.summary, "integrator = symplectic-euler");
     }
 }
+
+/// A preset's resolution past the elements a scene may hold is refused before the mesh is made,
+/// naming the field; the largest linear beam that fits (16 cubes across, 245,760 tetrahedra)
+/// is not refused by it.
+#[test]
+fn a_preset_resolution_past_the_element_limit_is_refused() {
+    for (preset, resolution, element) in
+        [("soft-cube-drop", 100_000, "tet4"), ("cantilever-beam", 17, "tet4"), ("twisted-bar", 7, "tet10")]
+    {
+        let msg = refused(&json!({ "preset": preset, "resolution": resolution, "element": element }));
+        assert!(msg.starts_with("field `resolution`: ") && msg.contains("2^18 linear"), "{preset}: {msg}");
+    }
+    let fits =
+        crate::scenes::by_name_with_order("cantilever-beam", Some(16), crate::model::ElementOrder::Linear);
+    assert!(fits.is_some_and(|r| r.is_ok()));
+}
