@@ -3,10 +3,11 @@
 //! tetrahedralised on load) or a cloth from an OBJ triangle surface, with its material, placement,
 //! initial velocity and pinned vertices.
 //!
-//! The mesh is read, placed (scale, rotation, translation: [`Placement`]), checked element by
-//! element in the file's numbering (a repeated vertex, an inverted tetrahedron or one of zero
-//! volume, or a triangle of zero area is refused, naming the file and the element), and added to
-//! a [`PbdBuilder`]:
+//! The mesh is read, placed (scale, rotation, translation: [`Placement`]; a mesh placed too
+//! large for its volumes to be finite is refused, naming `scale`), checked element by element in
+//! the file's numbering (a repeated vertex, an inverted tetrahedron or one of zero volume, or a
+//! triangle of zero area is refused, naming the file and the element), and added to a
+//! [`PbdBuilder`]:
 //!
 //! - **soft**: [`PbdBuilder::tet_mesh`], a distance constraint on every edge (`stretch`) and a
 //!   volume constraint per tetrahedron (`volume`), the masses lumped from `density` (kg/m^3), a
@@ -228,6 +229,17 @@ impl BodySpec {
             return Err(BuildError::invalid(
                 field("scale"),
                 format!("{file}: vertex {i} is not finite after the placement ({:?})", positions[i]),
+            ));
+        }
+        // Volumes are products of three coordinate differences, each at most twice the span.
+        let span = span(&positions, &elements);
+        if !(2.0 * span).powi(3).is_finite() {
+            return Err(BuildError::invalid(
+                field("scale"),
+                format!(
+                    "{file}: placed, the mesh spans {span:e} m, too large to measure its volumes (the scale \
+                     is too large)"
+                ),
             ));
         }
         // A soft body from an OBJ surface: its tetrahedra replace the surface.
@@ -569,6 +581,17 @@ fn check_elements(file: &str, positions: &[[f64; 3]], elements: &Elements) -> Re
 fn enclosed_volume(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> f64 {
     let p = |i: usize| DVec3::from_array(positions[i]);
     triangles.iter().map(|&[a, b, c]| p(a).dot(p(b).cross(p(c)))).sum::<f64>() / 6.0
+}
+
+/// The largest extent along an axis of the vertices of `elements`.
+fn span(positions: &[[f64; 3]], elements: &Elements) -> f64 {
+    let mut used = vec![None; positions.len()];
+    match elements {
+        Elements::Tets(t) => t.iter().flatten().for_each(|&i| used[i] = Some(0)),
+        Elements::Triangles(t) => t.iter().flatten().for_each(|&i| used[i] = Some(0)),
+    }
+    let (lo, hi) = bounds(positions, &used);
+    (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max)
 }
 
 /// The bounds of the used vertices.
