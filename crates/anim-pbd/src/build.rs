@@ -41,7 +41,7 @@ mod tet;
 mod validate;
 
 pub use builder::{EARTH_GRAVITY, MeshMass, PbdBuilder};
-pub(crate) use closed::closed_surface;
+pub(crate) use closed::{NotClosed, closed_outward};
 pub use cloth::{Bending, Cloth, ClothHandle, MeshParams};
 pub use error::{BuildError, InputError};
 pub use rope::Chain;

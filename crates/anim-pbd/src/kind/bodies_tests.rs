@@ -528,6 +528,29 @@ fn fields_that_do_not_fit_the_body_or_the_scene_are_refused_by_name() {
         serde_json::json!({ "bodies": [{ "mesh": cloth, "material": { "density": 1.0, "pressure": 1.2 } }] }),
     );
     assert!(msg.contains("cloth.obj: a cloth with pressure must be a closed surface, but edge"), "{msg}");
+    // A closed cloth whose triangles face inward (the unit cube's, reversed) has no pressure.
+    let cube = write_cube_obj(&dir);
+    let text = std::fs::read_to_string(dir.join(&cube)).expect("read");
+    let reversed: String = text
+        .lines()
+        .map(|l| match l.split_whitespace().collect::<Vec<_>>()[..] {
+            ["f", a, b, c] => format!("f {a} {c} {b}\n"),
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(dir.join("inward.obj"), reversed).expect("write");
+    let msg = refusal(
+        &dir,
+        serde_json::json!({ "bodies": [{ "mesh": "inward.obj", "material": { "density": 1.0, "pressure": 1.2 } }] }),
+    );
+    assert_eq!(
+        msg,
+        format!(
+            "field `bodies[0].material.pressure`: {}: the enclosed volume -1e0 is not positive: the triangles \
+             face inward",
+            dir.join("inward.obj").display()
+        )
+    );
 }
 
 /// A closed cloth with pressure is a balloon: it inflates to `pressure` times its volume.

@@ -21,7 +21,7 @@
 //! Vertices of the file that no element uses (a Gmsh geometry point, a stray OBJ vertex) are left
 //! out of the body; pinning one is refused.
 
-use crate::build::{Bending, MeshMass, MeshParams, PbdBuilder, TetMeshParams};
+use crate::build::{Bending, MeshMass, MeshParams, NotClosed, PbdBuilder, TetMeshParams, closed_outward};
 use crate::constraint::{ConstraintParams, tet_volume};
 use anim_core::glam::DVec3;
 use anim_core::scene::{BuildContext, BuildError, Placement, is_default};
@@ -284,7 +284,7 @@ impl BodySpec {
                 };
                 let r = b.tet_mesh(&used, &tets, &params).map_err(builder_error)?;
                 let surface = crate::shapes::tet_surface(&used, &tets);
-                let closed = crate::build::closed_surface(&surface).is_ok();
+                let closed = closed_outward(&surface, |i| DVec3::from_array(used[i])).is_ok();
                 (r, surface, closed)
             }
             Elements::Triangles(tris) => {
@@ -294,22 +294,25 @@ impl BodySpec {
                     stretch: material.stretch,
                     bending: material.bending.unwrap_or(Bending::None),
                 };
-                let closed =
-                    crate::build::closed_surface(&tris).is_ok() && enclosed_volume(&used, &tris) > 0.0;
+                let outward = closed_outward(&tris, |i| DVec3::from_array(used[i]));
+                let closed = outward.is_ok();
                 if let Some(pressure) = material.pressure {
-                    if let Err(reason) = crate::build::closed_surface(&tris) {
-                        return Err(BuildError::invalid(
-                            field("material.pressure"),
-                            format!("{file}: a cloth with pressure must be a closed surface, but {reason}"),
-                        ));
-                    }
-                    if !closed {
-                        return Err(BuildError::invalid(
-                            field("material.pressure"),
-                            format!(
-                                "{file}: the surface encloses a negative volume: its triangles face inward"
-                            ),
-                        ));
+                    match outward {
+                        Ok(()) => {}
+                        Err(NotClosed::Open(reason)) => {
+                            return Err(BuildError::invalid(
+                                field("material.pressure"),
+                                format!(
+                                    "{file}: a cloth with pressure must be a closed surface, but {reason}"
+                                ),
+                            ));
+                        }
+                        Err(inward @ NotClosed::Inward(_)) => {
+                            return Err(BuildError::invalid(
+                                field("material.pressure"),
+                                format!("{file}: {inward}"),
+                            ));
+                        }
                     }
                     let r = b.triangle_mesh(&used, &tris, &params).map_err(builder_error)?;
                     let shifted: Vec<[usize; 3]> = tris.iter().map(|t| t.map(|i| r.start + i)).collect();
@@ -575,12 +578,6 @@ fn check_elements(file: &str, positions: &[[f64; 3]], elements: &Elements) -> Re
         }
     }
     Ok(())
-}
-
-/// The enclosed volume `sum x_a . (x_b x x_c) / 6` of triangles over `positions`.
-fn enclosed_volume(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> f64 {
-    let p = |i: usize| DVec3::from_array(positions[i]);
-    triangles.iter().map(|&[a, b, c]| p(a).dot(p(b).cross(p(c)))).sum::<f64>() / 6.0
 }
 
 /// The largest extent along an axis of the vertices of `elements`.
