@@ -282,8 +282,11 @@ impl BodySpec {
                     stretch: Some(material.stretch),
                     volume: Some(material.volume.unwrap_or_default()),
                 };
+                let before = b.recorded_triangles().len();
                 let r = b.tet_mesh(&used, &tets, &params).map_err(builder_error)?;
-                let surface = crate::shapes::tet_surface(&used, &tets);
+                // The boundary faces the builder recorded, in the body's numbering.
+                let surface: Vec<[usize; 3]> =
+                    b.recorded_triangles()[before..].iter().map(|t| t.map(|i| i - r.start)).collect();
                 let closed = closed_outward(&surface, |i| DVec3::from_array(used[i])).is_ok();
                 (r, surface, closed)
             }
