@@ -33,7 +33,7 @@
 
 use super::scratch::Data;
 use crate::model::PbdModel;
-use crate::project::{CONTACT_ID, Ctx};
+use crate::project::{CONTACT_ID, Ctx, positional_friction};
 use anim_core::geometry::closest_point_on_triangle;
 use anim_core::glam::DVec3;
 
@@ -331,16 +331,10 @@ pub(super) fn project_body_contacts(
         // The relative correction `r` of the particle against the surface point is shared as
         // `w_i r / D` and `-w_k b_k r / D`, which moves the gap by exactly `r`.
         let mut r = c.normal * dn;
-        if dn > 0.0 && (mu_s > 0.0 || mu_k > 0.0) {
+        r -= positional_friction(c.normal, dn, mu_s, mu_k, || {
             let moved = |j: usize| p[j] - ctx.x[j];
-            let rel =
-                moved(i) + r - (c.bary[0] * moved(t[0]) + c.bary[1] * moved(t[1]) + c.bary[2] * moved(t[2]));
-            let tangent = rel - c.normal * rel.dot(c.normal);
-            let tl = tangent.length();
-            if tl > 0.0 {
-                r -= if tl < mu_s * dn { tangent } else { tangent * (mu_k * dn / tl).min(1.0) };
-            }
-        }
+            moved(i) + r - (c.bary[0] * moved(t[0]) + c.bary[1] * moved(t[1]) + c.bary[2] * moved(t[2]))
+        });
         let scale = r / denom;
         if !scale.is_finite() {
             ctx.flag(CONTACT_ID);
