@@ -16,8 +16,10 @@
 //! see [`crate::collide`]). There is no restitution between bodies.
 //!
 //! The normal is the triangle's (at `p`): outward for a closed surface, so a particle that went
-//! inside is pushed back out; for an open surface (cloth) it points to the side the particle was
-//! on at the start of the substep.
+//! inside is pushed back out, if it is within the reach above of the surface (one that went
+//! deeper, say through a thin body in one substep, gets no contact and stays inside: there is no
+//! inside test); for an open surface (cloth) it points to the side the particle was on at the
+//! start of the substep.
 //!
 //! The candidates come from a uniform grid hashed by cell and body (a counting sort into a
 //! fixed table), rebuilt every substep from the triangles' boxes grown by the search radius,
