@@ -27,10 +27,12 @@
 //!
 //! The builder and its constraints by hand are in `build/builder.rs`, the shapes in
 //! `build/rope.rs` ([`Chain`]), `build/cloth.rs` ([`Cloth`] and any triangle mesh) and
-//! `build/tet.rs` (any tetrahedral mesh), the contact bodies in `build/contact.rs`; the checks that turn a builder into a model in
-//! `build/validate.rs`, and [`BuildError`] in `build/error.rs`.
+//! `build/tet.rs` (any tetrahedral mesh), the contact bodies in `build/contact.rs`, the check of
+//! a closed surface oriented outward in `build/closed.rs`; the checks that turn a builder into a
+//! model in `build/validate.rs`, and [`BuildError`] in `build/error.rs`.
 
 mod builder;
+mod closed;
 mod cloth;
 mod contact;
 mod error;
@@ -39,8 +41,8 @@ mod tet;
 mod validate;
 
 pub use builder::{EARTH_GRAVITY, MeshMass, PbdBuilder};
+pub(crate) use closed::{NotClosed, closed_outward};
 pub use cloth::{Bending, Cloth, ClothHandle, MeshParams};
-pub(crate) use contact::closed_surface;
 pub use error::{BuildError, InputError};
 pub use rope::Chain;
 pub use tet::TetMeshParams;

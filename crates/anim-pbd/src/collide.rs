@@ -294,7 +294,7 @@ impl Collider {
 #[serde(deny_unknown_fields, default)]
 pub struct BodyContact {
     /// Distance kept between a particle of one body and the surface of another (m, > 0).
-    /// Default `0.005`.
+    /// Default [`DEFAULT_THICKNESS`](crate::kind::DEFAULT_THICKNESS), `0.005`, as a scene's.
     pub thickness: f64,
     /// Static friction coefficient `mu_s >= 0` between bodies. Default 0.
     pub static_friction: f64,
@@ -304,7 +304,7 @@ pub struct BodyContact {
 
 impl Default for BodyContact {
     fn default() -> Self {
-        Self { thickness: 0.005, static_friction: 0.0, kinetic_friction: 0.0 }
+        Self { thickness: crate::kind::DEFAULT_THICKNESS, static_friction: 0.0, kinetic_friction: 0.0 }
     }
 }
 

@@ -77,7 +77,10 @@
 //!
 //! The results of all three solvers are bitwise identical for any rayon thread count (tested with
 //! pools of 1, 2 and 4). Nothing allocates inside a step once the simulation exists: contact
-//! buffers are sized for every particle against every collider up front.
+//! buffers are sized for every particle against every collider up front, and those of the
+//! contacts between bodies for each particle against four other bodies (a step grows them only
+//! for a particle touching more at once, or in a scene so wide that rounding spreads the contact
+//! grid; `sim/body_contacts.rs`).
 //!
 //! **Failures** never pass silently: a step that makes a position or velocity non-finite, or
 //! stretches a distance constraint beyond [`PbdParams::max_stretch`], returns a [`PbdError`]

@@ -77,8 +77,10 @@ pub struct ContactBody {
     /// Its surface triangles, as model particle indices within its range.
     pub triangles: Vec<[usize; 3]>,
     /// A closed surface, oriented outward: a particle is pushed out along the outward normal
-    /// (one-sided, so a particle that went inside comes back out). Otherwise the surface is
-    /// two-sided (cloth): a particle stays on the side it was on at the start of the substep.
+    /// (one-sided, so a particle that went inside by less than the search reach, `thickness +
+    /// contact_margin` plus both sides' motion over the substep, comes back out; one that went
+    /// deeper gets no contact and stays inside). Otherwise the surface is two-sided (cloth): a
+    /// particle stays on the side it was on at the start of the substep.
     pub closed: bool,
 }
 

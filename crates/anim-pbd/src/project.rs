@@ -410,23 +410,42 @@ pub(crate) fn project_contact(ctx: &Ctx<'_>, c: &mut Contact, p: DVec3) -> DVec3
     }
     let mut dx = c.normal * dn;
     let col = &ctx.colliders[c.collider as usize];
-    if dn > 0.0 && (col.static_friction > 0.0 || col.kinetic_friction > 0.0) {
-        let moved = p + dx - ctx.x[i] - c.obstacle_dx;
-        let t = moved - c.normal * moved.dot(c.normal);
-        let tl = t.length();
-        if tl > 0.0 {
-            if tl < col.static_friction * dn {
-                dx -= t;
-            } else {
-                dx -= t * (col.kinetic_friction * dn / tl).min(1.0);
-            }
-        }
-    }
+    dx -= positional_friction(c.normal, dn, col.static_friction, col.kinetic_friction, || {
+        p + dx - ctx.x[i] - c.obstacle_dx
+    });
     if !dx.is_finite() {
         ctx.flag(CONTACT_ID);
         return DVec3::ZERO;
     }
     dx
+}
+
+/// Positional friction (Macklin et al. 2014, eq. 24; see [`collide`](crate::collide)) after a
+/// contact's normal correction `dn` along `normal`: the part of the tangential motion to remove,
+/// all of it when it is below `mu_s dn` (static), else `min(mu_k dn, |dx_t|)` of it (kinetic);
+/// `rel` is the motion over the substep relative to the other side, the correction included.
+/// Zero unless `dn > 0` and a coefficient is.
+#[inline]
+pub(crate) fn positional_friction(
+    normal: DVec3,
+    dn: f64,
+    mu_s: f64,
+    mu_k: f64,
+    rel: impl FnOnce() -> DVec3,
+) -> DVec3 {
+    if !(dn > 0.0 && (mu_s > 0.0 || mu_k > 0.0)) {
+        return DVec3::ZERO;
+    }
+    let rel = rel();
+    let t = rel - normal * rel.dot(normal);
+    let tl = t.length();
+    if !(tl > 0.0) {
+        DVec3::ZERO
+    } else if tl < mu_s * dn {
+        t
+    } else {
+        t * (mu_k * dn / tl).min(1.0)
+    }
 }
 
 /// The id [`Ctx`] records for a contact whose update was not finite.

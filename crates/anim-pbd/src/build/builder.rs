@@ -111,6 +111,12 @@ impl PbdBuilder {
         self.positions.len()
     }
 
+    /// The triangles recorded so far (model indices): those of [`triangle`](Self::triangle), the
+    /// triangle meshes' and the tetrahedral meshes' boundary faces, in the order they came.
+    pub(crate) fn recorded_triangles(&self) -> &[[usize; 3]] {
+        &self.triangles
+    }
+
     /// Number of constraints added so far (the index the next one gets).
     #[must_use]
     pub fn num_constraints(&self) -> usize {

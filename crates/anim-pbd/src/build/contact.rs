@@ -3,13 +3,15 @@
 //! surface triangles; a closed surface must be closed and consistently oriented outward (its
 //! particles are then pushed out of it along the outward normal), an open one (cloth) is
 //! two-sided. The checks run in [`PbdBuilder::build`]: ranges inside the model and disjoint,
-//! triangles inside their body's range with three distinct corners, a closed surface closed.
+//! triangles inside their body's range with three distinct corners, a closed surface closed,
+//! consistently oriented and enclosing a positive volume (`build/closed.rs`).
 
 use super::builder::PbdBuilder;
+use super::closed::closed_outward;
 use super::error::BuildError;
 use crate::collide::BodyContact;
 use crate::model::ContactBody;
-use std::collections::HashMap;
+use anim_core::glam::DVec3;
 use std::ops::Range;
 
 impl PbdBuilder {
@@ -62,51 +64,26 @@ impl PbdBuilder {
                 }
             }
             if body.closed {
-                closed_surface(&body.triangles).map_err(fail)?;
+                closed_outward(&body.triangles, |i| DVec3::from_array(self.positions[i]))
+                    .map_err(|e| fail(e.to_string()))?;
             }
         }
         Ok(())
     }
 }
 
-/// Whether `triangles` are closed and consistently oriented: every directed edge once, with its
-/// opposite; the reason, naming the edge and the triangle, if not.
-pub(crate) fn closed_surface(triangles: &[[usize; 3]]) -> Result<(), String> {
-    let mut directed: HashMap<(usize, usize), usize> = HashMap::new();
-    for (t, tri) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            let e = (tri[k], tri[(k + 1) % 3]);
-            if directed.insert(e, t).is_some() {
-                return Err(format!(
-                    "edge {e:?} runs the same way in two triangles (the second is triangle {t}): \
-                     the surface is not consistently oriented or not manifold"
-                ));
-            }
-        }
-    }
-    // In triangle order, so the error names the same edge every time.
-    for (t, tri) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            if !directed.contains_key(&(b, a)) {
-                return Err(format!(
-                    "edge ({a}, {b}) of triangle {t} has no opposite: the surface is not closed"
-                ));
-            }
-        }
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use crate::{BodyContact, BuildError, PbdBuilder};
 
-    /// Two tetrahedra's worth of particles: 0..4 and 4..8.
+    /// Two unit tetrahedra's particles, 0..4 and 4..8, each at the origin and its three unit
+    /// vectors (the second moved 2 m along x), so that [`TET`] faces outward.
     fn builder() -> PbdBuilder {
         let mut b = PbdBuilder::new();
+        let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
         for k in 0..8 {
-            b.particle([k as f64, (k % 3) as f64, (k % 2) as f64], 1.0);
+            let [x, y, z] = corners[k % 4];
+            b.particle([x + 2.0 * (k / 4) as f64, y, z], 1.0);
         }
         b
     }
@@ -143,5 +120,29 @@ mod tests {
         let model = b.build().expect("builds");
         assert_eq!(model.contact_bodies().len(), 2);
         assert_eq!(model.body_contact(), BodyContact::default());
+    }
+
+    /// A closed surface whose triangles face inward (each of [`TET`]'s reversed) would pull
+    /// the other bodies' particles into it: refused, as is a flat closed surface.
+    #[test]
+    fn a_closed_contact_body_facing_inward_or_flat_is_refused() {
+        let reason = |b: &PbdBuilder| match b.build() {
+            Err(BuildError::BadContactBody { body, reason }) => format!("{body}: {reason}"),
+            other => panic!("{other:?}"),
+        };
+        let inward = TET.map(|[a, b, c]| [a, c, b]);
+        let mut b = builder();
+        b.contact_body(4..8, &[[4, 5, 6]], false);
+        b.contact_body(0..4, &inward, true);
+        assert_eq!(
+            reason(&b),
+            "1: the enclosed volume -1.6666666666666666e-1 is not positive: the triangles face inward"
+        );
+        let mut b = PbdBuilder::new();
+        for p in [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]] {
+            b.particle(p, 1.0);
+        }
+        b.contact_body(0..4, &TET, true);
+        assert_eq!(reason(&b), "0: the enclosed volume 0e0 is not positive: the triangles face inward");
     }
 }

@@ -8,6 +8,7 @@
 //! directed edge appears once and has its opposite.
 
 use super::builder::{PbdBuilder, Pending, bad};
+use super::closed::closed_outward;
 use super::error::{BuildError, InputError};
 use crate::constraint::{
     AttachTarget, Constraint, ConstraintFunction, ConstraintParams, IsometricBending, dihedral,
@@ -319,7 +320,8 @@ impl PbdBuilder {
     }
 }
 
-/// Validates a closed mesh and converts it to local indices.
+/// Validates a closed mesh (closed, oriented outward: [`closed_outward`]) and converts it to
+/// local indices.
 fn volume_mesh(tris: &[[usize; 3]], pos: &[DVec3], constraint: usize) -> Result<VolumeMesh, BuildError> {
     let n = pos.len();
     let fail =
@@ -327,7 +329,6 @@ fn volume_mesh(tris: &[[usize; 3]], pos: &[DVec3], constraint: usize) -> Result<
     if tris.len() < 4 {
         return Err(fail(format!("a closed mesh needs at least 4 triangles, got {}", tris.len())));
     }
-    let mut directed: HashMap<(usize, usize), usize> = HashMap::new();
     for (t, tri) in tris.iter().enumerate() {
         if let Some(&i) = tri.iter().find(|&&i| i >= n) {
             return Err(fail(format!("triangle {t} names particle {i}, which does not exist")));
@@ -335,34 +336,12 @@ fn volume_mesh(tris: &[[usize; 3]], pos: &[DVec3], constraint: usize) -> Result<
         if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
             return Err(fail(format!("triangle {t} {tri:?} repeats a vertex")));
         }
-        for k in 0..3 {
-            let e = (tri[k], tri[(k + 1) % 3]);
-            if directed.insert(e, t).is_some() {
-                return Err(fail(format!(
-                    "directed edge {e:?} appears twice (triangle {t}): the mesh is not consistently oriented or not manifold"
-                )));
-            }
-        }
     }
-    for (&(a, b), &t) in &directed {
-        if !directed.contains_key(&(b, a)) {
-            return Err(fail(format!(
-                "edge ({a}, {b}) of triangle {t} has no opposite: the mesh is not closed"
-            )));
-        }
-    }
+    closed_outward(tris, |i| pos[i]).map_err(|e| fail(e.to_string()))?;
     let mut vertices: Vec<usize> = tris.iter().flatten().copied().collect();
     vertices.sort_unstable();
     vertices.dedup();
     let local: HashMap<usize, u32> = vertices.iter().enumerate().map(|(k, &v)| (v, k as u32)).collect();
     let triangles = tris.iter().map(|t| t.map(|i| local[&i])).collect();
-    let m = VolumeMesh { vertices, triangles };
-    let x: Vec<f64> = pos.iter().flat_map(|p| p.to_array()).collect();
-    let v = m.volume(&x);
-    if !(v > 0.0) {
-        return Err(fail(format!(
-            "enclosed volume {v:e} is not positive (are the normals pointing inward?)"
-        )));
-    }
-    Ok(m)
+    Ok(VolumeMesh { vertices, triangles })
 }

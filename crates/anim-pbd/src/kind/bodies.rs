@@ -8,8 +8,8 @@
 //! of one body do not collide with that body's own surface. The obstacles are colliders with the
 //! same thickness, friction (static and kinetic alike) and restitution.
 
+use super::PbdSceneParams;
 use super::body::BodySpec;
-use super::{MAX_PBD_COUNT, PbdSceneParams};
 use crate::build::{EARTH_GRAVITY, PbdBuilder};
 use crate::collide::{BodyContact, Collider};
 use crate::sim::{Method, PbdParams, PbdSimulation, SolverKind};
@@ -107,12 +107,12 @@ pub(super) fn build_bodies(
     for (spec, body) in p.bodies.iter().zip(&added) {
         set_velocity(spec, body.particles.clone(), &body.pinned, &mut state);
     }
-    let count = |v: Option<usize>, default| v.unwrap_or(default).min(MAX_PBD_COUNT);
+    // `iterations` and `substeps` outside [1, MAX_PBD_COUNT] were refused with the other fields.
     let params = PbdParams::new(
         p.method.unwrap_or(Method::Xpbd),
         SolverKind::ColoredGaussSeidel,
-        count(p.iterations, DEFAULT_ITERATIONS),
-        count(p.substeps, DEFAULT_SUBSTEPS),
+        p.iterations.unwrap_or(DEFAULT_ITERATIONS),
+        p.substeps.unwrap_or(DEFAULT_SUBSTEPS),
     );
     let sim = PbdSimulation::new(model, params).map_err(|e| BuildError::invalid("bodies", e.to_string()))?;
     Ok((sim, state))

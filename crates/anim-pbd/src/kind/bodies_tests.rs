@@ -384,6 +384,32 @@ fn a_missing_or_broken_mesh_file_is_named() {
     assert!(msg.contains("bad.obj:2:"), "{msg}");
 }
 
+/// A placed mesh too large for its volumes to be finite (`1e330 m^3`) is refused naming the
+/// scale, not reported as a zero-volume tetrahedron or a zero-area triangle.
+#[test]
+fn a_scale_too_large_to_measure_the_mesh_is_named() {
+    let dir = folder("huge");
+    let cube = write_tet_box(&dir, "cube", 1, [0.0; 3], 1.0);
+    let cloth = write_cloth(&dir, "cloth", 3, 1.0);
+    for (mesh, scale, span) in [(&cube, 1e110, "1e110"), (&cloth, 1e160, "1e160")] {
+        let msg = refusal(
+            &dir,
+            serde_json::json!({ "bodies": [
+                { "mesh": cloth, "material": { "density": 1.0 } },
+                { "mesh": mesh, "material": { "density": 1.0 }, "scale": scale },
+            ] }),
+        );
+        assert_eq!(
+            msg,
+            format!(
+                "field `bodies[1].scale`: {}: placed, the mesh spans {span} m, too large to measure its \
+                 volumes (the scale is too large)",
+                dir.join(mesh).display()
+            )
+        );
+    }
+}
+
 #[test]
 fn obstacles_pbd_cannot_collide_with_are_refused_by_index_and_shape() {
     let dir = folder("obstacles");
@@ -502,6 +528,29 @@ fn fields_that_do_not_fit_the_body_or_the_scene_are_refused_by_name() {
         serde_json::json!({ "bodies": [{ "mesh": cloth, "material": { "density": 1.0, "pressure": 1.2 } }] }),
     );
     assert!(msg.contains("cloth.obj: a cloth with pressure must be a closed surface, but edge"), "{msg}");
+    // A closed cloth whose triangles face inward (the unit cube's, reversed) has no pressure.
+    let cube = write_cube_obj(&dir);
+    let text = std::fs::read_to_string(dir.join(&cube)).expect("read");
+    let reversed: String = text
+        .lines()
+        .map(|l| match l.split_whitespace().collect::<Vec<_>>()[..] {
+            ["f", a, b, c] => format!("f {a} {c} {b}\n"),
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(dir.join("inward.obj"), reversed).expect("write");
+    let msg = refusal(
+        &dir,
+        serde_json::json!({ "bodies": [{ "mesh": "inward.obj", "material": { "density": 1.0, "pressure": 1.2 } }] }),
+    );
+    assert_eq!(
+        msg,
+        format!(
+            "field `bodies[0].material.pressure`: {}: the enclosed volume -1e0 is not positive: the triangles \
+             face inward",
+            dir.join("inward.obj").display()
+        )
+    );
 }
 
 /// A closed cloth with pressure is a balloon: it inflates to `pressure` times its volume.

@@ -3,10 +3,11 @@
 //! tetrahedralised on load) or a cloth from an OBJ triangle surface, with its material, placement,
 //! initial velocity and pinned vertices.
 //!
-//! The mesh is read, placed (scale, rotation, translation: [`Placement`]), checked element by
-//! element in the file's numbering (a repeated vertex, an inverted tetrahedron or one of zero
-//! volume, or a triangle of zero area is refused, naming the file and the element), and added to
-//! a [`PbdBuilder`]:
+//! The mesh is read, placed (scale, rotation, translation: [`Placement`]; a mesh placed too
+//! large for its volumes to be finite is refused, naming `scale`), checked element by element in
+//! the file's numbering (a repeated vertex, an inverted tetrahedron or one of zero volume, or a
+//! triangle of zero area is refused, naming the file and the element), and added to a
+//! [`PbdBuilder`]:
 //!
 //! - **soft**: [`PbdBuilder::tet_mesh`], a distance constraint on every edge (`stretch`) and a
 //!   volume constraint per tetrahedron (`volume`), the masses lumped from `density` (kg/m^3), a
@@ -20,7 +21,7 @@
 //! Vertices of the file that no element uses (a Gmsh geometry point, a stray OBJ vertex) are left
 //! out of the body; pinning one is refused.
 
-use crate::build::{Bending, MeshMass, MeshParams, PbdBuilder, TetMeshParams};
+use crate::build::{Bending, MeshMass, MeshParams, NotClosed, PbdBuilder, TetMeshParams, closed_outward};
 use crate::constraint::{ConstraintParams, tet_volume};
 use anim_core::glam::DVec3;
 use anim_core::scene::{BuildContext, BuildError, Placement, is_default};
@@ -230,6 +231,17 @@ impl BodySpec {
                 format!("{file}: vertex {i} is not finite after the placement ({:?})", positions[i]),
             ));
         }
+        // Volumes are products of three coordinate differences, each at most twice the span.
+        let span = span(&positions, &elements);
+        if !(2.0 * span).powi(3).is_finite() {
+            return Err(BuildError::invalid(
+                field("scale"),
+                format!(
+                    "{file}: placed, the mesh spans {span:e} m, too large to measure its volumes (the scale \
+                     is too large)"
+                ),
+            ));
+        }
         // A soft body from an OBJ surface: its tetrahedra replace the surface.
         let (positions, elements, file_vertices) = match (kind, elements, self.cell) {
             (BodyType::Soft, Elements::Triangles(tris), Some(cell)) => {
@@ -270,9 +282,12 @@ impl BodySpec {
                     stretch: Some(material.stretch),
                     volume: Some(material.volume.unwrap_or_default()),
                 };
+                let before = b.recorded_triangles().len();
                 let r = b.tet_mesh(&used, &tets, &params).map_err(builder_error)?;
-                let surface = crate::shapes::tet_surface(&used, &tets);
-                let closed = crate::build::closed_surface(&surface).is_ok();
+                // The boundary faces the builder recorded, in the body's numbering.
+                let surface: Vec<[usize; 3]> =
+                    b.recorded_triangles()[before..].iter().map(|t| t.map(|i| i - r.start)).collect();
+                let closed = closed_outward(&surface, |i| DVec3::from_array(used[i])).is_ok();
                 (r, surface, closed)
             }
             Elements::Triangles(tris) => {
@@ -282,22 +297,25 @@ impl BodySpec {
                     stretch: material.stretch,
                     bending: material.bending.unwrap_or(Bending::None),
                 };
-                let closed =
-                    crate::build::closed_surface(&tris).is_ok() && enclosed_volume(&used, &tris) > 0.0;
+                let outward = closed_outward(&tris, |i| DVec3::from_array(used[i]));
+                let closed = outward.is_ok();
                 if let Some(pressure) = material.pressure {
-                    if let Err(reason) = crate::build::closed_surface(&tris) {
-                        return Err(BuildError::invalid(
-                            field("material.pressure"),
-                            format!("{file}: a cloth with pressure must be a closed surface, but {reason}"),
-                        ));
-                    }
-                    if !closed {
-                        return Err(BuildError::invalid(
-                            field("material.pressure"),
-                            format!(
-                                "{file}: the surface encloses a negative volume: its triangles face inward"
-                            ),
-                        ));
+                    match outward {
+                        Ok(()) => {}
+                        Err(NotClosed::Open(reason)) => {
+                            return Err(BuildError::invalid(
+                                field("material.pressure"),
+                                format!(
+                                    "{file}: a cloth with pressure must be a closed surface, but {reason}"
+                                ),
+                            ));
+                        }
+                        Err(inward @ NotClosed::Inward(_)) => {
+                            return Err(BuildError::invalid(
+                                field("material.pressure"),
+                                format!("{file}: {inward}"),
+                            ));
+                        }
                     }
                     let r = b.triangle_mesh(&used, &tris, &params).map_err(builder_error)?;
                     let shifted: Vec<[usize; 3]> = tris.iter().map(|t| t.map(|i| r.start + i)).collect();
@@ -565,10 +583,15 @@ fn check_elements(file: &str, positions: &[[f64; 3]], elements: &Elements) -> Re
     Ok(())
 }
 
-/// The enclosed volume `sum x_a . (x_b x x_c) / 6` of triangles over `positions`.
-fn enclosed_volume(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> f64 {
-    let p = |i: usize| DVec3::from_array(positions[i]);
-    triangles.iter().map(|&[a, b, c]| p(a).dot(p(b).cross(p(c)))).sum::<f64>() / 6.0
+/// The largest extent along an axis of the vertices of `elements`.
+fn span(positions: &[[f64; 3]], elements: &Elements) -> f64 {
+    let mut used = vec![None; positions.len()];
+    match elements {
+        Elements::Tets(t) => t.iter().flatten().for_each(|&i| used[i] = Some(0)),
+        Elements::Triangles(t) => t.iter().flatten().for_each(|&i| used[i] = Some(0)),
+    }
+    let (lo, hi) = bounds(positions, &used);
+    (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max)
 }
 
 /// The bounds of the used vertices.

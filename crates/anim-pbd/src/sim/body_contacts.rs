@@ -16,20 +16,26 @@
 //! see [`crate::collide`]). There is no restitution between bodies.
 //!
 //! The normal is the triangle's (at `p`): outward for a closed surface, so a particle that went
-//! inside is pushed back out; for an open surface (cloth) it points to the side the particle was
-//! on at the start of the substep.
+//! inside is pushed back out, if it is within the reach above of the surface (one that went
+//! deeper, say through a thin body in one substep, gets no contact and stays inside: there is no
+//! inside test); for an open surface (cloth) it points to the side the particle was on at the
+//! start of the substep.
 //!
 //! The candidates come from a uniform grid hashed by cell and body (a counting sort into a
 //! fixed table), rebuilt every substep from the triangles' boxes grown by the search radius,
 //! with cells at least as large as the largest grown box, so that a particle looks in one
-//! bucket per other body. Particles are visited in increasing order and each bucket's triangles
-//! in increasing order, so the contacts and their order do not depend on the number of threads. The contacts are projected sequentially after the collider contacts in
-//! every iteration, whatever the solver. Buffers are sized when the simulation is made: a step
-//! allocates nothing unless a particle touches more than four other bodies at once.
+//! bucket per other body. The cells are counted from the lowest corner of the boxes, so that
+//! their rounding depends on the scene's extent, not on its distance from the origin. Particles
+//! are visited in increasing order and each bucket's triangles in increasing order, so the
+//! contacts and their order do not depend on the number of threads. The contacts are projected
+//! sequentially after the collider contacts in every iteration, whatever the solver. Buffers are
+//! sized when the simulation is made: a step allocates nothing unless a particle touches more
+//! than four other bodies at once, or the scene is so wide (some 1e13 cells) that rounding
+//! spreads a box over a third cell.
 
 use super::scratch::Data;
 use crate::model::PbdModel;
-use crate::project::{CONTACT_ID, Ctx};
+use crate::project::{CONTACT_ID, Ctx, positional_friction};
 use anim_core::geometry::closest_point_on_triangle;
 use anim_core::glam::DVec3;
 
@@ -109,18 +115,76 @@ fn bucket(c: [i64; 3], body: u32, mask: usize) -> usize {
     (h ^ (h >> 29)) as usize & mask
 }
 
-/// The cell of `p` for cells of size `size`, or `None` if it is out of the grid's range.
+/// The grid's cell coordinates are clamped to `[-CELL_LIMIT, CELL_LIMIT]`: far cells share
+/// a bucket (slower, never wrong), and no cell coordinate overflows.
+const CELL_LIMIT: f64 = 1e15;
+
+/// The cell of `q` (relative to the grid's origin) for cells of size `size`. Monotone in
+/// every coordinate, so that a point inside a box is inside the box's range of cells.
 #[inline]
-fn cell(p: DVec3, size: f64) -> Option<[i64; 3]> {
-    let c = (p / size).floor();
-    let lim = 1e15;
-    (c.abs().max_element() < lim).then_some([c.x as i64, c.y as i64, c.z as i64])
+fn cell(q: DVec3, size: f64) -> [i64; 3] {
+    let c = (q / size).floor();
+    // `as` maps a NaN to 0: a non-finite position lands in some cell, the step's guard reports it.
+    [c.x, c.y, c.z].map(|c| c.clamp(-CELL_LIMIT, CELL_LIMIT) as i64)
 }
 
 /// The cells from `lo` to `hi`, each once.
 fn cells(lo: [i64; 3], hi: [i64; 3]) -> impl Iterator<Item = [i64; 3]> {
     (lo[0]..=hi[0])
         .flat_map(move |x| (lo[1]..=hi[1]).flat_map(move |y| (lo[2]..=hi[2]).map(move |z| [x, y, z])))
+}
+
+/// The distance from particle `i` at `q` (relative to the grid's origin) to the surface
+/// triangle `t` with box `b` (relative to the same origin), when the triangle is a candidate:
+/// `q` inside the box grown by the reach `near + b.2`, not every particle pinned, and the
+/// distance below the reach. `p` and `w` are the predicted positions and inverse masses.
+#[inline]
+fn reach_distance(
+    p: &[DVec3],
+    w: &[f64],
+    i: usize,
+    q: DVec3,
+    near: f64,
+    t: [u32; 3],
+    b: &(DVec3, DVec3, f64),
+) -> Option<f64> {
+    let (lo, hi, moved) = *b;
+    let reach = near + moved;
+    if (q - (lo - reach)).min_element() < 0.0 || ((hi + reach) - q).min_element() < 0.0 {
+        return None;
+    }
+    let t = t.map(|j| j as usize);
+    if w[i] == 0.0 && t.iter().all(|&j| w[j] == 0.0) {
+        return None;
+    }
+    let (c, _) = closest_point_on_triangle(p[i], t.map(|j| p[j]));
+    let dist = (p[i] - c).length();
+    (dist < reach).then_some(dist)
+}
+
+/// The contact of particle `i` with triangle `t` of a body that is `closed` or not, at start
+/// positions `x` and predicted positions `p`; `None` where the triangle has no normal (zero
+/// area) or an open surface's particle started in its plane.
+fn pair_contact(x: &[DVec3], p: &[DVec3], i: usize, t: [u32; 3], closed: bool) -> Option<PairContact> {
+    let corners = t.map(|j| j as usize);
+    let (_, bary) = closest_point_on_triangle(p[i], corners.map(|j| p[j]));
+    let [a, b, c] = corners.map(|j| p[j]);
+    let face = (b - a).cross(c - a).try_normalize()?;
+    let normal = if closed {
+        face
+    } else {
+        let [a0, b0, c0] = corners.map(|j| x[j]);
+        let q0 = bary[0] * a0 + bary[1] * b0 + bary[2] * c0;
+        let side = (b0 - a0).cross(c0 - a0).dot(x[i] - q0);
+        if side > 0.0 {
+            face
+        } else if side < 0.0 {
+            -face
+        } else {
+            return None;
+        }
+    };
+    Some(PairContact { particle: i as u32, tri: t, bary, normal, lambda: 0.0 })
 }
 
 /// Line (8) for the contact bodies: fills `d.bodies.contacts` for the predicted positions `d.p`
@@ -140,43 +204,54 @@ pub(super) fn generate_body_contacts(model: &PbdModel, d: &mut Data, margin: f64
             most = most.max(motion(i));
         }
     }
-    // A triangle's box grown by `radius` holds every particle that can touch it.
-    let radius = thickness + margin + 2.0 * most;
-    let mut size = 0.0f64;
+    // A triangle's box grown by `radius` holds every particle that can touch it: a particle's
+    // reach `(thickness + margin + motion) + moved` never exceeds it, rounding included.
+    let radius = (thickness + margin + most) + most;
+    // The boxes, then relative to the lowest corner of them all: the grid's rounding then
+    // depends on the scene's extent, not on its distance from the origin.
+    let mut origin = DVec3::INFINITY;
     for (&(t, _), b) in bc.surface.iter().zip(bc.boxes.iter_mut()) {
         let t = t.map(|i| i as usize);
         let [a, b1, c] = t.map(|i| p[i]);
         let moved = motion(t[0]).max(motion(t[1])).max(motion(t[2]));
         *b = (a.min(b1).min(c), a.max(b1).max(c), moved);
+        origin = origin.min(b.0);
+    }
+    let mut size = 0.0f64;
+    for b in &mut bc.boxes {
+        (b.0, b.1) = (b.0 - origin, b.1 - origin);
         size = size.max((b.1 - b.0).max_element() + 2.0 * radius);
     }
-    // A little larger, so that rounding cannot spread a box over a third cell.
+    // A little larger, so that rounding does not spread a box over a third cell.
     let size = size * 1.001;
-    if !(size > 0.0 && size.is_finite()) {
+    if !(size > 0.0 && size.is_finite() && origin.is_finite()) {
         // Non-finite positions: the step's guard reports them.
         return;
     }
     // Counting sort of the triangles into the buckets of the cells their grown boxes overlap.
     let mask = bc.start.len() - 2;
-    let grown = |b: &(DVec3, DVec3, f64)| Some((cell(b.0 - radius, size)?, cell(b.1 + radius, size)?));
+    let grown = |b: &(DVec3, DVec3, f64)| (cell(b.0 - radius, size), cell(b.1 + radius, size));
     bc.start.iter_mut().for_each(|s| *s = 0);
     for (&(_, body), b) in bc.surface.iter().zip(&bc.boxes) {
-        if let Some((lo, hi)) = grown(b) {
-            for c in cells(lo, hi) {
-                bc.start[bucket(c, body, mask) + 1] += 1;
-            }
+        let (lo, hi) = grown(b);
+        for c in cells(lo, hi) {
+            bc.start[bucket(c, body, mask) + 1] += 1;
         }
     }
     for k in 1..bc.start.len() {
         bc.start[k] += bc.start[k - 1];
     }
+    let total = bc.start[bc.start.len() - 1] as usize;
+    if total > bc.entries.len() {
+        // Only when rounding spread boxes over a third cell (a scene some 1e13 cells across).
+        bc.entries.resize(total, 0);
+    }
     for (k, (&(_, body), b)) in bc.surface.iter().zip(&bc.boxes).enumerate() {
-        if let Some((lo, hi)) = grown(b) {
-            for c in cells(lo, hi) {
-                let slot = &mut bc.start[bucket(c, body, mask)];
-                bc.entries[*slot as usize] = k as u32;
-                *slot += 1;
-            }
+        let (lo, hi) = grown(b);
+        for c in cells(lo, hi) {
+            let slot = &mut bc.start[bucket(c, body, mask)];
+            bc.entries[*slot as usize] = k as u32;
+            *slot += 1;
         }
     }
     // The fill moved each bucket's start to the next one's: shift back.
@@ -187,29 +262,21 @@ pub(super) fn generate_body_contacts(model: &PbdModel, d: &mut Data, margin: f64
     let nb = model.contact_bodies.len() as u32;
     for (body, own) in model.contact_bodies.iter().zip(0u32..) {
         for i in body.particles.0..body.particles.1 {
-            let Some(c) = cell(p[i], size) else { continue };
+            let q = p[i] - origin;
+            let c = cell(q, size);
             bc.best.iter_mut().for_each(|b| *b = (f64::INFINITY, u32::MAX));
             let near = thickness + margin + motion(i);
             for other in (0..nb).filter(|&o| o != own) {
                 let k = bucket(c, other, mask);
                 for &e in &bc.entries[bc.start[k] as usize..bc.start[k + 1] as usize] {
                     let (t, from) = bc.surface[e as usize];
-                    let (lo, hi, moved) = bc.boxes[e as usize];
-                    let reach = near + moved;
-                    if from != other
-                        || (p[i] - (lo - reach)).min_element() < 0.0
-                        || ((hi + reach) - p[i]).min_element() < 0.0
-                    {
+                    if from != other {
                         continue;
                     }
-                    let t = t.map(|j| j as usize);
-                    if w[i] == 0.0 && t.iter().all(|&j| w[j] == 0.0) {
-                        continue;
-                    }
-                    let (q, _) = closest_point_on_triangle(p[i], t.map(|j| p[j]));
-                    let dist = (p[i] - q).length();
                     // Triangles come in increasing order: the first of equally close ones wins.
-                    if dist < reach && dist < bc.best[other as usize].0 {
+                    if let Some(dist) = reach_distance(p, w, i, q, near, t, &bc.boxes[e as usize])
+                        && dist < bc.best[other as usize].0
+                    {
                         bc.best[other as usize] = (dist, e);
                     }
                 }
@@ -220,25 +287,9 @@ pub(super) fn generate_body_contacts(model: &PbdModel, d: &mut Data, margin: f64
                 }
                 let (t, other) = bc.surface[k as usize];
                 let closed = model.contact_bodies[other as usize].closed;
-                let corners = t.map(|j| j as usize);
-                let (_, bary) = closest_point_on_triangle(p[i], corners.map(|j| p[j]));
-                let [a, b, c] = corners.map(|j| p[j]);
-                let Some(face) = (b - a).cross(c - a).try_normalize() else { continue };
-                let normal = if closed {
-                    face
-                } else {
-                    let [a0, b0, c0] = corners.map(|j| x[j]);
-                    let q0 = bary[0] * a0 + bary[1] * b0 + bary[2] * c0;
-                    let side = (b0 - a0).cross(c0 - a0).dot(x[i] - q0);
-                    if side > 0.0 {
-                        face
-                    } else if side < 0.0 {
-                        -face
-                    } else {
-                        continue;
-                    }
-                };
-                bc.contacts.push(PairContact { particle: i as u32, tri: t, bary, normal, lambda: 0.0 });
+                if let Some(contact) = pair_contact(x, p, i, t, closed) {
+                    bc.contacts.push(contact);
+                }
             }
         }
     }
@@ -282,16 +333,10 @@ pub(super) fn project_body_contacts(
         // The relative correction `r` of the particle against the surface point is shared as
         // `w_i r / D` and `-w_k b_k r / D`, which moves the gap by exactly `r`.
         let mut r = c.normal * dn;
-        if dn > 0.0 && (mu_s > 0.0 || mu_k > 0.0) {
+        r -= positional_friction(c.normal, dn, mu_s, mu_k, || {
             let moved = |j: usize| p[j] - ctx.x[j];
-            let rel =
-                moved(i) + r - (c.bary[0] * moved(t[0]) + c.bary[1] * moved(t[1]) + c.bary[2] * moved(t[2]));
-            let tangent = rel - c.normal * rel.dot(c.normal);
-            let tl = tangent.length();
-            if tl > 0.0 {
-                r -= if tl < mu_s * dn { tangent } else { tangent * (mu_k * dn / tl).min(1.0) };
-            }
-        }
+            moved(i) + r - (c.bary[0] * moved(t[0]) + c.bary[1] * moved(t[1]) + c.bary[2] * moved(t[2]))
+        });
         let scale = r / denom;
         if !scale.is_finite() {
             ctx.flag(CONTACT_ID);
@@ -303,3 +348,6 @@ pub(super) fn project_body_contacts(
         }
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,8 +1,11 @@
 //! The solver's scratch: every buffer a step writes (positions `x`, velocities `v`, predictions
 //! `p`, the compiled constraints and their multipliers, the sweep order, buffered corrections,
-//! contacts, body poses, wind forces), sized once from the model so that a step allocates nothing.
-//! Contacts are reserved for every particle against every collider, and for every particle of a
-//! contact body against every other contact body.
+//! contacts, body poses, wind forces), sized once from the model. Contacts with colliders are
+//! reserved for every particle against every collider, so they never grow. The contacts between
+//! contact bodies are reserved for every particle of a contact body against at most four other
+//! bodies, and their grid's table for two cells per axis of every surface triangle: a step
+//! allocates nothing unless a particle touches more than four other bodies at once or the scene
+//! is so wide that rounding spreads a triangle over a third cell (`sim/body_contacts.rs`).
 
 use super::body_contacts::BodyContactData;
 use crate::collide::{Contact, Pose};
