@@ -13,7 +13,7 @@
 //! triangle, one closest-point evaluation per node of its widened box: about
 //! `T (e / h + 2 BAND + 1)^3` evaluations for `T` triangles of extent `e` (a 12-triangle cube
 //! filling a quarter of a 64-cell domain: about 12 x 25^3 = 190 000; a mesh of 100 000 small
-//! triangles: about 100 000 x 9^3 = 7.3e7, a second or so), run in parallel over z-slices of
+//! triangles: about 100 000 x 9^3 = 7.3e7), run in parallel over z-slices of
 //! the box. A box of more than [`MAX_NODES`] nodes (64 MB of table) is refused.
 //!
 //! **Grid update.** A grid node inside the box whose table value is `<= 0` (inside, or on the
