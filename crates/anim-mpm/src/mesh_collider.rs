@@ -19,8 +19,8 @@
 //! **Grid update.** A grid node inside the box whose table value is `<= 0` (inside, or on the
 //! surface) gets the scene's [`Boundary`] condition with the outward normal the normalised
 //! central difference of the table at the node (one-sided at the box's faces). Where that
-//! difference vanishes (deeper than `BAND - 1` cells inside, where the table is clamped) the node
-//! is stopped (the obstacle is fixed). Nodes outside the box are outside the obstacle. A step
+//! difference vanishes (the node and its six neighbours all at least `BAND` cells inside, where
+//! the table is clamped) the node is stopped (the obstacle is fixed). Nodes outside the box are outside the obstacle. A step
 //! thus pays a table lookup per grid node in the box (seven for the nodes inside); nothing is
 //! allocated and the result does not depend on the thread count.
 //!
