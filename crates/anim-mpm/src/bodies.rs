@@ -1,6 +1,7 @@
 //! Bodies of an `mpm` scene file: matter of the user's own, sampled with particles inside a box,
 //! a sphere or a closed OBJ surface, each with its material and initial velocity, among plane,
-//! box and sphere obstacles in the unit domain.
+//! box and sphere obstacles and, in 3D, fixed closed OBJ surfaces (`obstacle_meshes`, level-set
+//! colliders of [`crate::mesh_collider`]) in the unit domain.
 //!
 //! A body fills its region with particles the way the built-in scenes fill theirs: a lattice
 //! of `particles_per_cell` particles per grid cell and axis (spacing `s = h / particles_per_cell`),
@@ -42,6 +43,7 @@ use anim_io::obj::{Polygons, read_obj};
 use serde::{Deserialize, Serialize};
 
 use crate::kind::MpmSceneParams;
+use crate::mesh_collider::MeshCollider;
 use crate::scenes::{MpmScene, Scene};
 use crate::{Collider, Material, MpmError, MpmParams, MpmSimulation, Particles, Shape};
 
@@ -109,7 +111,10 @@ impl BodySpec {
 /// [`BuildError::Invalid`] naming the field: `dim`, `resolution`, `particles_per_cell`,
 /// `gravity`, `wall`, `boundary`, `obstacles[k]` (a capsule or a bad shape), `bodies[k]` (no or
 /// two regions, outside the walls, no particle at this resolution, too many particles, particles
-/// inside an obstacle), `bodies[k].mesh` (the file and its line, triangle or edge),
+/// inside an obstacle or a mesh obstacle), `obstacle_meshes` (in 2D), `obstacle_meshes[k]` (a
+/// table past [`crate::mesh_collider::MAX_NODES`], outside the domain, no grid node inside),
+/// `obstacle_meshes[k].mesh` and `.scale`/`.rotate`/`.translate`, `bodies[k].mesh` (the file
+/// and its line, triangle or edge),
 /// `bodies[k].shape`, `bodies[k].material.KIND.FIELD`, `bodies[k].scale`/`rotate`/`translate`/
 /// `velocity`.
 pub fn build(params: &MpmSceneParams, context: &BuildContext<'_>) -> Result<MpmScene, BuildError> {
@@ -139,7 +144,9 @@ fn build_in<const D: usize>(p: &MpmSceneParams, context: &BuildContext<'_>) -> R
         body.material.compile(k).map_err(|e| material_error(k, &body.material, e))?;
     }
     let materials = p.bodies.iter().map(|b| b.material).collect();
-    let sim = MpmSimulation::<D>::new(params.clone(), materials).map_err(simulation_error)?;
+    let mut sim = MpmSimulation::<D>::new(params.clone(), materials).map_err(simulation_error)?;
+    let meshes = obstacle_meshes::<D>(p, &params, context)?;
+    sim.set_mesh_colliders(meshes).map_err(|e| BuildError::invalid("obstacle_meshes", reason(e)))?;
     let lattice = Lattice {
         spacing: params.h() / per_cell as f64,
         per_cell,
@@ -155,6 +162,7 @@ fn build_in<const D: usize>(p: &MpmSceneParams, context: &BuildContext<'_>) -> R
         seed(&mut state, body, k, &points, lattice.spacing)?;
     }
     check_obstacles(&params, &state)?;
+    check_obstacle_meshes(sim.mesh_colliders(), params.h(), &state)?;
     Ok(Scene { name: "bodies", description: "bodies of a scene file", sim, state, dt: 5e-4, duration: 1.0 })
 }
 
@@ -198,6 +206,40 @@ fn sim_params<const D: usize>(p: &MpmSceneParams) -> Result<MpmParams, BuildErro
         params.colliders.push(collider);
     }
     Ok(params)
+}
+
+/// The level-set colliders of `obstacle_meshes` (3D only), each surface read relative to
+/// `context`, placed and checked.
+fn obstacle_meshes<const D: usize>(
+    p: &MpmSceneParams,
+    params: &MpmParams,
+    context: &BuildContext<'_>,
+) -> Result<Vec<MeshCollider>, BuildError> {
+    if p.obstacle_meshes.is_empty() {
+        return Ok(Vec::new());
+    }
+    if D != 3 {
+        return Err(BuildError::invalid(
+            "obstacle_meshes",
+            "mesh obstacles are 3D; a 2D scene (dim = 2) takes the shapes of `obstacles`",
+        ));
+    }
+    let boundary = p.boundary.unwrap_or_default();
+    let mut out = Vec::with_capacity(p.obstacle_meshes.len());
+    for (k, m) in p.obstacle_meshes.iter().enumerate() {
+        let at = |field: &str| format!("obstacle_meshes[{k}].{field}");
+        let placement = m.placement();
+        placement.check().map_err(|e| match e {
+            BuildError::Invalid { field, message } => BuildError::invalid(at(&field), message),
+            other => other,
+        })?;
+        let surface = read_surface(&context.resolve(&m.mesh), &placement)
+            .map_err(|e| BuildError::invalid(at("mesh"), e))?;
+        let collider = MeshCollider::new(&surface, params, boundary)
+            .map_err(|e| BuildError::invalid(format!("obstacle_meshes[{k}]"), e))?;
+        out.push(collider);
+    }
+    Ok(out)
 }
 
 /// The reason of a parameter or collider error, without the crate's prefix.
@@ -391,7 +433,7 @@ impl Region {
 fn read_surface(path: &Path, placement: &Placement) -> Result<ClosedSurface, String> {
     let file = path.display();
     if !path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
-        return Err(format!("{file}: a body's mesh is a Wavefront OBJ surface (.obj)"));
+        return Err(format!("{file}: a mesh is a Wavefront OBJ surface (.obj)"));
     }
     let obj = read_obj(path, Polygons::Triangulate).map_err(|e| {
         let text = e.to_string();
@@ -525,6 +567,35 @@ fn check_obstacles<const D: usize>(params: &MpmParams, state: &Particles<D>) -> 
                     "{count} of its particles start inside obstacles[{j}] (a {}), the first at {:?}; move the body \
                      or the obstacle",
                     collider.shape.name(),
+                    &state.x[p * D..p * D + D]
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses particles that start inside a mesh obstacle (the table's trilinear interpolation
+/// negative at the particle), naming the body and the obstacle.
+fn check_obstacle_meshes<const D: usize>(
+    meshes: &[MeshCollider],
+    h: f64,
+    state: &Particles<D>,
+) -> Result<(), BuildError> {
+    for (j, mesh) in meshes.iter().enumerate() {
+        let inside = |p: &usize| {
+            let x: [f64; 3] =
+                std::array::from_fn(|a| if a < D { f64::from(state.x[p * D + a]) } else { 0.0 });
+            mesh.interpolate(x, h).is_some_and(|phi| phi < 0.0)
+        };
+        if let Some(p) = (0..state.len()).find(inside) {
+            let k = state.material[p];
+            let count = (0..state.len()).filter(|q| state.material[*q] == k && inside(q)).count();
+            return Err(BuildError::invalid(
+                format!("bodies[{k}]"),
+                format!(
+                    "{count} of its particles start inside obstacle_meshes[{j}], the first at {:?}; move the \
+                     body or the obstacle",
                     &state.x[p * D..p * D + D]
                 ),
             ));

@@ -13,9 +13,10 @@
 //! tables ([`BodySpec`]), each a box, a sphere or a closed OBJ surface filled with particles,
 //! with its material (elastic, snow, fluid or sand), placement and initial velocity, and the
 //! scene-wide `resolution`, `dim`, `particles_per_cell`, `transfer`, `kernel`, `gravity`,
-//! `obstacles` (planes, boxes, spheres), `boundary` (on the obstacles) and `wall` (on the
+//! `obstacles` (planes, boxes, spheres), `obstacle_meshes` (closed OBJ surfaces, 3D; level-set
+//! colliders, [`crate::mesh_collider`]), `boundary` (on the obstacles) and `wall` (on the
 //! domain's walls) ([`MpmSceneParams`], [`crate::bodies`]). Such a scene is framed by the
-//! domain's walls.
+//! domain's walls; mesh obstacles are not drawn.
 //!
 //! ```
 //! use anim_core::scene::BuildContext;
@@ -63,6 +64,7 @@
 //! ```
 
 use crate::bodies::{self, BodySpec};
+use crate::mesh_collider::ObstacleMesh;
 use crate::scenes::{self, MpmScene, SurgeFront};
 use crate::{Boundary, Kernel, MpmError, MpmParams, MpmSimulation, OutOfDomain, Particles, Shape, Transfer};
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
@@ -86,7 +88,7 @@ pub const KIND: SceneKind = SceneKind {
 /// Scene-file parameters of an `mpm` scene (the `[scene]` table without `kind`): a `preset`, or
 /// `bodies` of the user's own with the scene-wide fields around them (see [`crate::bodies`]).
 /// `resolution`, `transfer`, `kernel` and `particles_per_cell` apply to both; `dim`,
-/// `gravity`, `obstacles`, `boundary` and `wall` only to bodies.
+/// `gravity`, `obstacles`, `obstacle_meshes`, `boundary` and `wall` only to bodies.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MpmSceneParams {
@@ -119,6 +121,12 @@ pub struct MpmSceneParams {
     /// (a disk in 2D); a capsule is refused. Absent: none (the domain's walls remain).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub obstacles: Vec<Shape>,
+    /// Bodies (3D): fixed obstacles from closed OBJ surfaces ([`ObstacleMesh`]: `{ mesh =
+    /// "x.obj", scale, rotate, translate }`, the file relative to the scene file), level-set
+    /// colliders sampled on the grid ([`crate::mesh_collider`]), with the `boundary` condition.
+    /// Absent: none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacle_meshes: Vec<ObstacleMesh>,
     /// Bodies: the boundary condition on the obstacles ([`Boundary`]): `"sticky"`, `"slip"`,
     /// `{ separate = { friction = 0.3 } }` or `"separate-frictionless"`; absent:
     /// separate-frictionless.
@@ -229,6 +237,7 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
         ("dim", p.dim.is_some()),
         ("gravity", p.gravity.is_some()),
         ("obstacles", !p.obstacles.is_empty()),
+        ("obstacle_meshes", !p.obstacle_meshes.is_empty()),
         ("boundary", p.boundary.is_some()),
         ("wall", p.wall.is_some()),
     ];

@@ -43,7 +43,10 @@
 //!   run as a [`kind::MpmRun`] (checkpoints and frames);
 //! - [`bodies`]: a scene file's own bodies instead of a preset: boxes, spheres and closed OBJ
 //!   surfaces filled with particles, each with its material and velocity, among plane, box and
-//!   sphere obstacles.
+//!   sphere obstacles and, in 3D, closed OBJ surfaces;
+//! - [`mesh_collider`]: those mesh obstacles as level-set colliders: the signed distance sampled
+//!   once on the grid nodes around the mesh (`f32`, at most 2^24 nodes), read by the grid update
+//!   with its central-difference normal.
 //!
 //! The G2P affine update is `C_p = D_p^-1 sum ...` with `D_p^-1 = 4/dx^2` for the quadratic
 //! kernel (Jiang et al. 2015; Hu et al. 2018), and snow's plastic update is
@@ -124,6 +127,7 @@ pub mod hencky;
 pub mod kernel;
 pub mod kind;
 pub mod material;
+pub mod mesh_collider;
 mod particle_transfer;
 mod particles;
 pub mod plasticity;
@@ -136,6 +140,8 @@ mod transfer;
 mod bodies_tests;
 #[cfg(test)]
 mod kind_tests;
+#[cfg(test)]
+mod mesh_collider_tests;
 #[cfg(test)]
 mod tests;
 

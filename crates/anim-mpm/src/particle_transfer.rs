@@ -12,6 +12,7 @@ use crate::boundary::{Boundary, GridCollider};
 use crate::grid::{BLOCK, SparseGrid, WINDOW, pow};
 use crate::kernel::Spline;
 use crate::material::{Compiled, kirchhoff};
+use crate::mesh_collider::MeshCollider;
 use crate::particles::Particles;
 use crate::plasticity::project;
 use crate::simd::Avx2;
@@ -29,6 +30,8 @@ pub(crate) struct Ctx<'a, const D: usize> {
     pub wall_nodes: usize,
     pub wall: Boundary,
     pub colliders: &'a [GridCollider],
+    /// The fixed triangle-mesh obstacles.
+    pub meshes: &'a [MeshCollider],
     /// Time at the start of the substep.
     pub time: f32,
     /// Allowed particle coordinate range (same on every axis).

@@ -5,6 +5,7 @@ use crate::boundary::{Boundary, Collider, GridCollider};
 use crate::grid::SparseGrid;
 use crate::kernel::{Cubic, Kernel, Quadratic, Spline};
 use crate::material::{Compiled, Kind, Material, energy};
+use crate::mesh_collider::MeshCollider;
 use crate::particle_transfer::Ctx;
 use crate::particles::Particles;
 use crate::simd::{self, Avx2};
@@ -155,6 +156,8 @@ pub struct MpmSimulation<const D: usize> {
     compiled: Vec<Compiled>,
     /// The colliders in the grid's `f32`, converted once here.
     colliders: Vec<GridCollider>,
+    /// The fixed triangle-mesh obstacles ([`MpmSimulation::set_mesh_colliders`]).
+    meshes: Vec<MeshCollider>,
     pub(crate) grid: SparseGrid<D>,
     out: Particles<D>,
     backup: Particles<D>,
@@ -221,6 +224,7 @@ impl<const D: usize> MpmSimulation<D> {
             materials,
             compiled,
             colliders,
+            meshes: Vec::new(),
             out: Particles::new(),
             backup: Particles::new(),
             remove: Vec::new(),
@@ -236,6 +240,28 @@ impl<const D: usize> MpmSimulation<D> {
     #[must_use]
     pub fn params(&self) -> &MpmParams {
         &self.params
+    }
+
+    /// Sets the fixed triangle-mesh obstacles ([`MeshCollider`], level sets sampled on this
+    /// simulation's grid), applied in the grid update after the analytic colliders.
+    ///
+    /// # Errors
+    /// [`MpmError::BadParameter`] in 2D (mesh obstacles are 3D).
+    pub fn set_mesh_colliders(&mut self, meshes: Vec<MeshCollider>) -> Result<(), MpmError> {
+        if D != 3 && !meshes.is_empty() {
+            return Err(MpmError::BadParameter {
+                name: "mesh colliders",
+                reason: format!("mesh obstacles are 3D; this simulation is {D}D"),
+            });
+        }
+        self.meshes = meshes;
+        Ok(())
+    }
+
+    /// The fixed triangle-mesh obstacles.
+    #[must_use]
+    pub fn mesh_colliders(&self) -> &[MeshCollider] {
+        &self.meshes
     }
 
     /// The material table.
@@ -513,6 +539,7 @@ impl<const D: usize> MpmSimulation<D> {
             wall_nodes: self.params.wall_nodes,
             wall: self.params.wall,
             colliders: &self.colliders,
+            meshes: &self.meshes,
             time: self.time as f32,
             lo: lo as f32,
             hi: hi as f32,

@@ -143,6 +143,7 @@ pub(crate) fn grid_update<const D: usize>(grid: &mut SparseGrid<D>, ctx: &Ctx<'_
                 let origin: [usize; D] = std::array::from_fn(|a| block[a] as usize * BLOCK);
                 // Whether the block touches a wall layer or a collider may be present.
                 let near_wall = (0..D).any(|a| origin[a] < wall_lo || origin[a] + BLOCK > wall_hi);
+                let near_mesh = ctx.meshes.iter().any(|m| m.overlaps(&origin, BLOCK));
                 for l in 0..bn {
                     let node = nodes[l].to_array();
                     let m = node[0];
@@ -151,7 +152,7 @@ pub(crate) fn grid_update<const D: usize>(grid: &mut SparseGrid<D>, ctx: &Ctx<'_
                         continue;
                     }
                     let mut v = Vector::<D>::from_fn(|a, _| node[1 + a] / m) + gdt;
-                    if near_wall || !ctx.colliders.is_empty() {
+                    if near_wall || near_mesh || !ctx.colliders.is_empty() {
                         let mut idx = [0usize; D];
                         let mut r = l;
                         for a in 0..D {
@@ -180,6 +181,18 @@ pub(crate) fn grid_update<const D: usize>(grid: &mut SparseGrid<D>, ctx: &Ctx<'_
                                     let mut rel = v - vc;
                                     c.boundary.apply(&mut rel, &normal);
                                     v = rel + vc;
+                                }
+                            }
+                        }
+                        // Mesh obstacles (fixed): the table's normal, or stopped where it has none.
+                        if near_mesh {
+                            for m in ctx.meshes {
+                                if let Some(normal) = m.contact(&idx) {
+                                    if normal == Vector::<D>::zeros() {
+                                        v = Vector::<D>::zeros();
+                                    } else {
+                                        m.boundary.apply(&mut v, &normal);
+                                    }
                                 }
                             }
                         }
