@@ -3,7 +3,7 @@
 //! is `Send`, so the run loop hands snapshots to a writer thread and keeps stepping.
 
 use anim_core::scene::{Context, DynScene, Frame, Prop};
-use anim_io::preview::{Camera, Canvas, Colors, MeshStyle};
+use anim_io::preview::{Camera, Canvas, Colors, MeshStyle, Shading};
 use anim_io::{DataArray, FrameFormat, FrameWriter, ImageData, UnstructuredGrid};
 
 /// Frame formats the command line offers.
@@ -100,8 +100,9 @@ pub enum Geometry {
         radius: f64,
         /// Height of a ground plane `z = h`, if any.
         ground: Option<f64>,
-        /// Static spheres (colliders): centre and radius.
-        spheres: Vec<([f64; 3], f64)>,
+        /// What surrounds the bodies: spheres, boxes and capsules (colliders) drawn solid, a
+        /// tank's walls drawn as its edges.
+        obstacles: Vec<Prop>,
         /// Region kept in view.
         frame_box: ([f64; 3], [f64; 3]),
     },
@@ -124,7 +125,7 @@ pub enum Geometry {
 impl Geometry {
     /// How a scene with `context` is drawn and written: an image grid's fields, a system of a
     /// few unknowns in the plane (with the attractor or anchor the context names), or points in
-    /// 3-D with their triangles or lines, the ground and the spheres of the context.
+    /// 3-D with their triangles or lines, the ground and the obstacles of the context.
     #[must_use]
     pub fn from_context(context: &Context) -> Self {
         if let Some(image) = &context.image {
@@ -144,11 +145,13 @@ impl Geometry {
             };
         }
         let mut ground = None;
-        let mut spheres = Vec::new();
+        let mut obstacles = Vec::new();
         for prop in &context.props {
             match *prop {
                 Prop::Ground { height } => ground = Some(height),
-                Prop::Sphere { center, radius } => spheres.push((center, radius)),
+                Prop::Sphere { .. } | Prop::Cuboid { .. } | Prop::Capsule { .. } | Prop::Tank { .. } => {
+                    obstacles.push(*prop);
+                }
                 _ => {}
             }
         }
@@ -157,7 +160,7 @@ impl Geometry {
             edges: context.lines.clone(),
             radius: context.point_radius,
             ground,
-            spheres,
+            obstacles,
             frame_box: bounds,
         }
     }
@@ -322,10 +325,10 @@ impl View {
                 }
                 io(canvas.draw_particles(camera, &[p], 0.03 * scale, Colors::Uniform([60, 110, 200])))
             }
-            Geometry::Particles { triangles, edges, radius, ground, spheres, frame_box } => {
+            Geometry::Particles { triangles, edges, radius, ground, obstacles, frame_box } => {
                 triples(&s.x, &mut self.positions);
-                for (c, r) in spheres {
-                    io(canvas.draw_particles(camera, &[*c], *r, Colors::Uniform([190, 190, 180])))?;
+                for prop in obstacles {
+                    draw_obstacle(canvas, camera, prop)?;
                 }
                 if let Some(z) = ground {
                     // A floor under the framed region (not beyond it: corners behind the
@@ -380,5 +383,128 @@ impl View {
                 io(canvas.draw_scalar_field(&self.projection, nx, ny, Some(*range)))
             }
         }
+    }
+}
+
+/// The colour of obstacles: a light grey, apart from the bodies' blue and orange.
+const OBSTACLE: [u8; 3] = [190, 190, 180];
+
+/// Draws an obstacle prop: a sphere as a shaded ball, a box as its six faces, a capsule as its
+/// tube and two balls, a tank as its twelve edges.
+fn draw_obstacle(canvas: &mut Canvas, camera: &Camera, prop: &Prop) -> Result<(), String> {
+    let solid = MeshStyle { color: OBSTACLE, back_color: OBSTACLE, shading: Shading::Flat };
+    match *prop {
+        Prop::Sphere { center, radius } => {
+            io(canvas.draw_particles(camera, &[center], radius, Colors::Uniform(OBSTACLE)))
+        }
+        Prop::Cuboid { lo, hi } => io(canvas.draw_mesh(camera, &box_corners(lo, hi), &BOX_FACES, &solid)),
+        Prop::Tank { lo, hi } => io(canvas.draw_lines(
+            camera,
+            &box_corners(lo, hi),
+            &BOX_EDGES,
+            1.5,
+            Colors::Uniform([120, 120, 130]),
+        )),
+        Prop::Capsule { a, b, radius } => {
+            let (a, b) = (anim_core::glam::DVec3::from_array(a), anim_core::glam::DVec3::from_array(b));
+            let axis = b - a;
+            if axis.length() > 0.0 {
+                let u = axis.normalize().any_orthonormal_vector();
+                let v = axis.normalize().cross(u);
+                const SIDES: usize = 24;
+                let mut ring = Vec::with_capacity(2 * SIDES);
+                for end in [a, b] {
+                    for k in 0..SIDES {
+                        let t = std::f64::consts::TAU * k as f64 / SIDES as f64;
+                        ring.push((end + radius * (t.cos() * u + t.sin() * v)).to_array());
+                    }
+                }
+                let tube: Vec<[usize; 3]> = (0..SIDES)
+                    .flat_map(|k| {
+                        let n = (k + 1) % SIDES;
+                        [[k, n, SIDES + k], [n, SIDES + n, SIDES + k]]
+                    })
+                    .collect();
+                io(canvas.draw_mesh(camera, &ring, &tube, &solid))?;
+            }
+            io(canvas.draw_particles(
+                camera,
+                &[a.to_array(), b.to_array()],
+                radius,
+                Colors::Uniform(OBSTACLE),
+            ))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The corners of the box `[lo, hi]`, corner `i` taking `hi` on the axes of the bits of `i`.
+fn box_corners(lo: [f64; 3], hi: [f64; 3]) -> [[f64; 3]; 8] {
+    std::array::from_fn(|i| std::array::from_fn(|a| if i >> a & 1 == 1 { hi[a] } else { lo[a] }))
+}
+
+/// The twelve triangles of a box's faces over [`box_corners`], counter-clockwise from outside.
+const BOX_FACES: [[usize; 3]; 12] = [
+    [0, 2, 1],
+    [1, 2, 3],
+    [4, 5, 6],
+    [5, 7, 6],
+    [0, 1, 4],
+    [1, 5, 4],
+    [2, 6, 3],
+    [3, 6, 7],
+    [0, 4, 2],
+    [2, 4, 6],
+    [1, 3, 5],
+    [3, 7, 5],
+];
+
+/// The twelve edges of a box over [`box_corners`].
+const BOX_EDGES: [[usize; 2]; 12] =
+    [[0, 1], [2, 3], [4, 5], [6, 7], [0, 2], [1, 3], [4, 6], [5, 7], [0, 4], [1, 5], [2, 6], [3, 7]];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Pixels other than the white background.
+    fn painted(canvas: &Canvas) -> Vec<(u32, u32)> {
+        let w = canvas.width();
+        (0..canvas.pixels().len() as u32)
+            .map(|i| (i % w, i / w))
+            .filter(|&(x, y)| canvas.pixel(x, y) != [255, 255, 255])
+            .collect()
+    }
+
+    /// A box and a capsule through the middle of the view cover the centre pixel with a grey
+    /// of the obstacle colour's hue; a tank around the view is drawn as edges and leaves its
+    /// middle empty; a ground or attractor is not an obstacle.
+    #[test]
+    fn obstacles_are_drawn_solid_and_tanks_as_edges() {
+        let camera = Camera::framing([-1.0; 3], [1.0; 3], [0.55, 1.0, -0.45], [0.0, 0.0, 1.0]);
+        let grey =
+            |p: [u8; 3]| p != [255, 255, 255] && p[0].abs_diff(p[1]) <= 12 && p[1].abs_diff(p[2]) <= 12;
+        for prop in [
+            Prop::Cuboid { lo: [-0.3; 3], hi: [0.3; 3] },
+            Prop::Capsule { a: [-0.8, 0.0, 0.0], b: [0.8, 0.0, 0.0], radius: 0.1 },
+        ] {
+            let mut canvas = Canvas::new(120, 120, [255, 255, 255]);
+            draw_obstacle(&mut canvas, &camera, &prop).unwrap();
+            assert!(grey(canvas.pixel(60, 60)), "{prop:?}: {:?}", canvas.pixel(60, 60));
+        }
+        let mut canvas = Canvas::new(120, 120, [255, 255, 255]);
+        draw_obstacle(&mut canvas, &camera, &Prop::Tank { lo: [-1.0; 3], hi: [1.0; 3] }).unwrap();
+        assert_eq!(canvas.pixel(60, 60), [255, 255, 255]);
+        assert!(painted(&canvas).len() > 200, "{} pixels of edges", painted(&canvas).len());
+        let mut context = Context::default();
+        context.point_dim = 3;
+        context.props = vec![
+            Prop::Ground { height: 0.0 },
+            Prop::Cuboid { lo: [0.0; 3], hi: [1.0; 3] },
+            Prop::Tank { lo: [0.0; 3], hi: [2.0; 3] },
+        ];
+        let geometry = Geometry::from_context(&context);
+        let Geometry::Particles { ground, obstacles, .. } = geometry else { panic!("particles") };
+        assert_eq!((ground, obstacles.len()), (Some(0.0), 2));
     }
 }
