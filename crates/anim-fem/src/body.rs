@@ -21,6 +21,7 @@
 //!
 //! Units are SI: metres, kilograms, seconds, pascals. Scenes are z-up.
 
+use anim_core::scene::{is_unit_scale, unit_scale};
 use std::path::{Path, PathBuf};
 
 use anim_core::scene::{BuildError, Placement, is_default};
@@ -57,10 +58,6 @@ fn default_model() -> MaterialModel {
 /// file's vertices) and a `box` (the vertices inside or on it, after the placement).
 pub use anim_core::scene::{PinBox, PinSpec};
 
-fn one() -> f64 {
-    1.0
-}
-
 /// A body from a mesh file. Every field but `mesh` and `material` has a default; `cell` is
 /// required for an OBJ surface and refused for a tetrahedral mesh.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -74,7 +71,7 @@ pub struct BodySpec {
     /// The material.
     pub material: MaterialSpec,
     /// Uniform scale of the mesh about its origin, positive; default 1.
-    #[serde(default = "one", skip_serializing_if = "is_one")]
+    #[serde(default = "unit_scale", skip_serializing_if = "is_unit_scale")]
     pub scale: f64,
     /// Rotation about the mesh's origin as roll, pitch, yaw (rad): `Rz(yaw) Ry(pitch) Rx(roll)`,
     /// applied after the scale; default none.
@@ -98,10 +95,6 @@ pub struct BodySpec {
     /// its own coordinates with `cell / scale`, then placed), positive.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cell: Option<f64>,
-}
-
-fn is_one(x: &f64) -> bool {
-    *x == 1.0
 }
 
 /// A [`PinSpec`], with the box alone (`pin = { min, max }`, fem's spelling before every kind

@@ -53,14 +53,11 @@ use crate::mac::{flatten, unflatten};
 use crate::particles::Particles;
 use crate::sim::{FlipParams, FlipSimulation};
 use anim_core::geometry::Shape;
+use anim_core::scene::unit_scale;
 use anim_core::scene::{BuildContext, BuildError, Placement, is_default};
 use region::Region;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
-
-fn one() -> f64 {
-    1.0
-}
 
 /// A body of fluid: one `shape` or one closed `mesh`, placed, at an initial velocity.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -77,7 +74,7 @@ pub struct FluidBody {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mesh: Option<PathBuf>,
     /// Uniform scale about the origin of the shape's or mesh's coordinates, positive. Default 1.
-    #[serde(default = "one")]
+    #[serde(default = "unit_scale")]
     pub scale: f64,
     /// Roll, pitch, yaw (rad) about that origin after the scale: `Rz(yaw) Ry(pitch) Rx(roll)`;
     /// in 2D, yaw only. Default none.
@@ -91,23 +88,9 @@ pub struct FluidBody {
     pub velocity: [f64; 3],
 }
 
-/// A solid obstacle from a closed OBJ surface: the cells whose centres are inside it are solid.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ObstacleMesh {
-    /// The closed triangle surface, a Wavefront OBJ file relative to the scene file.
-    pub mesh: PathBuf,
-    /// Uniform scale about the mesh's origin, positive. Default 1.
-    #[serde(default = "one")]
-    pub scale: f64,
-    /// Roll, pitch, yaw (rad) about the mesh's origin after the scale; in 2D, yaw only.
-    /// Default none.
-    #[serde(default, skip_serializing_if = "is_default")]
-    pub rotate: [f64; 3],
-    /// Translation (m), applied last; in 2D, z is 0. Default none.
-    #[serde(default, skip_serializing_if = "is_default")]
-    pub translate: [f64; 3],
-}
+/// A solid obstacle from a closed OBJ surface (anim-core's spelling): the cells whose centres
+/// are inside it are solid; in 2D its rotation is a yaw and its translation has z = 0.
+pub use anim_core::scene::ObstacleMesh;
 
 /// Default cells across the tank: as the presets, 64 in 2D and 32 in 3D.
 #[must_use]

@@ -42,7 +42,7 @@ use crate::error::FluidError;
 use crate::mac::{MacFluid, MacState};
 use crate::pressure::PressureMethod;
 use crate::scenes::{self, FluidScene, FluidSim};
-use crate::smoke::{self, MeshObstacle, SourceSpec};
+use crate::smoke::{self, ObstacleMesh, SourceSpec};
 use anim_core::geometry::Shape;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
@@ -144,9 +144,9 @@ pub struct FluidSceneParams {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub obstacles: Option<Vec<Shape>>,
     /// Solids the smoke flows around, closed OBJ surfaces placed by `scale`, `rotate`,
-    /// `translate` ([`MeshObstacle`]); each must cover a cell centre. Default none.
+    /// `translate` ([`ObstacleMesh`]); each must cover a cell centre. Default none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub obstacle_meshes: Option<Vec<MeshObstacle>>,
+    pub obstacle_meshes: Option<Vec<ObstacleMesh>>,
 }
 
 impl FluidSceneParams {

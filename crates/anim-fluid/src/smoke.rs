@@ -40,6 +40,7 @@ mod region;
 #[cfg(test)]
 mod tests;
 
+use anim_core::scene::{is_unit_scale, unit_scale};
 use std::path::PathBuf;
 
 use anim_core::geometry::Shape;
@@ -84,15 +85,6 @@ pub mod defaults {
 /// The largest grid of a smoke scene, in cells (2^22: 128 x 192 x 128 fits, as does 2048^2).
 pub const MAX_CELLS: usize = 1 << 22;
 
-fn one() -> f64 {
-    1.0
-}
-
-#[allow(clippy::trivially_copy_pass_by_ref)] // serde's `skip_serializing_if` passes a reference
-fn is_one(x: &f64) -> bool {
-    *x == 1.0
-}
-
 fn source_density() -> f64 {
     defaults::SOURCE_DENSITY
 }
@@ -117,7 +109,7 @@ pub struct SourceSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mesh: Option<PathBuf>,
     /// Uniform scale of the mesh about its origin, positive; default 1. Only with `mesh`.
-    #[serde(default = "one", skip_serializing_if = "is_one")]
+    #[serde(default = "unit_scale", skip_serializing_if = "is_unit_scale")]
     pub scale: f64,
     /// Rotation of the mesh about its origin as roll, pitch, yaw (rad), `Rz(yaw) Ry(pitch)
     /// Rx(roll)`, after the scale; default none. Only with `mesh`.
@@ -127,10 +119,10 @@ pub struct SourceSpec {
     #[serde(default, skip_serializing_if = "is_default")]
     pub translate: [f64; 3],
     /// Density the source's cells are raised to every step, finite; default 1 (the plume's).
-    #[serde(default = "source_density", skip_serializing_if = "is_one")]
+    #[serde(default = "source_density", skip_serializing_if = "is_unit_scale")]
     pub density: f64,
     /// Temperature the source's cells are set to every step, finite; default 1 (the plume's).
-    #[serde(default = "source_temperature", skip_serializing_if = "is_one")]
+    #[serde(default = "source_temperature", skip_serializing_if = "is_unit_scale")]
     pub temperature: f64,
     /// Velocity (m/s) set every step on the faces inside the source (the plume's vent blows
     /// `[0, 0.5, 0]`); default none: the source leaves the velocity to the flow. A 2D scene
@@ -139,31 +131,9 @@ pub struct SourceSpec {
     pub velocity: Option<[f64; 3]>,
 }
 
-/// A closed OBJ surface as an obstacle (a table of `obstacle_meshes`), placed by `scale`,
-/// `rotate`, `translate`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MeshObstacle {
-    /// The OBJ file, relative to the scene file's folder: a closed, manifold, consistently
-    /// oriented triangle surface (polygons are fan-triangulated).
-    pub mesh: PathBuf,
-    /// Uniform scale about the mesh's origin, positive; default 1.
-    #[serde(default = "one", skip_serializing_if = "is_one")]
-    pub scale: f64,
-    /// Rotation about the mesh's origin as roll, pitch, yaw (rad), `Rz(yaw) Ry(pitch) Rx(roll)`,
-    /// after the scale; default none.
-    #[serde(default, skip_serializing_if = "is_default")]
-    pub rotate: [f64; 3],
-    /// Translation (m), applied last; default none.
-    #[serde(default, skip_serializing_if = "is_default")]
-    pub translate: [f64; 3],
-}
-
-impl MeshObstacle {
-    fn placement(&self) -> Placement {
-        Placement { scale: self.scale, rotate: self.rotate, translate: self.translate }
-    }
-}
+/// A closed OBJ surface as an obstacle (a table of `obstacle_meshes`; anim-core's spelling);
+/// in 2D it is placed in 3D and cut at `z = 0`.
+pub use anim_core::scene::ObstacleMesh;
 
 /// The grid of a smoke scene: cell counts, dimension, cell size.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -34,6 +34,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use anim_core::scene::unit_scale;
 use std::path::{Path, PathBuf};
 
 use anim_core::glam::DVec3;
@@ -58,10 +59,6 @@ pub const DEFAULT_PARTICLES_PER_CELL: usize = 2;
 /// backup it restores when a substep fails), about 11 GB.
 pub const MAX_PARTICLES: usize = 1 << 25;
 
-fn one() -> f64 {
-    1.0
-}
-
 /// One body of an `mpm` scene file (a `[[scene.bodies]]` table): its region, given by exactly
 /// one of `shape` and `mesh`, its material, its placement and its initial velocity.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -81,7 +78,7 @@ pub struct BodySpec {
     /// `{ fluid = { ... } }` or `{ sand = { ... } }`, each field defaulting as its doc states.
     pub material: Material,
     /// Uniform scale about the shape's or mesh's origin, positive; default 1.
-    #[serde(default = "one")]
+    #[serde(default = "unit_scale")]
     pub scale: f64,
     /// Rotation about the origin as roll, pitch, yaw (rad), `Rz(yaw) Ry(pitch) Rx(roll)`, after
     /// the scale (in 2D only the yaw, about z); default none.

@@ -28,15 +28,12 @@
 //! the trilinear interpolation of the table at its position is negative.
 
 use std::fmt;
-use std::path::PathBuf;
 use std::sync::Arc;
 
 use anim_core::geometry::closest_point_on_triangle;
 use anim_core::glam::DVec3;
-use anim_core::scene::{Placement, is_default};
 use anim_core::surface::ClosedSurface;
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 use crate::{Boundary, MpmParams, Vector};
 
@@ -49,37 +46,10 @@ pub const MARGIN: usize = 4;
 /// Cells within which the table holds the exact distance to the surface (clamped beyond).
 pub const BAND: usize = 4;
 
-fn one() -> f64 {
-    1.0
-}
-
 /// A fixed obstacle from a closed OBJ surface (`obstacle_meshes = [{ mesh, scale, rotate,
-/// translate }]` in a scene file of bodies, 3D), with the scene's `boundary` condition.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ObstacleMesh {
-    /// The closed triangle surface, a Wavefront OBJ file relative to the scene file (polygons
-    /// are fan-triangulated); closed, manifold and consistently oriented.
-    pub mesh: PathBuf,
-    /// Uniform scale about the mesh's origin, positive. Default 1.
-    #[serde(default = "one")]
-    pub scale: f64,
-    /// Roll, pitch, yaw (rad) about the mesh's origin after the scale, `Rz(yaw) Ry(pitch)
-    /// Rx(roll)`. Default none.
-    #[serde(default, skip_serializing_if = "is_default")]
-    pub rotate: [f64; 3],
-    /// Translation (m), applied last. Default none.
-    #[serde(default, skip_serializing_if = "is_default")]
-    pub translate: [f64; 3],
-}
-
-impl ObstacleMesh {
-    /// The obstacle's placement.
-    #[must_use]
-    pub fn placement(&self) -> Placement {
-        Placement { scale: self.scale, rotate: self.rotate, translate: self.translate }
-    }
-}
+/// translate }]` in a scene file of bodies, 3D; anim-core's spelling), with the scene's
+/// `boundary` condition.
+pub use anim_core::scene::ObstacleMesh;
 
 /// A fixed obstacle of a closed surface as the grid sees it: its signed distance table on the
 /// nodes of a box (see the [module](self)) and its boundary condition. Cloning shares the table.

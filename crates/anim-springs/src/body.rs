@@ -30,6 +30,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use anim_core::scene::{is_unit_scale, unit_scale};
 use std::path::{Path, PathBuf};
 
 use anim_core::integrate::IntegratorKind;
@@ -70,14 +71,6 @@ pub struct MaterialSpec {
 
 pub use anim_core::scene::{PinBox, PinSpec};
 
-fn one() -> f64 {
-    1.0
-}
-
-fn is_one(x: &f64) -> bool {
-    *x == 1.0
-}
-
 /// A cloth or shell from an OBJ triangle surface. Every field but `mesh` and `material` has a
 /// default.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -90,7 +83,7 @@ pub struct BodySpec {
     /// The material.
     pub material: MaterialSpec,
     /// Uniform scale of the mesh about its origin, > 0; default 1.
-    #[serde(default = "one", skip_serializing_if = "is_one")]
+    #[serde(default = "unit_scale", skip_serializing_if = "is_unit_scale")]
     pub scale: f64,
     /// Roll, pitch, yaw (rad): the rotation `Rz(yaw) Ry(pitch) Rx(roll)` about the mesh's
     /// origin, applied after the scale; default none.

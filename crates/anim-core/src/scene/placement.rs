@@ -18,9 +18,12 @@
 //! # Ok::<(), anim_core::scene::BuildError>(())
 //! ```
 
-use glam::{DMat3, DVec3, EulerRot};
+use std::path::PathBuf;
 
-use super::BuildError;
+use glam::{DMat3, DVec3, EulerRot};
+use serde::{Deserialize, Serialize};
+
+use super::{BuildError, is_default};
 
 /// Scale, rotation and translation of a body's asset, applied in that order.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -81,6 +84,54 @@ impl Placement {
             *p = (r * (self.scale * DVec3::from_array(*p)) + t).to_array();
         }
     }
+}
+
+/// A solid obstacle from a closed triangle surface, placed: a table of a scene file's
+/// `obstacle_meshes`, spelled alike by every kind that takes one:
+///
+/// ```toml
+/// obstacle_meshes = [ { mesh = "assets/rock.obj", scale = 0.5, rotate = [0.0, 0.0, 1.0], translate = [0.3, 0.0, 0.2] } ]
+/// ```
+///
+/// Each kind reads the file (relative to the scene file) as a closed, manifold, consistently
+/// oriented surface and says what it does in 2D.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleMesh {
+    /// The surface, a Wavefront OBJ file relative to the scene file (polygons are
+    /// fan-triangulated).
+    pub mesh: PathBuf,
+    /// Uniform scale about the mesh's origin, positive; default 1.
+    #[serde(default = "unit_scale", skip_serializing_if = "is_unit_scale")]
+    pub scale: f64,
+    /// Roll, pitch, yaw (rad) about the mesh's origin after the scale, `Rz(yaw) Ry(pitch)
+    /// Rx(roll)`; default none.
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub rotate: [f64; 3],
+    /// Translation (m), applied last; default none.
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub translate: [f64; 3],
+}
+
+impl ObstacleMesh {
+    /// The placement of the surface (unchecked: see [`Placement::check`]).
+    #[must_use]
+    pub fn placement(&self) -> Placement {
+        Placement { scale: self.scale, rotate: self.rotate, translate: self.translate }
+    }
+}
+
+/// The default `scale` of a scene file's body or mesh: 1 (for `#[serde(default = ...)]`).
+#[must_use]
+pub fn unit_scale() -> f64 {
+    1.0
+}
+
+/// Whether a `scale` is the default 1 (for `#[serde(skip_serializing_if = ...)]`).
+#[must_use]
+#[allow(clippy::trivially_copy_pass_by_ref)]
+pub fn is_unit_scale(scale: &f64) -> bool {
+    *scale == 1.0
 }
 
 #[cfg(test)]

@@ -25,6 +25,7 @@ use crate::build::{Bending, MeshMass, MeshParams, NotClosed, PbdBuilder, TetMesh
 use crate::constraint::{ConstraintParams, tet_volume};
 use anim_core::glam::DVec3;
 use anim_core::scene::{BuildContext, BuildError, Placement, is_default};
+use anim_core::scene::{is_unit_scale, unit_scale};
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -71,14 +72,6 @@ pub struct BodyMaterial {
 
 pub use anim_core::scene::{PinBox, PinSpec};
 
-fn one() -> f64 {
-    1.0
-}
-
-fn is_one(v: &f64) -> bool {
-    *v == 1.0
-}
-
 /// One `[[scene.bodies]]` table of a `pbd` scene file. Every field but `mesh` and `material` has
 /// a default.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -99,7 +92,7 @@ pub struct BodySpec {
     /// The material. Required.
     pub material: BodyMaterial,
     /// Uniform scale about the mesh's origin, positive. Default 1.
-    #[serde(default = "one", skip_serializing_if = "is_one")]
+    #[serde(default = "unit_scale", skip_serializing_if = "is_unit_scale")]
     pub scale: f64,
     /// Roll, pitch, yaw (rad) about the mesh's origin, after the scale: `Rz(yaw) Ry(pitch)
     /// Rx(roll)`. Default none.
