@@ -19,7 +19,14 @@
 //! inside is pushed back out, if it is within the reach above of the surface (one that went
 //! deeper, say through a thin body in one substep, gets no contact and stays inside: there is no
 //! inside test); for an open surface (cloth) it points to the side the particle was on at the
-//! start of the substep.
+//! start of the substep. Where the closest point is on an edge or a corner of the triangle (a
+//! barycentric coordinate 0) the normal is instead the direction from the closest point to the
+//! particle, turned to the side of the triangle's normal: a particle beside a body's edge,
+//! level with its bottom face, is as close to the side face, whose normal would push it
+//! sideways by up to `thickness` and make a body sliding over another catch on its vertices.
+//! Among triangles as close within `1e-9` of the particle's reach, the one whose normal best
+//! matches that direction wins (its cosine, or for an open surface its absolute value), then
+//! the first.
 //!
 //! The candidates come from a uniform grid hashed by cell and body (a counting sort into a
 //! fixed table), rebuilt every substep from the triangles' boxes grown by the search radius,
@@ -71,8 +78,9 @@ pub(super) struct BodyContactData {
     pub start: Vec<u32>,
     /// Surface triangles by bucket, in increasing order within each.
     pub entries: Vec<u32>,
-    /// Per contact body: `(distance, surface triangle)` of the closest triangle so far.
-    pub best: Vec<(f64, u32)>,
+    /// Per contact body: `(distance, fit, surface triangle)` of the closest triangle so far
+    /// (see [`reach_distance`]).
+    pub best: Vec<(f64, f64, u32)>,
     /// The contacts of the substep.
     pub contacts: Vec<PairContact>,
 }
@@ -98,7 +106,7 @@ impl BodyContactData {
             start: vec![0; (2 * surface.len()).next_power_of_two() + 1],
             entries: vec![0; entries],
             surface,
-            best: vec![(f64::INFINITY, u32::MAX); bodies.len()],
+            best: vec![(f64::INFINITY, f64::NEG_INFINITY, u32::MAX); bodies.len()],
             // A particle has at most one contact per other body; room for four of them.
             contacts: Vec::with_capacity(particles * (bodies.len() - 1).min(MAX_RESERVED)),
         }
@@ -137,8 +145,12 @@ fn cells(lo: [i64; 3], hi: [i64; 3]) -> impl Iterator<Item = [i64; 3]> {
 /// The distance from particle `i` at `q` (relative to the grid's origin) to the surface
 /// triangle `t` with box `b` (relative to the same origin), when the triangle is a candidate:
 /// `q` inside the box grown by the reach `near + b.2`, not every particle pinned, and the
-/// distance below the reach. `p` and `w` are the predicted positions and inverse masses.
+/// distance below the reach; with it, how well the triangle's face normal matches the direction
+/// from the closest point to the particle (the cosine of their angle, its absolute value for an
+/// open surface, 1 where the particle is on the triangle, -inf for a triangle of zero area).
+/// `p` and `w` are the predicted positions and inverse masses.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 fn reach_distance(
     p: &[DVec3],
     w: &[f64],
@@ -147,7 +159,8 @@ fn reach_distance(
     near: f64,
     t: [u32; 3],
     b: &(DVec3, DVec3, f64),
-) -> Option<f64> {
+    closed: bool,
+) -> Option<(f64, f64)> {
     let (lo, hi, moved) = *b;
     let reach = near + moved;
     if (q - (lo - reach)).min_element() < 0.0 || ((hi + reach) - q).min_element() < 0.0 {
@@ -157,9 +170,41 @@ fn reach_distance(
     if w[i] == 0.0 && t.iter().all(|&j| w[j] == 0.0) {
         return None;
     }
-    let (c, _) = closest_point_on_triangle(p[i], t.map(|j| p[j]));
-    let dist = (p[i] - c).length();
-    (dist < reach).then_some(dist)
+    let [a, b, c] = t.map(|j| p[j]);
+    let (closest, _) = closest_point_on_triangle(p[i], [a, b, c]);
+    let d = p[i] - closest;
+    let dist = d.length();
+    if !(dist < reach) {
+        return None;
+    }
+    let face = (b - a).cross(c - a);
+    let area = face.length();
+    let fit = if !(area > 0.0) {
+        f64::NEG_INFINITY
+    } else if dist > 0.0 {
+        let cos = d.dot(face) / (dist * area);
+        if closed { cos } else { cos.abs() }
+    } else {
+        1.0
+    };
+    Some((dist, fit))
+}
+
+/// Whether the candidate `(distance, fit)` of [`reach_distance`] beats the best so far `best`:
+/// closer by more than `tie` (m), or as close within `tie` and a better fit. Where the closest
+/// point is an edge or corner shared by several triangles their distances differ by rounding
+/// only, and the one the particle faces best wins: its normal then orients the contact.
+#[inline]
+fn beats((dist, fit): (f64, f64), best: (f64, f64), tie: f64) -> bool {
+    dist < best.0 - tie || (dist <= best.0 + tie && fit > best.1)
+}
+
+/// The distance within which two candidate triangles are as close, for a particle of reach
+/// `near` (m): far above the rounding of a distance in a scene near the origin, far below any
+/// distance that matters.
+#[inline]
+fn tie(near: f64) -> f64 {
+    1e-9 * near
 }
 
 /// The contact of particle `i` with triangle `t` of a body that is `closed` or not, at start
@@ -167,10 +212,10 @@ fn reach_distance(
 /// area) or an open surface's particle started in its plane.
 fn pair_contact(x: &[DVec3], p: &[DVec3], i: usize, t: [u32; 3], closed: bool) -> Option<PairContact> {
     let corners = t.map(|j| j as usize);
-    let (_, bary) = closest_point_on_triangle(p[i], corners.map(|j| p[j]));
+    let (closest, bary) = closest_point_on_triangle(p[i], corners.map(|j| p[j]));
     let [a, b, c] = corners.map(|j| p[j]);
     let face = (b - a).cross(c - a).try_normalize()?;
-    let normal = if closed {
+    let side = if closed {
         face
     } else {
         let [a0, b0, c0] = corners.map(|j| x[j]);
@@ -183,6 +228,22 @@ fn pair_contact(x: &[DVec3], p: &[DVec3], i: usize, t: [u32; 3], closed: bool) -
         } else {
             return None;
         }
+    };
+    // On an edge or a corner the face normal of one of the triangles sharing it could push the
+    // particle sideways (a vertex level with a face, beside its edge, is as close to the side
+    // face): the normal is then the direction from the closest point to the particle, turned to
+    // the side of the face normal; the face normal where the particle is on the edge.
+    let d = p[i] - closest;
+    let scale = (b - a).length().max((c - a).length()).max((c - b).length());
+    let normal = match d.try_normalize() {
+        Some(n) if bary.contains(&0.0) && d.length() > 1e-9 * scale => {
+            if n.dot(side) < 0.0 {
+                -n
+            } else {
+                n
+            }
+        }
+        _ => side,
     };
     Some(PairContact { particle: i as u32, tri: t, bary, normal, lambda: 0.0 })
 }
@@ -264,24 +325,27 @@ pub(super) fn generate_body_contacts(model: &PbdModel, d: &mut Data, margin: f64
         for i in body.particles.0..body.particles.1 {
             let q = p[i] - origin;
             let c = cell(q, size);
-            bc.best.iter_mut().for_each(|b| *b = (f64::INFINITY, u32::MAX));
+            bc.best.iter_mut().for_each(|b| *b = (f64::INFINITY, f64::NEG_INFINITY, u32::MAX));
             let near = thickness + margin + motion(i);
             for other in (0..nb).filter(|&o| o != own) {
                 let k = bucket(c, other, mask);
+                let closed = model.contact_bodies[other as usize].closed;
                 for &e in &bc.entries[bc.start[k] as usize..bc.start[k + 1] as usize] {
                     let (t, from) = bc.surface[e as usize];
                     if from != other {
                         continue;
                     }
-                    // Triangles come in increasing order: the first of equally close ones wins.
-                    if let Some(dist) = reach_distance(p, w, i, q, near, t, &bc.boxes[e as usize])
-                        && dist < bc.best[other as usize].0
+                    // Triangles come in increasing order: the first of equally close and fitting
+                    // ones wins.
+                    let best = &mut bc.best[other as usize];
+                    if let Some(found) = reach_distance(p, w, i, q, near, t, &bc.boxes[e as usize], closed)
+                        && beats(found, (best.0, best.1), tie(near))
                     {
-                        bc.best[other as usize] = (dist, e);
+                        *best = (found.0, found.1, e);
                     }
                 }
             }
-            for &(_, k) in &bc.best {
+            for &(_, _, k) in &bc.best {
                 if k == u32::MAX {
                     continue;
                 }
