@@ -1,6 +1,7 @@
 use super::*;
 
-fn cube() -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+/// The unit cube, 12 outward triangles.
+pub(super) fn cube() -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
     let p = vec![
         [0.0, 0.0, 0.0],
         [1.0, 0.0, 0.0],

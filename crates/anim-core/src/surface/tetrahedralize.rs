@@ -237,30 +237,7 @@ mod tests {
     /// binned finely (each face spans many cubes).
     #[test]
     fn the_binned_search_equals_the_full_search_within_reach() {
-        let p = vec![
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [1.0, 1.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [1.0, 0.0, 1.0],
-            [1.0, 1.0, 1.0],
-            [0.0, 1.0, 1.0],
-        ];
-        let t = vec![
-            [0, 2, 1],
-            [0, 3, 2],
-            [4, 5, 6],
-            [4, 6, 7],
-            [0, 1, 5],
-            [0, 5, 4],
-            [1, 2, 6],
-            [1, 6, 5],
-            [2, 3, 7],
-            [2, 7, 6],
-            [3, 0, 4],
-            [3, 4, 7],
-        ];
+        let (p, t) = crate::surface::tests::cube();
         let s = ClosedSurface::new(p, t).unwrap();
         let cell = 0.07;
         let near = Near::new(&s, cell);
