@@ -14,7 +14,7 @@ use anim_core::scene::{BuildContext, BuildError};
 use anim_core::solver::Solver;
 use serde_json::{Value, json};
 
-fn testdata() -> &'static Path {
+pub(crate) fn testdata() -> &'static Path {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/testdata"))
 }
 
@@ -26,7 +26,7 @@ fn build(value: Value) -> Result<MpmScene, BuildError> {
     bodies::build(&params(value), &BuildContext { base: Some(testdata()) })
 }
 
-fn three(value: Value) -> Scene<3> {
+pub(crate) fn three(value: Value) -> Scene<3> {
     match build(value).expect("builds") {
         MpmScene::Three(s) => s,
         MpmScene::Two(_) => panic!("a 2D scene"),
@@ -41,7 +41,7 @@ fn two(value: Value) -> Scene<2> {
 }
 
 /// `(field, message)` of a refusal by the kind's build (the path a scene file goes).
-fn refused(value: Value) -> (String, String) {
+pub(crate) fn refused(value: Value) -> (String, String) {
     match (KIND.build)(&value, &BuildContext { base: Some(testdata()) }).err().expect("refused") {
         BuildError::Invalid { field, message } | BuildError::Schema { field, message } => (field, message),
         other => (String::new(), other.to_string()),
@@ -52,11 +52,11 @@ fn mass<const D: usize>(s: &Scene<D>) -> f64 {
     s.state.mass.iter().map(|&m| f64::from(m)).sum()
 }
 
-fn jelly() -> Value {
+pub(crate) fn jelly() -> Value {
     json!({ "elastic": { "young": 2e4, "poisson": 0.3, "density": 1000.0 } })
 }
 
-fn cube(center: [f64; 3], half: f64) -> Value {
+pub(crate) fn cube(center: [f64; 3], half: f64) -> Value {
     json!({ "box": { "center": center, "half_extents": [half, half, half] } })
 }
 

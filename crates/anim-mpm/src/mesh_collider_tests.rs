@@ -4,45 +4,16 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::path::Path;
-
 use crate::bodies;
-use crate::kind::MpmSceneParams;
 use crate::mesh_collider::{BAND, MAX_NODES, MeshCollider};
 use crate::scenes::{MpmScene, Scene};
-use crate::{Boundary, Collider, KIND, MpmParams, Shape, Vector};
-use anim_core::scene::{BuildContext, BuildError};
+use crate::{Boundary, Collider, MpmParams, Shape, Vector};
+use anim_core::scene::BuildContext;
 use anim_core::solver::Solver;
 use anim_core::surface::ClosedSurface;
 use serde_json::{Value, json};
 
-fn testdata() -> &'static Path {
-    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/testdata"))
-}
-
-fn three(value: Value) -> Scene<3> {
-    let params: MpmSceneParams = serde_json::from_value(value).expect("scene-file parameters");
-    match bodies::build(&params, &BuildContext { base: Some(testdata()) }).expect("builds") {
-        MpmScene::Three(s) => s,
-        MpmScene::Two(_) => panic!("a 2D scene"),
-    }
-}
-
-/// `(field, message)` of a refusal by the kind's build (the path a scene file goes).
-fn refused(value: Value) -> (String, String) {
-    match (KIND.build)(&value, &BuildContext { base: Some(testdata()) }).err().expect("refused") {
-        BuildError::Invalid { field, message } | BuildError::Schema { field, message } => (field, message),
-        other => (String::new(), other.to_string()),
-    }
-}
-
-fn jelly() -> Value {
-    json!({ "elastic": { "young": 2e4, "poisson": 0.3, "density": 1000.0 } })
-}
-
-fn cube(center: [f64; 3], half: f64) -> Value {
-    json!({ "box": { "center": center, "half_extents": [half, half, half] } })
-}
+use crate::bodies_tests::{cube, jelly, refused, testdata, three};
 
 /// The box `[lo, hi]` as 12 outward triangles.
 fn box_surface(lo: [f64; 3], hi: [f64; 3]) -> ClosedSurface {

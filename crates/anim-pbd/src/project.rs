@@ -387,6 +387,24 @@ fn project_volume<A: Access>(
     }
 }
 
+/// The correction along the normal of a rigid contact (an inequality) whose gap is `value` and
+/// whose inverse masses along the normal sum to `w`, accumulating the multiplier `lambda`: XPBD
+/// with zero compliance (`dlambda = -C / w`, kept `>= -lambda`, the correction `w dlambda`), or
+/// PBD's projection of a negative gap.
+#[inline]
+pub(crate) fn contact_correction(xpbd: bool, value: f64, w: f64, lambda: &mut f64) -> f64 {
+    if xpbd {
+        let dl = (-value / w).max(-*lambda);
+        *lambda += dl;
+        w * dl
+    } else if value < 0.0 {
+        *lambda += -value;
+        -value
+    } else {
+        0.0
+    }
+}
+
 /// Projects a contact (always rigid, an inequality) with positional friction (see
 /// [`collide`](crate::collide)); returns the correction of its particle.
 #[inline]
@@ -394,17 +412,7 @@ pub(crate) fn project_contact(ctx: &Ctx<'_>, c: &mut Contact, p: DVec3) -> DVec3
     let i = c.particle as usize;
     let w = ctx.w[i];
     let value = c.normal.dot(p) - c.offset;
-    let dn = if ctx.xpbd {
-        // alpha = 0: dlambda = -C / w, kept >= -lambda; dp = w n dlambda.
-        let dl = (-value / w).max(-c.lambda);
-        c.lambda += dl;
-        w * dl
-    } else if value < 0.0 {
-        c.lambda += -value;
-        -value
-    } else {
-        0.0
-    };
+    let dn = contact_correction(ctx.xpbd, value, w, &mut c.lambda);
     if dn == 0.0 {
         return DVec3::ZERO;
     }

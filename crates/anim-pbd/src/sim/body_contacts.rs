@@ -42,7 +42,7 @@
 
 use super::scratch::Data;
 use crate::model::PbdModel;
-use crate::project::{CONTACT_ID, Ctx, positional_friction};
+use crate::project::{CONTACT_ID, Ctx, contact_correction, positional_friction};
 use anim_core::geometry::closest_point_on_triangle;
 use anim_core::glam::DVec3;
 
@@ -381,16 +381,7 @@ pub(super) fn project_body_contacts(
         let q = c.bary[0] * p[t[0]] + c.bary[1] * p[t[1]] + c.bary[2] * p[t[2]];
         let value = c.normal.dot(p[i] - q) - thickness;
         // The correction of the gap along the normal (m).
-        let dn = if ctx.xpbd {
-            let dl = (-value / denom).max(-c.lambda);
-            c.lambda += dl;
-            dl * denom
-        } else if value < 0.0 {
-            c.lambda += -value;
-            -value
-        } else {
-            0.0
-        };
+        let dn = contact_correction(ctx.xpbd, value, denom, &mut c.lambda);
         if dn == 0.0 {
             continue;
         }
