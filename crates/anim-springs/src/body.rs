@@ -336,10 +336,10 @@ fn pinned_vertices(
     }
     if let Some(region) = pin.region {
         let PinBox { min, max } = region;
-        if !region.is_finite() {
+        if !region.is_valid() {
             return Err(SceneError::invalid(
                 format!("{field}.box"),
-                format!("min {min:?} and max {max:?} must be finite"),
+                format!("min {min:?} and max {max:?} must be finite with min <= max on every axis"),
             ));
         }
         let before = pins.len();

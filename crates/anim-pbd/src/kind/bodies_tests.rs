@@ -327,6 +327,12 @@ fn a_pin_out_of_range_names_the_field_the_index_and_the_vertex_count() {
         "{msg}"
     );
     assert!(msg.ends_with("spans [-0.5, -0.5, 1.0] to [0.5, 0.5, 1.0])"), "{msg}");
+    // A pin table with neither `vertices` nor `box` pins nothing: refused, as in every kind.
+    let msg = refusal(
+        &dir,
+        serde_json::json!({ "bodies": [{ "mesh": cloth, "material": { "density": 1.0 }, "pin": {} }] }),
+    );
+    assert_eq!(msg, "field `bodies[0].pin`: give `vertices`, `box` or both");
 }
 
 #[test]

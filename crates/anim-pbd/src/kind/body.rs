@@ -395,6 +395,9 @@ impl BodySpec {
     ) -> Result<Vec<usize>, BuildError> {
         let Some(pin) = &self.pin else { return Ok(Vec::new()) };
         let fail = |m: String| BuildError::invalid(format!("bodies[{k}].pin"), m);
+        if pin.vertices.is_empty() && pin.region.is_none() {
+            return Err(fail("give `vertices`, `box` or both".into()));
+        }
         let mut out = Vec::new();
         if !pin.vertices.is_empty() {
             let Some(n) = file_vertices else {

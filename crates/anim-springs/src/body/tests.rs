@@ -305,6 +305,11 @@ fn refusals_name_the_field_the_file_and_the_element() {
     assert_eq!(field, "bodies[0].pin");
     assert!(message.contains("holds no vertex") && message.contains(&grid), "{message}");
     assert_eq!(refusal(&dir, with("pin", serde_json::json!({}))).0, "bodies[0].pin");
+    // A box with min above max is refused as such, not as holding no vertex.
+    let (field, message) =
+        refusal(&dir, with("pin", serde_json::json!({ "box": { "min": [1, 0, 0], "max": [0, 1, 1] } })));
+    assert_eq!(field, "bodies[0].pin.box");
+    assert!(message.contains("min <= max"), "{message}");
     // A missing file is named.
     let (field, message) = refusal(&dir, with("mesh", serde_json::json!("nowhere/cloth.obj")));
     assert_eq!(field, "bodies[0].mesh");
