@@ -191,8 +191,9 @@ impl MeshCollider {
         Some(if len > 0.0 && len.is_finite() { g / len } else { Vector::<D>::zeros() })
     }
 
-    /// The outward normal at grid node `idx` as [`contact`](Self::contact) gives it to the grid
-    /// update (`None` outside the obstacle; zero where it is stopped).
+    /// The outward normal the grid update uses at grid node `idx`: the normalised central
+    /// difference of the table, one-sided at the box's faces (`None` outside the obstacle; zero
+    /// where the difference vanishes and the node is stopped).
     #[must_use]
     pub fn normal(&self, idx: [usize; 3]) -> Option<[f32; 3]> {
         self.contact::<3>(&idx).map(|n| [n[0], n[1], n[2]])
