@@ -125,10 +125,7 @@ fn placement(
     dim: usize,
 ) -> Result<Placement, BuildError> {
     let p = Placement { scale, rotate, translate };
-    p.check().map_err(|e| match e {
-        BuildError::Invalid { field, message } => invalid(format!("{prefix}.{field}"), message),
-        other => other,
-    })?;
+    p.check().map_err(|e| e.within(prefix))?;
     if dim == 2 {
         if rotate[0] != 0.0 || rotate[1] != 0.0 {
             return Err(invalid(

@@ -226,10 +226,7 @@ fn obstacle_meshes<const D: usize>(
     for (k, m) in p.obstacle_meshes.iter().enumerate() {
         let at = |field: &str| format!("obstacle_meshes[{k}].{field}");
         let placement = m.placement();
-        placement.check().map_err(|e| match e {
-            BuildError::Invalid { field, message } => BuildError::invalid(at(&field), message),
-            other => other,
-        })?;
+        placement.check().map_err(|e| e.within(&format!("obstacle_meshes[{k}]")))?;
         let surface = read_surface(&context.resolve(&m.mesh), &placement)
             .map_err(|e| BuildError::invalid(at("mesh"), e))?;
         let collider = MeshCollider::new(&surface, params, boundary)
@@ -296,10 +293,7 @@ impl Region {
     fn of<const D: usize>(body: &BodySpec, k: usize, context: &BuildContext<'_>) -> Result<Self, BuildError> {
         let at = |field: &str| format!("bodies[{k}].{field}");
         let placement = body.placement();
-        placement.check().map_err(|e| match e {
-            BuildError::Invalid { field, message } => BuildError::invalid(at(&field), message),
-            other => other,
-        })?;
+        placement.check().map_err(|e| e.within(&format!("bodies[{k}]")))?;
         if D == 2 && (body.rotate[0] != 0.0 || body.rotate[1] != 0.0) {
             return Err(BuildError::invalid(
                 at("rotate"),

@@ -119,6 +119,28 @@ impl BuildError {
     pub fn invalid(field: impl Into<String>, message: impl Into<String>) -> Self {
         Self::Invalid { field: field.into(), message: message.into() }
     }
+
+    /// The same error, of a field of the table `prefix` (such as `bodies[2]`): its field becomes
+    /// `prefix.field`, or `prefix` for the table itself.
+    ///
+    /// ```
+    /// use anim_core::scene::{BuildError, Placement};
+    ///
+    /// let bad = Placement { scale: 0.0, ..Placement::default() };
+    /// let e = bad.check().unwrap_err().within("bodies[2]");
+    /// assert_eq!(e.to_string(), "field `bodies[2].scale`: must be positive and finite, got 0");
+    /// let table = BuildError::Schema { field: String::new(), message: "unknown field `x`".into() };
+    /// assert_eq!(table.within("bodies[0]").to_string(), "field `bodies[0]`: unknown field `x`");
+    /// ```
+    #[must_use]
+    pub fn within(self, prefix: &str) -> Self {
+        let join =
+            |field: String| if field.is_empty() { prefix.to_string() } else { format!("{prefix}.{field}") };
+        match self {
+            Self::Schema { field, message } => Self::Schema { field: join(field), message },
+            Self::Invalid { field, message } => Self::Invalid { field: join(field), message },
+        }
+    }
 }
 
 /// The parameters of a kind, read from their scene-file form.

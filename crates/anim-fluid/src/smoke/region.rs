@@ -43,10 +43,7 @@ impl Region {
         context: &BuildContext<'_>,
         field: &str,
     ) -> Result<Self, BuildError> {
-        placement.check().map_err(|e| match e {
-            BuildError::Invalid { field: f, message } => BuildError::invalid(format!("{field}.{f}"), message),
-            other => other,
-        })?;
+        placement.check().map_err(|e| e.within(field))?;
         let path = context.resolve(mesh);
         let obj = read_obj(&path, Polygons::Triangulate)
             .map_err(|e| BuildError::invalid(format!("{field}.mesh"), e.to_string()))?;

@@ -208,7 +208,7 @@ impl BodySpec {
         }
         self.check_material(k, kind)?;
         let placement = self.placement();
-        placement.check().map_err(|e| prefixed(e, &format!("bodies[{k}].")))?;
+        placement.check().map_err(|e| e.within(&format!("bodies[{k}]")))?;
         if !self.velocity.iter().all(|v| v.is_finite()) {
             return Err(BuildError::invalid(
                 field("velocity"),
@@ -447,17 +447,6 @@ impl BodySpec {
         out.sort_unstable();
         out.dedup();
         Ok(out)
-    }
-}
-
-/// `e` with `prefix` put before its field.
-fn prefixed(e: BuildError, prefix: &str) -> BuildError {
-    match e {
-        BuildError::Invalid { field, message } => BuildError::invalid(format!("{prefix}{field}"), message),
-        BuildError::Schema { field, message } => {
-            BuildError::Schema { field: format!("{prefix}{field}"), message }
-        }
-        other => other,
     }
 }
 
