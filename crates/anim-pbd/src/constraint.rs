@@ -300,6 +300,18 @@ pub(crate) fn wrap_angle(a: f64) -> f64 {
     }
 }
 
+/// Whether a tetrahedron of signed volume `v` is flat: `|v|` at most `1e-12` of the cube of its
+/// longest edge (a relative test, whatever the mesh's size), or not a number.
+pub(crate) fn tet_is_flat(p: [DVec3; 4], v: f64) -> bool {
+    let mut l2 = 0.0f64;
+    for a in 0..4 {
+        for b in a + 1..4 {
+            l2 = l2.max((p[a] - p[b]).length_squared());
+        }
+    }
+    !(v.abs() > 1e-12 * l2 * l2.sqrt())
+}
+
 /// Signed volume of a tetrahedron and its gradient.
 #[inline]
 pub(crate) fn tet_volume(p: [DVec3; 4]) -> (f64, Grad4) {

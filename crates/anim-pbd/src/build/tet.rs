@@ -7,7 +7,7 @@
 
 use super::builder::{MeshMass, PbdBuilder, check_mass, key};
 use super::error::{BuildError, InputError};
-use crate::constraint::{ConstraintParams, tet_volume};
+use crate::constraint::{ConstraintParams, tet_is_flat, tet_volume};
 use anim_core::glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
@@ -64,13 +64,7 @@ impl PbdBuilder {
                     }
                 }
             }
-            let mut l2 = 0.0f64;
-            for a in 0..4 {
-                for b in a + 1..4 {
-                    l2 = l2.max((p[a] - p[b]).length_squared());
-                }
-            }
-            if !(v.abs() > 1e-12 * l2 * l2.sqrt()) {
+            if tet_is_flat(p, v) {
                 return Err(BuildError::DegenerateTet {
                     tet: t,
                     vertices: *tet,

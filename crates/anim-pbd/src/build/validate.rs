@@ -12,7 +12,7 @@ use super::closed::closed_outward;
 use super::error::{BuildError, InputError};
 use crate::constraint::{
     AttachTarget, Constraint, ConstraintFunction, ConstraintParams, IsometricBending, dihedral,
-    isometric_weights, tet_volume,
+    isometric_weights, tet_is_flat, tet_volume,
 };
 use crate::model::{Particle, PbdModel, VolumeMesh};
 use anim_core::glam::DVec3;
@@ -244,13 +244,7 @@ impl PbdBuilder {
             Pending::Tet(s) => {
                 let p4 = s.map(|i| pos[i]);
                 let v = tet_volume(p4).0;
-                let mut l2 = 0.0f64;
-                for a in 0..4 {
-                    for b in a + 1..4 {
-                        l2 = l2.max((p4[a] - p4[b]).length_squared());
-                    }
-                }
-                if !(v.abs() > 1e-12 * l2 * l2.sqrt()) {
+                if tet_is_flat(p4, v) {
                     return Err(degenerate("zero volume"));
                 }
                 ConstraintFunction::TetVolume { particles: *s, rest_volume: v }

@@ -22,7 +22,7 @@
 //! out of the body; pinning one is refused.
 
 use crate::build::{Bending, MeshMass, MeshParams, NotClosed, PbdBuilder, TetMeshParams, closed_outward};
-use crate::constraint::{ConstraintParams, tet_volume};
+use crate::constraint::{ConstraintParams, tet_is_flat, tet_volume};
 use anim_core::glam::DVec3;
 use anim_core::scene::{BuildContext, BuildError, Placement, is_default};
 use anim_core::scene::{is_unit_scale, unit_scale};
@@ -532,13 +532,7 @@ fn check_elements(file: &str, positions: &[[f64; 3]], elements: &Elements) -> Re
                 }
                 let x = tet.map(p);
                 let v = tet_volume(x).0;
-                let mut l2 = 0.0f64;
-                for a in 0..4 {
-                    for b in a + 1..4 {
-                        l2 = l2.max((x[a] - x[b]).length_squared());
-                    }
-                }
-                if !(v.abs() > 1e-12 * l2 * l2.sqrt()) {
+                if tet_is_flat(x, v) {
                     return Err(format!(
                         "{file}: tetrahedron {t} (vertices {}) has zero volume (placed: {v:e} m^3)",
                         list(tet)
