@@ -48,6 +48,15 @@ pub(crate) fn refused(value: Value) -> (String, String) {
     }
 }
 
+/// The mean height (y) and mean speed of the particles of material `k`.
+pub(crate) fn body_height_and_speed(s: &Scene<3>, k: u16) -> (f64, f64) {
+    let ps: Vec<usize> = (0..s.state.len()).filter(|&p| s.state.material[p] == k).collect();
+    let n = ps.len() as f64;
+    let y = ps.iter().map(|&p| f64::from(s.state.x[3 * p + 1])).sum::<f64>() / n;
+    let v = ps.iter().map(|&p| f64::from(s.state.velocity(p).norm())).sum::<f64>() / n;
+    (y, v)
+}
+
 fn mass<const D: usize>(s: &Scene<D>) -> f64 {
     s.state.mass.iter().map(|&m| f64::from(m)).sum()
 }
@@ -224,13 +233,7 @@ fn bodies_land_on_an_obstacle_without_passing_through() {
         ],
     }));
     let h = 1.0 / 16.0;
-    let body = |s: &Scene<3>, k: u16| -> (f64, f64) {
-        let ps: Vec<usize> = (0..s.state.len()).filter(|&p| s.state.material[p] == k).collect();
-        let n = ps.len() as f64;
-        let y = ps.iter().map(|&p| f64::from(s.state.x[3 * p + 1])).sum::<f64>() / n;
-        let v = ps.iter().map(|&p| f64::from(s.state.velocity(p).norm())).sum::<f64>() / n;
-        (y, v)
-    };
+    let body = body_height_and_speed;
     let mut lowest = f32::MAX;
     // The jelly's centre: lowest so far, highest since.
     let (mut bottom, mut rebound) = (f64::MAX, f64::MIN);

@@ -13,7 +13,7 @@ use anim_core::solver::Solver;
 use anim_core::surface::ClosedSurface;
 use serde_json::{Value, json};
 
-use crate::bodies_tests::{cube, jelly, refused, testdata, three};
+use crate::bodies_tests::{body_height_and_speed, cube, jelly, refused, testdata, three};
 
 /// The box `[lo, hi]` as 12 outward triangles.
 fn box_surface(lo: [f64; 3], hi: [f64; 3]) -> ClosedSurface {
@@ -98,13 +98,7 @@ fn bodies_land_on_a_mesh_obstacle_without_passing_through() {
     }));
     let h = 1.0 / 16.0;
     let mesh = s.sim.mesh_colliders()[0].clone();
-    let body = |s: &Scene<3>, k: u16| -> (f64, f64) {
-        let ps: Vec<usize> = (0..s.state.len()).filter(|&p| s.state.material[p] == k).collect();
-        let n = ps.len() as f64;
-        let y = ps.iter().map(|&p| f64::from(s.state.x[3 * p + 1])).sum::<f64>() / n;
-        let v = ps.iter().map(|&p| f64::from(s.state.velocity(p).norm())).sum::<f64>() / n;
-        (y, v)
-    };
+    let body = body_height_and_speed;
     let mut lowest = f32::MAX;
     let mut deepest = f64::MAX;
     let (mut bottom, mut rebound) = (f64::MAX, f64::MIN);

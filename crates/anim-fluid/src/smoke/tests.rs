@@ -31,6 +31,25 @@ fn distance(p: [f64; 3], c: [f64; 3]) -> f64 {
     ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2)).sqrt()
 }
 
+/// Checks the solid cells of a `dim`-dimensional `fluid` against a ball of centre `c`: a cell
+/// whose centre is nearer than `inner` must be solid, one at `r` or beyond must not; returns the
+/// cells between (undecided by the check) and the solid cells.
+fn solid_ball(fluid: &MacFluid, dim: usize, c: [f64; 3], inner: f64, r: f64) -> (usize, usize) {
+    let (mut band, mut solid) = (0, 0);
+    for (k, &is_solid) in fluid.solid().iter().enumerate() {
+        let d = distance(centre(k, fluid.dims(), fluid.h(), dim), c);
+        if d < inner {
+            assert!(is_solid, "{dim}D cell {k} at distance {d} is inside the surface");
+        } else if d >= r {
+            assert!(!is_solid, "{dim}D cell {k} at distance {d} is outside the surface");
+        } else {
+            band += 1;
+        }
+        solid += usize::from(is_solid);
+    }
+    (band, solid)
+}
+
 /// A closed UV sphere as OBJ text: `rings` latitude bands, `segments` around, one vertex at
 /// each pole, triangles facing outward.
 fn sphere_obj(center: [f64; 3], r: f64, rings: usize, segments: usize) -> String {
@@ -179,18 +198,7 @@ fn a_mesh_obstacle_marks_the_cells_inside_its_surface() {
     // Each face spans at most pi / rings of latitude and 2 pi / segments of longitude: its
     // points are at least r cos(pi / rings) from the centre.
     let inner = r * (std::f64::consts::PI / rings as f64).cos();
-    let (mut band, mut solid) = (0, 0);
-    for (k, &is_solid) in fluid.solid().iter().enumerate() {
-        let d = distance(centre(k, fluid.dims(), fluid.h(), 3), c);
-        if d < inner {
-            assert!(is_solid, "cell {k} at distance {d} is inside the surface");
-        } else if d >= r {
-            assert!(!is_solid, "cell {k} at distance {d} is outside the surface");
-        } else {
-            band += 1;
-        }
-        solid += usize::from(is_solid);
-    }
+    let (band, solid) = solid_ball(fluid, 3, c, inner, r);
     assert!(band < solid / 10, "{band} of {solid} cells undecided");
     // A 2D scene cuts the mesh at z = 0: the disk of the sphere's equator (the sphere centred on
     // z = 0), and a mesh that does not reach z = 0 is refused.
@@ -204,18 +212,7 @@ fn a_mesh_obstacle_marks_the_cells_inside_its_surface() {
     let scene = p.scene_in(&BuildContext { base: Some(&dir) }).expect("builds");
     let (fluid, _) = mac(&scene);
     let inner = r * (std::f64::consts::PI / segments as f64 * 2.0).cos();
-    let (mut band, mut solid) = (0, 0);
-    for (k, &is_solid) in fluid.solid().iter().enumerate() {
-        let d = distance(centre(k, fluid.dims(), fluid.h(), 2), c);
-        if d < inner {
-            assert!(is_solid, "2D cell {k} at distance {d} is inside the surface");
-        } else if d >= r {
-            assert!(!is_solid, "2D cell {k} at distance {d} is outside the surface");
-        } else {
-            band += 1;
-        }
-        solid += usize::from(is_solid);
-    }
+    let (band, solid) = solid_ball(fluid, 2, c, inner, r);
     assert!(solid > 100 && band < solid / 10, "{band} of {solid} cells undecided");
     let mut value = value;
     value["obstacle_meshes"][0]["translate"] = json!([0.45, 0.7, 0.5]);
