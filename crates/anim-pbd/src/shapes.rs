@@ -9,70 +9,8 @@ use crate::constraint::tet_volume;
 use anim_core::glam::DVec3;
 use std::collections::HashMap;
 
-/// A unit-radius icosphere around the origin: the icosahedron subdivided `subdivisions` times
-/// (20 * 4^s triangles), outward-oriented, closed.
-#[must_use]
-pub fn icosphere(subdivisions: usize) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut pos: Vec<DVec3> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .iter()
-    .map(|&p| DVec3::from_array(p).normalize())
-    .collect();
-    let mut tris: Vec<[usize; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..subdivisions {
-        let mut mid: HashMap<(usize, usize), usize> = HashMap::new();
-        let mut next = Vec::with_capacity(4 * tris.len());
-        let mut midpoint = |a: usize, b: usize, pos: &mut Vec<DVec3>| {
-            let k = if a < b { (a, b) } else { (b, a) };
-            *mid.entry(k).or_insert_with(|| {
-                pos.push(((pos[a] + pos[b]) * 0.5).normalize());
-                pos.len() - 1
-            })
-        };
-        for [a, b, c] in tris {
-            let ab = midpoint(a, b, &mut pos);
-            let bc = midpoint(b, c, &mut pos);
-            let ca = midpoint(c, a, &mut pos);
-            next.extend_from_slice(&[[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        tris = next;
-    }
-    (pos.iter().map(|p| p.to_array()).collect(), tris)
-}
+/// A unit-radius icosphere around the origin (anim-core's, re-exported here).
+pub use anim_core::surface::icosphere;
 
 /// A box of `n[0] x n[1] x n[2]` cubic cells of edge `h` from `origin`, each cell split into 6
 /// tetrahedra around its main diagonal (Kuhn's subdivision: conforming across cells). All

@@ -31,62 +31,8 @@ pub(super) fn cube() -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
 
 /// A sphere of radius `r`: the icosahedron subdivided `levels` times, vertices on the sphere.
 fn sphere(r: f64, levels: usize) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
-    let g = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut p: Vec<DVec3> = [
-        [-1.0, g, 0.0],
-        [1.0, g, 0.0],
-        [-1.0, -g, 0.0],
-        [1.0, -g, 0.0],
-        [0.0, -1.0, g],
-        [0.0, 1.0, g],
-        [0.0, -1.0, -g],
-        [0.0, 1.0, -g],
-        [g, 0.0, -1.0],
-        [g, 0.0, 1.0],
-        [-g, 0.0, -1.0],
-        [-g, 0.0, 1.0],
-    ]
-    .iter()
-    .map(|v| DVec3::from_array(*v).normalize())
-    .collect();
-    let mut t: Vec<[usize; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..levels {
-        let mut mid: HashMap<(usize, usize), usize> = HashMap::new();
-        let mut split = |a: usize, b: usize, p: &mut Vec<DVec3>| {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                p.push((p[a] + p[b]).normalize());
-                p.len() - 1
-            })
-        };
-        let mut next = Vec::new();
-        for [a, b, c] in t {
-            let (ab, bc, ca) = (split(a, b, &mut p), split(b, c, &mut p), split(c, a, &mut p));
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        t = next;
-    }
-    (p.iter().map(|v| (*v * r).to_array()).collect(), t)
+    let (p, t) = icosphere(levels);
+    (p.iter().map(|v| v.map(|x| x * r)).collect(), t)
 }
 
 /// A torus about z, major radius `big`, minor `small`, `n` by `m` quads split in two.
