@@ -8,39 +8,7 @@ times (642 vertices, 1280 triangles) pushed out radially. Needs numpy only.
 from pathlib import Path
 
 import numpy as np
-
-
-def icosphere(subdivisions):
-    t = (1.0 + 5.0**0.5) / 2.0
-    v = [
-        (-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0),
-        (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
-        (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1),
-    ]
-    f = [
-        (0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11),
-        (1, 5, 9), (5, 11, 4), (11, 10, 2), (10, 7, 6), (7, 1, 8),
-        (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9),
-        (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1),
-    ]
-    verts = [np.array(p, float) / np.linalg.norm(p) for p in v]
-    for _ in range(subdivisions):
-        midpoint = {}
-
-        def middle(a, b):
-            key = (min(a, b), max(a, b))
-            if key not in midpoint:
-                m = verts[a] + verts[b]
-                verts.append(m / np.linalg.norm(m))
-                midpoint[key] = len(verts) - 1
-            return midpoint[key]
-
-        finer = []
-        for a, b, c in f:
-            ab, bc, ca = middle(a, b), middle(b, c), middle(c, a)
-            finer += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
-        f = finer
-    return np.array(verts), np.array(f)
+from icosphere import icosphere
 
 
 def radius(u):
@@ -62,6 +30,7 @@ def radius(u):
 
 def main():
     u, faces = icosphere(3)
+    u = np.array(u)
     r, scale = radius(u)
     p = u * r[:, None] * scale
     out = Path(__file__).with_name("blob.obj")

@@ -9,39 +9,7 @@ ray from the centre, so the surface stays closed, manifold and outward oriented.
 from pathlib import Path
 
 import numpy as np
-
-
-def icosphere(subdivisions):
-    t = (1.0 + 5.0**0.5) / 2.0
-    vertices = [
-        (-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0),
-        (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
-        (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1),
-    ]
-    faces = [
-        (0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11),
-        (1, 5, 9), (5, 11, 4), (11, 10, 2), (10, 7, 6), (7, 1, 8),
-        (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9),
-        (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1),
-    ]
-    vertices = [np.array(v, dtype=float) / np.linalg.norm(v) for v in vertices]
-    for _ in range(subdivisions):
-        midpoint = {}
-
-        def middle(a, b):
-            key = (min(a, b), max(a, b))
-            if key not in midpoint:
-                m = vertices[a] + vertices[b]
-                vertices.append(m / np.linalg.norm(m))
-                midpoint[key] = len(vertices) - 1
-            return midpoint[key]
-
-        refined = []
-        for a, b, c in faces:
-            ab, bc, ca = middle(a, b), middle(b, c), middle(c, a)
-            refined += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
-        faces = refined
-    return np.array(vertices), faces
+from icosphere import icosphere
 
 
 def bump(directions, towards, height, width):
@@ -54,6 +22,7 @@ def bump(directions, towards, height, width):
 
 def main():
     directions, faces = icosphere(3)
+    directions = np.array(directions)
     radius = np.ones(len(directions))
     radius += bump(directions, (0.9, 0.0, 0.6), 0.35, 0.08)  # head, forward (+x) and up
     radius += bump(directions, (0.45, 0.3, 1.0), 0.7, 0.025)  # right ear
