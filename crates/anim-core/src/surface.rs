@@ -23,6 +23,9 @@
 //!   excludes inverting it). The tetrahedra are all well shaped; the boundary follows the surface
 //!   to within a fraction of a cell where the cells resolve it, and features smaller than a cell
 //!   are lost.
+//! - [`DistanceField`] samples the signed distance to the surface on a lattice (exact near
+//!   the surface, by fast sweeping beyond) and interpolates it with its gradient and Hessian:
+//!   the collider of a triangle-mesh obstacle.
 //!
 //! ```
 //! use anim_core::surface::ClosedSurface;
@@ -52,10 +55,15 @@ use crate::geometry::closest_point_on_triangle;
 
 use glam::DVec3;
 
+mod distance;
+#[cfg(test)]
+mod distance_tests;
 mod lattice;
 #[cfg(test)]
 mod tests;
 mod tetrahedralize;
+
+pub use distance::{DistanceField, FieldSample};
 
 /// A tetrahedral mesh: the vertex positions and the tetrahedra (four vertex indices each,
 /// positively oriented).

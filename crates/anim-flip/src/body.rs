@@ -207,6 +207,7 @@ fn obstacles<const D: usize>(
     }
     for (k, m) in params.obstacle_meshes.iter().enumerate() {
         let prefix = format!("obstacle_meshes[{k}]");
+        m.refuse_cell().map_err(|e| invalid(format!("{prefix}.cell"), e))?;
         let place = placement(&prefix, m.scale, m.rotate, m.translate, D)?;
         let region = Region::mesh(&m.mesh, place, context, &format!("{prefix}.mesh"))?;
         out.push((prefix, region));

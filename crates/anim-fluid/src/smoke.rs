@@ -297,6 +297,7 @@ pub(crate) fn build(p: &FluidSceneParams, context: &BuildContext<'_>) -> Result<
     });
     let meshes = p.obstacle_meshes.iter().flatten().enumerate().map(|(k, m)| {
         let field = format!("obstacle_meshes[{k}]");
+        m.refuse_cell().map_err(|e| BuildError::invalid(format!("{field}.cell"), e))?;
         Region::mesh(&m.mesh, m.placement(), context, &field).map(|r| (field, r))
     });
     for region in regions.chain(meshes) {

@@ -159,7 +159,7 @@ fn build_in<const D: usize>(p: &MpmSceneParams, context: &BuildContext<'_>) -> R
         seed(&mut state, body, k, &points, lattice.spacing)?;
     }
     check_obstacles(&params, &state)?;
-    check_obstacle_meshes(sim.mesh_colliders(), params.h(), &state)?;
+    check_obstacle_meshes(sim.mesh_colliders(), &state)?;
     Ok(Scene { name: "bodies", description: "bodies of a scene file", sim, state, dt: 5e-4, duration: 1.0 })
 }
 
@@ -225,6 +225,7 @@ fn obstacle_meshes<const D: usize>(
     let mut out = Vec::with_capacity(p.obstacle_meshes.len());
     for (k, m) in p.obstacle_meshes.iter().enumerate() {
         let at = |field: &str| format!("obstacle_meshes[{k}].{field}");
+        m.refuse_cell().map_err(|e| BuildError::invalid(at("cell"), e))?;
         let placement = m.placement();
         placement.check().map_err(|e| e.within(&format!("obstacle_meshes[{k}]")))?;
         let surface = read_surface(&context.resolve(&m.mesh), &placement)
@@ -570,14 +571,13 @@ fn check_obstacles<const D: usize>(params: &MpmParams, state: &Particles<D>) -> 
 /// negative at the particle), naming the body and the obstacle.
 fn check_obstacle_meshes<const D: usize>(
     meshes: &[MeshCollider],
-    h: f64,
     state: &Particles<D>,
 ) -> Result<(), BuildError> {
     for (j, mesh) in meshes.iter().enumerate() {
         let inside = |p: &usize| {
             let x: [f64; 3] =
                 std::array::from_fn(|a| if a < D { f64::from(state.x[p * D + a]) } else { 0.0 });
-            mesh.interpolate(x, h).is_some_and(|phi| phi < 0.0)
+            mesh.interpolate(x).is_some_and(|phi| phi < 0.0)
         };
         if let Some(p) = (0..state.len()).find(inside) {
             let k = state.material[p];

@@ -106,7 +106,7 @@ fn bodies_land_on_a_mesh_obstacle_without_passing_through() {
         s.sim.step(&mut s.state, 1e-3).unwrap();
         lowest = s.state.x.chunks_exact(3).map(|p| p[1]).fold(lowest, f32::min);
         for p in s.state.x.chunks_exact(3) {
-            if let Some(phi) = mesh.interpolate(std::array::from_fn(|a| f64::from(p[a])), h) {
+            if let Some(phi) = mesh.interpolate(std::array::from_fn(|a| f64::from(p[a]))) {
                 deepest = deepest.min(phi);
             }
         }
@@ -154,6 +154,9 @@ fn mesh_obstacles_are_refused_by_field() {
     assert!(field == "obstacle_meshes[0]" && message.contains("outside the domain"), "{message}");
     let (_, message) = refused(scene(json!({ "mesh": "cube.obj", "colour": "red" }), above.clone()));
     assert!(message.contains("colour"), "{message}");
+    // `cell` sets the distance field of the particle and element kinds; here the grid is used.
+    let (field, message) = refused(scene(json!({ "mesh": "cube.obj", "cell": 0.01 }), above.clone()));
+    assert!(field == "obstacle_meshes[0].cell" && message.contains("own grid"), "{field}: {message}");
     // A table past the cap: 0.051 to 0.951 m at resolution 300 is nodes 15.3 to 285.3, widened
     // by 4: nodes 11 to 290, 280 per axis.
     let mut big =
@@ -200,7 +203,7 @@ fn a_scene_with_a_mesh_obstacle_is_bitwise_identical_for_any_thread_count() {
         .state
         .x
         .chunks_exact(3)
-        .filter_map(|p| mesh.interpolate(std::array::from_fn(|a| f64::from(p[a])), h));
+        .filter_map(|p| mesh.interpolate(std::array::from_fn(|a| f64::from(p[a]))));
     assert!(near.fold(f64::MAX, f64::min) < h, "the body never came near the obstacle");
     for threads in [2, 3] {
         let other = landing_in(threads);

@@ -24,6 +24,7 @@ use glam::{DMat3, DVec3, EulerRot};
 use serde::{Deserialize, Serialize};
 
 use super::{BuildError, is_default};
+use crate::surface::{ClosedSurface, DistanceField};
 
 /// Scale, rotation and translation of a body's asset, applied in that order.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -94,7 +95,10 @@ impl Placement {
 /// ```
 ///
 /// Each kind reads the file (relative to the scene file) as a closed, manifold, consistently
-/// oriented surface and says what it does in 2D.
+/// oriented surface and says what it does in 2D. The grid kinds (mpm, flip, fluid) sample it on
+/// their own grid; the particle and element kinds (fem, pbd, springs) on a
+/// [`DistanceField`](crate::surface::DistanceField) of spacing `cell`
+/// ([`ObstacleMesh::field`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObstacleMesh {
@@ -111,13 +115,56 @@ pub struct ObstacleMesh {
     /// Translation (m), applied last; default none.
     #[serde(default, skip_serializing_if = "is_default")]
     pub translate: [f64; 3],
+    /// The spacing (m) of the distance field the particle and element kinds sample the placed
+    /// surface on; default the longest side of its bounds over
+    /// [`DEFAULT_CELLS`](Self::DEFAULT_CELLS). The grid kinds use their grid's cells and refuse
+    /// it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cell: Option<f64>,
 }
 
 impl ObstacleMesh {
+    /// Cells along the longest side of the placed surface's bounds when `cell` is not given.
+    pub const DEFAULT_CELLS: f64 = 64.0;
+
     /// The placement of the surface (unchecked: see [`Placement::check`]).
     #[must_use]
     pub fn placement(&self) -> Placement {
         Placement { scale: self.scale, rotate: self.rotate, translate: self.translate }
+    }
+
+    /// The distance field of the placed `surface` for a particle or element kind: spacing
+    /// `cell` (or the default), over the surface's bounds widened by `margin` (m) plus two
+    /// cells, so that a point within `margin` of the surface is in the field.
+    ///
+    /// # Errors
+    /// A message naming `cell` for a cell that is not positive and finite or too fine for the
+    /// surface (more than 2^24 nodes), or the margin's reason.
+    pub fn field(&self, surface: &ClosedSurface, margin: f64) -> Result<DistanceField, String> {
+        let (lo, hi) = surface.bounds();
+        let longest = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+        let cell = self.cell.unwrap_or(longest / Self::DEFAULT_CELLS);
+        if !(cell > 0.0 && cell.is_finite()) {
+            return Err(format!("cell must be positive and finite (m), got {cell}"));
+        }
+        DistanceField::around(surface, cell, margin + 2.0 * cell).map_err(|e| match self.cell {
+            Some(_) => format!("cell = {cell} m: {e}"),
+            None => format!("the default cell ({cell} m, the longest side over 64): {e}; set `cell`"),
+        })
+    }
+
+    /// Refuses `cell` in a kind that samples the surface on its own grid.
+    ///
+    /// # Errors
+    /// A message saying why, when `cell` is set.
+    pub fn refuse_cell(&self) -> Result<(), String> {
+        match self.cell {
+            Some(cell) => Err(format!(
+                "cell = {cell}: this kind samples mesh obstacles on its own grid (`cell` sets the \
+                 distance field of the fem, pbd and springs kinds)"
+            )),
+            None => Ok(()),
+        }
     }
 }
 
