@@ -2,7 +2,7 @@
 //! and per-frame [`Snapshot`]s. A [`View`] turns the two into frame files and preview images; it
 //! is `Send`, so the run loop hands snapshots to a writer thread and keeps stepping.
 
-use anim_core::scene::{Context, DynScene, Frame, Prop};
+use anim_core::scene::{Context, DynScene, Frame, MeshProp, Prop};
 use anim_io::preview::{Camera, Canvas, Colors, MeshStyle, Shading};
 use anim_io::{DataArray, FrameFormat, FrameWriter, ImageData, UnstructuredGrid};
 
@@ -103,6 +103,8 @@ pub enum Geometry {
         /// What surrounds the bodies: spheres, boxes and capsules (colliders) drawn solid, a
         /// tank's walls drawn as its edges.
         obstacles: Vec<Prop>,
+        /// Obstacles of triangles (the user's closed surfaces), drawn solid.
+        meshes: Vec<MeshProp>,
         /// Region kept in view.
         frame_box: ([f64; 3], [f64; 3]),
     },
@@ -161,6 +163,7 @@ impl Geometry {
             radius: context.point_radius,
             ground,
             obstacles,
+            meshes: context.mesh_props.clone(),
             frame_box: bounds,
         }
     }
@@ -325,10 +328,13 @@ impl View {
                 }
                 io(canvas.draw_particles(camera, &[p], 0.03 * scale, Colors::Uniform([60, 110, 200])))
             }
-            Geometry::Particles { triangles, edges, radius, ground, obstacles, frame_box } => {
+            Geometry::Particles { triangles, edges, radius, ground, obstacles, meshes, frame_box } => {
                 triples(&s.x, &mut self.positions);
                 for prop in obstacles {
                     draw_obstacle(canvas, camera, prop)?;
+                }
+                for mesh in meshes {
+                    io(canvas.draw_mesh(camera, &mesh.positions, &mesh.triangles, &OBSTACLE_STYLE))?;
                 }
                 if let Some(z) = ground {
                     // A floor under the framed region (not beyond it: corners behind the
@@ -389,10 +395,13 @@ impl View {
 /// The colour of obstacles: a light grey, apart from the bodies' blue and orange.
 const OBSTACLE: [u8; 3] = [190, 190, 180];
 
+/// How solid obstacles are drawn: the obstacle colour on both sides, flat shaded.
+const OBSTACLE_STYLE: MeshStyle = MeshStyle { color: OBSTACLE, back_color: OBSTACLE, shading: Shading::Flat };
+
 /// Draws an obstacle prop: a sphere as a shaded ball, a box as its six faces, a capsule as its
 /// tube and two balls, a tank as its twelve edges.
 fn draw_obstacle(canvas: &mut Canvas, camera: &Camera, prop: &Prop) -> Result<(), String> {
-    let solid = MeshStyle { color: OBSTACLE, back_color: OBSTACLE, shading: Shading::Flat };
+    let solid = OBSTACLE_STYLE;
     match *prop {
         Prop::Sphere { center, radius } => {
             io(canvas.draw_particles(camera, &[center], radius, Colors::Uniform(OBSTACLE)))
@@ -506,5 +515,33 @@ mod tests {
         let geometry = Geometry::from_context(&context);
         let Geometry::Particles { ground, obstacles, .. } = geometry else { panic!("particles") };
         assert_eq!((ground, obstacles.len()), (Some(0.0), 2));
+    }
+
+    /// A mesh obstacle of the context (a tetrahedron around the view's centre) is drawn solid
+    /// in the obstacle grey where it covers the picture, and nowhere else.
+    #[test]
+    fn mesh_obstacles_are_drawn_solid() {
+        let mut context = Context::default();
+        context.point_dim = 3;
+        context.bounds = Some(([-1.0; 3], [1.0; 3]));
+        let s = 0.5;
+        context.mesh_props = vec![MeshProp {
+            positions: vec![[s, s, s], [s, -s, -s], [-s, s, -s], [-s, -s, s]],
+            triangles: vec![[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]],
+        }];
+        let camera = Camera::framing([-1.0; 3], [1.0; 3], [0.55, 1.0, -0.45], [0.0, 0.0, 1.0]);
+        let mut view = View::new(Geometry::from_context(&context));
+        let mut canvas = Canvas::new(120, 120, [255, 255, 255]);
+        view.draw(&mut canvas, &camera, &Snapshot::default()).unwrap();
+        let centre = canvas.pixel(60, 60);
+        assert!(centre != [255, 255, 255] && centre[0].abs_diff(centre[2]) <= 12, "{centre:?}");
+        // The tetrahedron's bounding box (about a third of the view) bounds what is painted.
+        let painted = painted(&canvas);
+        assert!(
+            painted.len() > 300
+                && painted.iter().all(|&(x, y)| (20..100).contains(&x) && (20..100).contains(&y)),
+            "{}",
+            painted.len()
+        );
     }
 }

@@ -48,13 +48,14 @@ mod tests;
 
 pub use scene::BodyScene;
 
-use crate::kind::FlipSceneParams;
+use crate::kind::{FlipSceneParams, z_up};
 use crate::mac::{flatten, unflatten};
 use crate::particles::Particles;
 use crate::sim::{FlipParams, FlipSimulation};
 use anim_core::geometry::Shape;
 use anim_core::scene::unit_scale;
-use anim_core::scene::{BuildContext, BuildError, Placement, is_default};
+use anim_core::scene::{BuildContext, BuildError, MeshProp, Placement, is_default};
+use anim_core::surface::ClosedSurface;
 use region::Region;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -191,7 +192,21 @@ pub fn build<const D: usize>(
     mark_solid(&mut sim, &obstacles)?;
     let particles = seed(&sim, params, context, origin)?;
     let shapes = params.obstacles.clone();
-    Ok((BodyScene::new(sim, origin, shapes), particles))
+    // In 2D a mesh obstacle is its cross-section z = 0, which the preview does not draw.
+    let meshes = match D {
+        3 => obstacles.iter().filter_map(|(_, region)| region.surface()).map(mesh_prop).collect(),
+        _ => Vec::new(),
+    };
+    Ok((BodyScene::new(sim, origin, shapes, meshes), particles))
+}
+
+/// A mesh obstacle as drawn: the surface of the scene file's frame turned z up (a rotation,
+/// which keeps the triangles' orientation).
+fn mesh_prop(surface: &ClosedSurface) -> MeshProp {
+    MeshProp {
+        positions: surface.positions().iter().map(|p| z_up::<3>(&p.to_array())).collect(),
+        triangles: surface.triangles().to_vec(),
+    }
 }
 
 /// The regions of `obstacles` and `obstacle_meshes`, each with its field.

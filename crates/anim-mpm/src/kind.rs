@@ -69,7 +69,7 @@ use crate::scenes::{self, MpmScene, SurgeFront};
 use crate::{Boundary, Kernel, MpmError, MpmParams, MpmSimulation, OutOfDomain, Particles, Shape, Transfer};
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
-    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
+    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, MeshProp, Preset, Prop,
     RunDefaults, SceneKind, Simulated, View, params, saved_field,
 };
 use anim_core::solver::{Solver, StepClock, StepReport};
@@ -487,6 +487,10 @@ impl<const D: usize> View for MpmRun<D> {
         }
         context.props.push(tank);
         context.props.extend(params.colliders.iter().filter_map(|c| collider(c.shape, D)));
+        context.mesh_props.extend(self.sim.mesh_colliders().iter().map(|m| MeshProp {
+            positions: m.surface().positions().iter().map(|p| p.to_array()).collect(),
+            triangles: m.surface().triangles().to_vec(),
+        }));
         context
     }
 

@@ -24,6 +24,8 @@
 //! **Particles.** A particle is inside the obstacle (and refused when a scene starts so) when
 //! the trilinear interpolation of the table at its position is negative.
 
+use std::sync::Arc;
+
 use anim_core::surface::{ClosedSurface, DistanceField};
 
 use crate::{Boundary, MpmParams, Vector};
@@ -52,6 +54,8 @@ pub struct MeshCollider {
     counts: [usize; 3],
     /// Signed distance (m) on the nodes of the box.
     phi: DistanceField,
+    /// The surface (placed), for drawing.
+    surface: Arc<ClosedSurface>,
     /// Boundary condition on the surface.
     pub(crate) boundary: Boundary,
 }
@@ -106,7 +110,13 @@ impl MeshCollider {
                 "has no grid node inside it at resolution {n} (cells {h} m): it would have no effect"
             ));
         }
-        Ok(Self { lo, counts, phi, boundary })
+        Ok(Self { lo, counts, phi, surface: Arc::new(surface.clone()), boundary })
+    }
+
+    /// The surface the table samples, placed in the domain.
+    #[must_use]
+    pub fn surface(&self) -> &ClosedSurface {
+        &self.surface
     }
 
     /// The first node index and the node counts of the table's box, per axis.

@@ -211,3 +211,23 @@ fn a_scene_with_a_mesh_obstacle_is_bitwise_identical_for_any_thread_count() {
         assert_eq!(one.state, other.state, "{threads} threads");
     }
 }
+
+/// The scene's picture holds each mesh obstacle's placed surface, in the frames' coordinates.
+#[test]
+fn the_context_draws_a_mesh_obstacle_where_it_is() {
+    let params = json!({
+        "resolution": 16,
+        "obstacle_meshes": [{ "mesh": "cube.obj", "scale": 0.6, "translate": [0.2, -0.2, 0.2] }],
+        "bodies": [{ "shape": cube([0.5, 0.6, 0.5], 0.1), "material": jelly() }],
+    });
+    let scene = (crate::kind::KIND.build)(&params, &BuildContext { base: Some(testdata()) }).expect("builds");
+    let context = scene.context();
+    assert_eq!(context.mesh_props.len(), 1);
+    let mesh = &context.mesh_props[0];
+    assert_eq!(mesh.triangles.len(), 12);
+    let lo = mesh.positions.iter().fold([f64::INFINITY; 3], |a, p| std::array::from_fn(|k| a[k].min(p[k])));
+    let hi =
+        mesh.positions.iter().fold([f64::NEG_INFINITY; 3], |a, p| std::array::from_fn(|k| a[k].max(p[k])));
+    let close = |a: [f64; 3], b: [f64; 3]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
+    assert!(close(lo, [0.2, -0.2, 0.2]) && close(hi, [0.8, 0.4, 0.8]), "{lo:?} {hi:?}");
+}

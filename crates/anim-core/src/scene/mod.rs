@@ -59,4 +59,4 @@ pub use looped::Looped;
 pub use pin::{PinBox, PinSpec};
 pub use placement::{ObstacleMesh, Placement, is_unit_scale, unit_scale};
 pub use preset::{BuildContext, BuildError, BuildFn, Preset, RunDefaults, SceneKind, is_default, params};
-pub use view::{Context, Field, Frame, ImageGrid, Prop, View, frame_box, ground_height};
+pub use view::{Context, Field, Frame, ImageGrid, MeshProp, Prop, View, frame_box, ground_height};

@@ -210,4 +210,36 @@ mod tests {
         let bad = Placement { rotate: [f64::NAN, 0.0, 0.0], ..Placement::default() };
         assert!(matches!(bad.check(), Err(BuildError::Invalid { field, .. }) if field == "rotate"));
     }
+
+    /// A mesh obstacle's field: 64 cells along the longest side by default, `cell` when given,
+    /// covering the surface widened by the margin and two cells; bad cells named.
+    #[test]
+    fn a_mesh_obstacle_field_takes_its_cell_or_the_longest_side_over_64() {
+        let (p, t) = crate::surface::icosphere(2);
+        let p: Vec<[f64; 3]> = p.iter().map(|v| [2.0 * v[0], v[1], v[2]]).collect();
+        let surface = ClosedSurface::new(p, t).unwrap();
+        let mut mesh = ObstacleMesh {
+            mesh: PathBuf::from("egg.obj"),
+            scale: 1.0,
+            rotate: [0.0; 3],
+            translate: [0.0; 3],
+            cell: None,
+        };
+        let field = mesh.field(&surface, 0.1).unwrap();
+        let (lo, hi) = surface.bounds();
+        assert_eq!(field.spacing(), (hi[0] - lo[0]) / 64.0);
+        let reach = 0.1 + 2.0 * field.spacing();
+        for a in 0..3 {
+            assert!((field.origin()[a] - (lo[a] - reach)).abs() < 1e-12);
+            assert!(field.far_corner()[a] >= hi[a] + reach - 1e-12);
+        }
+        mesh.cell = Some(0.25);
+        assert_eq!(mesh.field(&surface, 0.0).unwrap().spacing(), 0.25);
+        mesh.cell = Some(-1.0);
+        assert!(mesh.field(&surface, 0.0).unwrap_err().contains("cell must be positive"));
+        mesh.cell = Some(1e-4);
+        let message = mesh.field(&surface, 0.0).unwrap_err();
+        assert!(message.starts_with("cell = 0.0001 m") && message.contains("2^24"), "{message}");
+        assert!(mesh.refuse_cell().unwrap_err().contains("own grid"));
+    }
 }

@@ -29,6 +29,8 @@ pub struct Context {
     pub point_radius: f64,
     /// What surrounds the points: ground, colliders, walls, attractors.
     pub props: Vec<Prop>,
+    /// Obstacles of triangles (the user's closed surfaces), drawn solid.
+    pub mesh_props: Vec<MeshProp>,
     /// The region the motion of the scene stays in: corners `(lo, hi)`, for framing a picture.
     pub bounds: Option<([f64; 3], [f64; 3])>,
     /// The grid of an image scene (a grid fluid), whose frames hold cell fields and no points.
@@ -87,6 +89,16 @@ pub enum Prop {
         /// The point it is tied to.
         point: usize,
     },
+}
+
+/// A fixed obstacle of triangles in the picture (a closed surface from a scene file's
+/// `obstacle_meshes`, placed), counter-clockwise seen from outside.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MeshProp {
+    /// Vertex positions (m).
+    pub positions: Vec<[f64; 3]>,
+    /// Triangles, three vertex indices each.
+    pub triangles: Vec<[usize; 3]>,
 }
 
 impl Prop {

@@ -75,6 +75,14 @@ impl Region {
         Ok(Region { kind: Kind::Surface(Box::new(surface)), lo, hi })
     }
 
+    /// The closed surface of a mesh region (placed), `None` for a shape.
+    pub(crate) fn surface(&self) -> Option<&ClosedSurface> {
+        match &self.kind {
+            Kind::Surface(surface) => Some(surface),
+            Kind::Shape { .. } => None,
+        }
+    }
+
     /// Whether each point `(start + i + 1/2) spacing` of a `D`-dimensional lattice,
     /// `i < counts` per axis, is inside (z = 0 in 2D), x fastest. Points on a shape's boundary
     /// are outside; a surface classifies by rows ([`ClosedSurface::inside_lattice`]).

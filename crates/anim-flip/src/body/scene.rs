@@ -6,7 +6,7 @@ use crate::kind::{box_z_up, z_up};
 use crate::particles::Particles;
 use crate::sim::FlipSimulation;
 use anim_core::geometry::Shape;
-use anim_core::scene::{Checkpoint, CheckpointError, Context, Frame, Prop, View};
+use anim_core::scene::{Checkpoint, CheckpointError, Context, Frame, MeshProp, Prop, View};
 use anim_core::solver::{Solver, StepReport};
 
 /// A fluid of bodies: the simulation, whose grid starts at the outer corner of the walls, and
@@ -20,11 +20,18 @@ pub struct BodyScene<const D: usize> {
     pub origin: [f64; D],
     /// The obstacle shapes, in the scene file's frame (drawn as props).
     pub obstacles: Vec<Shape>,
+    /// The mesh obstacles as drawn (z up).
+    pub meshes: Vec<MeshProp>,
 }
 
 impl<const D: usize> BodyScene<D> {
-    pub(crate) fn new(sim: FlipSimulation<D>, origin: [f64; D], obstacles: Vec<Shape>) -> Self {
-        Self { sim, origin, obstacles }
+    pub(crate) fn new(
+        sim: FlipSimulation<D>,
+        origin: [f64; D],
+        obstacles: Vec<Shape>,
+        meshes: Vec<MeshProp>,
+    ) -> Self {
+        Self { sim, origin, obstacles, meshes }
     }
 
     /// A point of the simulation's frame in the scene file's frame.
@@ -101,6 +108,7 @@ impl<const D: usize> View for BodyScene<D> {
         context.point_radius = 0.25 * self.sim.grid().h();
         context.props.push(Prop::Tank { lo: tank.0, hi: tank.1 });
         context.props.extend(self.obstacles.iter().filter_map(prop::<D>));
+        context.mesh_props.clone_from(&self.meshes);
         context.bounds = Some(tank);
         context
     }

@@ -1,7 +1,7 @@
 use super::*;
 use crate::kind::KIND;
 use crate::scenes;
-use anim_core::scene::{Frame, Prop};
+use anim_core::scene::{Frame, Prop, View};
 use anim_core::solver::Solver;
 use serde_json::{Value, json};
 use std::path::Path;
@@ -214,6 +214,7 @@ fn frames_and_props_are_in_the_scene_files_frame_z_up() {
     scene.frame(&mut frame);
     assert!(frame.points.chunks_exact(3).all(|p| p[1] == 0.0 && p[0] > 0.0 && p[2] > 0.0));
     assert_eq!(scene.context().props[1], Prop::Sphere { center: [0.5, 0.0, 0.12], radius: 0.16 });
+    assert!(scene.context().mesh_props.is_empty());
 }
 
 /// A scene of bodies resumes from its checkpoint bit for bit.
@@ -378,7 +379,7 @@ fn other_refusals_name_their_field() {
 #[test]
 fn an_obstacle_mesh_makes_the_cells_of_the_equal_box_solid() {
     let body = json!({ "shape": boxed([0.5, 0.8, 0.5], [0.1, 0.1, 0.1]) });
-    let (by_mesh, _) = build3(json!({
+    let (by_mesh, particles) = build3(json!({
         "resolution": 16,
         "bodies": [body],
         "obstacle_meshes": [{ "mesh": "cube.obj", "scale": 0.25, "translate": [0.5, 0.25, 0.5] }],
@@ -389,4 +390,17 @@ fn an_obstacle_mesh_makes_the_cells_of_the_equal_box_solid() {
             .expect("builds");
     assert_eq!(by_mesh.sim.solid(), by_box.sim.solid());
     assert_eq!(by_mesh.sim.solid().iter().filter(|s| **s).count(), 18 * 18 * 18 - 16 * 16 * 16 + 4 * 4 * 4);
+    // Drawn where the box is, z up (the box prop's corners), the shape obstacle as a prop.
+    assert!(by_mesh.meshes.len() == 1 && by_box.meshes.is_empty());
+    let corners = |p: &[[f64; 3]]| {
+        let lo = p.iter().fold([f64::INFINITY; 3], |a, q| std::array::from_fn(|k| a[k].min(q[k])));
+        let hi = p.iter().fold([f64::NEG_INFINITY; 3], |a, q| std::array::from_fn(|k| a[k].max(q[k])));
+        (lo, hi)
+    };
+    let drawn = by_box.context(&particles).props[1];
+    assert_eq!(by_mesh.context(&particles).mesh_props, by_mesh.meshes);
+    assert_eq!(drawn, {
+        let (lo, hi) = corners(&by_mesh.meshes[0].positions);
+        Prop::Cuboid { lo, hi }
+    });
 }
