@@ -154,6 +154,8 @@ struct Metrics {
     resumed_from_frame: Option<usize>,
     checkpoints_written: usize,
     files: Vec<String>,
+    /// What the scene's reading skipped or ignored ([`anim_core::scene::Context::notes`]).
+    notes: Vec<String>,
 }
 
 /// The checkpoint of a run: the scene and output settings it was started with, how far it got,
@@ -199,6 +201,8 @@ struct Session {
     runner: Box<dyn DynScene>,
     /// How the scene is drawn and written.
     geometry: Geometry,
+    /// The context's notes ([`anim_core::scene::Context::notes`]).
+    notes: Vec<String>,
     start_frame: usize,
     steps: u64,
     written_times: Vec<f64>,
@@ -278,7 +282,8 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
             _ => e,
         }
     })?;
-    let geometry = Geometry::from_context(&runner.context());
+    let context = runner.context();
+    let geometry = Geometry::from_context(&context);
     let format = args.format.unwrap_or_else(|| geometry.natural_format());
     if !geometry.accepts(format) {
         return Err(if format == OutputFormat::Vti {
@@ -307,6 +312,7 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
         quiet: args.quiet,
         runner,
         geometry,
+        notes: context.notes,
         start_frame: 0,
         steps: 0,
         written_times: Vec::new(),
@@ -345,7 +351,8 @@ fn resumed(args: &ResumeArgs) -> Result<Session, String> {
     }
     let mut runner = scene::build(&file, &ckpt.origin, None).map_err(|e| e.to_string())?;
     runner.restore(&ckpt.runner).map_err(|e| format!("{}: {e}", args.checkpoint.display()))?;
-    let geometry = Geometry::from_context(&runner.context());
+    let context = runner.context();
+    let geometry = Geometry::from_context(&context);
     Ok(Session {
         file,
         origin: ckpt.origin,
@@ -357,6 +364,7 @@ fn resumed(args: &ResumeArgs) -> Result<Session, String> {
         quiet: args.quiet,
         runner,
         geometry,
+        notes: context.notes,
         start_frame: ckpt.frame,
         steps: ckpt.steps,
         written_times: ckpt.written_times,
@@ -395,6 +403,11 @@ impl Session {
 
 fn execute(mut s: Session) -> Result<(), String> {
     let out = s.out.clone();
+    if !s.quiet {
+        for note in &s.notes {
+            println!("note: {note}");
+        }
+    }
     std::fs::create_dir_all(&out)
         .map_err(|e| format!("{}: cannot create output folder: {e}", out.display()))?;
     let run = s.file.run;
@@ -510,6 +523,7 @@ fn execute(mut s: Session) -> Result<(), String> {
         resumed_from_frame: s.resumed.then_some(s.start_frame),
         checkpoints_written: checkpoints,
         files,
+        notes: s.notes.clone(),
     };
     let metrics_path = out.join("metrics.json");
     anim_io::metrics::write_json(&metrics_path, &metrics).map_err(|e| e.to_string())?;

@@ -333,3 +333,40 @@ fn a_broken_mesh_is_refused_naming_the_file_and_element() {
     assert!(!out.exists(), "a refused run wrote {}", out.display());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// What a loader skips reaches the user: a glTF file that uses an extension the skinning
+/// ignores runs, and the run prints a note naming the extension and keeps it in its metrics.
+#[test]
+fn a_gltf_loader_note_is_printed_and_kept_in_the_metrics() {
+    let dir = temp("gltf-note");
+    std::fs::create_dir_all(&dir).unwrap();
+    let skin =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../anim-skin/testdata/skin_embedded.gltf");
+    let mut gltf: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(skin).unwrap()).unwrap();
+    gltf["extensionsUsed"] = serde_json::json!(["KHR_materials_emissive_strength"]);
+    std::fs::write(dir.join("noted.gltf"), gltf.to_string()).unwrap();
+    let scene = dir.join("noted.toml");
+    let text = "name = \"noted\"\n[run]\ndt = 0.05\nframes = 2\n[scene]\nkind = \"skinning\"\nfile = \"noted.gltf\"\nmethod = \"lbs\"\n";
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.join("out");
+    let run = Command::new(env!("CARGO_BIN_EXE_anim"))
+        .args(["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--no-preview"])
+        .output()
+        .expect("the anim binary runs");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        stdout
+            .lines()
+            .any(|l| l.starts_with("note: extension KHR_materials_emissive_strength is used and ignored")),
+        "{stdout}"
+    );
+    let metrics: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    let notes = metrics["notes"].as_array().expect("notes");
+    assert!(
+        notes.len() == 1 && notes[0].as_str().unwrap().contains("KHR_materials_emissive_strength"),
+        "{notes:?}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

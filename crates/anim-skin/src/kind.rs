@@ -337,6 +337,7 @@ impl View for SkinPlayback {
         context.point_dim = 3;
         context.triangles.clone_from(&self.triangles);
         context.bounds = Some(anim_core::scene::frame_box(&state.x, None, false));
+        context.notes.clone_from(&self.scene.warnings);
         context
     }
 

@@ -35,6 +35,10 @@ pub struct Context {
     pub bounds: Option<([f64; 3], [f64; 3])>,
     /// The grid of an image scene (a grid fluid), whose frames hold cell fields and no points.
     pub image: Option<ImageGrid>,
+    /// What the user should know about how the scene was read: parts of an input file that
+    /// were skipped or ignored (a loader's warnings), one sentence each. The `anim` command
+    /// prints them when a run starts and keeps them in its metrics.
+    pub notes: Vec<String>,
 }
 
 /// A thing in the scene that is not simulated but is part of its picture.
