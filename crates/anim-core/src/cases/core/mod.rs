@@ -1,7 +1,9 @@
 //! anim-core's own cases: integrators on the harmonic oscillator and the Kepler orbit, Lie-group
-//! identities, the 3x3 SVD, determinism across thread counts and the Kepler soak run.
+//! identities, the 3x3 SVD, determinism across thread counts, the Kepler soak run, and the
+//! work-precision of a mesh obstacle's distance field.
 
 mod determinism;
+mod distance;
 mod integrators;
 mod lie_svd;
 mod soak;
@@ -111,6 +113,11 @@ pub fn register(r: &mut Registry) {
         crate_name: CRATE,
         name: "integrators on the Kepler orbit",
         run: study::kepler_study,
+    });
+    r.studies.push(Study {
+        crate_name: CRATE,
+        name: "distance field of a mesh obstacle",
+        run: distance::distance_field_study,
     });
     // `anim run --tolerance` picks an integrator for the oscillator and Kepler kinds from these.
     r.study_uses.push(StudyUse::scene("core-oscillator", "harmonic-oscillator", Some(OSCILLATOR_HORIZON)));
