@@ -17,7 +17,8 @@
 //! with a `.pvd` series for meshes, VTK `.vti` image data with a `.pvd` for fluid grids (cell
 //! fields `density` and `velocity`), `frames.csv` for systems of a few unknowns) or the one asked
 //! for, `preview.gif` (and `preview.png`, the last frame; fluids show their density), and
-//! `metrics.json`.
+//! `metrics.json`. Ctrl-C finishes the frame being stepped and then the folder (`"status":
+//! "interrupted"` in the metrics, exit status 130); a second Ctrl-C quits at once.
 
 use anim_cli::run::{self, ResumeArgs, RunArgs};
 use anim_cli::scene;
@@ -84,17 +85,19 @@ fn main() -> ExitCode {
             print!("{}", builtin_listing());
             ExitCode::SUCCESS
         }
-        Command::Run(args) => finish(run::run(&args)),
-        Command::Resume(args) => finish(run::resume(&args)),
+        Command::Run(args) => finish(run::stop_on_interrupt().and_then(|()| run::run(&args))),
+        Command::Resume(args) => finish(run::stop_on_interrupt().and_then(|()| run::resume(&args))),
     }
 }
 
+/// Exit status 0 for a finished run, 130 (as a shell reports SIGINT) for one stopped by Ctrl-C,
+/// 1 for any other error.
 fn finish(result: Result<(), String>) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
-            ExitCode::FAILURE
+            if run::interrupted() { ExitCode::from(130) } else { ExitCode::FAILURE }
         }
     }
 }

@@ -61,7 +61,9 @@ impl Writer {
     fn finish(self) -> Result<Vec<String>, String> {
         let mut files = Vec::new();
         if let Some(frames) = &self.frames {
-            let n = frames.sequence().frames().len();
+            // The frames in this folder (a run resumed into a new folder has only its own).
+            let sequence = frames.sequence();
+            let n = sequence.frames().iter().filter(|(_, f)| sequence.dir().join(f).is_file()).count();
             match frames.finish().map_err(|e| e.to_string())? {
                 Some(pvd) => files.push(format!("{} ({n} frames)", pvd.display())),
                 None => files.push(format!(

@@ -9,6 +9,7 @@ use anim_core::scene::{DynScene, Frame};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 /// `anim resume`: continue a checkpointed run.
@@ -438,7 +439,12 @@ fn execute(mut s: Session) -> Result<(), String> {
     let mut checkpoints = 0usize;
     let mut table_error: Option<(f64, f64)> = None;
     let mut max_residual: Option<f64> = None;
+    let mut interrupted = None;
     'frames: for frame in s.start_frame..run.frames {
+        if interrupts() > 0 {
+            interrupted = Some(frame);
+            break;
+        }
         let t_step = Instant::now();
         for _ in 0..run.steps_per_frame {
             match s.runner.step(run.dt) {
@@ -475,12 +481,17 @@ fn execute(mut s: Session) -> Result<(), String> {
         if writes_files && frame.is_multiple_of(s.stride) {
             s.written_times.push(s.runner.time());
         }
+        let stopping = interrupts() > 0 && frame + 1 < run.frames;
         if let Some(every) = s.checkpoint_every
-            && (frame + 1).is_multiple_of(every)
+            && ((frame + 1).is_multiple_of(every) || stopping)
             && frame + 1 < run.frames
         {
             s.checkpoint(frame + 1)?;
             checkpoints += 1;
+        }
+        if stopping {
+            interrupted = Some(frame + 1);
+            break;
         }
         if !s.quiet && !bar_shown && start.elapsed() > Duration::from_secs(1) {
             bar.set_draw_target(ProgressDrawTarget::stderr());
@@ -500,7 +511,11 @@ fn execute(mut s: Session) -> Result<(), String> {
         scene: s.file.name.clone(),
         system: s.file.scene.system(),
         method: s.runner.method(),
-        status: failure.clone().map_or_else(|| "completed".into(), |f| format!("diverged at {f}")),
+        status: match (&failure, interrupted) {
+            (Some(f), _) => format!("diverged at {f}"),
+            (None, Some(_)) => "interrupted".into(),
+            (None, None) => "completed".into(),
+        },
         dt: run.dt,
         steps: s.steps,
         frames: run.frames,
@@ -561,12 +576,50 @@ fn execute(mut s: Session) -> Result<(), String> {
         }
         println!("  wrote {}", metrics_path.display());
     }
-    match failure {
-        Some(f) => {
+    match (failure, interrupted) {
+        (Some(f), _) => {
             Err(format!("simulation diverged at {f} (frames up to the failure and metrics were written)"))
         }
-        None => Ok(()),
+        (None, Some(done)) => Err(format!(
+            "interrupted after frame {done} of {} (its frames, preview and metrics were written{})",
+            run.frames,
+            if s.checkpoint_every.is_some() { ", and a checkpoint to resume from" } else { "" }
+        )),
+        (None, None) => Ok(()),
     }
+}
+
+/// How many interrupt signals (Ctrl-C) the process has had since
+/// [`stop_on_interrupt`] was called.
+static INTERRUPTS: AtomicUsize = AtomicUsize::new(0);
+
+fn interrupts() -> usize {
+    INTERRUPTS.load(Ordering::Relaxed)
+}
+
+/// Whether the process was interrupted (Ctrl-C) during a run.
+#[must_use]
+pub fn interrupted() -> bool {
+    interrupts() > 0
+}
+
+/// Makes Ctrl-C (SIGINT, and SIGTERM) end a run cleanly: the frame being stepped is finished,
+/// then the folder is completed as after the last frame (the frame series and its `.pvd`, the
+/// preview of the frames so far, `metrics.json` with `"status": "interrupted"`, and a
+/// checkpoint to resume from when `--checkpoint-every` was given), and [`run`] returns an error
+/// saying so. A second Ctrl-C quits at once (exit status 130).
+///
+/// # Errors
+/// The handler could not be installed (one was installed before).
+pub fn stop_on_interrupt() -> Result<(), String> {
+    ctrlc::set_handler(|| {
+        if INTERRUPTS.fetch_add(1, Ordering::Relaxed) == 0 {
+            eprintln!("\ninterrupted: finishing the current frame and the output folder (Ctrl-C again to quit at once)");
+        } else {
+            std::process::exit(130);
+        }
+    })
+    .map_err(|e| format!("cannot handle Ctrl-C: {e}"))
 }
 
 /// Runs the scene `args` names and writes its output.

@@ -133,3 +133,53 @@ fn damaged_or_foreign_checkpoints_are_clear_errors() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Ctrl-C ends a run cleanly: the frame being stepped is finished, the folder completed (every
+/// file the `.pvd` lists exists, the preview and metrics with status "interrupted" are
+/// written, and a checkpoint since `--checkpoint-every` was given), the exit status is 130, and
+/// the checkpoint resumes.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_run_finishes_its_folder_and_resumes() {
+    let dir = std::env::temp_dir().join(format!("anim-cli-interrupt-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_anim"))
+        .args(["run", "cloth", "--frames", "1000000", "--checkpoint-every", "1000000", "--quiet"])
+        .arg("--out")
+        .arg(&dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the anim binary runs");
+    // Wait for a few frames, then interrupt.
+    let pvd_dir = dir.join("frames");
+    let start = std::time::Instant::now();
+    while std::fs::read_dir(&pvd_dir).map_or(0, |d| d.count()) < 3 {
+        assert!(start.elapsed().as_secs() < 120, "no frames written");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let kill = std::process::Command::new("kill").args(["-INT", &child.id().to_string()]).status();
+    assert!(kill.is_ok_and(|s| s.success()));
+    let out = child.wait_with_output().expect("the run ends");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted after frame"), "{stderr}");
+    let metrics: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(metrics["status"], "interrupted");
+    let pvd = std::fs::read_to_string(pvd_dir.join("frames.pvd")).unwrap();
+    let listed: Vec<&str> = pvd.split("file=\"").skip(1).filter_map(|s| s.split('"').next()).collect();
+    assert!(listed.len() >= 3, "{pvd}");
+    assert!(listed.iter().all(|f| pvd_dir.join(f).is_file()), "{listed:?}");
+    assert!(dir.join("preview.png").is_file() && dir.join("checkpoint.anim").is_file());
+    // The checkpoint is at the last frame written: resuming for two more frames adds two files.
+    let resumed = std::process::Command::new(env!("CARGO_BIN_EXE_anim"))
+        .arg("resume")
+        .arg(dir.join("checkpoint.anim"))
+        .args(["--frames", &(listed.len() + 2).to_string(), "--quiet"])
+        .output()
+        .expect("resume runs");
+    assert!(resumed.status.success(), "{}", String::from_utf8_lossy(&resumed.stderr));
+    let pvd = std::fs::read_to_string(pvd_dir.join("frames.pvd")).unwrap();
+    assert_eq!(pvd.matches("file=\"").count(), listed.len() + 2, "{pvd}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -59,10 +59,14 @@ impl FrameSequence {
         &self.dir
     }
 
-    /// Writes `dir/{name}` as a `.pvd` collection of the frames so far and returns its path.
+    /// Writes `dir/{name}` as a `.pvd` collection of the frames so far whose files are in the
+    /// folder, and returns its path. A run resumed into another folder thus lists the frames it
+    /// wrote there, not the earlier ones left in the first folder.
     pub fn write_pvd(&self, name: &str) -> Result<PathBuf, IoError> {
         let path = self.dir.join(name);
-        write_pvd(&path, &self.frames)?;
+        let present: Vec<(f64, PathBuf)> =
+            self.frames.iter().filter(|(_, file)| self.dir.join(file).is_file()).cloned().collect();
+        write_pvd(&path, &present)?;
         Ok(path)
     }
 }
@@ -299,6 +303,18 @@ mod tests {
             text.contains("file=\"frame_00000.vtu\"") && text.contains("file=\"frame_00002.vtu\""),
             "{text}"
         );
+        // Resumed into another folder: its .pvd lists only the frame written there.
+        let other = tmp("vtu-elsewhere");
+        let mut w = FrameWriter::continuing(&other, FrameFormat::Vtu, &[0.0, 0.25]).unwrap();
+        w.write(0.5, &UnstructuredGrid::new(&pts).tetrahedra(&tets)).unwrap();
+        let text = std::fs::read_to_string(w.finish().unwrap().unwrap()).unwrap();
+        assert!(
+            text.contains("file=\"frame_00002.vtu\"")
+                && !text.contains("frame_00000")
+                && !text.contains("frame_00001"),
+            "{text}"
+        );
+        std::fs::remove_dir_all(other).unwrap();
         assert_eq!("PLY".parse::<FrameFormat>(), Ok(FrameFormat::Ply));
         assert_eq!("vti".parse::<FrameFormat>(), Ok(FrameFormat::Vti));
         assert!("stl".parse::<FrameFormat>().is_err());
