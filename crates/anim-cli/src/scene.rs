@@ -283,16 +283,29 @@ fn is_header(line: &str) -> bool {
 /// Byte offset of the line assigning `name` in the table whose header line starts at `header`,
 /// before the next table.
 fn field_in_table(text: &str, header: usize, name: &str) -> Option<usize> {
-    let mut offset = header;
-    for (n, line) in text[header..].split_inclusive('\n').enumerate() {
-        let trimmed = line.trim_start();
-        if n > 0 && is_header(line) {
+    assignment(text, header, name, true)
+}
+
+/// Byte offset of the first line assigning `name` (`name = ...`, indented or not; the offset of
+/// the key) among the lines of `text` from the one holding byte `from` on; with `table`, `from`
+/// is on a table's header line and the search ends at the next table header.
+fn assignment(text: &str, from: usize, name: &str, table: bool) -> Option<usize> {
+    let mut offset = 0;
+    let mut first = true;
+    for line in text.split_inclusive('\n') {
+        let start = offset;
+        offset += line.len();
+        if offset <= from {
+            continue;
+        }
+        if table && !first && is_header(line) {
             return None;
         }
-        if n > 0 && trimmed.strip_prefix(name).is_some_and(|r| r.trim_start().starts_with('=')) {
-            return Some(offset + (line.len() - trimmed.len()));
+        first = false;
+        let trimmed = line.trim_start();
+        if trimmed.strip_prefix(name).is_some_and(|r| r.trim_start().starts_with('=')) {
+            return Some(start + (line.len() - trimmed.len()));
         }
-        offset += line.len();
     }
     None
 }
@@ -303,19 +316,9 @@ fn unknown_field(message: &str) -> Option<&str> {
     Some(rest.split_once('`')?.0)
 }
 
-/// Byte offset of the first line at or after `from` that assigns `name`.
+/// Byte offset of the first line, from the one holding byte `from` on, that assigns `name`.
 fn field_offset(text: &str, from: usize, name: &str) -> Option<usize> {
-    let mut offset = 0;
-    for line in text.split_inclusive('\n') {
-        let trimmed = line.trim_start();
-        if offset >= from.saturating_sub(line.len())
-            && trimmed.strip_prefix(name).is_some_and(|r| r.trim_start().starts_with('='))
-        {
-            return Some(offset + (line.len() - trimmed.len()));
-        }
-        offset += line.len();
-    }
-    None
+    assignment(text, from, name, false)
 }
 
 fn line_col(text: &str, offset: usize) -> (usize, usize) {

@@ -293,6 +293,32 @@ pub fn closest_point_on_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> (DVec3, [f6
     (a + ab * v + ac * u, [1.0 - v - u, v, u])
 }
 
+/// Six times the signed volume of the tetrahedron `(a, b, c, d)`: the triple product
+/// `(b - a) . ((c - a) x (d - a))`, positive when `d` is on the side of the triangle `(a, b, c)`
+/// its counter-clockwise normal points to, zero for a flat one.
+///
+/// ```
+/// use anim_core::geometry::tet_signed_volume6;
+/// use anim_core::glam::DVec3;
+///
+/// let [o, x, y, z] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// assert_eq!(tet_signed_volume6(o, x, y, z), 1.0);
+/// assert_eq!(tet_signed_volume6(o, y, x, z), -1.0);
+/// assert_eq!(tet_signed_volume6(o, x, y, [0.3, 0.7, 0.0]), 0.0);
+/// // The same bits as glam's dot and cross products, term for term.
+/// let p = [[0.1, -0.7, 0.3], [1.3, 0.2, -0.4], [-0.6, 0.9, 0.8], [0.4, 0.3, 1.7]];
+/// let [a, b, c, d] = p.map(DVec3::from_array);
+/// assert_eq!(tet_signed_volume6(p[0], p[1], p[2], p[3]).to_bits(), (b - a).dot((c - a).cross(d - a)).to_bits());
+/// ```
+#[inline]
+#[must_use]
+pub fn tet_signed_volume6(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
+    let sub = |p: [f64; 3]| [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
+    let (u, v, w) = (sub(b), sub(c), sub(d));
+    u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+        + u[2] * (v[0] * w[1] - v[1] * w[0])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -29,7 +29,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::body::{BodyError, BodySpec, Budget, finite3};
+use crate::body::{BodyError, BodySpec, Budget, finite3, pin_error};
 use crate::boundary::Obstacle;
 use crate::mesh::TetMesh;
 use crate::model::{EARTH_GRAVITY, ElementOrder, FemModel};
@@ -179,20 +179,10 @@ fn build_within(
         let field = || format!("bodies[{k}].pin");
         model.pin_vertices(listed).map_err(|e| BodyError::new(field(), e))?;
         if let Some(region) = body.pin.as_ref().and_then(|p| p.region) {
-            let inside: Vec<usize> = (0..model.vertices())
-                .filter(|&i| owner[i] == k && region.contains(model.mesh().positions[i]))
-                .collect();
-            if inside.is_empty() {
-                return Err(BodyError::new(
-                    field(),
-                    format!(
-                        "the box from {:?} to {:?} holds no vertex of body {k} ({}) after its placement",
-                        region.min,
-                        region.max,
-                        body.mesh.display()
-                    ),
-                ));
-            }
+            let of = format!("body {k} ({})", body.mesh.display());
+            let inside = region
+                .select(&model.mesh().positions, &of, |i| owner[i] == k)
+                .map_err(|e| pin_error(field(), &e))?;
             model.pin_vertices(&inside).map_err(|e| BodyError::new(field(), e))?;
         }
     }

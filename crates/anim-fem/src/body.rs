@@ -56,7 +56,7 @@ fn default_model() -> MaterialModel {
 
 /// The pinned vertices of a body, spelled as in every kind: `vertices` (indices of the mesh
 /// file's vertices) and a `box` (the vertices inside or on it, after the placement).
-pub use anim_core::scene::{PinBox, PinSpec};
+pub use anim_core::scene::{PinBox, PinError, PinSpec};
 
 /// A body from a mesh file. Every field but `mesh` and `material` has a default; `cell` is
 /// required for an OBJ surface and refused for a tetrahedral mesh.
@@ -235,7 +235,7 @@ impl BodySpec {
             .map_err(|e| BodyError::new("material", e))?;
         finite3("velocity", self.velocity)?;
         if let Some(pin) = &self.pin {
-            check_pin(pin)?;
+            pin.check().map_err(|e| pin_error("pin", &e))?;
         }
         let (mut tets, source) = if is_obj(mesh) {
             let Some(cell) = self.cell else {
@@ -287,7 +287,7 @@ impl BodySpec {
             (tets, mesh.display().to_string())
         };
         let pinned = match &self.pin {
-            Some(pin) => pinned_vertices(&pin.vertices, &tets, &mesh.display().to_string())?,
+            Some(pin) => pinned_vertices(pin, &tets, &mesh.display().to_string())?,
             None => Vec::new(),
         };
         placement.apply_all(&mut tets.positions);
@@ -297,47 +297,28 @@ impl BodySpec {
     }
 }
 
-/// Checks a `pin` table on its own: something to pin, a box with finite corners and `min <= max`.
-fn check_pin(pin: &PinSpec) -> Result<(), BodyError> {
-    match pin.region {
-        None if pin.vertices.is_empty() => {
-            Err(BodyError::new("pin", "pins nothing: give `vertices`, a `box` or both"))
-        }
-        Some(b) if !b.is_valid() => Err(BodyError::new(
-            "pin",
-            format!(
-                "the box needs finite corners with min <= max on every axis, got min {:?}, max {:?}",
-                b.min, b.max
-            ),
-        )),
-        _ => Ok(()),
+/// A refusal of the `pin` table, as a [`BodyError`] of `field`; a table that pins nothing says
+/// so first.
+pub(crate) fn pin_error(field: impl Into<String>, e: &PinError) -> BodyError {
+    match e {
+        PinError::Nothing => BodyError::new(field, format!("pins nothing: {e}")),
+        e => BodyError::new(field, e),
     }
 }
 
-/// The vertices `listed` of the mesh read from `file`, checked in range and in an element.
-fn pinned_vertices(listed: &[usize], mesh: &TetMesh, file: &str) -> Result<Vec<usize>, BodyError> {
-    if listed.is_empty() {
-        return Ok(Vec::new());
+/// The listed vertices of `pin` of the mesh read from `file`, checked in range and in an element.
+fn pinned_vertices(pin: &PinSpec, mesh: &TetMesh, file: &str) -> Result<Vec<usize>, BodyError> {
+    let pinned = pin.listed(mesh.positions.len(), file).map_err(|e| pin_error("pin", &e))?;
+    if pinned.is_empty() {
+        return Ok(pinned);
     }
-    let n = mesh.positions.len();
-    let mut used = vec![false; n];
+    let mut used = vec![false; mesh.positions.len()];
     for &v in mesh.tets.iter().flatten() {
         used[v] = true;
     }
-    let mut pinned = listed.to_vec();
-    for &i in &pinned {
-        if i >= n {
-            return Err(BodyError::new(
-                "pin",
-                format!("vertex {i} is out of range: {file} has {n} vertices (0 to {})", n.saturating_sub(1)),
-            ));
-        }
-        if !used[i] {
-            return Err(BodyError::new("pin", format!("vertex {i} of {file} belongs to no tetrahedron")));
-        }
+    if let Some(i) = pinned.iter().find(|&&i| !used[i]) {
+        return Err(BodyError::new("pin", format!("vertex {i} of {file} belongs to no tetrahedron")));
     }
-    pinned.sort_unstable();
-    pinned.dedup();
     Ok(pinned)
 }
 

@@ -14,16 +14,9 @@ use std::path::Path;
 /// `|6 V| <= DEGENERACY * (longest edge)^3` (a regular tetrahedron has `6 V / l^3 = 0.707`).
 pub const DEGENERACY: f64 = 1e-12;
 
-/// Six times the signed volume of the tetrahedron `(a, b, c, d)`.
-#[inline]
-#[must_use]
-pub fn signed_volume6(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
-    let u = sub(b, a);
-    let v = sub(c, a);
-    let w = sub(d, a);
-    u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
-        + u[2] * (v[0] * w[1] - v[1] * w[0])
-}
+/// Six times the signed volume of the tetrahedron `(a, b, c, d)` (anim-core's
+/// [`tet_signed_volume6`](anim_core::geometry::tet_signed_volume6)).
+pub use anim_core::geometry::tet_signed_volume6 as signed_volume6;
 
 #[inline]
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {

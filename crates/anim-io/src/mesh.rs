@@ -112,6 +112,13 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+/// Six times the signed volume of the tetrahedron `p` (anim-io depends on no crate of the
+/// workspace; anim-core's `geometry::tet_signed_volume6` is the same triple product, its terms in
+/// another order).
+fn volume6([a, b, c, d]: [[f64; 3]; 4]) -> f64 {
+    dot(cross(sub(b, a), sub(c, a)), sub(d, a))
+}
+
 fn norm2(a: [f64; 3]) -> f64 {
     dot(a, a)
 }
@@ -186,13 +193,12 @@ impl TetMesh {
     /// names a vertex that does not exist.
     pub fn signed_volume6(&self, e: usize) -> Option<f64> {
         let t = self.tets.get(e)?;
-        let [a, b, c, d] = [
+        Some(volume6([
             *self.positions.get(t[0])?,
             *self.positions.get(t[1])?,
             *self.positions.get(t[2])?,
             *self.positions.get(t[3])?,
-        ];
-        Some(dot(cross(sub(b, a), sub(c, a)), sub(d, a)))
+        ]))
     }
 
     /// Checks every tetrahedron: indices in range, non-zero volume, positive orientation; and
@@ -220,7 +226,7 @@ impl TetMesh {
                     l2 = l2.max(norm2(sub(p[j], p[i])));
                 }
             }
-            let v6 = dot(cross(sub(p[1], p[0]), sub(p[2], p[0])), sub(p[3], p[0]));
+            let v6 = volume6(p);
             if v6.abs() <= DEGENERACY_TOLERANCE * l2 * l2.sqrt() {
                 r.degenerate.push(e);
             } else if v6 < 0.0 {

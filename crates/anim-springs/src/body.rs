@@ -69,7 +69,7 @@ pub struct MaterialSpec {
     pub bending_damping: f64,
 }
 
-pub use anim_core::scene::{PinBox, PinSpec};
+pub use anim_core::scene::{PinBox, PinError, PinSpec};
 
 /// A cloth or shell from an OBJ triangle surface. Every field but `mesh` and `material` has a
 /// default.
@@ -309,51 +309,25 @@ fn add_body(
     Ok(pins)
 }
 
-/// The vertices `pin` holds: the listed ones (checked against the vertex count) and those in
-/// its box (which must hold one), sorted and without repeats.
+/// The vertices `pin` holds ([`PinSpec::resolve`]), its refusal on `field` or the part of the
+/// table at fault (`pin.vertices[k]`, `pin.box`).
 fn pinned_vertices(
     pin: &PinSpec,
     positions: &[[f64; 3]],
     field: &str,
     file: &str,
 ) -> Result<Vec<usize>, SceneError> {
-    let n = positions.len();
-    if pin.vertices.is_empty() && pin.region.is_none() {
-        return Err(SceneError::invalid(field, "give `vertices`, `box` or both"));
-    }
-    let mut pins = Vec::new();
-    for (k, &v) in pin.vertices.iter().enumerate() {
-        if v >= n {
-            return Err(SceneError::invalid(
-                format!("{field}.vertices[{k}]"),
-                format!(
-                    "vertex {v} does not exist: {file} has {n} vertices (0-based indices 0 to {})",
-                    n - 1
-                ),
-            ));
-        }
-        pins.push(v);
-    }
-    if let Some(region) = pin.region {
-        let PinBox { min, max } = region;
-        if !region.is_valid() {
-            return Err(SceneError::invalid(
-                format!("{field}.box"),
-                format!("min {min:?} and max {max:?} must be finite with min <= max on every axis"),
-            ));
-        }
-        let before = pins.len();
-        pins.extend(positions.iter().enumerate().filter(|(_, p)| region.contains(**p)).map(|(v, _)| v));
-        if pins.len() == before {
-            return Err(SceneError::invalid(
-                field,
-                format!("the box from {min:?} to {max:?} holds no vertex of {file} as placed"),
-            ));
-        }
-    }
-    pins.sort_unstable();
-    pins.dedup();
-    Ok(pins)
+    pin.resolve(positions, file).map_err(|e| {
+        let field = e.field().map_or_else(|| field.to_string(), |part| format!("{field}.{part}"));
+        let message = match e {
+            PinError::OutOfRange { vertex, count, .. } => format!(
+                "vertex {vertex} does not exist: {file} has {count} vertices (0-based indices 0 to {})",
+                count.saturating_sub(1)
+            ),
+            e => e.to_string(),
+        };
+        SceneError::invalid(field, message)
+    })
 }
 
 fn check_contact(c: &ContactSpec) -> Result<(), SceneError> {

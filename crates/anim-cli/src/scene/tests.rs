@@ -175,3 +175,28 @@ mesh = "c.msh"
     assert_eq!(line("bodies[3].mesh"), None);
     assert_eq!(line("gravity"), None);
 }
+
+/// The line scanner both lookups share: a key's own line (not a longer key's, nor an earlier
+/// line's), indented or not; from a table header it stops at the next table, from any other byte
+/// it reads on.
+#[test]
+fn a_key_is_found_on_its_own_line_from_the_line_holding_the_start() {
+    let text = "[scene.robot]\nkind = \"a\"\n[scene]\nkinds = 1\n  kind= \"b\"\n[scene.x]\nspeed = 2\n";
+    let line = |at: Option<usize>| at.map(|at| line_col(text, at));
+    let scene = table_header(text, "scene").expect("header");
+    // From the header of [scene], not the `kind` of the line before it, nor `kinds`.
+    assert_eq!(line(field_in_table(text, scene, "kind")), Some((5, 3)));
+    assert_eq!(line(field_offset(text, scene, "kind")), Some((5, 3)));
+    // A table's search ends at the next table; the other reads on.
+    assert_eq!(field_in_table(text, scene, "speed"), None);
+    assert_eq!(line(field_offset(text, scene, "speed")), Some((7, 1)));
+    // From the middle of a line, that line is read.
+    let mid = text.find("= \"a\"").expect("value");
+    assert_eq!(line(field_offset(text, mid, "kind")), Some((2, 1)));
+    // The unknown kind of such a file is refused on its own line.
+    let file = KEPLER
+        .replace("[scene]\nkind = \"kepler-orbit\"", "[scene.robot]\nkind = \"a\"\n[scene]\nkind = \"warp\"");
+    let msg = err(&file);
+    let kind = file.lines().position(|l| l == "kind = \"warp\"").expect("kind") + 1;
+    assert!(msg.starts_with(&format!("s.toml:{kind}:")), "expected line {kind}: {msg}");
+}

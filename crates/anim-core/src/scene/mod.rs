@@ -56,7 +56,7 @@ pub use checkpoint::{
 };
 pub use dynamic::{DynScene, Simulated, StepError};
 pub use looped::Looped;
-pub use pin::{PinBox, PinSpec};
+pub use pin::{PinBox, PinError, PinSpec};
 pub use placement::{ObstacleMesh, Placement, is_unit_scale, unit_scale};
 pub use preset::{BuildContext, BuildError, BuildFn, Preset, RunDefaults, SceneKind, is_default, params};
 pub use view::{Context, Field, Frame, ImageGrid, MeshProp, Prop, View, frame_box, ground_height};

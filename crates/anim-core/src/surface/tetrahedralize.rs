@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 
 use super::{ClosedSurface, SurfaceError, Tetrahedra};
-use crate::geometry::closest_point_on_triangle;
+use crate::geometry::{closest_point_on_triangle, tet_signed_volume6};
 
 /// The most lattice cubes a mesh may span.
 pub(super) const MAX_CUBES: usize = 1 << 21;
@@ -83,8 +83,8 @@ pub(super) fn mesh(s: &ClosedSurface, cell: f64) -> Result<Tetrahedra, SurfaceEr
 
 /// Six times the signed volume of a tetrahedron.
 fn volume6(p: &[DVec3], t: [usize; 4]) -> f64 {
-    let [a, b, c, d] = t.map(|i| p[i]);
-    (b - a).dot((c - a).cross(d - a))
+    let [a, b, c, d] = t.map(|i| p[i].to_array());
+    tet_signed_volume6(a, b, c, d)
 }
 
 /// Moves each boundary vertex onto the surface, or 3/4, 1/2 or 1/4 of the way, or leaves it,

@@ -395,58 +395,21 @@ impl BodySpec {
     ) -> Result<Vec<usize>, BuildError> {
         let Some(pin) = &self.pin else { return Ok(Vec::new()) };
         let fail = |m: String| BuildError::invalid(format!("bodies[{k}].pin"), m);
-        if pin.vertices.is_empty() && pin.region.is_none() {
-            return Err(fail("give `vertices`, `box` or both".into()));
+        if file_vertices.is_none() && !pin.vertices.is_empty() {
+            return Err(fail(format!(
+                "`vertices` name vertices of the mesh file, but a soft body tetrahedralised from {file} has \
+                 vertices of its own: pin it with a `box`"
+            )));
         }
-        let mut out = Vec::new();
-        if !pin.vertices.is_empty() {
-            let Some(n) = file_vertices else {
-                return Err(fail(format!(
-                    "`vertices` name vertices of the mesh file, but a soft body tetrahedralised from {file} has \
-                     vertices of its own: pin it with a `box`"
-                )));
-            };
-            for &i in &pin.vertices {
-                if i >= n {
-                    return Err(fail(format!(
-                        "vertex {i} is out of range: {file} has {n} vertices (0 to {})",
-                        n.saturating_sub(1)
-                    )));
-                }
-                match map[i] {
-                    Some(v) => out.push(v),
-                    None => {
-                        return Err(fail(format!("vertex {i} of {file} belongs to no element of the body")));
-                    }
-                }
-            }
-        }
-        if let Some(bx) = pin.region {
-            if !bx.is_valid() {
-                return Err(fail(format!(
-                    "the box needs finite corners with min <= max on every axis, got min {:?}, max {:?}",
-                    bx.min, bx.max
-                )));
-            }
-            let before = out.len();
-            out.extend(
-                positions
-                    .iter()
-                    .zip(map)
-                    .filter(|(p, m)| m.is_some() && bx.contains(**p))
-                    .filter_map(|(_, m)| *m),
-            );
-            if out.len() == before {
-                let (lo, hi) = bounds(positions, map);
-                return Err(fail(format!(
-                    "the box from {:?} to {:?} holds no vertex of the body (placed, it spans {lo:?} to {hi:?})",
-                    bx.min, bx.max
-                )));
-            }
-        }
-        out.sort_unstable();
-        out.dedup();
-        Ok(out)
+        let pinned =
+            pin.resolve_among(positions, file, |i| map[i].is_some()).map_err(|e| fail(e.to_string()))?;
+        // The box took used vertices only; a listed one may be unused.
+        pinned
+            .iter()
+            .map(|&i| {
+                map[i].ok_or_else(|| fail(format!("vertex {i} of {file} belongs to no element of the body")))
+            })
+            .collect()
     }
 }
 
