@@ -140,7 +140,10 @@ struct Metrics {
     output_seconds: f64,
     output_fraction: f64,
     writer_busy_seconds: f64,
+    /// Steps over the run's wall-clock time (stepping and the output it could not hide).
     steps_per_second: f64,
+    /// Steps over the time spent stepping alone.
+    stepping_steps_per_second: f64,
     energy_initial: Option<f64>,
     energy_final: Option<f64>,
     relative_energy_change: Option<f64>,
@@ -248,10 +251,12 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
     for arg in &args.set {
         set_param(&mut file, arg)?;
     }
+    let mut default_scene = None;
     if let Some(tol) = args.tolerance {
         if args.dt.is_some() {
             return Err("give --dt or --tolerance, not both (--tolerance picks the step)".into());
         }
+        default_scene = Some(file.clone());
         let choice = tolerance::choose(&mut file, tol, &tolerance::table()?)?;
         if let Some(r) = args.resolution {
             // The scene had resolution r before the pick (set above); putting it back changes
@@ -283,6 +288,12 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
             _ => e,
         }
     })?;
+    let mut runner = runner;
+    if let Some(default) = default_scene
+        && !args.quiet
+    {
+        compare_with_default(&default, &file, &origin, runner.as_mut());
+    }
     let context = runner.context();
     let geometry = Geometry::from_context(&context);
     let format = args.format.unwrap_or_else(|| geometry.natural_format());
@@ -526,7 +537,8 @@ fn execute(mut s: Session) -> Result<(), String> {
         output_seconds,
         output_fraction: output_seconds / wall.max(1e-12),
         writer_busy_seconds: writer_seconds,
-        steps_per_second: steps_here as f64 / step_seconds.max(1e-12),
+        steps_per_second: steps_here as f64 / wall.max(1e-12),
+        stepping_steps_per_second: steps_here as f64 / step_seconds.max(1e-12),
         energy_initial: energy0,
         energy_final: energy,
         relative_energy_change: energy0.zip(energy).map(|(e0, e)| (e - e0) / e0.abs().max(f64::MIN_POSITIVE)),
@@ -547,13 +559,14 @@ fn execute(mut s: Session) -> Result<(), String> {
             println!("resumed at frame {f} (step {first_step})");
         }
         println!(
-            "{}: {} steps of {} s with {} in {:.2} s ({:.0} steps/s); output {:.0}% of the time",
+            "{}: {} steps of {} s with {} in {:.2} s ({:.0} steps/s, {:.0} stepping alone); output {:.0}% of the time",
             metrics.scene,
             steps_here,
             metrics.dt,
             metrics.method,
             wall,
             metrics.steps_per_second,
+            metrics.stepping_steps_per_second,
             100.0 * metrics.output_fraction
         );
         if let Some(d) = metrics.relative_energy_change {
@@ -562,11 +575,16 @@ fn execute(mut s: Session) -> Result<(), String> {
         if let Some(e) = metrics.max_error_vs_exact {
             println!("  max error against the exact solution {e:.3e}");
         }
-        if let (Some(tol), Some((last, max))) = (s.tolerance, table_error) {
-            println!(
+        match (s.tolerance, table_error) {
+            (Some(tol), Some((last, max))) => println!(
                 "  error on the table's measure: final {last:.3e}, max over the frames {max:.3e}; tolerance {tol:e} {}",
                 if last <= tol { "met" } else { "NOT met" }
-            );
+            ),
+            (Some(_), None) => println!(
+                "  error on the table's measure: not measured (this scene carries no reference for it; the \
+                 study's error at the picked point is the estimate)"
+            ),
+            _ => {}
         }
         for f in &metrics.files {
             println!("  wrote {f}");
@@ -586,6 +604,63 @@ fn execute(mut s: Session) -> Result<(), String> {
             if s.checkpoint_every.is_some() { ", and a checkpoint to resume from" } else { "" }
         )),
         (None, None) => Ok(()),
+    }
+}
+
+/// Seconds a frame of `runner` takes, measured on its first steps after one untimed step (which
+/// pays one-time setup such as a factorisation's analysis): at most a frame's steps, and no
+/// more once 0.2 s have passed. The runner is then restored to where it was (its checkpoint
+/// contract: bit for bit). `None` when a step or the restore fails.
+fn seconds_per_frame(runner: &mut dyn DynScene, dt: f64, steps_per_frame: usize) -> Option<f64> {
+    let saved = runner.save();
+    runner.step(dt).ok()?;
+    let start = Instant::now();
+    let mut steps = 0;
+    while steps < steps_per_frame && (steps == 0 || start.elapsed() < Duration::from_millis(200)) {
+        runner.step(dt).ok()?;
+        steps += 1;
+    }
+    let per_step = start.elapsed().as_secs_f64() / steps as f64;
+    runner.restore(&saved).ok()?;
+    Some(per_step * steps_per_frame as f64)
+}
+
+/// Prints how the cost of a frame with the method `--tolerance` picked compares with the
+/// scene's own method (both measured here, on a few steps), and a warning when the pick is more
+/// than 5 times slower.
+fn compare_with_default(default: &SceneFile, picked: &SceneFile, origin: &Path, runner: &mut dyn DynScene) {
+    let measured = scene::build(default, origin, None).ok().and_then(|mut d| {
+        let base = seconds_per_frame(d.as_mut(), default.run.dt, default.run.steps_per_frame)?;
+        let pick = seconds_per_frame(runner, picked.run.dt, picked.run.steps_per_frame)?;
+        Some((pick, base))
+    });
+    match measured {
+        Some((pick, base)) if pick > 5.0 * base => eprintln!(
+            "warning: --tolerance: a frame with the picked method takes about {:.0}x the time of the scene's \
+             own method ({} against {} per frame, measured on a few steps)",
+            pick / base,
+            seconds(pick),
+            seconds(base)
+        ),
+        Some((pick, base)) => println!(
+            "--tolerance: a frame takes {} with the picked method, {} with the scene's own (measured on a few steps)",
+            seconds(pick),
+            seconds(base)
+        ),
+        None => {
+            println!("--tolerance: the cost against the scene's own method was not measured (a step failed)")
+        }
+    }
+}
+
+/// A duration for people: `1.2 s`, `35 ms`, `120 us`.
+fn seconds(s: f64) -> String {
+    if s >= 1.0 {
+        format!("{s:.1} s")
+    } else if s >= 1e-3 {
+        format!("{:.0} ms", s * 1e3)
+    } else {
+        format!("{:.0} us", s * 1e6)
     }
 }
 

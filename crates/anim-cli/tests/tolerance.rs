@@ -141,6 +141,13 @@ fn the_beam_and_the_cloth_run_the_picked_method_to_the_end() {
         let m = metrics(&dir);
         assert_eq!(m["status"], "completed", "{scene}");
         assert!(m["tolerance_error_final"].is_null(), "{scene}: no reference, no error");
+        // Said so, and the pick's cost measured against the scene's own method.
+        assert!(stdout.contains("error on the table's measure: not measured"), "{stdout}");
+        assert!(
+            stdout.contains("with the scene's own (measured on a few steps)")
+                || stderr.contains("warning: --tolerance: a frame with the picked method takes about"),
+            "{stdout}\n{stderr}"
+        );
         std::fs::remove_dir_all(&dir).ok();
     }
 }
