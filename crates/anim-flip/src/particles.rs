@@ -126,6 +126,13 @@ impl<const D: usize> Particles<D> {
         self.v.iter().map(|v| 0.5 * v.iter().map(|x| x * x).sum::<f64>()).sum()
     }
 
+    /// Gravitational potential energy per unit particle mass in the field `gravity`, relative to
+    /// the frame's origin (the grid's lower corner, below every particle): `sum_p -g . x_p`.
+    #[must_use]
+    pub fn potential_energy(&self, gravity: &[f64; D]) -> f64 {
+        self.x.iter().map(|x| -(0..D).map(|a| gravity[a] * x[a]).sum::<f64>()).sum()
+    }
+
     /// Largest particle speed.
     #[must_use]
     pub fn max_speed(&self) -> f64 {
@@ -174,5 +181,22 @@ impl<'de, const D: usize> serde::Deserialize<'de> for Particles<D> {
                 .map(|m| std::array::from_fn(|r| std::array::from_fn(|k| m[r * D + k])))
                 .collect();
         Ok(Self { x, v, c })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Energy per unit mass: `|v|^2 / 2` plus `-g . x`, by hand for two particles.
+    #[test]
+    fn kinetic_and_potential_energy_per_unit_mass() {
+        let mut p = Particles::<2>::new();
+        p.push([0.5, 0.25], [3.0, 4.0]);
+        p.push([0.1, 1.0], [0.0, -1.0]);
+        assert_eq!(p.kinetic_energy(), 12.5 + 0.5);
+        assert_eq!(p.potential_energy(&[0.0, -9.81]), 9.81 * 0.25 + 9.81 * 1.0);
+        // A tilted gravity weighs both components.
+        assert_eq!(p.potential_energy(&[1.0, -2.0]), (-0.5 + 0.5) + (-0.1 + 2.0));
     }
 }

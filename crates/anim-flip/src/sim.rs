@@ -744,7 +744,9 @@ impl<const D: usize> Solver for FlipSimulation<D> {
         let mut report = StepReport::at_time(self.time);
         report.iterations = info.pressure_iterations;
         report.residual = Some(info.pressure_residual);
-        report.energy = Some(state.kinetic_energy());
+        // Kinetic plus gravitational energy per unit particle mass (a shaken tank's moving
+        // frame adds no potential of its own here).
+        report.energy = Some(state.kinetic_energy() + state.potential_energy(&self.params.gravity));
         report.linear_momentum = Some(momentum);
         report.angular_momentum = Some(state.angular_momentum([0.0; D]));
         report.constraint_violation = Some(info.max_divergence);
