@@ -48,14 +48,15 @@ use crate::sim::{Method, PbdSimulation};
 use anim_core::integrate::State;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
-    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
-    RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
+    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, ObstacleMesh, Preset,
+    Prop, RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
     save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
 
 mod bodies;
 mod body;
+mod obstacles;
 mod surface;
 
 pub use bodies::{DEFAULT_ITERATIONS, DEFAULT_SUBSTEPS, DEFAULT_THICKNESS};
@@ -110,6 +111,13 @@ pub struct PbdSceneParams {
     /// only.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub obstacles: Vec<crate::Shape>,
+    /// Static obstacles from closed OBJ surfaces (anim-core's [`ObstacleMesh`]: `mesh` relative
+    /// to the scene file, `scale`, `rotate`, `translate`, and `cell`, the spacing of the signed
+    /// distance field the surface is sampled on, default its longest side over 64), each a
+    /// [`MeshCollider`](crate::MeshCollider) with the scene's friction, restitution and
+    /// thickness. Default none. Bodies only.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacle_meshes: Vec<ObstacleMesh>,
     /// Friction coefficient (static and kinetic) against the obstacles and between bodies,
     /// `>= 0`. Default 0. Bodies only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -419,5 +427,7 @@ fn tolerance_adapter(
 
 #[cfg(test)]
 mod bodies_tests;
+#[cfg(test)]
+mod obstacles_tests;
 #[cfg(test)]
 mod tests;
