@@ -149,6 +149,9 @@
 //! flag in the wind on a swaying pole, a rope of 100 links, a soft tetrahedral blob, a balloon)
 //! and prints energy, momentum, constraint violation and timings:
 //! `cargo run --release -p anim-pbd --example cloth_drape -- flag`.
+//! `examples/mesh_sphere.rs` measures a [`MeshCollider`] against the analytic sphere for several
+//! field spacings (resting positions, field build time, step time):
+//! `cargo run --release -p anim-pbd --example mesh_sphere`.
 //!
 //! ## Precision
 //!
