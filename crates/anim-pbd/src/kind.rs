@@ -15,8 +15,9 @@
 //! soft bodies from tetrahedral meshes (Gmsh `.msh`, TetGen `.node`/`.ele`, or a closed OBJ
 //! surface filled with tetrahedra) and cloths from OBJ surfaces, each with its material
 //! ([`BodyMaterial`]), placement, initial velocity and pins ([`PinSpec`]), among `obstacles`
-//! (anim-core's [`Shape`](crate::Shape): plane, sphere, box, capsule) with a scene-wide
-//! friction, restitution and thickness. The bodies collide with the obstacles and with each other
+//! (anim-core's [`Shape`](crate::Shape): plane, sphere, box, capsule) and `obstacle_meshes`
+//! (closed OBJ surfaces, each a [`MeshCollider`](crate::MeshCollider) of its signed distance
+//! field) with a scene-wide friction, restitution and thickness. The bodies collide with the obstacles and with each other
 //! (particles against the other bodies' surfaces; a body does not collide with itself).
 //!
 //! ```toml
@@ -41,7 +42,7 @@
 //! the simulation's memory: step count, external forces, pending body targets) and [`View`]
 //! (the particles and their velocities; the model's triangles, or the boundary of its
 //! tetrahedra, its edges and tetrahedra, the particles of zero inverse mass as pins, and the
-//! static colliders: ground, spheres, capsules and boxes).
+//! static shape colliders: ground, spheres, capsules and boxes; mesh colliders are not drawn).
 
 use crate::scenes;
 use crate::sim::{Method, PbdSimulation};
