@@ -1,6 +1,7 @@
 //! Obstacles: kinematic bodies (moved by a prescribed motion, not by the simulation) and the
-//! collider shapes (plane, sphere, box, capsule) from which line (8) of the PBD loop,
-//! `generateCollisionConstraints(x_i -> p_i)`, makes inequality constraints every step.
+//! colliders, shapes (plane, sphere, box, capsule: [`Collider`]) and closed triangle meshes
+//! ([`MeshCollider`], the signed distance field of the surface), from which line (8) of the PBD
+//! loop, `generateCollisionConstraints(x_i -> p_i)`, makes inequality constraints every step.
 //!
 //! # Contacts
 //!
@@ -19,6 +20,11 @@
 //! passed through a shape thinner than its motion). A contact is always rigid (compliance 0) and
 //! inactive while `C >= 0`; the margin lets it catch a particle that the internal constraints push
 //! into the shape during the iterations.
+//!
+//! A mesh collider reads `phi` and `n` from its distance field (trilinear between the lattice's
+//! nodes, `n` the normalised gradient) and takes `q = p - phi n`; it is solid too, and a particle
+//! outside the field's lattice gets no contact. The model's normal is frozen for the substep, so
+//! no derivative of `n` (no curvature term) enters the projection.
 //!
 //! **Friction** is positional (Macklin et al. 2014, "Unified particle physics", eq. 24): after a
 //! projection that pushed the particle out by `d`, its tangential motion relative to the obstacle
@@ -59,6 +65,12 @@
 
 use anim_core::glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
+
+mod mesh;
+#[cfg(test)]
+mod mesh_tests;
+
+pub use mesh::MeshCollider;
 
 /// A rigid pose: `world = position + rotation * local`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -265,25 +277,52 @@ impl Collider {
         self.shape.check()?;
         let mut c = *self;
         c.shape = c.shape.normalized();
-        let nonneg = |v: f64| v >= 0.0 && v.is_finite();
-        if !nonneg(c.thickness) {
-            return Err(format!("thickness must be non-negative and finite, got {}", c.thickness));
-        }
-        if !nonneg(c.static_friction) || !nonneg(c.kinetic_friction) {
-            return Err(format!(
-                "friction coefficients must be non-negative and finite, got {} and {}",
-                c.static_friction, c.kinetic_friction
-            ));
-        }
-        if !(0.0..=1.0).contains(&c.restitution) {
-            return Err(format!("restitution must lie in [0, 1], got {}", c.restitution));
-        }
-        if let Some(b) = c.body
-            && b >= bodies
-        {
-            return Err(format!("body {b} does not exist (the model has {bodies} kinematic bodies)"));
-        }
+        check_contact(c.thickness, c.static_friction, c.kinetic_friction, c.restitution, c.body, bodies)?;
         Ok(c)
+    }
+}
+
+/// Checks a collider's contact parameters (a shape's or a mesh's): thickness and friction
+/// non-negative and finite, restitution in `[0, 1]`, the body among `bodies`; the reason on
+/// failure.
+fn check_contact(
+    thickness: f64,
+    static_friction: f64,
+    kinetic_friction: f64,
+    restitution: f64,
+    body: Option<usize>,
+    bodies: usize,
+) -> Result<(), String> {
+    let nonneg = |v: f64| v >= 0.0 && v.is_finite();
+    if !nonneg(thickness) {
+        return Err(format!("thickness must be non-negative and finite, got {thickness}"));
+    }
+    if !nonneg(static_friction) || !nonneg(kinetic_friction) {
+        return Err(format!(
+            "friction coefficients must be non-negative and finite, got {static_friction} and {kinetic_friction}"
+        ));
+    }
+    if !(0.0..=1.0).contains(&restitution) {
+        return Err(format!("restitution must lie in [0, 1], got {restitution}"));
+    }
+    if let Some(b) = body
+        && b >= bodies
+    {
+        return Err(format!("body {b} does not exist (the model has {bodies} kinematic bodies)"));
+    }
+    Ok(())
+}
+
+/// The coefficients `(mu_s, mu_k, e)` of contact collider `ci`: the shape colliders are numbered
+/// first, the mesh colliders after them.
+#[inline]
+pub(crate) fn coefficients(colliders: &[Collider], meshes: &[MeshCollider], ci: usize) -> (f64, f64, f64) {
+    match colliders.get(ci) {
+        Some(c) => (c.static_friction, c.kinetic_friction, c.restitution),
+        None => {
+            let m = &meshes[ci - colliders.len()];
+            (m.static_friction, m.kinetic_friction, m.restitution)
+        }
     }
 }
 
@@ -330,7 +369,8 @@ impl BodyContact {
 pub(crate) struct Contact {
     /// The particle.
     pub particle: u32,
-    /// The collider.
+    /// The collider: a shape collider's index, or the number of shape colliders plus a mesh
+    /// collider's index.
     pub collider: u32,
     /// Outward normal at the contact point.
     pub normal: DVec3,

@@ -15,8 +15,9 @@
 //! soft bodies from tetrahedral meshes (Gmsh `.msh`, TetGen `.node`/`.ele`, or a closed OBJ
 //! surface filled with tetrahedra) and cloths from OBJ surfaces, each with its material
 //! ([`BodyMaterial`]), placement, initial velocity and pins ([`PinSpec`]), among `obstacles`
-//! (anim-core's [`Shape`](crate::Shape): plane, sphere, box, capsule) with a scene-wide
-//! friction, restitution and thickness. The bodies collide with the obstacles and with each other
+//! (anim-core's [`Shape`](crate::Shape): plane, sphere, box, capsule) and `obstacle_meshes`
+//! (closed OBJ surfaces, each a [`MeshCollider`](crate::MeshCollider) of its signed distance
+//! field) with a scene-wide friction, restitution and thickness. The bodies collide with the obstacles and with each other
 //! (particles against the other bodies' surfaces; a body does not collide with itself).
 //!
 //! ```toml
@@ -41,21 +42,22 @@
 //! the simulation's memory: step count, external forces, pending body targets) and [`View`]
 //! (the particles and their velocities; the model's triangles, or the boundary of its
 //! tetrahedra, its edges and tetrahedra, the particles of zero inverse mass as pins, and the
-//! static colliders: ground, spheres, capsules and boxes).
+//! static shape colliders: ground, spheres, capsules and boxes; mesh colliders are not drawn).
 
 use crate::scenes;
 use crate::sim::{Method, PbdSimulation};
 use anim_core::integrate::State;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
-    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
-    RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
+    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, ObstacleMesh, Preset,
+    Prop, RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
     save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
 
 mod bodies;
 mod body;
+mod obstacles;
 mod surface;
 
 pub use bodies::{DEFAULT_ITERATIONS, DEFAULT_SUBSTEPS, DEFAULT_THICKNESS};
@@ -110,6 +112,13 @@ pub struct PbdSceneParams {
     /// only.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub obstacles: Vec<crate::Shape>,
+    /// Static obstacles from closed OBJ surfaces (anim-core's [`ObstacleMesh`]: `mesh` relative
+    /// to the scene file, `scale`, `rotate`, `translate`, and `cell`, the spacing of the signed
+    /// distance field the surface is sampled on, default its longest side over 64), each a
+    /// [`MeshCollider`](crate::MeshCollider) with the scene's friction, restitution and
+    /// thickness. Default none. Bodies only.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacle_meshes: Vec<ObstacleMesh>,
     /// Friction coefficient (static and kinetic) against the obstacles and between bodies,
     /// `>= 0`. Default 0. Bodies only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -419,5 +428,7 @@ fn tolerance_adapter(
 
 #[cfg(test)]
 mod bodies_tests;
+#[cfg(test)]
+mod obstacles_tests;
 #[cfg(test)]
 mod tests;

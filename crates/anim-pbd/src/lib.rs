@@ -2,7 +2,7 @@
 //!
 //! Position based dynamics (Müller et al. 2007) and extended PBD, XPBD (Macklin et al. 2016): cloth, ropes,
 //! soft bodies and balloons as particles held by constraints, with collisions against planes,
-//! spheres, boxes and capsules, friction and restitution. Parallel, and bitwise deterministic for
+//! spheres, boxes, capsules and closed triangle meshes, friction and restitution. Parallel, and bitwise deterministic for
 //! any number of threads.
 //!
 //! ## What it models
@@ -21,8 +21,9 @@
 //! - **tetrahedral volume** `V - V_0`, and a **global volume** `sum_t x_a . (x_b x x_c) / 6 -
 //!   k_pressure V_0` over a closed mesh (balloons);
 //! - **attachment** `|x_i - t| - d` to a fixed point or a point of a moving [`KinematicBody`];
-//! - **contacts**, inequality constraints against [`Collider`]s generated every step (line 8 of
-//!   the loop), with static and kinetic **friction** and **restitution** ([`collide`]);
+//! - **contacts**, inequality constraints against [`Collider`]s (shapes) and [`MeshCollider`]s
+//!   (closed triangle meshes as signed distance fields) generated every step (line 8 of the
+//!   loop), with static and kinetic **friction** and **restitution** ([`collide`]);
 //!   between bodies ([`ContactBody`], [`PbdBuilder::contact_body`]), a particle of one body
 //!   against the closest surface triangle of another, with friction (no self-collision).
 //!
@@ -148,6 +149,9 @@
 //! flag in the wind on a swaying pole, a rope of 100 links, a soft tetrahedral blob, a balloon)
 //! and prints energy, momentum, constraint violation and timings:
 //! `cargo run --release -p anim-pbd --example cloth_drape -- flag`.
+//! `examples/mesh_sphere.rs` measures a [`MeshCollider`] against the analytic sphere for several
+//! field spacings (resting positions, field build time, step time):
+//! `cargo run --release -p anim-pbd --example mesh_sphere`.
 //!
 //! ## Precision
 //!
@@ -182,7 +186,7 @@ pub use build::{
     Bending, BuildError, Chain, Cloth, ClothHandle, EARTH_GRAVITY, InputError, MeshMass, MeshParams,
     PbdBuilder, TetMeshParams,
 };
-pub use collide::{BodyContact, BodyMotion, Collider, KinematicBody, Pose, Shape};
+pub use collide::{BodyContact, BodyMotion, Collider, KinematicBody, MeshCollider, Pose, Shape};
 pub use constraint::{AttachTarget, Constraint, ConstraintFunction, ConstraintParams, ConstraintType};
 pub use kind::KIND;
 pub use model::{ContactBody, Particle, PbdModel, SparseGradient, VolumeMesh, Wind};

@@ -9,7 +9,7 @@
 //! time `t` (which drives the kinematic bodies). The model never holds positions; it reads them
 //! from the state it is handed.
 
-use crate::collide::{BodyContact, Collider, KinematicBody};
+use crate::collide::{BodyContact, Collider, KinematicBody, MeshCollider};
 use crate::constraint::{AttachTarget, Constraint, ConstraintFunction, load};
 use anim_core::glam::DVec3;
 use anim_core::integrate::State;
@@ -110,6 +110,7 @@ pub struct PbdModel {
     pub(crate) constraints: Vec<Constraint>,
     pub(crate) volume_meshes: Vec<VolumeMesh>,
     pub(crate) colliders: Vec<Collider>,
+    pub(crate) mesh_colliders: Vec<MeshCollider>,
     pub(crate) bodies: Vec<KinematicBody>,
     pub(crate) gravity: DVec3,
     pub(crate) wind: Option<Wind>,
@@ -183,6 +184,12 @@ impl PbdModel {
     #[must_use]
     pub fn colliders(&self) -> &[Collider] {
         &self.colliders
+    }
+
+    /// The mesh colliders (their contacts are numbered after the shape colliders').
+    #[must_use]
+    pub fn mesh_colliders(&self) -> &[MeshCollider] {
+        &self.mesh_colliders
     }
 
     /// The kinematic bodies.

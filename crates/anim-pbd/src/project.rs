@@ -35,7 +35,7 @@
 //! Constraints of one colour share no movable particle, so within a colour both give bitwise the
 //! same positions, whatever the number of threads.
 
-use crate::collide::{Collider, Contact, Pose};
+use crate::collide::{Collider, Contact, MeshCollider, Pose, coefficients};
 use crate::constraint::{
     AttachTarget, Constraint, ConstraintFunction, ConstraintType, MIN_LENGTH, dihedral, distance, isometric,
     tet_volume, wrap_angle,
@@ -95,6 +95,7 @@ pub(crate) struct Ctx<'a> {
     pub meshes: &'a [VolumeMesh],
     pub scratch: &'a [Mutex<Vec<DVec3>>],
     pub colliders: &'a [Collider],
+    pub mesh_colliders: &'a [MeshCollider],
     /// Smallest model index of a constraint whose update was not finite (`usize::MAX`: none).
     pub bad: &'a AtomicUsize,
 }
@@ -417,10 +418,8 @@ pub(crate) fn project_contact(ctx: &Ctx<'_>, c: &mut Contact, p: DVec3) -> DVec3
         return DVec3::ZERO;
     }
     let mut dx = c.normal * dn;
-    let col = &ctx.colliders[c.collider as usize];
-    dx -= positional_friction(c.normal, dn, col.static_friction, col.kinetic_friction, || {
-        p + dx - ctx.x[i] - c.obstacle_dx
-    });
+    let (mu_s, mu_k, _) = coefficients(ctx.colliders, ctx.mesh_colliders, c.collider as usize);
+    dx -= positional_friction(c.normal, dn, mu_s, mu_k, || p + dx - ctx.x[i] - c.obstacle_dx);
     if !dx.is_finite() {
         ctx.flag(CONTACT_ID);
         return DVec3::ZERO;

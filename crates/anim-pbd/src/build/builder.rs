@@ -9,7 +9,7 @@
 //! The helpers below check the shape builders' own parameters and name the offending one.
 
 use super::error::{BuildError, InputError};
-use crate::collide::{BodyContact, Collider, KinematicBody};
+use crate::collide::{BodyContact, Collider, KinematicBody, MeshCollider};
 use crate::constraint::{AttachTarget, ConstraintParams};
 use crate::model::{ContactBody, Wind};
 use anim_core::glam::DVec3;
@@ -48,6 +48,7 @@ pub struct PbdBuilder {
     pub(super) pending: Vec<(Pending, ConstraintParams)>,
     pub(super) volume_meshes: Vec<(Vec<[usize; 3]>, usize)>,
     pub(super) colliders: Vec<Collider>,
+    pub(super) mesh_colliders: Vec<MeshCollider>,
     pub(super) bodies: Vec<KinematicBody>,
     pub(super) gravity: [f64; 3],
     pub(super) wind: Option<Wind>,
@@ -158,6 +159,13 @@ impl PbdBuilder {
     pub fn collider(&mut self, c: Collider) -> usize {
         self.colliders.push(c);
         self.colliders.len() - 1
+    }
+
+    /// Adds a collider whose geometry is a closed triangle mesh's signed distance field
+    /// ([`MeshCollider`]) and returns its index among the mesh colliders.
+    pub fn mesh_collider(&mut self, c: MeshCollider) -> usize {
+        self.mesh_colliders.push(c);
+        self.mesh_colliders.len() - 1
     }
 
     /// Records a triangle for rendering and wind (it adds no constraint).

@@ -148,6 +148,14 @@ pub enum BuildError {
         /// What is wrong.
         reason: String,
     },
+    /// A mesh collider's contact parameters are not valid.
+    #[error("mesh collider {collider}: {reason}")]
+    BadMeshCollider {
+        /// Mesh collider index.
+        collider: usize,
+        /// What is wrong.
+        reason: String,
+    },
     /// A contact body's particle range or surface is not valid.
     #[error("contact body {body}: {reason}")]
     BadContactBody {

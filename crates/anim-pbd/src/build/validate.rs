@@ -78,6 +78,10 @@ impl PbdBuilder {
                     .map_err(|reason| BuildError::Input(InputError::BadCollider { collider: k, reason }))
             })
             .collect::<Result<Vec<_>, _>>()?;
+        for (k, c) in self.mesh_colliders.iter().enumerate() {
+            c.validate(self.bodies.len())
+                .map_err(|reason| BuildError::BadMeshCollider { collider: k, reason })?;
+        }
         if let Some(w) = self.wind
             && !(w.velocity.iter().all(|v| v.is_finite())
                 && w.drag >= 0.0
@@ -160,6 +164,7 @@ impl PbdBuilder {
             constraints,
             volume_meshes,
             colliders,
+            mesh_colliders: self.mesh_colliders.clone(),
             bodies: self.bodies.clone(),
             gravity: DVec3::from_array(self.gravity),
             wind: self.wind,

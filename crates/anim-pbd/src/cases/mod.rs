@@ -4,8 +4,8 @@
 //! XPBD's static stretch of a hanging chain for every iteration count and time step,
 //! PBD's effective stiffness against both, momentum conservation of every internal constraint
 //! with unequal masses, constraint gradients against finite differences, determinism across
-//! thread counts (`conformance`, on the chain of `chain`; the cloth drape on 1, 2 and 4 threads:
-//! `determinism`); hard cases (1000:1 mass ratio, 10x
+//! thread counts (`conformance`, on the chain of `chain`; the cloth drape, over the analytic
+//! sphere and over a mesh sphere, on 1, 2 and 4 threads: `determinism`); hard cases (1000:1 mass ratio, 10x
 //! over-stretch, pins next to free particles, zero compliance, coincident and degenerate
 //! stencils, bad input, an injected NaN: `hard_cases`); a work-precision study on the hanging
 //! cloth (PBD vs XPBD, iterations vs substeps: `study`); and the timed runs of
@@ -30,8 +30,8 @@ use study::{cloth_constraint_study, cloth_position_study};
 pub use peer::{PeerRun, peer_cloth};
 pub use study::{STUDY_T, study_problem};
 
-/// Registers the crate's cases: conformance, hard cases, studies, the determinism check of the
-/// drape and its soak run, in that order.
+/// Registers the crate's cases: conformance, hard cases, studies, the determinism checks of the
+/// drape (over the analytic and over a mesh sphere) and its soak run, in that order.
 pub fn register(r: &mut Registry) {
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
@@ -128,6 +128,11 @@ pub fn register(r: &mut Registry) {
         crate_name: CRATE,
         name: "determinism: cloth drape on 1, 2, 4 threads",
         run: Box::new(determinism::drape),
+    });
+    r.conformance.push(ConformanceCase {
+        crate_name: CRATE,
+        name: "determinism: cloth drape on a mesh sphere on 1, 2, 4 threads",
+        run: Box::new(determinism::drape_on_mesh),
     });
     r.soak.push(soak::DRAPE);
 }

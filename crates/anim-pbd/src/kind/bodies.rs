@@ -5,13 +5,15 @@
 //! Every body is added to one [`PbdBuilder`] in the order given. Unless `body_contacts = false`,
 //! each body is also a contact body: its particles collide with the other bodies' surfaces (a
 //! soft body's boundary, a cloth's triangles), with the scene's thickness and friction; particles
-//! of one body do not collide with that body's own surface. The obstacles are colliders with the
-//! same thickness, friction (static and kinetic alike) and restitution.
+//! of one body do not collide with that body's own surface. The obstacles (shapes, and the
+//! `obstacle_meshes` as [`MeshCollider`]s of their distance fields) are colliders with the same
+//! thickness, friction (static and kinetic alike) and restitution; a mesh's field covers its
+//! surface's bounds widened by the thickness plus the contact margin (and two cells).
 
 use super::PbdSceneParams;
 use super::body::BodySpec;
 use crate::build::{EARTH_GRAVITY, PbdBuilder};
-use crate::collide::{BodyContact, Collider};
+use crate::collide::{BodyContact, Collider, MeshCollider};
 use crate::sim::{Method, PbdParams, PbdSimulation, SolverKind};
 use anim_core::integrate::State;
 use anim_core::scene::{BuildContext, BuildError};
@@ -27,6 +29,7 @@ pub const DEFAULT_SUBSTEPS: usize = 4;
 pub(super) fn refuse_body_fields(p: &PbdSceneParams) -> Result<(), BuildError> {
     let given = [
         ("obstacles", !p.obstacles.is_empty()),
+        ("obstacle_meshes", !p.obstacle_meshes.is_empty()),
         ("friction", p.friction.is_some()),
         ("restitution", p.restitution.is_some()),
         ("thickness", p.thickness.is_some()),
@@ -82,6 +85,14 @@ pub(super) fn build_bodies(
             .check()
             .map_err(|e| BuildError::invalid(format!("obstacles[{k}]"), format!("{}: {e}", shape.name())))?;
     }
+    // `iterations` and `substeps` outside [1, MAX_PBD_COUNT] were refused with the other fields.
+    let params = PbdParams::new(
+        p.method.unwrap_or(Method::Xpbd),
+        SolverKind::ColoredGaussSeidel,
+        p.iterations.unwrap_or(DEFAULT_ITERATIONS),
+        p.substeps.unwrap_or(DEFAULT_SUBSTEPS),
+    );
+    let fields = super::obstacles::fields(&p.obstacle_meshes, context, thickness + params.contact_margin)?;
     let mut b = PbdBuilder::new();
     b.gravity(gravity);
     let mut added = Vec::with_capacity(p.bodies.len());
@@ -102,18 +113,19 @@ pub(super) fn build_bodies(
                 .with_restitution(restitution),
         );
     }
+    for field in fields {
+        b.mesh_collider(
+            MeshCollider::new(field)
+                .with_thickness(thickness)
+                .with_friction(friction, friction)
+                .with_restitution(restitution),
+        );
+    }
     let model = b.build().map_err(|e| BuildError::invalid("bodies", e.to_string()))?;
     let mut state = model.rest_state();
     for (spec, body) in p.bodies.iter().zip(&added) {
         set_velocity(spec, body.particles.clone(), &body.pinned, &mut state);
     }
-    // `iterations` and `substeps` outside [1, MAX_PBD_COUNT] were refused with the other fields.
-    let params = PbdParams::new(
-        p.method.unwrap_or(Method::Xpbd),
-        SolverKind::ColoredGaussSeidel,
-        p.iterations.unwrap_or(DEFAULT_ITERATIONS),
-        p.substeps.unwrap_or(DEFAULT_SUBSTEPS),
-    );
     let sim = PbdSimulation::new(model, params).map_err(|e| BuildError::invalid("bodies", e.to_string()))?;
     Ok((sim, state))
 }

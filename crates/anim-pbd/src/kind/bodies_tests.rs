@@ -7,7 +7,7 @@ use anim_core::solver::Solver;
 use std::path::{Path, PathBuf};
 
 /// A fresh folder for one test's files.
-fn folder(test: &str) -> PathBuf {
+pub(super) fn folder(test: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("anim-pbd-bodies-{}-{test}", std::process::id()));
     std::fs::remove_dir_all(&dir).ok();
     std::fs::create_dir_all(&dir).expect("temporary folder");
@@ -33,7 +33,7 @@ fn write_tet_box(dir: &Path, name: &str, n: usize, origin: [f64; 3], h: f64) -> 
 
 /// Writes an OBJ square grid of `n x n` vertices and side `side` in the plane `z = 0` centred on
 /// the origin (vertex `ix + n iy`); returns its name.
-fn write_cloth(dir: &Path, name: &str, n: usize, side: f64) -> String {
+pub(super) fn write_cloth(dir: &Path, name: &str, n: usize, side: f64) -> String {
     let mut text = String::new();
     for iy in 0..n {
         for ix in 0..n {
@@ -60,12 +60,12 @@ fn build_in(dir: &Path, value: serde_json::Value) -> Result<(PbdSimulation, Stat
     bodies::build_bodies(&scene(value), &BuildContext { base: Some(dir) })
 }
 
-fn built(dir: &Path, value: serde_json::Value) -> (PbdSimulation, State) {
+pub(super) fn built(dir: &Path, value: serde_json::Value) -> (PbdSimulation, State) {
     build_in(dir, value).expect("builds")
 }
 
 /// The message of the refusal of `value`, through the kind's builder.
-fn refusal(dir: &Path, value: serde_json::Value) -> String {
+pub(super) fn refusal(dir: &Path, value: serde_json::Value) -> String {
     (KIND.build)(&value, &BuildContext { base: Some(dir) }).err().expect("refused").to_string()
 }
 
@@ -590,7 +590,7 @@ fn a_closed_cloth_with_pressure_inflates() {
 }
 
 /// Writes the closed OBJ surface of the unit cube `[0, 1]^3`, twelve outward triangles.
-fn write_cube_obj(dir: &Path) -> String {
+pub(super) fn write_cube_obj(dir: &Path) -> String {
     let mut text = String::new();
     for i in 0..8 {
         text += &format!("v {} {} {}\n", i & 1, (i >> 1) & 1, (i >> 2) & 1);

@@ -7,6 +7,11 @@
 //! surface point moved over the substep (friction acts relative to it) and the normal velocity
 //! before the solve (for restitution at line 16).
 //!
+//! A shape collider gives the signed distance and normal analytically; a mesh collider
+//! ([`MeshCollider`](crate::MeshCollider)) samples them from its distance field, and a particle
+//! outside the field's lattice gets no contact. The shape colliders come first, then the mesh
+//! colliders, numbered on after them.
+//!
 //! Contacts are generated collider by collider, particles in increasing order, so each particle
 //! appears at most once per collider: each collider's contacts form one group that the coloured
 //! and Jacobi sweeps project in parallel.
@@ -19,42 +24,66 @@ use anim_core::glam::DVec3;
 /// Line (8): fills `d.contacts` and their per-collider groups `d.contact_groups` for predicted
 /// positions `d.p`, with speculative margin `margin`, over a substep of length `h`.
 pub(super) fn generate_contacts(model: &PbdModel, d: &mut Data, margin: f64, h: f64) {
-    let n = model.num_particles();
-    let w = &model.inv_mass;
     d.contacts.clear();
     d.contact_groups.clear();
     for (ci, col) in model.colliders.iter().enumerate() {
-        let start = d.contacts.len();
-        let (pose, prev) = match col.body {
-            Some(b) => (d.pose_sub[b], d.pose_sub_prev[b]),
-            None => (Pose::IDENTITY, Pose::IDENTITY),
-        };
-        for i in 0..n {
-            if w[i] == 0.0 {
-                continue;
-            }
-            let p = d.p[i];
-            let local = pose.inverse_apply(p);
-            let (phi, nl) = col.shape.signed_distance(local);
-            if !(phi < col.thickness + margin + (p - d.x[i]).length()) {
-                continue;
-            }
-            let normal = pose.rotation * nl;
-            let q = p - normal * phi;
-            let ql = pose.inverse_apply(q);
-            let obstacle_dx = q - prev.apply(ql);
-            let vn_pre = normal.dot(d.v[i] - obstacle_dx / h);
-            d.contacts.push(Contact {
-                particle: i as u32,
-                collider: ci as u32,
-                normal,
-                offset: normal.dot(q) + col.thickness,
-                obstacle_dx,
-                vn_pre,
-                lambda: 0.0,
-                dx: DVec3::ZERO,
-            });
-        }
-        d.contact_groups.push(start..d.contacts.len());
+        let distance = |local| Some(col.shape.signed_distance(local));
+        collider_contacts(model, d, ci, col.body, col.thickness, margin, h, distance);
     }
+    let first = model.colliders.len();
+    for (k, col) in model.mesh_colliders.iter().enumerate() {
+        let distance = |local| col.signed_distance(local);
+        collider_contacts(model, d, first + k, col.body, col.thickness, margin, h, distance);
+    }
+}
+
+/// The contacts of collider `ci` (on `body`, keeping `thickness`) as one group, its signed
+/// distance and outward normal in its own frame given by `distance` (`None`: no contact).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn collider_contacts(
+    model: &PbdModel,
+    d: &mut Data,
+    ci: usize,
+    body: Option<usize>,
+    thickness: f64,
+    margin: f64,
+    h: f64,
+    distance: impl Fn(DVec3) -> Option<(f64, DVec3)>,
+) {
+    let w = &model.inv_mass;
+    let start = d.contacts.len();
+    let (pose, prev) = match body {
+        Some(b) => (d.pose_sub[b], d.pose_sub_prev[b]),
+        None => (Pose::IDENTITY, Pose::IDENTITY),
+    };
+    for i in 0..model.num_particles() {
+        if w[i] == 0.0 {
+            continue;
+        }
+        let p = d.p[i];
+        let local = pose.inverse_apply(p);
+        let Some((phi, nl)) = distance(local) else {
+            continue;
+        };
+        if !(phi < thickness + margin + (p - d.x[i]).length()) {
+            continue;
+        }
+        let normal = pose.rotation * nl;
+        let q = p - normal * phi;
+        let ql = pose.inverse_apply(q);
+        let obstacle_dx = q - prev.apply(ql);
+        let vn_pre = normal.dot(d.v[i] - obstacle_dx / h);
+        d.contacts.push(Contact {
+            particle: i as u32,
+            collider: ci as u32,
+            normal,
+            offset: normal.dot(q) + thickness,
+            obstacle_dx,
+            vn_pre,
+            lambda: 0.0,
+            dx: DVec3::ZERO,
+        });
+    }
+    d.contact_groups.push(start..d.contacts.len());
 }

@@ -54,7 +54,7 @@ impl Data {
     pub(super) fn new(model: &PbdModel) -> Self {
         let n = model.num_particles();
         let nb = model.bodies.len();
-        let nc = model.colliders.len();
+        let nc = model.colliders.len() + model.mesh_colliders.len();
         let scratch =
             model.volume_meshes.iter().map(|m| Mutex::new(vec![DVec3::ZERO; m.vertices.len()])).collect();
         let mut data = Data {

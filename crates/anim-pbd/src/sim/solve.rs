@@ -126,6 +126,7 @@ pub(super) fn solve_constraints(model: &PbdModel, params: &PbdParams, d: &mut Da
         meshes: &model.volume_meshes,
         scratch: &d.scratch,
         colliders: &model.colliders,
+        mesh_colliders: &model.mesh_colliders,
         bad: &d.bad,
     };
     let parallel = rayon::current_num_threads() > 1;

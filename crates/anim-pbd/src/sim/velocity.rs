@@ -17,6 +17,7 @@
 
 use super::parallel::{CHUNK, PARALLEL_MIN};
 use super::scratch::Data;
+use crate::collide::coefficients;
 use crate::model::PbdModel;
 use anim_core::glam::{DMat3, DVec3};
 use rayon::prelude::*;
@@ -85,11 +86,11 @@ pub(super) fn restitution(model: &PbdModel, d: &mut Data, h: f64) {
     let gmag = model.gravity.length();
     for c in &d.contacts {
         if c.lambda > 0.0 {
-            let col = &model.colliders[c.collider as usize];
+            let (_, _, e) = coefficients(&model.colliders, &model.mesh_colliders, c.collider as usize);
             let i = c.particle as usize;
             let vo = c.obstacle_dx * inv_h;
             let vn = c.normal.dot(d.v[i] - vo);
-            let target = if c.vn_pre < -2.0 * gmag * h { -col.restitution * c.vn_pre } else { 0.0 };
+            let target = if c.vn_pre < -2.0 * gmag * h { -e * c.vn_pre } else { 0.0 };
             d.v[i] += c.normal * (target.max(0.0) - vn);
         }
     }
