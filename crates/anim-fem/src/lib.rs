@@ -109,6 +109,8 @@ mod contact_tests;
 #[cfg(test)]
 mod kind_tests;
 #[cfg(test)]
+mod mesh_obstacle_tests;
+#[cfg(test)]
 mod tests;
 #[cfg(test)]
 mod tests_quadratic;
