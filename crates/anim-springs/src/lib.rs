@@ -138,11 +138,12 @@ mod geom;
 pub mod kind;
 mod mesh;
 pub mod network;
+mod obstacles;
 pub mod scenes;
 mod sim;
 
 pub use build::{Chain, Cloth, EARTH_GRAVITY, Lattice, MeshMass, MeshSprings, NetworkBuilder, SpringParams};
-pub use contact::{Collider, Shape};
+pub use contact::{Collider, MeshCollider, Shape};
 pub use error::{BuildError, InputError};
 pub use kind::KIND;
 pub use mesh::TriangleMesh;
