@@ -263,6 +263,24 @@ fn mesh_contact_is_bitwise_identical_for_any_thread_count() {
     }
 }
 
+/// `add_mesh_obstacle` refuses a bad stiffness or friction coefficient, naming it, and adds
+/// nothing.
+#[test]
+fn bad_mesh_obstacle_parameters_are_named() {
+    let field = DistanceField::around(&mesh_box([0.0; 3], [1.0; 3]), 0.1, 0.0).unwrap();
+    let mut model = cube(2.0);
+    for (stiffness, friction, name) in [
+        (0.0, 0.0, "contact stiffness"),
+        (f64::NAN, 0.0, "contact stiffness"),
+        (1e5, -0.1, "friction"),
+        (1e5, f64::INFINITY, "friction"),
+    ] {
+        let err = model.add_mesh_obstacle(field.clone(), stiffness, friction).unwrap_err();
+        assert!(matches!(err, crate::FemError::BadParameter { name: n, .. } if n == name), "{err}");
+    }
+    assert!(model.mesh_obstacles().is_empty() && model.contact_stiffness() == 0.0);
+}
+
 fn field_of(e: BuildError) -> (String, String) {
     match e {
         BuildError::Invalid { field, message } | BuildError::Schema { field, message } => (field, message),

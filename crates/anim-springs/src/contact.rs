@@ -1,5 +1,6 @@
-//! Colliders: planes, spheres, axis-aligned boxes and capsules, as penalty forces with their
-//! Jacobians.
+//! Colliders: planes, spheres, axis-aligned boxes and capsules ([`Collider`]), and closed
+//! triangle meshes sampled on anim-core's signed distance field ([`MeshCollider`]), as penalty
+//! forces with their Jacobians.
 //!
 //! # Why penalty forces
 //!
@@ -52,7 +53,9 @@
 //! and beside a box's corner within the thickness, `c` the corner), `(I - n n^T - a a^T) / r`
 //! beside a capsule's axis (`a` the unit axis, `r` the distance to it) and beside a box's edge
 //! within the thickness, zero in a plane and inside a box or beside its faces (its normal is
-//! constant on each face's side of the inner ridges, where it jumps). In the default
+//! constant on each face's side of the inner ridges, where it jumps). For a mesh, `phi` is the
+//! field's trilinear interpolant, `n` its normalised gradient, `dp/dx = -|grad phi| n` (about
+//! `-n`) and `dn/dx = (I - n n^T) H / |grad phi|` with `H` the field's Hessian. In the default
 //! [`JacobianMode::Definite`](crate::JacobianMode::Definite) only the normal stiffness is kept,
 //! with `1 - tau_n v_n` clamped at 0: symmetric and negative semi-definite, as conjugate gradients
 //! and Cholesky need, while the force itself is unchanged (Newton converges to the same step, a

@@ -218,7 +218,7 @@ impl SpringNetwork {
     /// build); the scratch data is made anew, in the network's Jacobian mode.
     ///
     /// # Errors
-    /// [`BuildError::BadMeshCollider`](crate::error::BuildError::BadMeshCollider) for bad
+    /// [`BuildError::BadMeshCollider`] for bad
     /// contact parameters, numbered after the mesh colliders already there; nothing is added
     /// then.
     pub fn add_mesh_colliders(&mut self, meshes: Vec<MeshCollider>) -> Result<(), BuildError> {

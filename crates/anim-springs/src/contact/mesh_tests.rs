@@ -230,6 +230,33 @@ fn a_particle_rests_on_a_mesh_box_where_it_rests_on_the_box() {
     }
 }
 
+/// A mesh collider with a parameter out of range is refused naming it, by the builder and when
+/// added to a built network (numbered after the mesh colliders already there).
+#[test]
+fn a_bad_mesh_collider_is_named() {
+    let field = DistanceField::around(&mesh_box([0.0; 3], [1.0; 3]), 0.1, 0.0).expect("field");
+    let mut b = NetworkBuilder::new();
+    b.particle([0.0, 0.0, 2.0], 1.0);
+    b.mesh_collider(MeshCollider::new(field.clone(), 0.0));
+    let err = b.build().unwrap_err();
+    assert!(matches!(err, crate::BuildError::BadMeshCollider { collider: 0, .. }), "{err:?}");
+    assert!(err.to_string().starts_with("mesh collider 0: stiffness"), "{err}");
+    let mut b = NetworkBuilder::new();
+    b.particle([0.0, 0.0, 2.0], 1.0);
+    b.mesh_collider(MeshCollider::new(field.clone(), 1.0));
+    let mut net = b.build().expect("builds");
+    for bad in [
+        MeshCollider::new(field.clone(), 1.0).with_damping(-1.0),
+        MeshCollider::new(field.clone(), 1.0).with_friction(f64::NAN),
+        MeshCollider::new(field.clone(), 1.0).with_smoothing(-1.0),
+        MeshCollider::new(field.clone(), 1.0).with_thickness(f64::INFINITY),
+    ] {
+        let err = net.add_mesh_colliders(vec![MeshCollider::new(field.clone(), 1.0), bad]).unwrap_err();
+        assert!(matches!(err, crate::BuildError::BadMeshCollider { collider: 2, .. }), "{err:?}");
+    }
+    assert_eq!(net.model().mesh_colliders().len(), 1);
+}
+
 /// A cloth of more particles than the parallel threshold falls onto a mesh sphere: the same bits
 /// on 1, 2 and 4 threads, explicit and implicit.
 #[test]
