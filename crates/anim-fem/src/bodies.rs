@@ -1,7 +1,8 @@
 //! Several bodies of the user's own in one scene: each [`BodySpec`] is loaded, placed and
 //! checked, then the bodies are merged into one [`FemModel`] (the vertices of body `k` after
 //! those of bodies `0..k`, its elements of its own material) that shares the [`World`]: gravity,
-//! the obstacles with their penalty stiffness and friction, and Rayleigh damping.
+//! the obstacles (shapes, and closed OBJ surfaces sampled on a distance field) with their
+//! penalty stiffness and friction, and Rayleigh damping.
 //!
 //! Bodies do not collide with each other (contact is vertex against obstacle only): where two
 //! bodies meet, they pass through each other.
@@ -36,6 +37,9 @@ use crate::model::{EARTH_GRAVITY, ElementOrder, FemModel};
 use crate::scenes::FemScene;
 use crate::sim::FemParams;
 use anim_core::integrate::State;
+use anim_core::scene::{BuildError, ObstacleMesh};
+use anim_core::surface::{ClosedSurface, DistanceField};
+use anim_io::obj::{Polygons, read_obj};
 
 /// The most linear tetrahedra the bodies of a scene may have together: 2^18 = 262,144. At this
 /// size the model and its simulation take about 0.8 GB, and the first backward-Euler step with
@@ -63,6 +67,10 @@ pub struct World {
     pub gravity: [f64; 3],
     /// Obstacles every body collides with (planes, spheres, boxes, capsules); default none.
     pub obstacles: Vec<Obstacle>,
+    /// Closed OBJ surfaces every body collides with, each placed and sampled on a distance
+    /// field of spacing `cell` (see [`ObstacleMesh`]), paths resolved as the bodies' meshes
+    /// are; default none.
+    pub obstacle_meshes: Vec<ObstacleMesh>,
     /// Penalty stiffness of the obstacles (N/m) in backward Euler steps, positive; default
     /// `1e7`. Symplectic Euler projects vertices out of the obstacles instead.
     pub contact_stiffness: f64,
@@ -80,6 +88,7 @@ impl Default for World {
         World {
             gravity: EARTH_GRAVITY,
             obstacles: Vec::new(),
+            obstacle_meshes: Vec::new(),
             contact_stiffness: DEFAULT_CONTACT_STIFFNESS,
             friction: 0.0,
             rayleigh: 0.0,
@@ -127,7 +136,10 @@ impl World {
 /// [`max_elements`]`(order)`; `bodies[k].pin` for a pin box that holds no vertex of body `k`
 /// (and the pin errors of [`BodySpec::load`]);
 /// `gravity`, `contact_stiffness`, `friction`, `rayleigh` for a value out of range;
-/// `obstacles[i]` for an invalid shape.
+/// `obstacles[i]` for an invalid shape; `obstacle_meshes[k].mesh` for a file that does not read
+/// or a surface that is not closed, manifold and consistently oriented (the file and the
+/// triangle, edge or vertex), `obstacle_meshes[k].cell` for a spacing that is not positive and
+/// finite or too fine, `obstacle_meshes[k].scale` (`.rotate`, `.translate`) for a bad placement.
 pub fn build(
     bodies: &[BodySpec],
     world: &World,
@@ -191,6 +203,13 @@ fn build_within(
             .add_obstacle_with_friction(*obstacle, world.contact_stiffness, world.friction)
             .map_err(|e| BodyError::new(format!("obstacles[{i}]"), e))?;
     }
+    for (k, m) in world.obstacle_meshes.iter().enumerate() {
+        let field =
+            mesh_field(m, &resolve(&m.mesh)).map_err(|e| e.within(&format!("obstacle_meshes[{k}]")))?;
+        model
+            .add_mesh_obstacle(field, world.contact_stiffness, world.friction)
+            .map_err(|e| BodyError::new(format!("obstacle_meshes[{k}]"), e))?;
+    }
     let x = model.rest_positions();
     // Pinned vertices start at rest, whatever their body's velocity.
     let fixed = model.fixed();
@@ -210,6 +229,37 @@ fn build_within(
         duration: 1.0,
         params,
     })
+}
+
+/// The distance field of a mesh obstacle read from `path`: placed, checked closed, sampled at
+/// its `cell`. Errors name the field of the table (`mesh`, `cell`, `scale`, ...).
+fn mesh_field(m: &ObstacleMesh, path: &Path) -> Result<DistanceField, BodyError> {
+    let placement = m.placement();
+    placement.check().map_err(|e| match e {
+        BuildError::Invalid { field, message } => BodyError::new(field, message),
+        other => BodyError::new("scale", other),
+    })?;
+    let file = path.display();
+    if !path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
+        return Err(BodyError::new(
+            "mesh",
+            format!("{file}: a mesh obstacle is a Wavefront OBJ surface (.obj)"),
+        ));
+    }
+    let obj = read_obj(path, Polygons::Triangulate).map_err(|e| {
+        let text = e.to_string();
+        BodyError::new(
+            "mesh",
+            if text.contains(&file.to_string()) { text } else { format!("{file}: {text}") },
+        )
+    })?;
+    let mut positions = obj.positions;
+    placement.apply_all(&mut positions);
+    let surface = ClosedSurface::new(positions, obj.triangles).map_err(|e| {
+        BodyError::new("mesh", format!("{file}: {e} (vertices and triangles numbered from 0 in file order)"))
+    })?;
+    // Contact needs the field where `phi < 0` only: no margin beyond the two cells `field` adds.
+    m.field(&surface, 0.0).map_err(|e| BodyError::new("cell", format!("{file}: {e}")))
 }
 
 /// The body of every node of `model`: a corner vertex by the range of its body (`starts[k]..

@@ -1,23 +1,32 @@
 //! Boundary conditions and contact: pinned degrees of freedom, kinematic vertex groups that follow
 //! a prescribed motion, and rigid obstacles (a half-space ground or any plane, a sphere, an
 //! axis-aligned box, a capsule: anim-core's shared collider
-//! [`Shape`](anim_core::geometry::Shape)), each with a Coulomb
-//! friction coefficient `mu >= 0` given when it is added to a model
-//! ([`FemModel::add_obstacle_with_friction`](crate::model::FemModel::add_obstacle_with_friction);
-//! `mu = 0`, the default of `add_obstacle`, is frictionless).
+//! [`Shape`](anim_core::geometry::Shape); or a closed triangle mesh sampled on anim-core's
+//! [`DistanceField`]), each with a Coulomb friction coefficient `mu >= 0` given when it is added
+//! to a model ([`FemModel::add_obstacle_with_friction`](crate::model::FemModel::add_obstacle_with_friction),
+//! [`FemModel::add_mesh_obstacle`](crate::model::FemModel::add_mesh_obstacle);
+//! `mu = 0`, the default of `add_obstacle`, is frictionless). Both kinds are a [`Collider`] to
+//! the contact code, which sees only `(phi, grad phi)` at a vertex.
 //!
 //! Contact is handled per integrator: the explicit step projects penetrating vertices back to the
 //! obstacle surface and removes their approaching normal velocity; the implicit step adds the
-//! penalty energy `kappa/2 max(-phi(x), 0)^2` (`phi` the signed distance, [`obstacle_distance`])
-//! to the incremental potential, so Newton's line search sees it: its gradient is
-//! `-kappa max(-phi, 0) n` (`n = grad phi`, the outward normal) and its Hessian is taken as
-//! `kappa n n^T` where `phi < 0`, the Gauss-Newton part, which drops the curvature term
-//! `-kappa phi grad n` (zero for a plane and inside a box, where `phi` is linear; positive
-//! semi-definite or not for a sphere or a capsule, so it is left out). Friction is velocity-level Coulomb in the explicit
-//! step and IPC's lagged, smoothed friction potential in the implicit one
-//! ([`crate::friction`]). Contact is vertex against obstacle only: no self-collision, no
-//! body-body contact.
+//! penalty energy `kappa/2 max(-phi(x), 0)^2` (`phi` the signed distance, [`obstacle_distance`]
+//! for a shape, the field's trilinear interpolant for a mesh) to the incremental potential, so
+//! Newton's line search sees it: its gradient is `-kappa max(-phi, 0) grad phi` (for a shape
+//! `grad phi = n`, the outward unit normal; for a mesh the interpolant's gradient, of about unit
+//! length, so that the gradient is exactly the energy's) and its Hessian is taken as
+//! `kappa grad phi grad phi^T` where `phi < 0`, the Gauss-Newton part, which drops the curvature
+//! term `-kappa phi grad grad phi` (zero for a plane and inside a box, where `phi` is linear;
+//! positive semi-definite or not for a sphere, a capsule or a mesh, so it is left out). Friction
+//! is velocity-level Coulomb in the explicit step and IPC's lagged, smoothed friction potential
+//! in the implicit one ([`crate::friction`]). Contact is vertex against obstacle only: no
+//! self-collision, no body-body contact.
+//!
+//! A mesh obstacle's field covers the mesh's bounds widened by a margin; a vertex outside the
+//! field's lattice is far outside the mesh and not in contact.
 
+use anim_core::glam::DVec3;
+use anim_core::surface::DistanceField;
 use anim_material::nalgebra::{Rotation3, Unit, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -123,12 +132,103 @@ pub fn obstacle_distance(obstacle: &Obstacle, x: [f64; 3]) -> (f64, [f64; 3]) {
 #[must_use]
 pub fn penalty(obstacle: &Obstacle, k: f64, x: [f64; 3]) -> Option<(f64, [f64; 3], [f64; 9])> {
     let (phi, n) = obstacle_distance(obstacle, x);
+    penalty_of(phi, n, k)
+}
+
+/// The penalty of a vertex at signed distance `phi` with distance gradient `g` (see [`penalty`]).
+#[inline]
+fn penalty_of(phi: f64, g: [f64; 3], k: f64) -> Option<(f64, [f64; 3], [f64; 9])> {
     if phi < 0.0 {
-        let grad = [k * phi * n[0], k * phi * n[1], k * phi * n[2]];
-        let hess = std::array::from_fn(|i| k * n[i / 3] * n[i % 3]);
+        let grad = [k * phi * g[0], k * phi * g[1], k * phi * g[2]];
+        let hess = std::array::from_fn(|i| k * g[i / 3] * g[i % 3]);
         Some((0.5 * k * phi * phi, grad, hess))
     } else {
         None
+    }
+}
+
+/// A rigid obstacle as the contact code sees it: a shape or a mesh's distance field.
+#[derive(Debug, Clone, Copy)]
+pub enum Collider<'a> {
+    /// A plane, sphere, box or capsule ([`obstacle_distance`]).
+    Shape(&'a Obstacle),
+    /// A closed triangle mesh sampled on a [`DistanceField`] (trilinear between its nodes).
+    Mesh(&'a DistanceField),
+}
+
+impl Collider<'_> {
+    /// `(phi, grad phi)` at `x`: for a shape, [`obstacle_distance`] (the gradient is the unit
+    /// normal); for a mesh, the field's interpolated distance and its gradient (about unit
+    /// length, zero on the medial axis). `None` outside a mesh's lattice: far outside, no
+    /// contact.
+    #[inline]
+    #[must_use]
+    pub fn gradient(&self, x: [f64; 3]) -> Option<(f64, [f64; 3])> {
+        match self {
+            Collider::Shape(o) => Some(obstacle_distance(o, x)),
+            Collider::Mesh(field) => {
+                field.sample(DVec3::from_array(x)).map(|s| (s.distance, s.gradient.to_array()))
+            }
+        }
+    }
+
+    /// `(phi, n)` at `x`, `n` the outward unit normal (for a mesh the normalised gradient of the
+    /// field, zero where the gradient vanishes); `None` outside a mesh's lattice.
+    #[inline]
+    #[must_use]
+    pub fn distance(&self, x: [f64; 3]) -> Option<(f64, [f64; 3])> {
+        match self {
+            Collider::Shape(o) => Some(obstacle_distance(o, x)),
+            Collider::Mesh(field) => {
+                field.sample(DVec3::from_array(x)).map(|s| (s.distance, s.normal().to_array()))
+            }
+        }
+    }
+
+    /// The penalty contact of a vertex at `x` at stiffness `k`: `None` outside (`phi >= 0`, or
+    /// outside a mesh's lattice); inside, the energy `k/2 phi^2`, its gradient `k phi g` and the
+    /// Gauss-Newton Hessian `k g g^T` (row-major 3 x 3), with `(phi, g)` of
+    /// [`gradient`](Self::gradient). For a shape this is [`penalty`].
+    #[inline]
+    #[must_use]
+    pub fn penalty(&self, k: f64, x: [f64; 3]) -> Option<(f64, [f64; 3], [f64; 9])> {
+        let (phi, g) = self.gradient(x)?;
+        penalty_of(phi, g, k)
+    }
+}
+
+/// The rigid obstacles of a model, as the contact code reads them: the shapes and the meshes,
+/// each with its friction coefficient, shapes first.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Colliders<'a> {
+    /// The shapes.
+    pub shapes: &'a [Obstacle],
+    /// The friction coefficient of each shape.
+    pub shape_friction: &'a [f64],
+    /// The meshes' distance fields.
+    pub meshes: &'a [DistanceField],
+    /// The friction coefficient of each mesh.
+    pub mesh_friction: &'a [f64],
+}
+
+impl<'a> Colliders<'a> {
+    /// Whether there is no obstacle.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.shapes.is_empty() && self.meshes.is_empty()
+    }
+
+    /// Every obstacle with its friction coefficient: the shapes, then the meshes.
+    pub fn iter(&self) -> impl Iterator<Item = (Collider<'a>, f64)> + use<'a> {
+        let shapes = self.shapes.iter().map(Collider::Shape).zip(self.shape_friction.iter().copied());
+        let meshes = self.meshes.iter().map(Collider::Mesh).zip(self.mesh_friction.iter().copied());
+        shapes.chain(meshes)
+    }
+
+    /// How many obstacles have a positive friction coefficient.
+    #[must_use]
+    pub fn frictional(&self) -> usize {
+        self.shape_friction.iter().chain(self.mesh_friction).filter(|&&mu| mu > 0.0).count()
     }
 }
 

@@ -43,7 +43,7 @@
 //! frictional obstacle, made when the simulation is built, so a step does not allocate; they are
 //! summed in vertex order, so results do not depend on the thread count.
 
-use crate::boundary::{Obstacle, obstacle_distance};
+use crate::boundary::Colliders;
 
 /// Default smoothing velocity `eps_v` of the implicit friction (m/s): tangential speeds below it
 /// count as sticking.
@@ -91,12 +91,11 @@ pub fn tangent_basis(n: [f64; 3]) -> [[f64; 3]; 2] {
 }
 
 /// Appends to `out` the friction contacts of a backward Euler step starting at positions `xn`:
-/// one per vertex (not fully fixed) and obstacle with `friction[o] > 0` that the vertex
+/// one per vertex (not fully fixed) and obstacle (shape or mesh) with `mu > 0` that the vertex
 /// penetrates, with `lambda = kappa (-phi)`. `out` is cleared first; it never grows past
 /// `vertices x frictional obstacles` entries.
 pub fn lagged_contacts(
-    obstacles: &[Obstacle],
-    friction: &[f64],
+    obstacles: Colliders<'_>,
     kappa: f64,
     threshold: f64,
     xn: &[f64],
@@ -104,7 +103,7 @@ pub fn lagged_contacts(
     out: &mut Vec<FrictionContact>,
 ) {
     out.clear();
-    if friction.iter().all(|&mu| mu == 0.0) {
+    if obstacles.frictional() == 0 {
         return;
     }
     for (i, p) in xn.chunks_exact(3).enumerate() {
@@ -112,11 +111,11 @@ pub fn lagged_contacts(
             continue;
         }
         let start = [p[0], p[1], p[2]];
-        for (o, &mu) in obstacles.iter().zip(friction) {
+        for (o, mu) in obstacles.iter() {
             if mu == 0.0 {
                 continue;
             }
-            let (phi, n) = obstacle_distance(o, start);
+            let Some((phi, n)) = o.distance(start) else { continue };
             if phi < 0.0 {
                 out.push(FrictionContact {
                     vertex: i,

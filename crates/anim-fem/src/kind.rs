@@ -13,7 +13,8 @@
 //! the user's, with its material, placement, initial velocity and pins (anim-core's `PinSpec`:
 //! `vertices` of the mesh file and a `box`). The `[scene]` table then also holds what the
 //! bodies share ([`World`]): `gravity`, `obstacles` (planes, spheres, boxes, capsules),
-//! `contact_stiffness`, `friction` and `rayleigh`. The bodies collide with the obstacles, not
+//! `obstacle_meshes` (closed OBJ surfaces, anim-core's [`ObstacleMesh`], sampled on a distance
+//! field of spacing `cell`), `contact_stiffness`, `friction` and `rayleigh`. The bodies collide with the obstacles, not
 //! with each other. A preset refuses these fields, and `bodies` refuses
 //! `resolution`.
 //!
@@ -45,8 +46,8 @@ use crate::sim::{FemSimulation, LinearSolverChoice, TimeIntegrator};
 use anim_core::integrate::State;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
-    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
-    RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
+    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, ObstacleMesh, Preset,
+    Prop, RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
     save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
@@ -80,6 +81,12 @@ pub struct FemSceneParams {
     /// `capsule`: [`Obstacle`]); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub obstacles: Option<Vec<Obstacle>>,
+    /// With `bodies`: closed OBJ surfaces every body collides with (anim-core's
+    /// [`ObstacleMesh`]: `mesh` relative to the scene file, `scale`, `rotate`, `translate`, and
+    /// `cell`, the spacing of the distance field they are sampled on, default the longest side
+    /// over 64), with the same `contact_stiffness` and `friction` as `obstacles`; absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub obstacle_meshes: Option<Vec<ObstacleMesh>>,
     /// With `bodies`: penalty stiffness of the obstacles (N/m) in backward Euler steps (symplectic
     /// Euler projects instead), positive; absent: `1e7`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -148,6 +155,7 @@ impl FemSceneParams {
         [
             ("gravity", self.gravity.is_some()),
             ("obstacles", self.obstacles.is_some()),
+            ("obstacle_meshes", self.obstacle_meshes.is_some()),
             ("contact_stiffness", self.contact_stiffness.is_some()),
             ("friction", self.friction.is_some()),
             ("rayleigh", self.rayleigh.is_some()),
@@ -161,6 +169,7 @@ impl FemSceneParams {
         World {
             gravity: self.gravity.unwrap_or(EARTH_GRAVITY),
             obstacles: self.obstacles.clone().unwrap_or_default(),
+            obstacle_meshes: self.obstacle_meshes.clone().unwrap_or_default(),
             contact_stiffness: self.contact_stiffness.unwrap_or(DEFAULT_CONTACT_STIFFNESS),
             friction: self.friction.unwrap_or(0.0),
             rayleigh: self.rayleigh.unwrap_or(0.0),

@@ -11,7 +11,7 @@
 //! | [`element`] | the linear tetrahedron: `Dm^-1`, `W = abs(det Dm)/6`, `F = Ds Dm^-1`, forces `H = -W P(F) Dm^-T`, `f4 = -(f1+f2+f3)`, stiffness | Sifakis & Barbič 2012, Algorithm 1 |
 //! | [`assembly`] | ordered parallel assembly of forces and the sparse stiffness (identical for any thread count) | - |
 //! | [`model`] | a body of linear or 10-node tetrahedra ([`ElementOrder`](model::ElementOrder)): precomputed rest data, a material per element, lumped or consistent mass, gravity, loads, pinned and kinematic vertices, obstacles with a friction coefficient each | - |
-//! | [`boundary`] | kinematic motions; plane, sphere, box and capsule obstacles (penalty contact) | - |
+//! | [`boundary`] | kinematic motions; plane, sphere, box and capsule obstacles and closed triangle meshes on a signed distance field (penalty contact) | - |
 //! | [`friction`] | Coulomb friction at obstacle contacts: velocity-level in explicit steps, IPC's lagged smoothed potential (Li et al. 2020, section 5) in backward Euler | - |
 //! | [`newton`] | Newton on the incremental potential with a backtracking line search, Rayleigh damping `gamma` | backward Euler as an incremental potential |
 //! | [`sim`] | symplectic Euler and backward Euler steps, quasi-static solves, the `Solver` implementation | symplectic and backward Euler |
@@ -108,6 +108,8 @@ mod contact_shape_tests;
 mod contact_tests;
 #[cfg(test)]
 mod kind_tests;
+#[cfg(test)]
+mod mesh_obstacle_tests;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]

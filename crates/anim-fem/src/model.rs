@@ -27,9 +27,12 @@ use crate::mesh::{TetMesh, validate};
 use crate::newton::ElasticBody;
 use crate::tet10::{Tet10Elements, consistent_mass_coefficient, lumped_mass_coefficient};
 use anim_core::linalg::CsrMatrix;
+use anim_core::surface::DistanceField;
 use anim_material::nalgebra::Matrix3;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
+
+mod obstacles;
 
 /// Standard gravity, z-up (m/s^2).
 pub const EARTH_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
@@ -108,6 +111,8 @@ pub struct FemModel {
     kinematic: Vec<KinematicGroup>,
     obstacles: Vec<Obstacle>,
     friction: Vec<f64>,
+    mesh_obstacles: Vec<DistanceField>,
+    mesh_friction: Vec<f64>,
     contact_stiffness: f64,
 }
 
@@ -290,6 +295,8 @@ impl FemModel {
             kinematic: Vec::new(),
             obstacles: Vec::new(),
             friction: Vec::new(),
+            mesh_obstacles: Vec::new(),
+            mesh_friction: Vec::new(),
             contact_stiffness: 0.0,
         })
     }
@@ -376,53 +383,6 @@ impl FemModel {
             }
             self.loads[3 * vertex + c] += force[c];
         }
-        Ok(())
-    }
-
-    /// Adds a frictionless obstacle with penalty stiffness `stiffness` for implicit steps (the
-    /// largest stiffness given is used for all obstacles).
-    ///
-    /// # Errors
-    /// [`FemError::BadParameter`] for a non-positive stiffness; [`FemError::BadObstacle`] for a
-    /// shape that fails [`Shape::check`](anim_core::geometry::Shape::check) (a non-positive
-    /// sphere radius or box half extent, a zero plane normal, a capsule whose ends coincide).
-    pub fn add_obstacle(&mut self, obstacle: Obstacle, stiffness: f64) -> Result<(), FemError> {
-        self.add_obstacle_with_friction(obstacle, stiffness, 0.0)
-    }
-
-    /// Adds an obstacle with penalty stiffness `stiffness` (as [`add_obstacle`](Self::add_obstacle))
-    /// and Coulomb friction coefficient `friction` (`mu >= 0`; 0 is frictionless), see
-    /// [`friction`](crate::friction).
-    ///
-    /// # Errors
-    /// [`FemError::BadParameter`] for a negative or non-finite friction coefficient (named
-    /// `friction`), a non-positive stiffness; [`FemError::BadObstacle`] as for `add_obstacle`.
-    pub fn add_obstacle_with_friction(
-        &mut self,
-        obstacle: Obstacle,
-        stiffness: f64,
-        friction: f64,
-    ) -> Result<(), FemError> {
-        if !(friction >= 0.0) || !friction.is_finite() {
-            return Err(FemError::BadParameter {
-                name: "friction",
-                value: friction,
-                reason: "must be finite and >= 0",
-            });
-        }
-        if !(stiffness > 0.0) || !stiffness.is_finite() {
-            return Err(FemError::BadParameter {
-                name: "contact stiffness",
-                value: stiffness,
-                reason: "must be finite and > 0",
-            });
-        }
-        let index = self.obstacles.len();
-        let bad = |reason: String| FemError::BadObstacle { obstacle: index, reason };
-        obstacle.check().map_err(bad)?;
-        self.obstacles.push(obstacle);
-        self.friction.push(friction);
-        self.contact_stiffness = self.contact_stiffness.max(stiffness);
         Ok(())
     }
 
@@ -596,25 +556,6 @@ impl FemModel {
     #[must_use]
     pub fn kinematic(&self) -> &[KinematicGroup] {
         &self.kinematic
-    }
-
-    /// Obstacles.
-    #[must_use]
-    pub fn obstacles(&self) -> &[Obstacle] {
-        &self.obstacles
-    }
-
-    /// Coulomb friction coefficient of each obstacle (same order as
-    /// [`obstacles`](Self::obstacles); 0 for frictionless).
-    #[must_use]
-    pub fn obstacle_friction(&self) -> &[f64] {
-        &self.friction
-    }
-
-    /// Penalty stiffness of the obstacles.
-    #[must_use]
-    pub fn contact_stiffness(&self) -> f64 {
-        self.contact_stiffness
     }
 
     /// The rest positions, flat (`[x0, y0, z0, x1, ...]`).

@@ -30,7 +30,7 @@
 //! Degrees of freedom marked fixed keep their value: their rows and columns of the matrix are
 //! replaced by the identity and their gradient entries by zero.
 
-use crate::boundary::{Obstacle, penalty};
+use crate::boundary::Colliders;
 use crate::error::FemError;
 use crate::friction::FrictionContact;
 use anim_core::linalg::{CsrMatrix, LinearSolver, SystemMatrix, dot};
@@ -76,8 +76,8 @@ pub struct Potential<'a> {
     pub damping: Option<(f64, &'a [f64])>,
     /// External force (gravity and nodal loads), constant over the step.
     pub external: &'a [f64],
-    /// Obstacles and the penalty stiffness `kappa`.
-    pub obstacles: &'a [Obstacle],
+    /// Obstacles (shapes and meshes; their friction coefficients are not read here).
+    pub obstacles: Colliders<'a>,
     /// Penalty stiffness.
     pub contact_stiffness: f64,
     /// Lagged friction contacts of the step (empty: frictionless), see [`crate::friction`].
@@ -240,8 +240,8 @@ fn contact_terms(
     for i in 0..x.len() / 3 {
         let p = [x[3 * i], x[3 * i + 1], x[3 * i + 2]];
         let mut block = [0.0; 9];
-        for o in pot.obstacles {
-            if let Some((e, g_o, h_o)) = penalty(o, k, p) {
+        for (o, _) in pot.obstacles.iter() {
+            if let Some((e, g_o, h_o)) = o.penalty(k, p) {
                 energy += e;
                 if let Some(g) = grad.as_deref_mut() {
                     for c in 0..3 {
@@ -474,6 +474,7 @@ pub fn minimize<B: ElasticBody>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::boundary::Obstacle;
     use crate::friction::lagged_contacts;
     use crate::generate::box_mesh;
     use crate::material::{Material, MaterialModel};
@@ -500,15 +501,7 @@ mod tests {
         let fixed = vec![false; n];
         let threshold = 1.5e-3;
         let mut contacts = Vec::new();
-        lagged_contacts(
-            model.obstacles(),
-            model.obstacle_friction(),
-            1e4,
-            threshold,
-            &xn,
-            &fixed,
-            &mut contacts,
-        );
+        lagged_contacts(model.colliders(), 1e4, threshold, &xn, &fixed, &mut contacts);
         assert_eq!(contacts.len(), 4, "the four bottom vertices penetrate at x_n");
         let dt = 0.01;
         let mut rng = ChaCha8Rng::seed_from_u64(5);
@@ -520,7 +513,7 @@ mod tests {
             consistent_mass: None,
             damping: None,
             external: &external,
-            obstacles: model.obstacles(),
+            obstacles: model.colliders(),
             contact_stiffness: model.contact_stiffness(),
             friction: &contacts,
             fixed: &fixed,

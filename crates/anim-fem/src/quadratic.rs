@@ -12,6 +12,7 @@
 //! obstacle and both time integrators of the linear body); [`QuadraticModel`] is the
 //! quasi-static front end the conformance cases use.
 
+use crate::boundary::Colliders;
 use crate::error::FemError;
 use crate::generate::Tet10Mesh;
 use crate::material::Material;
@@ -114,7 +115,7 @@ impl QuadraticModel {
                 consistent_mass: None,
                 damping: None,
                 external: &external,
-                obstacles: &[],
+                obstacles: Colliders::default(),
                 contact_stiffness: 0.0,
                 friction: &[],
                 fixed: model.fixed(),

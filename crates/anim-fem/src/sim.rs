@@ -27,7 +27,6 @@
 //! [`FemError::NonFiniteElement`] (the element and its `det F`), with messages that begin with
 //! `anim-fem: step N:`.
 
-use crate::boundary::obstacle_distance;
 use crate::error::{FemError, StateField};
 use crate::friction::{self, FrictionContact};
 use crate::ldlt::SparseLdlt;
@@ -305,9 +304,7 @@ impl FemSimulation {
             xhat: vec![0.0; n],
             saved_x: vec![0.0; n],
             saved_v: vec![0.0; n],
-            friction_contacts: Vec::with_capacity(
-                model.vertices() * model.obstacle_friction().iter().filter(|&&mu| mu > 0.0).count(),
-            ),
+            friction_contacts: Vec::with_capacity(model.vertices() * model.colliders().frictional()),
             model,
             params,
             steps: 0,
@@ -472,13 +469,13 @@ impl FemSimulation {
 
     fn project_contacts(&self, state: &mut State, dt: f64) {
         let fixed = self.model.fixed();
-        for (o, &mu) in self.model.obstacles().iter().zip(self.model.obstacle_friction()) {
+        for (o, mu) in self.model.colliders().iter() {
             for i in 0..self.model.vertices() {
                 if fixed[3 * i] && fixed[3 * i + 1] && fixed[3 * i + 2] {
                     continue;
                 }
                 let p = [state.x[3 * i], state.x[3 * i + 1], state.x[3 * i + 2]];
-                let (phi, n) = obstacle_distance(o, p);
+                let Some((phi, n)) = o.distance(p) else { continue };
                 if phi < 0.0 {
                     let vn: f64 = (0..3).map(|c| state.v[3 * i + c] * n[c]).sum();
                     for c in 0..3 {
@@ -514,8 +511,7 @@ impl FemSimulation {
         }
         self.model.external_force(1.0, &mut self.external);
         friction::lagged_contacts(
-            self.model.obstacles(),
-            self.model.obstacle_friction(),
+            self.model.colliders(),
             self.model.contact_stiffness(),
             self.params.friction_eps_v * dt,
             &self.xn,
@@ -554,7 +550,7 @@ impl FemSimulation {
             },
             damping: if gamma > 0.0 { Some((gamma / dt, &self.xn)) } else { None },
             external: &self.external,
-            obstacles: self.model.obstacles(),
+            obstacles: self.model.colliders(),
             contact_stiffness: self.model.contact_stiffness(),
             friction: &self.friction_contacts,
             fixed,
@@ -605,7 +601,7 @@ impl FemSimulation {
                 consistent_mass: None,
                 damping: None,
                 external: &self.external,
-                obstacles: self.model.obstacles(),
+                obstacles: self.model.colliders(),
                 contact_stiffness: self.model.contact_stiffness(),
                 friction: &[],
                 fixed: self.model.fixed(),

@@ -1,12 +1,14 @@
 //! The architecture invariant "no solver allocates inside `step`" for FEM: after the first step,
 //! symplectic Euler and backward Euler steps (every linear solver) of linear and 10-node bodies
-//! (lumped and consistent mass, Rayleigh damping, kinematic nodes, an obstacle) on a rayon pool
+//! (lumped and consistent mass, Rayleigh damping, kinematic nodes, a shape obstacle and a mesh
+//! obstacle with friction, both touched by the body) on a rayon pool
 //! of 2 threads perform no heap allocation. Counted by a wrapping global allocator, so this file is its own
 //! test binary.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use anim_core::alloc_count::CountingAllocator;
+use anim_core::surface::{ClosedSurface, DistanceField};
 use anim_fem::boundary::{Motion, Obstacle};
 use anim_fem::generate::box_mesh;
 use anim_fem::material::{Material, MaterialModel};
@@ -21,6 +23,26 @@ fn steps_do_not_allocate() {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("pool");
     let mesh = box_mesh([0.0, -0.05, 0.02], [0.6, 0.1, 0.1], [6, 1, 1]).unwrap();
     let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
+    // A block under the middle of the beam, its top 5 mm above the beam's bottom (z = 0.02).
+    let (lo, hi) = ([0.15, -0.1, -0.1], [0.45, 0.1, 0.025]);
+    let corners: Vec<[f64; 3]> =
+        (0..8).map(|k| [0, 1, 2].map(|a| if (k >> a) & 1 == 1 { hi[a] } else { lo[a] })).collect();
+    let faces = [
+        [0, 2, 3],
+        [0, 3, 1],
+        [4, 5, 7],
+        [4, 7, 6],
+        [0, 1, 5],
+        [0, 5, 4],
+        [2, 6, 7],
+        [2, 7, 3],
+        [0, 4, 6],
+        [0, 6, 2],
+        [1, 3, 7],
+        [1, 7, 5],
+    ];
+    let block = ClosedSurface::new(corners, faces.to_vec()).unwrap();
+    let field = DistanceField::around(&block, 0.02, 0.05).unwrap();
     let explicit = FemParams::new(TimeIntegrator::SymplecticEuler);
     let implicit =
         LinearSolverChoice::ALL.map(|s| FemParams::new(TimeIntegrator::BackwardEuler).with_linear_solver(s));
@@ -38,6 +60,11 @@ fn steps_do_not_allocate() {
             model.pin_vertices(&left).unwrap();
             model.add_kinematic(&right, Motion::Translate { velocity: [0.0, 0.0, -0.1] }).unwrap();
             model.add_obstacle(Obstacle::ground(0.0), 1e5).unwrap();
+            model.add_mesh_obstacle(field.clone(), 1e5, 0.3).unwrap();
+            let touching = model.mesh().positions.iter().filter(|p| {
+                field.sample(anim_core::glam::DVec3::from_array(**p)).is_some_and(|s| s.distance < 0.0)
+            });
+            assert!(touching.count() >= 4, "the beam's bottom is inside the block");
             let mut sim = FemSimulation::new(model, params.with_rayleigh(1e-4)).unwrap();
             let mut state = sim.rest_state();
             // The counter sees every thread of the process, including the pool's own bookkeeping

@@ -23,7 +23,7 @@
 //! # Ok::<(), anim_springs::BuildError>(())
 //! ```
 
-use crate::contact::Collider;
+use crate::contact::{Collider, MeshCollider};
 use crate::error::{BuildError, InputError};
 use crate::network::{Particle, Spring, SpringKind, SpringModel, SpringNetwork};
 use anim_core::glam::DVec3;
@@ -160,6 +160,7 @@ pub struct NetworkBuilder {
     triangles: Vec<[usize; 3]>,
     gravity: [f64; 3],
     colliders: Vec<Collider>,
+    mesh_colliders: Vec<MeshCollider>,
 }
 
 /// Standard gravity pointing down the z axis (m/s^2): the scenes' convention is z up.
@@ -255,6 +256,12 @@ impl NetworkBuilder {
     /// Adds a collider.
     pub fn collider(&mut self, c: Collider) -> &mut Self {
         self.colliders.push(c);
+        self
+    }
+
+    /// Adds a collider bounded by a closed triangle mesh ([`MeshCollider`]).
+    pub fn mesh_collider(&mut self, c: MeshCollider) -> &mut Self {
+        self.mesh_colliders.push(c);
         self
     }
 
@@ -629,6 +636,9 @@ impl NetworkBuilder {
             c.check().map_err(|reason| BuildError::Input(InputError::BadCollider { collider, reason }))?;
             colliders.push(c.normalized());
         }
+        for (collider, c) in self.mesh_colliders.iter().enumerate() {
+            c.check().map_err(|reason| BuildError::BadMeshCollider { collider, reason })?;
+        }
         let model = SpringModel::new(
             particles,
             self.positions.clone(),
@@ -636,6 +646,7 @@ impl NetworkBuilder {
             self.triangles.clone(),
             DVec3::from_array(self.gravity),
             colliders,
+            self.mesh_colliders.clone(),
         );
         Ok(SpringNetwork::from_model(model))
     }

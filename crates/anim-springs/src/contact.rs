@@ -1,5 +1,6 @@
-//! Colliders: planes, spheres, axis-aligned boxes and capsules, as penalty forces with their
-//! Jacobians.
+//! Colliders: planes, spheres, axis-aligned boxes and capsules ([`Collider`]), and closed
+//! triangle meshes sampled on anim-core's signed distance field ([`MeshCollider`]), as penalty
+//! forces with their Jacobians.
 //!
 //! # Why penalty forces
 //!
@@ -52,7 +53,9 @@
 //! and beside a box's corner within the thickness, `c` the corner), `(I - n n^T - a a^T) / r`
 //! beside a capsule's axis (`a` the unit axis, `r` the distance to it) and beside a box's edge
 //! within the thickness, zero in a plane and inside a box or beside its faces (its normal is
-//! constant on each face's side of the inner ridges, where it jumps). In the default
+//! constant on each face's side of the inner ridges, where it jumps). For a mesh, `phi` is the
+//! field's trilinear interpolant, `n` its normalised gradient, `dp/dx = -|grad phi| n` (about
+//! `-n`) and `dn/dx = (I - n n^T) H / |grad phi|` with `H` the field's Hessian. In the default
 //! [`JacobianMode::Definite`](crate::JacobianMode::Definite) only the normal stiffness is kept,
 //! with `1 - tau_n v_n` clamped at 0: symmetric and negative semi-definite, as conjugate gradients
 //! and Cholesky need, while the force itself is unchanged (Newton converges to the same step, a
@@ -75,25 +78,36 @@ use serde::{Deserialize, Serialize};
 /// contact handles all four: plane, sphere, axis-aligned box and capsule.
 pub use anim_core::geometry::Shape;
 
-/// How a collider's outward normal turns as a particle moves inside it:
-/// `dn/dx = curvature (I - n n^T - axis axis^T)`.
+/// How a collider's signed distance changes as a particle moves inside it: its gradient's length
+/// and how the outward normal turns.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Bend {
-    /// `1 / r`: `r` the distance to a sphere's centre, a capsule's axis, or a box's nearest
-    /// edge or corner (outside it, within the thickness); 0 when the normal is constant (a
-    /// plane, a box's inside or beside a face, a particle at the centre or on the axis).
-    curvature: f64,
-    /// The unit axis of a capsule beside its cylindrical part, or of a box's edge; zero
-    /// otherwise.
-    axis: DVec3,
+pub(crate) enum Bend {
+    /// A shape's: the gradient is the unit normal, `dn/dx = curvature (I - n n^T - axis axis^T)`.
+    Turn {
+        /// `1 / r`: `r` the distance to a sphere's centre, a capsule's axis, or a box's nearest
+        /// edge or corner (outside it, within the thickness); 0 when the normal is constant (a
+        /// plane, a box's inside or beside a face, a particle at the centre or on the axis).
+        curvature: f64,
+        /// The unit axis of a capsule beside its cylindrical part, or of a box's edge; zero
+        /// otherwise.
+        axis: DVec3,
+    },
+    /// A distance field's ([`MeshCollider`]): `|grad phi| = slope` (about 1) and
+    /// `dn/dx = (I - n n^T) H / |grad phi|`, `H` the field's Hessian.
+    Field {
+        /// `|grad phi|`.
+        slope: f64,
+        /// `dn/dx`.
+        dn_dx: DMat3,
+    },
 }
 
 impl Bend {
-    const NONE: Bend = Bend { curvature: 0.0, axis: DVec3::ZERO };
+    const NONE: Bend = Bend::Turn { curvature: 0.0, axis: DVec3::ZERO };
 
     /// Turning about a point, as in a sphere.
     fn round(curvature: f64) -> Self {
-        Bend { curvature, axis: DVec3::ZERO }
+        Bend::Turn { curvature, axis: DVec3::ZERO }
     }
 }
 
@@ -182,22 +196,19 @@ impl Collider {
     /// Checks the parameters; returns a description of the first problem (a shape's names the
     /// shape).
     pub(crate) fn check(&self) -> Result<(), String> {
-        if !(self.stiffness > 0.0 && self.stiffness.is_finite()) {
-            return Err(format!("stiffness must be positive and finite, got {}", self.stiffness));
-        }
-        if !(self.damping >= 0.0 && self.damping.is_finite()) {
-            return Err(format!("damping must be non-negative and finite, got {}", self.damping));
-        }
-        if !(self.friction >= 0.0 && self.friction.is_finite()) {
-            return Err(format!("friction must be non-negative and finite, got {}", self.friction));
-        }
-        if !(self.smoothing >= 0.0 && self.smoothing.is_finite()) {
-            return Err(format!("smoothing must be non-negative and finite, got {}", self.smoothing));
-        }
-        if !(self.thickness >= 0.0 && self.thickness.is_finite()) {
-            return Err(format!("thickness must be non-negative and finite, got {}", self.thickness));
-        }
+        self.law().check(self.thickness)?;
         self.shape.check()
+    }
+
+    /// The penalty law of the collider's parameters.
+    #[inline]
+    fn law(&self) -> Law {
+        Law {
+            stiffness: self.stiffness,
+            damping: self.damping,
+            friction: self.friction,
+            smoothing: self.smoothing,
+        }
     }
 
     /// A copy with a unit plane normal (called once the parameters are checked).
@@ -245,7 +256,7 @@ impl Collider {
                 let bend = match (out.bitmask().count_ones(), distance > MIN_LENGTH) {
                     (2, true) => {
                         let along = DVec3::select(out, DVec3::ZERO, DVec3::ONE);
-                        Bend { curvature: 1.0 / distance, axis: along }
+                        Bend::Turn { curvature: 1.0 / distance, axis: along }
                     }
                     (3, true) => Bend::round(1.0 / distance),
                     _ => Bend::NONE,
@@ -267,13 +278,63 @@ impl Collider {
                 let ab = b - a;
                 let t = (x - a).dot(ab) / ab.length_squared();
                 let bend = if t > 0.0 && t < 1.0 {
-                    Bend { curvature: 1.0 / r, axis: ab.normalize() }
+                    Bend::Turn { curvature: 1.0 / r, axis: ab.normalize() }
                 } else {
                     Bend::round(1.0 / r)
                 };
                 Some((-phi, n, bend))
             }
         }
+    }
+
+    /// Force on a particle at `(x, v)`.
+    #[inline]
+    pub(crate) fn force(&self, x: DVec3, v: DVec3) -> DVec3 {
+        self.law().force(self.probe(x), v)
+    }
+
+    /// Penalty energy `E(p)`.
+    #[inline]
+    pub(crate) fn energy(&self, x: DVec3) -> f64 {
+        self.law().energy(self.probe(x))
+    }
+
+    /// Adds the Jacobians `df/dx` (definite or exact) and `df/dv` at `(x, v)` to `k` and `d`.
+    #[inline]
+    pub(crate) fn jacobians(&self, x: DVec3, v: DVec3, exact: bool, k: &mut DMat3, d: &mut DMat3) {
+        self.law().jacobians(self.probe(x), v, exact, k, d);
+    }
+}
+
+/// The penalty law shared by the shape and mesh colliders: the force, energy and Jacobians of a
+/// particle given its penetration, normal and [`Bend`] (see the [module docs](self)).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Law {
+    stiffness: f64,
+    damping: f64,
+    friction: f64,
+    smoothing: f64,
+}
+
+impl Law {
+    /// Checks the parameters and a thickness.
+    pub(crate) fn check(&self, thickness: f64) -> Result<(), String> {
+        if !(self.stiffness > 0.0 && self.stiffness.is_finite()) {
+            return Err(format!("stiffness must be positive and finite, got {}", self.stiffness));
+        }
+        if !(self.damping >= 0.0 && self.damping.is_finite()) {
+            return Err(format!("damping must be non-negative and finite, got {}", self.damping));
+        }
+        if !(self.friction >= 0.0 && self.friction.is_finite()) {
+            return Err(format!("friction must be non-negative and finite, got {}", self.friction));
+        }
+        if !(self.smoothing >= 0.0 && self.smoothing.is_finite()) {
+            return Err(format!("smoothing must be non-negative and finite, got {}", self.smoothing));
+        }
+        if !(thickness >= 0.0 && thickness.is_finite()) {
+            return Err(format!("thickness must be non-negative and finite, got {thickness}"));
+        }
+        Ok(())
     }
 
     /// Elastic normal force magnitude `phi(p)`, its derivative `phi'(p)` and energy `E(p)` (see
@@ -288,10 +349,10 @@ impl Collider {
         }
     }
 
-    /// Force on a particle at `(x, v)`.
+    /// Force on a particle of velocity `v` at a probe's result.
     #[inline]
-    pub(crate) fn force(&self, x: DVec3, v: DVec3) -> DVec3 {
-        match self.probe(x) {
+    fn force(&self, probe: Option<(f64, DVec3, Bend)>, v: DVec3) -> DVec3 {
+        match probe {
             None => DVec3::ZERO,
             Some((p, n, _)) => {
                 let (phi, _, _) = self.elastic(p);
@@ -304,40 +365,62 @@ impl Collider {
 
     /// Penalty energy `E(p)`.
     #[inline]
-    pub(crate) fn energy(&self, x: DVec3) -> f64 {
-        self.probe(x).map_or(0.0, |(p, _, _)| self.elastic(p).2)
+    fn energy(&self, probe: Option<(f64, DVec3, Bend)>) -> f64 {
+        probe.map_or(0.0, |(p, _, _)| self.elastic(p).2)
     }
 
-    /// Adds the Jacobians `df/dx` (definite or exact) and `df/dv` at `(x, v)` to `k` and `d`.
+    /// Adds the Jacobians `df/dx` (definite or exact) and `df/dv` at a probe's result to `k`
+    /// and `d`.
     #[inline]
-    pub(crate) fn jacobians(&self, x: DVec3, v: DVec3, exact: bool, k: &mut DMat3, d: &mut DMat3) {
-        let Some((p, n, bend)) = self.probe(x) else {
+    fn jacobians(
+        &self,
+        probe: Option<(f64, DVec3, Bend)>,
+        v: DVec3,
+        exact: bool,
+        k: &mut DMat3,
+        d: &mut DMat3,
+    ) {
+        let Some((p, n, bend)) = probe else {
             return;
         };
         let (phi, dphi, _) = self.elastic(p);
+        // dp/dx = -|grad phi| n: 1 for a shape, about 1 for a field.
+        let slope = match bend {
+            Bend::Turn { .. } => 1.0,
+            Bend::Field { slope, .. } => slope,
+        };
         let (tn, tt) = (self.damping, self.friction);
         let nn = outer(n, n);
         let proj = DMat3::IDENTITY - nn;
         let vn = n.dot(v);
         *d -= phi * (tn * nn + tt * proj);
         if !exact {
-            // The symmetric normal part of -phi' g n^T (g . n = 1 - tau_n v_n), clamped to stay
-            // negative semi-definite when the particle separates fast.
-            *k -= (dphi * (1.0 - tn * vn).max(0.0)) * nn;
+            // The symmetric normal part of -phi' |grad phi| g n^T (g . n = 1 - tau_n v_n),
+            // clamped to stay negative semi-definite when the particle separates fast.
+            *k -= (dphi * slope * (1.0 - tn * vn).max(0.0)) * nn;
             return;
         }
         // f = phi(p) g(n, v), g = n + (tau_t - tau_n)(n . v) n - tau_t v;
-        // df/dx = -phi' g n^T + phi (dg/dn) (dn/dx), dn/dx = curvature (I - n n^T).
+        // df/dx = -phi' |grad phi| g n^T + phi (dg/dn) (dn/dx).
         let g = n + (tt - tn) * vn * n - tt * v;
-        *k -= dphi * outer(g, n);
-        if bend.curvature > 0.0 {
-            let dg_dn = DMat3::IDENTITY + (tt - tn) * (vn * DMat3::IDENTITY + outer(n, v));
-            // dn/dx = curvature (I - n n^T - a a^T); a = 0 but beside a capsule's axis.
-            let turn = if bend.axis == DVec3::ZERO { proj } else { proj - outer(bend.axis, bend.axis) };
-            *k += (phi * bend.curvature) * (dg_dn * turn);
+        *k -= (dphi * slope) * outer(g, n);
+        let dg_dn = || DMat3::IDENTITY + (tt - tn) * (vn * DMat3::IDENTITY + outer(n, v));
+        match bend {
+            Bend::Turn { curvature, axis } if curvature > 0.0 => {
+                // dn/dx = curvature (I - n n^T - a a^T); a = 0 but beside a capsule's axis.
+                let turn = if axis == DVec3::ZERO { proj } else { proj - outer(axis, axis) };
+                *k += (phi * curvature) * (dg_dn() * turn);
+            }
+            Bend::Field { dn_dx, .. } => *k += phi * (dg_dn() * dn_dx),
+            Bend::Turn { .. } => {}
         }
     }
 }
 
+mod mesh;
+pub use mesh::MeshCollider;
+
+#[cfg(test)]
+mod mesh_tests;
 #[cfg(test)]
 mod tests;

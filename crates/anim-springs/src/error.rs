@@ -71,6 +71,14 @@ pub enum BuildError {
         /// The vertex opposite the edge in both.
         c: usize,
     },
+    /// A mesh collider's parameters are invalid.
+    #[error("mesh collider {collider}: {reason}")]
+    BadMeshCollider {
+        /// Mesh collider index, in the order added.
+        collider: usize,
+        /// What is wrong.
+        reason: String,
+    },
     /// A Wavefront OBJ file could not be read.
     #[error("OBJ line {line}: {message}")]
     Obj {

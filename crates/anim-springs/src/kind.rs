@@ -12,7 +12,9 @@
 //! a `preset`, or `[[scene.bodies]]` tables ([`BodySpec`]), cloth and shells of the user's own
 //! from OBJ triangle surfaces, each with its material (area density, edge and bending springs),
 //! placement, initial velocity and pinned vertices, among scene-wide `obstacles` (planes,
-//! spheres, boxes and capsules: anim-core's [`Shape`]) with their `contact`, under `gravity`.
+//! spheres, boxes and capsules: anim-core's [`Shape`]) and `obstacle_meshes` (closed OBJ
+//! surfaces, anim-core's [`ObstacleMesh`], sampled on a distance field of spacing `cell`), with
+//! their `contact`, under `gravity`.
 //! Bodies do not collide with each other. The scene is a [`SpringSimulation`] with its [`State`]: it implements
 //! [`Checkpoint`] (the state and the simulation's memory, the integrator's included) and
 //! [`View`] (the particles and their velocities; springs as lines, cloth triangles, pinned
@@ -21,6 +23,7 @@
 use crate::EARTH_GRAVITY;
 use crate::body::{BodySpec, ContactSpec, build_bodies};
 use crate::contact::Shape;
+use crate::obstacles::mesh_colliders;
 use crate::scenes;
 use crate::sim::SpringSimulation;
 use anim_core::integrate::{IntegratorKind, State};
@@ -28,8 +31,8 @@ use anim_core::linalg::LinearSolverKind;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::systems::integrator;
 use anim_core::scene::{
-    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, Prop,
-    RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
+    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, ObstacleMesh, Preset,
+    Prop, RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
     save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
@@ -75,6 +78,12 @@ pub struct SpringsParams {
     /// `sphere`, `box`, `capsule`); default none.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub obstacles: Vec<Shape>,
+    /// With `bodies`: closed OBJ surfaces every body collides with (anim-core's
+    /// [`ObstacleMesh`]: `mesh` relative to the scene file, `scale`, `rotate`, `translate`, and
+    /// `cell`, the spacing of the distance field they are sampled on, default the longest side
+    /// over 64), with the same `contact`; default none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacle_meshes: Vec<ObstacleMesh>,
     /// With `bodies`: gravity (m/s²); default `[0, 0, -9.81]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gravity: Option<[f64; 3]>,
@@ -120,6 +129,7 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
         (Some(name), true) => {
             for (field, given) in [
                 ("obstacles", !p.obstacles.is_empty()),
+                ("obstacle_meshes", !p.obstacle_meshes.is_empty()),
                 ("gravity", p.gravity.is_some()),
                 ("contact", p.contact.is_some()),
             ] {
@@ -139,13 +149,22 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
                     "a preset's field: a body's resolution is its mesh's",
                 ));
             }
-            build_bodies(
+            let contact = p.contact.unwrap_or_default();
+            let mut scene = build_bodies(
                 &p.bodies,
                 &p.obstacles,
                 p.gravity.unwrap_or(EARTH_GRAVITY),
-                &p.contact.unwrap_or_default(),
+                &contact,
                 |mesh| context.resolve(mesh),
-            )?
+            )?;
+            if !p.obstacle_meshes.is_empty() {
+                let meshes = mesh_colliders(&p.obstacle_meshes, &contact, |mesh| context.resolve(mesh))?;
+                scene
+                    .network
+                    .add_mesh_colliders(meshes)
+                    .map_err(|e| BuildError::invalid("obstacle_meshes", e.to_string()))?;
+            }
+            scene
         }
         (Some(_), false) => {
             return Err(BuildError::invalid("bodies", "give a built-in `preset` or `bodies`, not both"));

@@ -16,8 +16,9 @@
 //!   ```
 //!
 //!   (Hooke's law, `f_i = sum_{j != i} f_ij`, `dv_i/dt = f_i / m_i`, `dx_i/dt = v_i`).
-//! - **Gravity** and **colliders** (planes, spheres, axis-aligned boxes, capsules) as penalty
-//!   forces with friction ([`contact`]).
+//! - **Gravity** and **colliders** (planes, spheres, axis-aligned boxes, capsules, and closed
+//!   triangle meshes on a signed distance field, [`MeshCollider`]) as penalty forces with
+//!   friction ([`contact`]).
 //! - **Builders** ([`NetworkBuilder`]): a chain, a cloth grid with structural, shear and bending
 //!   springs, a 3-D lattice with face and body diagonals, any triangle mesh (an edge spring per
 //!   unique edge, optional bending springs across interior edges; [`TriangleMesh::from_obj`]
@@ -138,11 +139,12 @@ mod geom;
 pub mod kind;
 mod mesh;
 pub mod network;
+mod obstacles;
 pub mod scenes;
 mod sim;
 
 pub use build::{Chain, Cloth, EARTH_GRAVITY, Lattice, MeshMass, MeshSprings, NetworkBuilder, SpringParams};
-pub use contact::{Collider, Shape};
+pub use contact::{Collider, MeshCollider, Shape};
 pub use error::{BuildError, InputError};
 pub use kind::KIND;
 pub use mesh::TriangleMesh;

@@ -74,6 +74,7 @@
 mod forces;
 mod model;
 
+use crate::contact::MeshCollider;
 use crate::error::{BuildError, InputError};
 pub use crate::geom::MIN_LENGTH;
 pub use model::{MAX_PARTICLES, MAX_SPRINGS, Particle, Spring, SpringKind, SpringModel};
@@ -180,7 +181,7 @@ fn chunks(n: usize) -> usize {
 impl SpringData {
     fn new(model: &SpringModel, mode: JacobianMode) -> Self {
         let (n, m) = (model.particles.len(), model.springs.len());
-        let contact = if model.colliders.is_empty() { 0 } else { n };
+        let contact = if model.has_contact() { n } else { 0 };
         Self {
             spring_force: vec![DVec3::ZERO; m],
             lin: vec![[0.0; 6]; m],
@@ -210,6 +211,24 @@ impl SpringNetwork {
     pub(crate) fn from_model(model: SpringModel) -> Self {
         let data = SpringData::new(&model, JacobianMode::Definite);
         Self { model, data }
+    }
+
+    /// Adds mesh colliders to a built network (as
+    /// [`NetworkBuilder::mesh_collider`](crate::NetworkBuilder::mesh_collider) does before the
+    /// build); the scratch data is made anew, in the network's Jacobian mode.
+    ///
+    /// # Errors
+    /// [`BuildError::BadMeshCollider`] for bad
+    /// contact parameters, numbered after the mesh colliders already there; nothing is added
+    /// then.
+    pub fn add_mesh_colliders(&mut self, meshes: Vec<MeshCollider>) -> Result<(), BuildError> {
+        let first = self.model.mesh_colliders.len();
+        for (k, c) in meshes.iter().enumerate() {
+            c.check().map_err(|reason| BuildError::BadMeshCollider { collider: first + k, reason })?;
+        }
+        self.model.mesh_colliders.extend(meshes);
+        self.data = SpringData::new(&self.model, self.data.mode);
+        Ok(())
     }
 
     /// The model (particles, springs, colliders, topology).
@@ -368,6 +387,9 @@ impl SpringNetwork {
             kinetic += 0.5 * part.mass * vp.length_squared();
             gravity -= part.mass * model.gravity.dot(xp);
             for c in &model.colliders {
+                contact += c.energy(xp);
+            }
+            for c in &model.mesh_colliders {
                 contact += c.energy(xp);
             }
         }

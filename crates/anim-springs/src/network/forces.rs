@@ -99,6 +99,9 @@ impl SpringModel {
         for c in &self.colliders {
             f += c.force(xp, vp);
         }
+        for c in &self.mesh_colliders {
+            f += c.force(xp, vp);
+        }
         f
     }
 }
@@ -166,7 +169,7 @@ impl SpringNetwork {
                     minus += spring_force[e.spring()];
                 }
                 let mut acc = model.particles[p].mass * model.gravity + (plus - minus);
-                if !model.colliders.is_empty() {
+                if model.has_contact() {
                     acc += model.contact_force(load(x, p), load(v, p));
                 }
                 if accel {
@@ -239,13 +242,16 @@ impl MechanicalSystem for SpringNetwork {
                 }
             });
         }
-        if !model.colliders.is_empty() {
+        if model.has_contact() {
             let exact = mode == JacobianMode::Exact;
             let n = model.particles.len();
             let work = |p: usize, kc: &mut DMat3, dc: &mut DMat3| {
                 *kc = DMat3::ZERO;
                 *dc = DMat3::ZERO;
                 for c in &model.colliders {
+                    c.jacobians(load(x, p), load(v, p), exact, kc, dc);
+                }
+                for c in &model.mesh_colliders {
                     c.jacobians(load(x, p), load(v, p), exact, kc, dc);
                 }
             };

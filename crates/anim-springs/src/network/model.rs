@@ -8,7 +8,7 @@
 //! per-particle sum of the force and Jacobian kernels runs in that fixed order, which is what
 //! makes them independent of the thread count.
 
-use crate::contact::Collider;
+use crate::contact::{Collider, MeshCollider};
 use anim_core::glam::DVec3;
 use serde::{Deserialize, Serialize};
 
@@ -91,6 +91,7 @@ pub struct SpringModel {
     pub(super) triangles: Vec<[usize; 3]>,
     pub(super) gravity: DVec3,
     pub(super) colliders: Vec<Collider>,
+    pub(super) mesh_colliders: Vec<MeshCollider>,
     pub(super) inv_mass: Vec<f64>,
     /// Particles of each spring (compact copy of `springs` for the kernels).
     pub(super) ends: Vec<[u32; 2]>,
@@ -111,6 +112,7 @@ impl SpringModel {
         triangles: Vec<[usize; 3]>,
         gravity: DVec3,
         colliders: Vec<Collider>,
+        mesh_colliders: Vec<MeshCollider>,
     ) -> Self {
         let n = particles.len();
         let inv_mass = particles.iter().map(|p| if p.pinned { 0.0 } else { 1.0 / p.mass }).collect();
@@ -149,6 +151,7 @@ impl SpringModel {
             triangles,
             gravity,
             colliders,
+            mesh_colliders,
             inv_mass,
             ends,
             params,
@@ -193,6 +196,18 @@ impl SpringModel {
     #[must_use]
     pub fn colliders(&self) -> &[Collider] {
         &self.colliders
+    }
+
+    /// The mesh colliders.
+    #[must_use]
+    pub fn mesh_colliders(&self) -> &[MeshCollider] {
+        &self.mesh_colliders
+    }
+
+    /// Whether any collider (shape or mesh) acts.
+    #[inline]
+    pub(super) fn has_contact(&self) -> bool {
+        !self.colliders.is_empty() || !self.mesh_colliders.is_empty()
     }
 
     /// Springs incident to particle `p` as `(spring index, other particle)`: first those whose

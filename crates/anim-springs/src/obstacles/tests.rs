@@ -1,0 +1,131 @@
+//! A scene file's `obstacle_meshes`: a cloth rests on a mesh block as on the same `box` obstacle,
+//! and every refusal names its field and the file.
+
+use anim_core::scene::{BuildContext, BuildError, Frame};
+
+/// A folder of this test's own under the system's temporary folder.
+fn folder(test: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("anim-springs-obstacles-{}-{test}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).expect("temporary folder");
+    dir
+}
+
+/// The unit cube `[0, 1]^3` as 12 outward triangles, without the triangles in `missing`.
+fn cube_obj(missing: &[usize]) -> String {
+    let mut text = String::new();
+    for k in 0..8 {
+        text += &format!("v {} {} {}\n", k & 1, (k >> 1) & 1, (k >> 2) & 1);
+    }
+    let faces = [
+        [1, 3, 4],
+        [1, 4, 2],
+        [5, 6, 8],
+        [5, 8, 7],
+        [1, 2, 6],
+        [1, 6, 5],
+        [3, 7, 8],
+        [3, 8, 4],
+        [1, 5, 7],
+        [1, 7, 3],
+        [2, 4, 8],
+        [2, 8, 6],
+    ];
+    for (t, f) in faces.iter().enumerate() {
+        if !missing.contains(&t) {
+            text += &format!("f {} {} {}\n", f[0], f[1], f[2]);
+        }
+    }
+    text
+}
+
+/// A flat 5 x 5 cloth of 0.4 m at z = 0.
+fn cloth_obj() -> String {
+    let mut s = String::new();
+    for iy in 0..5 {
+        for ix in 0..5 {
+            s += &format!("v {} {} 0\n", 0.1 * ix as f64, 0.1 * iy as f64);
+        }
+    }
+    for iy in 0..4 {
+        for ix in 0..4 {
+            let a = iy * 5 + ix + 1;
+            s += &format!("f {} {} {}\nf {} {} {}\n", a, a + 1, a + 6, a, a + 6, a + 5);
+        }
+    }
+    s
+}
+
+fn field_of(e: BuildError) -> (String, String) {
+    match e {
+        BuildError::Invalid { field, message } | BuildError::Schema { field, message } => (field, message),
+        other => panic!("unexpected {other}"),
+    }
+}
+
+#[test]
+fn a_cloth_rests_on_a_mesh_block_and_refusals_name_the_field_and_the_file() {
+    let dir = folder("kind");
+    std::fs::write(dir.join("block.obj"), cube_obj(&[])).expect("obj");
+    std::fs::write(dir.join("holed.obj"), cube_obj(&[7])).expect("obj");
+    std::fs::write(dir.join("block.stl"), cube_obj(&[])).expect("stl");
+    std::fs::write(dir.join("cloth.obj"), cloth_obj()).expect("cloth");
+    let build = |value: serde_json::Value| (crate::KIND.build)(&value, &BuildContext { base: Some(&dir) });
+    let refused = |value: serde_json::Value| field_of(build(value).err().expect("refused"));
+    let cloth = serde_json::json!({
+        "mesh": "cloth.obj",
+        "material": { "density": 0.2, "stiffness": 200.0 },
+        "translate": [-0.2, -0.2, 0.52],
+    });
+    // The unit block scaled to 1 m about its corner, moved to [-0.5, 0.5]^2 x [-0.5, 0.5]: its
+    // top at z = 0.5 under the whole cloth.
+    let block = serde_json::json!({ "mesh": "block.obj", "translate": [-0.5, -0.5, -0.5], "cell": 0.05 });
+    let with = |key: &str, value: serde_json::Value| {
+        let mut b = block.clone();
+        b[key] = value;
+        b
+    };
+    let contact = serde_json::json!({ "stiffness": 1e3, "thickness": 0.01 });
+    let scene = |meshes: serde_json::Value| serde_json::json!({ "bodies": [cloth], "obstacle_meshes": meshes, "contact": contact });
+    let rest = |params: serde_json::Value| {
+        let mut s = build(params).expect("builds");
+        for _ in 0..100 {
+            s.step(0.005).expect("steps");
+        }
+        let mut frame = Frame::default();
+        s.frame(&mut frame);
+        frame.points
+    };
+    let on_mesh = rest(scene(serde_json::json!([block])));
+    let boxed =
+        serde_json::json!([{ "box": { "center": [0.0, 0.0, 0.0], "half_extents": [0.5, 0.5, 0.5] } }]);
+    let on_box = rest(serde_json::json!({ "bodies": [cloth], "obstacles": boxed, "contact": contact }));
+    // Resting on the top, held 1 cm off it.
+    assert!(on_mesh.chunks(3).all(|p| (p[2] - 0.51).abs() < 2e-3), "{on_mesh:?}");
+    // The top face is flat: the field is exact there, to the f32 of its nodes.
+    let apart = on_mesh.iter().zip(&on_box).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    assert!(apart < 1e-6, "{apart}");
+
+    let (f, m) = refused(scene(serde_json::json!([with("mesh", "missing.obj".into())])));
+    assert_eq!(f, "obstacle_meshes[0].mesh");
+    assert!(m.contains("missing.obj"), "{m}");
+    let (f, m) = refused(scene(serde_json::json!([block, with("mesh", "holed.obj".into())])));
+    assert_eq!(f, "obstacle_meshes[1].mesh");
+    assert!(m.contains("holed.obj") && m.contains("edge ("), "{m}");
+    let (f, m) = refused(scene(serde_json::json!([with("mesh", "block.stl".into())])));
+    assert_eq!(f, "obstacle_meshes[0].mesh");
+    assert!(m.contains("block.stl") && m.contains("OBJ"), "{m}");
+    for cell in [0.0, -1.0] {
+        let (f, m) = refused(scene(serde_json::json!([with("cell", cell.into())])));
+        assert_eq!(f, "obstacle_meshes[0].cell");
+        assert!(m.contains("block.obj") && m.contains("positive"), "{cell}: {m}");
+    }
+    let (f, m) = refused(scene(serde_json::json!([with("cell", 1e-4.into())])));
+    assert_eq!(f, "obstacle_meshes[0].cell");
+    assert!(m.contains("2^24"), "{m}");
+    let (f, _) = refused(scene(serde_json::json!([with("scale", (-1.0).into())])));
+    assert_eq!(f, "obstacle_meshes[0].scale");
+    let (f, m) = refused(serde_json::json!({ "preset": "hanging-cloth", "obstacle_meshes": [block] }));
+    assert_eq!(f, "obstacle_meshes");
+    assert!(m.contains("bodies"), "{m}");
+}
