@@ -46,8 +46,8 @@ use crate::sim::{FemSimulation, LinearSolverChoice, TimeIntegrator};
 use anim_core::integrate::State;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
-    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, ObstacleMesh, Preset,
-    Prop, RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
+    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, MeshProp, ObstacleMesh,
+    Preset, Prop, RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
     save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
@@ -291,6 +291,7 @@ impl View for FemSimulation {
         context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
         context.props.extend(ground.map(|height| Prop::Ground { height }));
         context.props.extend(solids);
+        context.mesh_props.extend(model.mesh_obstacles().iter().map(|f| MeshProp::from(f.surface())));
         context
     }
 

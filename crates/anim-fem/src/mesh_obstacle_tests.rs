@@ -312,6 +312,11 @@ fn the_scene_files_obstacle_meshes() {
         b
     };
     let scene = |meshes: serde_json::Value| serde_json::json!({ "bodies": [body], "obstacle_meshes": meshes, "rayleigh": 0.01 });
+    // The picture draws the block's twelve triangles where it is placed.
+    let drawn = build(scene(serde_json::json!([block]))).expect("builds").context().mesh_props;
+    assert!(drawn.len() == 1 && drawn[0].triangles.len() == 12, "{drawn:?}");
+    let lowest = drawn[0].positions.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min);
+    assert_eq!(lowest, block["translate"][2].as_f64().unwrap());
     let rest = |params: serde_json::Value| {
         let mut s = build(params).expect("builds");
         for _ in 0..60 {

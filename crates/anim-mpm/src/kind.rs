@@ -487,10 +487,7 @@ impl<const D: usize> View for MpmRun<D> {
         }
         context.props.push(tank);
         context.props.extend(params.colliders.iter().filter_map(|c| collider(c.shape, D)));
-        context.mesh_props.extend(self.sim.mesh_colliders().iter().map(|m| MeshProp {
-            positions: m.surface().positions().iter().map(|p| p.to_array()).collect(),
-            triangles: m.surface().triangles().to_vec(),
-        }));
+        context.mesh_props.extend(self.sim.mesh_colliders().iter().map(|m| MeshProp::from(m.surface())));
         context
     }
 

@@ -24,8 +24,6 @@
 //! **Particles.** A particle is inside the obstacle (and refused when a scene starts so) when
 //! the trilinear interpolation of the table at its position is negative.
 
-use std::sync::Arc;
-
 use anim_core::surface::{ClosedSurface, DistanceField};
 
 use crate::{Boundary, MpmParams, Vector};
@@ -52,10 +50,8 @@ pub struct MeshCollider {
     lo: [usize; 3],
     /// Nodes of the box per axis.
     counts: [usize; 3],
-    /// Signed distance (m) on the nodes of the box.
+    /// Signed distance (m) on the nodes of the box (with the placed surface it samples).
     phi: DistanceField,
-    /// The surface (placed), for drawing.
-    surface: Arc<ClosedSurface>,
     /// Boundary condition on the surface.
     pub(crate) boundary: Boundary,
 }
@@ -110,13 +106,13 @@ impl MeshCollider {
                 "has no grid node inside it at resolution {n} (cells {h} m): it would have no effect"
             ));
         }
-        Ok(Self { lo, counts, phi, surface: Arc::new(surface.clone()), boundary })
+        Ok(Self { lo, counts, phi, boundary })
     }
 
     /// The surface the table samples, placed in the domain.
     #[must_use]
     pub fn surface(&self) -> &ClosedSurface {
-        &self.surface
+        self.phi.surface()
     }
 
     /// The first node index and the node counts of the table's box, per axis.

@@ -49,8 +49,8 @@ use crate::sim::{Method, PbdSimulation};
 use anim_core::integrate::State;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
-    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, ObstacleMesh, Preset,
-    Prop, RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
+    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, MeshProp, ObstacleMesh,
+    Preset, Prop, RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
     save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
@@ -292,6 +292,14 @@ impl View for PbdSimulation {
         context.props.extend(ground.map(|height| Prop::Ground { height }));
         context.props.extend(spheres);
         context.props.extend(others);
+        // Mesh obstacles fixed in the world (on no kinematic body), as shapes are.
+        context.mesh_props.extend(
+            model
+                .mesh_colliders()
+                .iter()
+                .filter(|c| c.body.is_none())
+                .map(|c| MeshProp::from(c.field.surface())),
+        );
         context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
         context
     }

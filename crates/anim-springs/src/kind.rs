@@ -31,8 +31,8 @@ use anim_core::linalg::LinearSolverKind;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::systems::integrator;
 use anim_core::scene::{
-    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, ObstacleMesh, Preset,
-    Prop, RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
+    BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, MeshProp, ObstacleMesh,
+    Preset, Prop, RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
     save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
@@ -256,6 +256,9 @@ impl View for SpringSimulation {
         context.point_radius = 0.15 * mean_length;
         context.props.extend(ground.map(|height| Prop::Ground { height }));
         context.props.extend(colliders.iter().filter_map(|c| Prop::of_shape(&c.shape)));
+        context
+            .mesh_props
+            .extend(network.model().mesh_colliders().iter().map(|c| MeshProp::from(c.field.surface())));
         context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
         context
     }

@@ -6,6 +6,7 @@
 
 use crate::geometry::Shape;
 use crate::solver::Solver;
+use crate::surface::ClosedSurface;
 
 /// The static part of a scene's picture, fixed for the run: the cells that join the points,
 /// the props around them (ground, colliders, walls), pinned points and the region the motion
@@ -103,6 +104,15 @@ pub struct MeshProp {
     pub positions: Vec<[f64; 3]>,
     /// Triangles, three vertex indices each.
     pub triangles: Vec<[usize; 3]>,
+}
+
+impl From<&ClosedSurface> for MeshProp {
+    fn from(surface: &ClosedSurface) -> Self {
+        MeshProp {
+            positions: surface.positions().iter().map(|p| p.to_array()).collect(),
+            triangles: surface.triangles().to_vec(),
+        }
+    }
 }
 
 impl Prop {

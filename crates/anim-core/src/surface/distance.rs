@@ -37,7 +37,8 @@ use crate::geometry::closest_point_on_triangle;
 /// distance is within `O(h^2)` of the true one; a sharp edge or corner is rounded over about a
 /// spacing. Outside the lattice a query returns `None`.
 ///
-/// Cloning shares the table.
+/// The field keeps the surface it samples ([`surface`](Self::surface)), for drawing it and for
+/// exact queries. Cloning shares the table and the surface.
 ///
 /// ```
 /// use anim_core::glam::DVec3;
@@ -60,6 +61,7 @@ pub struct DistanceField {
     spacing: f64,
     counts: [usize; 3],
     values: Arc<[f32]>,
+    surface: Arc<ClosedSurface>,
 }
 
 impl fmt::Debug for DistanceField {
@@ -116,7 +118,7 @@ impl DistanceField {
     ) -> Result<Self, SurfaceError> {
         check(origin, spacing, counts, band)?;
         let values = signed(surface, origin, spacing, counts, band)?;
-        Ok(Self { origin: DVec3::from_array(origin), spacing, counts, values: values.into() })
+        Ok(Self::of(surface, origin, spacing, counts, values))
     }
 
     /// The signed distance of `surface` on the whole lattice: exact near the surface, by fast
@@ -133,7 +135,18 @@ impl DistanceField {
         check(origin, spacing, counts, SWEEP_BAND)?;
         let mut values = signed(surface, origin, spacing, counts, SWEEP_BAND)?;
         sweep(&mut values, counts, spacing, SWEEP_BAND as f64 * spacing);
-        Ok(Self { origin: DVec3::from_array(origin), spacing, counts, values: values.into() })
+        Ok(Self::of(surface, origin, spacing, counts, values))
+    }
+
+    fn of(
+        surface: &ClosedSurface,
+        origin: [f64; 3],
+        spacing: f64,
+        counts: [usize; 3],
+        values: Vec<f32>,
+    ) -> Self {
+        let (origin, values, surface) = (DVec3::from_array(origin), values.into(), Arc::new(surface.clone()));
+        Self { origin, spacing, counts, values, surface }
     }
 
     /// [`new`](Self::new) on the lattice of spacing `cell` that covers the surface's bounds
@@ -167,6 +180,12 @@ impl DistanceField {
             )));
         }
         Self::new(surface, origin, cell, counts_f.map(|c| c as usize))
+    }
+
+    /// The surface the field samples.
+    #[must_use]
+    pub fn surface(&self) -> &ClosedSurface {
+        &self.surface
     }
 
     /// The lattice's first node (m).

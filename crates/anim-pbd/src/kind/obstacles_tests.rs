@@ -46,6 +46,12 @@ fn a_cloth_lands_on_a_mesh_box_as_on_the_analytic_box() {
     let (mut sim, mut state) = built(&dir, cloth_over_box(&cloth, 0.6, true));
     let mesh = sim.model().mesh_colliders()[0].clone();
     assert_eq!((mesh.thickness, mesh.static_friction, mesh.kinetic_friction), (0.01, 0.5, 0.5));
+    // The picture draws the placed surface of the mesh obstacle.
+    let drawn = anim_core::scene::View::context(&sim, &state).mesh_props;
+    assert!(
+        drawn.len() == 1 && drawn[0].triangles.len() == mesh.field.surface().triangles().len(),
+        "{drawn:?}"
+    );
     let on_mesh = run(&mut sim, &mut state, 60);
     let (mut sim, mut state) = built(&dir, cloth_over_box(&cloth, 0.6, false));
     let exact = run(&mut sim, &mut state, 60);

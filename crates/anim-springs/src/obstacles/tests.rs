@@ -87,6 +87,11 @@ fn a_cloth_rests_on_a_mesh_block_and_refusals_name_the_field_and_the_file() {
     };
     let contact = serde_json::json!({ "stiffness": 1e3, "thickness": 0.01 });
     let scene = |meshes: serde_json::Value| serde_json::json!({ "bodies": [cloth], "obstacle_meshes": meshes, "contact": contact });
+    // The picture draws the block's twelve triangles where it is placed.
+    let drawn = build(scene(serde_json::json!([block]))).expect("builds").context().mesh_props;
+    assert!(drawn.len() == 1 && drawn[0].triangles.len() == 12, "{drawn:?}");
+    let lowest = drawn[0].positions.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min);
+    assert_eq!(lowest, block["translate"][2].as_f64().unwrap());
     let rest = |params: serde_json::Value| {
         let mut s = build(params).expect("builds");
         for _ in 0..100 {
