@@ -292,7 +292,7 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
     if let Some(default) = default_scene
         && !args.quiet
     {
-        compare_with_default(&default, &file, &origin, runner.as_mut());
+        compare_with_default(&default, &file, &origin, runner.as_mut())?;
     }
     let context = runner.context();
     let geometry = Geometry::from_context(&context);
@@ -610,30 +610,55 @@ fn execute(mut s: Session) -> Result<(), String> {
 /// Seconds a frame of `runner` takes, measured on its first steps after one untimed step (which
 /// pays one-time setup such as a factorisation's analysis): at most a frame's steps, and no
 /// more once 0.2 s have passed. The runner is then restored to where it was (its checkpoint
-/// contract: bit for bit). `None` when a step or the restore fails.
-fn seconds_per_frame(runner: &mut dyn DynScene, dt: f64, steps_per_frame: usize) -> Option<f64> {
+/// contract: bit for bit), whether or not the measurement succeeded; the time is `None` when a
+/// step failed.
+///
+/// # Errors
+/// The restore failed: the runner is not where the run must start.
+fn seconds_per_frame(
+    runner: &mut dyn DynScene,
+    dt: f64,
+    steps_per_frame: usize,
+) -> Result<Option<f64>, String> {
     let saved = runner.save();
-    runner.step(dt).ok()?;
-    let start = Instant::now();
-    let mut steps = 0;
-    while steps < steps_per_frame && (steps == 0 || start.elapsed() < Duration::from_millis(200)) {
+    let measured = (|| {
         runner.step(dt).ok()?;
-        steps += 1;
-    }
-    let per_step = start.elapsed().as_secs_f64() / steps as f64;
-    runner.restore(&saved).ok()?;
-    Some(per_step * steps_per_frame as f64)
+        let start = Instant::now();
+        let mut steps = 0;
+        while steps < steps_per_frame && (steps == 0 || start.elapsed() < Duration::from_millis(200)) {
+            runner.step(dt).ok()?;
+            steps += 1;
+        }
+        Some(start.elapsed().as_secs_f64() / steps as f64 * steps_per_frame as f64)
+    })();
+    runner
+        .restore(&saved)
+        .map_err(|e| format!("--tolerance: the scene could not be put back after timing a few steps: {e}"))?;
+    Ok(measured)
 }
 
 /// Prints how the cost of a frame with the method `--tolerance` picked compares with the
 /// scene's own method (both measured here, on a few steps), and a warning when the pick is more
-/// than 5 times slower.
-fn compare_with_default(default: &SceneFile, picked: &SceneFile, origin: &Path, runner: &mut dyn DynScene) {
-    let measured = scene::build(default, origin, None).ok().and_then(|mut d| {
-        let base = seconds_per_frame(d.as_mut(), default.run.dt, default.run.steps_per_frame)?;
-        let pick = seconds_per_frame(runner, picked.run.dt, picked.run.steps_per_frame)?;
-        Some((pick, base))
-    });
+/// than 5 times slower. `runner` is left where it was.
+///
+/// # Errors
+/// `runner` could not be put back after timing ([`seconds_per_frame`]).
+fn compare_with_default(
+    default: &SceneFile,
+    picked: &SceneFile,
+    origin: &Path,
+    runner: &mut dyn DynScene,
+) -> Result<(), String> {
+    let base = match scene::build(default, origin, None) {
+        Ok(mut d) => seconds_per_frame(d.as_mut(), default.run.dt, default.run.steps_per_frame)?,
+        Err(_) => None,
+    };
+    let measured = match base {
+        Some(base) => {
+            seconds_per_frame(runner, picked.run.dt, picked.run.steps_per_frame)?.map(|pick| (pick, base))
+        }
+        None => None,
+    };
     match measured {
         Some((pick, base)) if pick > 5.0 * base => eprintln!(
             "warning: --tolerance: a frame with the picked method takes about {:.0}x the time of the scene's \
@@ -651,6 +676,7 @@ fn compare_with_default(default: &SceneFile, picked: &SceneFile, origin: &Path, 
             println!("--tolerance: the cost against the scene's own method was not measured (a step failed)")
         }
     }
+    Ok(())
 }
 
 /// A duration for people: `1.2 s`, `35 ms`, `120 us`.
@@ -712,4 +738,66 @@ pub fn run(args: &RunArgs) -> Result<(), String> {
 /// As [`run`], and for a checkpoint that cannot be read or restored.
 pub fn resume(args: &ResumeArgs) -> Result<(), String> {
     resumed(args).and_then(execute)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use anim_core::scene::{CheckpointError, Context, StepError};
+    use anim_core::solver::StepReport;
+
+    /// A scene whose state is a step count and whose step fails once it reaches `fail_at`.
+    struct Counter {
+        steps: u32,
+        fail_at: u32,
+    }
+
+    #[derive(Debug, thiserror::Error)]
+    #[error("step {0} fails")]
+    struct Fails(u32);
+
+    impl DynScene for Counter {
+        fn step(&mut self, _: f64) -> Result<StepReport, StepError> {
+            if self.steps >= self.fail_at {
+                return Err(StepError::new(Fails(self.steps)));
+            }
+            self.steps += 1;
+            Ok(StepReport::at_time(f64::from(self.steps)))
+        }
+        fn time(&self) -> f64 {
+            f64::from(self.steps)
+        }
+        fn save(&self) -> serde_json::Value {
+            self.steps.into()
+        }
+        fn restore(&mut self, saved: &serde_json::Value) -> Result<(), CheckpointError> {
+            self.steps = saved.as_u64().and_then(|s| u32::try_from(s).ok()).unwrap_or(0);
+            Ok(())
+        }
+        fn method(&self) -> String {
+            "counter".into()
+        }
+        fn context(&self) -> Context {
+            Context::default()
+        }
+        fn frame(&self, _: &mut Frame) {}
+        fn reference_error(&self) -> Option<f64> {
+            None
+        }
+        fn provoke_overflow(&mut self) -> Option<String> {
+            None
+        }
+    }
+
+    /// Timing a few steps leaves the scene where it was, whether the steps succeed or one of
+    /// them fails (the run then starts from the scene's own start, not from where the failing
+    /// measurement stopped).
+    #[test]
+    fn timing_a_frame_puts_the_scene_back_even_when_a_step_fails() {
+        for (start, fail_at, measured) in [(0, 100, true), (2, 4, false), (3, 3, false)] {
+            let mut scene = Counter { steps: start, fail_at };
+            let time = seconds_per_frame(&mut scene, 0.1, 10).unwrap();
+            assert_eq!((time.is_some(), scene.steps), (measured, start), "start {start}, fail at {fail_at}");
+        }
+    }
 }
