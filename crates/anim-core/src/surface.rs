@@ -340,6 +340,27 @@ impl ClosedSurface {
     }
 }
 
+/// The axis-aligned box with corners `lo` and `hi` as a closed surface: its eight corners,
+/// numbered by the bits `(x, y, z)` of their index (corner `k` takes `hi` on axis `a` where bit
+/// `a` of `k` is set), and twelve outward triangles, two per face.
+///
+/// ```
+/// let (p, t) = anim_core::surface::cuboid([0.0, 0.0, 0.0], [2.0, 1.0, 0.5]);
+/// assert_eq!((p[5], t.len()), ([2.0, 0.0, 0.5], 12));
+/// let s = anim_core::surface::ClosedSurface::new(p, t)?;
+/// assert!((s.volume() - 1.0).abs() < 1e-15 && s.contains([1.0, 0.5, 0.25]));
+/// # Ok::<(), anim_core::surface::SurfaceError>(())
+/// ```
+#[must_use]
+pub fn cuboid(lo: [f64; 3], hi: [f64; 3]) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+    let corners =
+        (0..8).map(|k| std::array::from_fn(|a| if (k >> a) & 1 == 1 { hi[a] } else { lo[a] })).collect();
+    // Each face as a quad counter-clockwise from outside, split along its first diagonal.
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let triangles = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+    (corners, triangles)
+}
+
 /// A unit-radius icosphere around the origin: the icosahedron subdivided `subdivisions` times
 /// (20 * 4^s triangles), outward-oriented, closed: the midpoint of each edge is pushed out onto
 /// the sphere, shared by the edge's two triangles.

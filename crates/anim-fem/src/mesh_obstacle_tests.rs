@@ -47,23 +47,8 @@ fn mesh_ball(subdivisions: usize) -> (ClosedSurface, f64) {
 
 /// The box `[lo, hi]` as a closed surface of 12 outward triangles.
 fn mesh_box(lo: [f64; 3], hi: [f64; 3]) -> ClosedSurface {
-    let p: Vec<[f64; 3]> =
-        (0..8).map(|k| [0, 1, 2].map(|a| if (k >> a) & 1 == 1 { hi[a] } else { lo[a] })).collect();
-    let t = [
-        [0, 2, 3],
-        [0, 3, 1],
-        [4, 5, 7],
-        [4, 7, 6],
-        [0, 1, 5],
-        [0, 5, 4],
-        [2, 6, 7],
-        [2, 7, 3],
-        [0, 4, 6],
-        [0, 6, 2],
-        [1, 3, 7],
-        [1, 7, 5],
-    ];
-    ClosedSurface::new(p, t.to_vec()).unwrap()
+    let (p, t) = anim_core::surface::cuboid(lo, hi);
+    ClosedSurface::new(p, t).unwrap()
 }
 
 fn material() -> Material {

@@ -25,23 +25,8 @@ fn steps_do_not_allocate() {
     let material = Material::new(MaterialModel::StableNeoHookean, 1e5, 0.3, 1000.0).unwrap();
     // A block under the middle of the beam, its top 5 mm above the beam's bottom (z = 0.02).
     let (lo, hi) = ([0.15, -0.1, -0.1], [0.45, 0.1, 0.025]);
-    let corners: Vec<[f64; 3]> =
-        (0..8).map(|k| [0, 1, 2].map(|a| if (k >> a) & 1 == 1 { hi[a] } else { lo[a] })).collect();
-    let faces = [
-        [0, 2, 3],
-        [0, 3, 1],
-        [4, 5, 7],
-        [4, 7, 6],
-        [0, 1, 5],
-        [0, 5, 4],
-        [2, 6, 7],
-        [2, 7, 3],
-        [0, 4, 6],
-        [0, 6, 2],
-        [1, 3, 7],
-        [1, 7, 5],
-    ];
-    let block = ClosedSurface::new(corners, faces.to_vec()).unwrap();
+    let (corners, faces) = anim_core::surface::cuboid(lo, hi);
+    let block = ClosedSurface::new(corners, faces).unwrap();
     let field = DistanceField::around(&block, 0.02, 0.05).unwrap();
     let explicit = FemParams::new(TimeIntegrator::SymplecticEuler);
     let implicit =

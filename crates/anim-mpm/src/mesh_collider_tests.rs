@@ -17,11 +17,7 @@ use crate::bodies_tests::{body_height_and_speed, cube, jelly, refused, testdata,
 
 /// The box `[lo, hi]` as 12 outward triangles.
 fn box_surface(lo: [f64; 3], hi: [f64; 3]) -> ClosedSurface {
-    let positions: Vec<[f64; 3]> =
-        (0..8).map(|c| std::array::from_fn(|a| if c >> a & 1 == 1 { hi[a] } else { lo[a] })).collect();
-    // Corners by bits (x, y, z); each face as two outward triangles.
-    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-    let triangles = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+    let (positions, triangles) = anim_core::surface::cuboid(lo, hi);
     ClosedSurface::new(positions, triangles).expect("a closed box")
 }
 

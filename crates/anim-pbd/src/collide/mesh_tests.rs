@@ -18,22 +18,7 @@ fn placed(mesh: (Vec<[f64; 3]>, Vec<[usize; 3]>), scale: f64, shift: DVec3) -> C
 
 /// The unit cube `[0, 1]^3` as twelve outward triangles.
 fn unit_cube() -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
-    let p = (0..8).map(|i| [f64::from(i & 1), f64::from((i >> 1) & 1), f64::from((i >> 2) & 1)]).collect();
-    let t = vec![
-        [0, 2, 3],
-        [0, 3, 1],
-        [4, 5, 7],
-        [4, 7, 6],
-        [0, 1, 5],
-        [0, 5, 4],
-        [1, 3, 7],
-        [1, 7, 5],
-        [3, 2, 6],
-        [3, 6, 7],
-        [2, 0, 4],
-        [2, 4, 6],
-    ];
-    (p, t)
+    anim_core::surface::cuboid([0.0; 3], [1.0; 3])
 }
 
 /// Directions from the sphere's centre at which particles rest: the poles, the equator and

@@ -591,24 +591,12 @@ fn a_closed_cloth_with_pressure_inflates() {
 
 /// Writes the closed OBJ surface of the unit cube `[0, 1]^3`, twelve outward triangles.
 pub(super) fn write_cube_obj(dir: &Path) -> String {
+    let (corners, faces) = anim_core::surface::cuboid([0.0; 3], [1.0; 3]);
     let mut text = String::new();
-    for i in 0..8 {
-        text += &format!("v {} {} {}\n", i & 1, (i >> 1) & 1, (i >> 2) & 1);
+    for v in corners {
+        text += &format!("v {} {} {}\n", v[0], v[1], v[2]);
     }
-    for f in [
-        [0, 2, 3],
-        [0, 3, 1],
-        [4, 5, 7],
-        [4, 7, 6],
-        [0, 1, 5],
-        [0, 5, 4],
-        [1, 3, 7],
-        [1, 7, 5],
-        [3, 2, 6],
-        [3, 6, 7],
-        [2, 0, 4],
-        [2, 4, 6],
-    ] {
+    for f in faces {
         text += &format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1);
     }
     std::fs::write(dir.join("cube.obj"), text).expect("write");
