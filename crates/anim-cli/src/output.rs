@@ -5,6 +5,7 @@ use crate::view::{Geometry, OutputFormat, Snapshot, View};
 use anim_core::scene::{DynScene, Frame};
 use anim_io::FrameWriter;
 use anim_io::preview::{Canvas, GifWriter};
+use anim_io::viewer::{Viewer, ViewerField};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -23,6 +24,8 @@ pub(crate) struct Output {
     /// The scene's frame, scratch reused from frame to frame.
     frame: Frame,
     grid: bool,
+    /// Coordinates per point of the scene's frames.
+    point_dim: usize,
 }
 
 /// The writer thread's state.
@@ -33,6 +36,24 @@ struct Writer {
     frames: Option<FrameWriter>,
     csv: Option<std::io::BufWriter<std::fs::File>>,
     gif: Option<(GifWriter, Canvas, anim_io::preview::Camera, usize)>,
+    viewer: Option<RunViewer>,
+}
+
+/// The browser viewer of a run.
+struct RunViewer {
+    page: Viewer,
+    /// The name and colour range of a grid's cell field (a grid scene).
+    cells: Option<(&'static str, (f64, f64))>,
+}
+
+/// What the browser viewer of a run is made from.
+pub(crate) struct ViewerSpec<'a> {
+    /// The page's title (the scene's name).
+    pub title: &'a str,
+    /// The scene's static context.
+    pub context: &'a anim_core::scene::Context,
+    /// Whether the run continues an earlier one (the index keeps its frames).
+    pub resume: bool,
 }
 
 impl Writer {
@@ -47,6 +68,24 @@ impl Writer {
                 writeln!(csv, "{index},{:e},{},{},{}", s.t, values.join(","), opt(s.energy), opt(s.error))
                     .map_err(|e| e.to_string())?;
             }
+        }
+        if let Some(RunViewer { page: viewer, cells }) = &mut self.viewer
+            && index.is_multiple_of(self.stride)
+        {
+            let result = match cells {
+                Some((name, range)) => {
+                    viewer.frame(index, s.t, &[], 3, &[ViewerField::cells(name, &s.x, *range)])
+                }
+                None => {
+                    let fields: Vec<ViewerField<'_>> = s
+                        .fields
+                        .iter()
+                        .map(|f| ViewerField::points(f.name, f.components, &f.values))
+                        .collect();
+                    viewer.frame(index, s.t, &s.x, s.point_dim, &fields)
+                }
+            };
+            result.map_err(|e| e.to_string())?;
         }
         if let Some((gif, canvas, camera, every)) = &mut self.gif
             && index.is_multiple_of(*every)
@@ -73,6 +112,11 @@ impl Writer {
                 )),
             }
         }
+        if let Some(RunViewer { page: viewer, .. }) = self.viewer {
+            let n = viewer.len();
+            let page = viewer.finish().map_err(|e| e.to_string())?;
+            files.push(format!("{} ({n} frames)", page.display()));
+        }
         if let Some(mut csv) = self.csv {
             csv.flush().map_err(|e| e.to_string())?;
             files.push(self.dir.join("frames.csv").display().to_string());
@@ -98,10 +142,19 @@ impl Output {
         preview: Option<(u32, usize)>,
         (geometry, dof): (&Geometry, usize),
         continuing: Option<&[f64]>,
+        viewer: Option<ViewerSpec<'_>>,
     ) -> Result<Self, String> {
         let grid = matches!(geometry, Geometry::Grid { .. });
         let view = View::new(geometry.clone());
-        let mut writer = Writer { dir: dir.to_path_buf(), stride, view, frames: None, csv: None, gif: None };
+        let mut writer =
+            Writer { dir: dir.to_path_buf(), stride, view, frames: None, csv: None, gif: None, viewer: None };
+        let point_dim = viewer.as_ref().map_or(3, |spec| spec.context.point_dim);
+        if let Some(spec) = viewer {
+            let json = serde_json::to_value(spec.context).map_err(|e| format!("viewer context: {e}"))?;
+            let page = Viewer::create(dir, spec.title, &json, spec.resume).map_err(|e| e.to_string())?;
+            let cells = spec.context.image.map(|g| (g.shown, g.range));
+            writer.viewer = Some(RunViewer { page, cells });
+        }
         if let Some(f) = format.frame_format() {
             let frames = FrameWriter::continuing(dir.join("frames"), f, continuing.unwrap_or(&[]));
             writer.frames = Some(frames.map_err(|e| e.to_string())?);
@@ -164,6 +217,7 @@ impl Output {
             spare: Vec::new(),
             frame: Frame::default(),
             grid,
+            point_dim,
         })
     }
 
@@ -177,9 +231,10 @@ impl Output {
         self.spare.extend(self.returned.try_iter());
         let mut snapshot = self.spare.pop().unwrap_or_default();
         snapshot.fill(runner, &mut self.frame, self.grid, energy);
-        let sent = self.sender.as_ref().map(|s| s.send((index, snapshot)));
+        snapshot.point_dim = self.point_dim;
+        let sent = self.sender.as_ref().map(|s| s.send((index, snapshot)).is_ok());
         match sent {
-            Some(Ok(())) => Ok(()),
+            Some(true) => Ok(()),
             // The writer stopped early: its error is reported by `finish`.
             _ => Err("the frame writer stopped".into()),
         }

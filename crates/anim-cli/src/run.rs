@@ -1,7 +1,7 @@
 //! A run of a scene: from the command line's arguments or a checkpoint to frames, a preview,
 //! `metrics.json` and checkpoints. Every scene is a [`DynScene`] built through the registry.
 
-use crate::output::Output;
+use crate::output::{Output, ViewerSpec};
 use crate::scene::{self, SceneFile};
 use crate::tolerance;
 use crate::view::{Geometry, OutputFormat, Snapshot};
@@ -64,6 +64,9 @@ pub struct RunArgs {
     /// Skip the GIF/PNG preview.
     #[arg(long)]
     pub no_preview: bool,
+    /// Skip the browser viewer (`viewer.html` and `viewer/` beside the frames).
+    #[arg(long)]
+    pub no_viewer: bool,
     /// Preview width in pixels (height is 3/4 of it).
     #[arg(long, default_value_t = 320)]
     pub preview_width: u32,
@@ -175,6 +178,9 @@ struct RunCheckpoint {
     format: OutputFormat,
     stride: usize,
     preview_width: Option<u32>,
+    /// Whether the run writes the browser viewer (checkpoints written before it existed: yes).
+    #[serde(default = "yes")]
+    viewer: bool,
     checkpoint_every: Option<usize>,
     /// Frames completed.
     frame: usize,
@@ -185,6 +191,11 @@ struct RunCheckpoint {
     max_error: Option<f64>,
     newton_iterations: usize,
     runner: serde_json::Value,
+}
+
+/// The default of a flag that older checkpoints lack.
+fn yes() -> bool {
+    true
 }
 
 /// Version 2: the scene is a registered kind with its parameters, the runner a [`DynScene`]
@@ -200,6 +211,7 @@ struct Session {
     format: OutputFormat,
     stride: usize,
     preview_width: Option<u32>,
+    viewer: bool,
     checkpoint_every: Option<usize>,
     quiet: bool,
     runner: Box<dyn DynScene>,
@@ -320,6 +332,7 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
         format,
         stride: args.stride,
         preview_width: (!args.no_preview).then_some(args.preview_width),
+        viewer: !args.no_viewer,
         checkpoint_every: args.checkpoint_every,
         quiet: args.quiet,
         runner,
@@ -372,6 +385,7 @@ fn resumed(args: &ResumeArgs) -> Result<Session, String> {
         format: ckpt.format,
         stride: ckpt.stride,
         preview_width: ckpt.preview_width,
+        viewer: ckpt.viewer,
         checkpoint_every: ckpt.checkpoint_every,
         quiet: args.quiet,
         runner,
@@ -398,6 +412,7 @@ impl Session {
             format: self.format,
             stride: self.stride,
             preview_width: self.preview_width,
+            viewer: self.viewer,
             checkpoint_every: self.checkpoint_every,
             frame,
             steps: self.steps,
@@ -431,7 +446,10 @@ fn execute(mut s: Session) -> Result<(), String> {
         snap.fill(s.runner.as_ref(), &mut Frame::default(), false, None);
         snap.x.len()
     };
-    let mut output = Output::new(&out, s.format, s.stride, preview, (&s.geometry, dof), continuing)?;
+    let context = s.viewer.then(|| s.runner.context());
+    let viewer =
+        context.as_ref().map(|context| ViewerSpec { title: &s.file.name, context, resume: s.resumed });
+    let mut output = Output::new(&out, s.format, s.stride, preview, (&s.geometry, dof), continuing, viewer)?;
     let writes_files = s.format.frame_format().is_some();
 
     let first_step = s.steps;

@@ -51,6 +51,10 @@ pub struct Snapshot {
     pub energy: Option<f64>,
     /// Error against an exact solution, where one exists.
     pub error: Option<f64>,
+    /// Coordinates per point of `x` (not a grid).
+    pub point_dim: usize,
+    /// Every named field of the frame (not a grid's), for the browser viewer.
+    pub fields: Vec<anim_core::scene::Field>,
 }
 
 impl Snapshot {
@@ -69,6 +73,14 @@ impl Snapshot {
             }
         } else {
             self.x.extend_from_slice(&frame.points);
+            // Reuse the buffers of the previous frame's fields.
+            self.fields.truncate(frame.fields.len());
+            for (k, f) in frame.fields.iter().enumerate() {
+                match self.fields.get_mut(k) {
+                    Some(mine) => mine.clone_from(f),
+                    None => self.fields.push(f.clone()),
+                }
+            }
         }
         if let Some(v) = velocity {
             self.v.extend_from_slice(&v.values);

@@ -171,6 +171,10 @@ fn an_interrupted_run_finishes_its_folder_and_resumes() {
     assert!(listed.len() >= 3, "{pvd}");
     assert!(listed.iter().all(|f| pvd_dir.join(f).is_file()), "{listed:?}");
     assert!(dir.join("preview.png").is_file() && dir.join("checkpoint.anim").is_file());
+    // The browser viewer lists the same frames, every one present.
+    let shown = viewer_frames(&dir);
+    assert_eq!(shown.len(), listed.len(), "{shown:?}");
+    assert!(dir.join("viewer.html").is_file());
     // The checkpoint is at the last frame written: resuming for two more frames adds two files.
     let resumed = std::process::Command::new(env!("CARGO_BIN_EXE_anim"))
         .arg("resume")
@@ -181,5 +185,17 @@ fn an_interrupted_run_finishes_its_folder_and_resumes() {
     assert!(resumed.status.success(), "{}", String::from_utf8_lossy(&resumed.stderr));
     let pvd = std::fs::read_to_string(pvd_dir.join("frames.pvd")).unwrap();
     assert_eq!(pvd.matches("file=\"").count(), listed.len() + 2, "{pvd}");
+    assert_eq!(viewer_frames(&dir).len(), listed.len() + 2);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The frame files `viewer/index.js` lists, after checking each is present.
+fn viewer_frames(dir: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(dir.join("viewer/index.js")).unwrap();
+    let json = text.trim().strip_prefix("ANIM.index(").and_then(|t| t.strip_suffix(");")).unwrap();
+    let index: serde_json::Value = serde_json::from_str(json).unwrap();
+    let files: Vec<String> =
+        index["frames"].as_array().unwrap().iter().map(|f| f[1].as_str().unwrap().to_string()).collect();
+    assert!(files.iter().all(|f| dir.join("viewer").join(f).is_file()), "{files:?}");
+    files
 }

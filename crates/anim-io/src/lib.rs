@@ -14,6 +14,7 @@
 //! | [`tetgen`] | TetGen `.node` + `.ele`, read | written by TetGen, meshio |
 //! | [`frames`] | numbered sequences `frame_00000.vtu ...` in any of the writers' formats | ParaView (with the `.pvd`), Blender and Houdini sequence importers |
 //! | [`preview`] | PNG frames and animated GIFs from a software renderer (feature `output`, default) | any image viewer, a browser |
+//! | [`viewer`] | `viewer.html` beside a run's frames: orbit, play, time slider, colour by field (three.js embedded; feature `output`, default) | any browser, from the folder, offline |
 //! | [`metrics`] | CSV and JSON of per-step metrics (serde; feature `output`, default) | spreadsheets, pandas, plotting scripts |
 //!
 //! Readers return plain types ([`TriMesh`], [`TetMesh`], or a format's own struct that keeps
@@ -75,6 +76,8 @@ pub mod ply;
 pub mod preview;
 pub mod tetgen;
 mod text;
+#[cfg(feature = "output")]
+pub mod viewer;
 pub mod vtk;
 
 pub use checkpoint::{

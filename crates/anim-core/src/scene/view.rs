@@ -11,7 +11,7 @@ use crate::surface::ClosedSurface;
 /// The static part of a scene's picture, fixed for the run: the cells that join the points,
 /// the props around them (ground, colliders, walls), pinned points and the region the motion
 /// stays in. Built once by [`View::context`].
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 #[non_exhaustive]
 pub struct Context {
     /// Coordinates per point in a [`Frame`]: 1 or 2 for a system of a few unknowns drawn in the
@@ -43,7 +43,7 @@ pub struct Context {
 }
 
 /// A thing in the scene that is not simulated but is part of its picture.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 #[non_exhaustive]
 pub enum Prop {
     /// The ground plane `z = height`.
@@ -98,7 +98,7 @@ pub enum Prop {
 
 /// A fixed obstacle of triangles in the picture (a closed surface from a scene file's
 /// `obstacle_meshes`, placed), counter-clockwise seen from outside.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct MeshProp {
     /// Vertex positions (m).
     pub positions: Vec<[f64; 3]>,
@@ -142,7 +142,7 @@ pub fn ground_height<'a>(shapes: impl IntoIterator<Item = &'a Shape>) -> Option<
 }
 
 /// A regular grid of cells whose fields an image scene writes.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct ImageGrid {
     /// Cells along x, y, z (1 along z in 2D).
     pub dims: [usize; 3],
