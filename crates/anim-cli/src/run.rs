@@ -149,7 +149,13 @@ struct Metrics {
     stepping_steps_per_second: f64,
     energy_initial: Option<f64>,
     energy_final: Option<f64>,
+    /// `(energy_final - energy_initial) / energy_scale`.
     relative_energy_change: Option<f64>,
+    /// The energy in play: the largest over the run of kinetic + |gravitational - initial
+    /// gravitational| + |elastic| (see `energy_scale_is`).
+    energy_scale: Option<f64>,
+    /// What `energy_scale` is, in words.
+    energy_scale_is: Option<&'static str>,
     max_error_vs_exact: Option<f64>,
     /// `--tolerance` asked for.
     tolerance: Option<f64>,
@@ -188,9 +194,57 @@ struct RunCheckpoint {
     /// Times of the frame files written so far.
     written_times: Vec<f64>,
     energy_initial: Option<f64>,
+    /// The energy scale so far and the gravitational energy it is measured from.
+    #[serde(default)]
+    energy_scale: EnergyScale,
     max_error: Option<f64>,
     newton_iterations: usize,
     runner: serde_json::Value,
+}
+
+/// The scale a run's energy change is measured against: the largest over the run of the energy
+/// in play, [`anim_core::solver::EnergyParts::scale`] from the first step's gravitational
+/// energy where the solver reports the parts, else the largest `|energy|`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, serde::Deserialize)]
+struct EnergyScale {
+    /// The first step's gravitational energy (solvers that report the parts).
+    gravity0: Option<f64>,
+    /// The largest energy in play so far.
+    largest: Option<f64>,
+    /// Whether the scale came from the parts.
+    from_parts: bool,
+}
+
+impl EnergyScale {
+    /// Takes a step's report into account.
+    fn add(&mut self, report: &anim_core::solver::StepReport) {
+        let now = match (report.energy_parts, report.energy) {
+            (Some(parts), _) => {
+                let g0 = *self.gravity0.get_or_insert(parts.gravity);
+                self.from_parts = true;
+                parts.scale(g0)
+            }
+            (None, Some(e)) => e.abs(),
+            (None, None) => return,
+        };
+        if now.is_finite() {
+            self.largest = Some(self.largest.map_or(now, |m| m.max(now)));
+        }
+    }
+
+    /// `change` relative to the scale; `None` when the scale is 0 (nothing in play).
+    fn relative(&self, change: f64) -> Option<f64> {
+        self.largest.filter(|&s| s > 0.0).map(|s| change / s)
+    }
+
+    /// What the scale is, in words.
+    fn meaning(&self) -> &'static str {
+        if self.from_parts {
+            "largest over the run of kinetic + |gravitational change| + |elastic| energy"
+        } else {
+            "the largest |total energy| over the run"
+        }
+    }
 }
 
 /// The default of a flag that older checkpoints lack.
@@ -223,6 +277,7 @@ struct Session {
     steps: u64,
     written_times: Vec<f64>,
     energy_initial: Option<f64>,
+    energy_scale: EnergyScale,
     max_error: Option<f64>,
     newton_iterations: usize,
     resumed: bool,
@@ -342,6 +397,7 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
         steps: 0,
         written_times: Vec::new(),
         energy_initial: None,
+        energy_scale: EnergyScale::default(),
         max_error: None,
         newton_iterations: 0,
         resumed: false,
@@ -395,6 +451,7 @@ fn resumed(args: &ResumeArgs) -> Result<Session, String> {
         steps: ckpt.steps,
         written_times: ckpt.written_times,
         energy_initial: ckpt.energy_initial,
+        energy_scale: ckpt.energy_scale,
         max_error: ckpt.max_error,
         newton_iterations: ckpt.newton_iterations,
         resumed: true,
@@ -418,6 +475,7 @@ impl Session {
             steps: self.steps,
             written_times: self.written_times.clone(),
             energy_initial: self.energy_initial,
+            energy_scale: self.energy_scale,
             max_error: self.max_error,
             newton_iterations: self.newton_iterations,
             runner: self.runner.save(),
@@ -486,6 +544,7 @@ fn execute(mut s: Session) -> Result<(), String> {
                     if s.energy_initial.is_none() {
                         s.energy_initial = energy;
                     }
+                    s.energy_scale.add(&report);
                 }
                 Err(e) => {
                     failure = Some(format!("step {}: {e}", s.steps));
@@ -559,7 +618,9 @@ fn execute(mut s: Session) -> Result<(), String> {
         stepping_steps_per_second: steps_here as f64 / step_seconds.max(1e-12),
         energy_initial: energy0,
         energy_final: energy,
-        relative_energy_change: energy0.zip(energy).map(|(e0, e)| (e - e0) / e0.abs().max(f64::MIN_POSITIVE)),
+        relative_energy_change: energy0.zip(energy).and_then(|(e0, e)| s.energy_scale.relative(e - e0)),
+        energy_scale: s.energy_scale.largest,
+        energy_scale_is: s.energy_scale.largest.map(|_| s.energy_scale.meaning()),
         max_error_vs_exact: s.max_error,
         tolerance: s.tolerance,
         tolerance_error_final: table_error.map(|e| e.0),
@@ -587,8 +648,17 @@ fn execute(mut s: Session) -> Result<(), String> {
             metrics.stepping_steps_per_second,
             100.0 * metrics.output_fraction
         );
-        if let Some(d) = metrics.relative_energy_change {
-            println!("  relative energy change {d:.3e}");
+        match (metrics.relative_energy_change, metrics.energy_scale) {
+            (Some(d), Some(scale)) => {
+                println!(
+                    "  energy change {d:.3e} relative to the energy in play, {scale:.3e} ({})",
+                    s.energy_scale.meaning()
+                )
+            }
+            (None, Some(_)) => {
+                println!("  energy change: not measured (nothing moved, was lifted or deformed)")
+            }
+            _ => {}
         }
         if let Some(e) = metrics.max_error_vs_exact {
             println!("  max error against the exact solution {e:.3e}");

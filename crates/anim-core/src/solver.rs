@@ -22,12 +22,58 @@ pub struct StepReport {
     pub residual: Option<f64>,
     /// Total energy (kinetic + potential) after the step, where defined.
     pub energy: Option<f64>,
+    /// The parts of [`StepReport::energy`], where the solver tells them apart: the scale its
+    /// changes are measured against (see [`EnergyParts`]).
+    pub energy_parts: Option<EnergyParts>,
     /// Total linear momentum after the step, where defined.
     pub linear_momentum: Option<[f64; 3]>,
     /// Total angular momentum about the origin after the step, where defined.
     pub angular_momentum: Option<[f64; 3]>,
     /// Constraint violation (PBD, joints) or velocity divergence (fluids), where defined.
     pub constraint_violation: Option<f64>,
+}
+
+/// The parts of a total energy: kinetic, gravitational (whose zero is wherever the scene's
+/// origin is) and the rest of the potential (springs, elasticity, contact and limit
+/// penalties, attraction to a centre), in joules (or per unit mass where the solver says so).
+///
+/// The total can pass through zero while its parts are large (a chain released at rest at the
+/// height of its pivot has total energy 0 all along), so a relative change of the total is
+/// measured against [`EnergyParts::scale`] instead.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct EnergyParts {
+    /// Kinetic energy.
+    pub kinetic: f64,
+    /// Gravitational potential energy.
+    pub gravity: f64,
+    /// Every other potential energy (elastic, contact, limits, an attracting centre).
+    pub elastic: f64,
+}
+
+impl EnergyParts {
+    /// The total energy.
+    #[must_use]
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.gravity + self.elastic
+    }
+
+    /// The energy in play relative to a reference state's gravitational energy `gravity0`:
+    /// `|kinetic| + |gravity - gravity0| + |elastic|`. It does not depend on where the zero of
+    /// height is, and it is never small while something moves, is lifted or deformed.
+    ///
+    /// ```
+    /// use anim_core::solver::EnergyParts;
+    /// // A mass of 1 kg released from rest: after falling 1 m (g = 9.81) the total is unchanged,
+    /// // 9.81 J moved from gravity to motion, and that is the scale.
+    /// let start = EnergyParts { kinetic: 0.0, gravity: 0.0, elastic: 0.0 };
+    /// let later = EnergyParts { kinetic: 9.81, gravity: -9.81, elastic: 0.0 };
+    /// assert_eq!(later.total(), start.total());
+    /// assert_eq!(later.scale(start.gravity), 19.62);
+    /// ```
+    #[must_use]
+    pub fn scale(&self, gravity0: f64) -> f64 {
+        self.kinetic.abs() + (self.gravity - gravity0).abs() + self.elastic.abs()
+    }
 }
 
 impl StepReport {

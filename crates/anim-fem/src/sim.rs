@@ -657,7 +657,7 @@ impl FemSimulation {
 
     /// Total energy without allocating: uses the external force of the step just taken and
     /// the acceleration buffer as scratch.
-    fn step_energy(&mut self, state: &State) -> f64 {
+    fn step_energy(&mut self, state: &State) -> anim_core::solver::EnergyParts {
         let kinetic = match self.model.mass_kind() {
             MassKind::Lumped => self.kinetic_energy(&state.v),
             MassKind::Consistent => {
@@ -665,7 +665,12 @@ impl FemSimulation {
                 0.5 * anim_core::linalg::dot(&state.v, &self.acc)
             }
         };
-        kinetic + self.model.elastic_energy(&state.x) - anim_core::linalg::dot(&self.external, &state.x)
+        anim_core::solver::EnergyParts {
+            kinetic,
+            // The potential of the constant external load (gravity and any applied force).
+            gravity: -anim_core::linalg::dot(&self.external, &state.x),
+            elastic: self.model.elastic_energy(&state.x),
+        }
     }
 
     /// Linear and angular momentum (about the origin): `sum_i m_i v_i` and
@@ -756,7 +761,8 @@ impl FemSimulation {
         let mut report = StepReport::at_time(state.t);
         report.iterations = if newton_iterations > 0 { newton_iterations } else { linear_iterations };
         report.residual = residual;
-        report.energy = if self.params.report_energy { Some(self.step_energy(state)) } else { None };
+        report.energy_parts = self.params.report_energy.then(|| self.step_energy(state));
+        report.energy = report.energy_parts.map(|e| e.total());
         report.linear_momentum = Some(p);
         report.angular_momentum = Some(l);
         Ok(report)

@@ -746,7 +746,13 @@ impl<const D: usize> Solver for FlipSimulation<D> {
         report.residual = Some(info.pressure_residual);
         // Kinetic plus gravitational energy per unit particle mass (a shaken tank's moving
         // frame adds no potential of its own here).
-        report.energy = Some(state.kinetic_energy() + state.potential_energy(&self.params.gravity));
+        let parts = anim_core::solver::EnergyParts {
+            kinetic: state.kinetic_energy(),
+            gravity: state.potential_energy(&self.params.gravity),
+            elastic: 0.0,
+        };
+        report.energy = Some(parts.total());
+        report.energy_parts = Some(parts);
         report.linear_momentum = Some(momentum);
         report.angular_momentum = Some(state.angular_momentum([0.0; D]));
         report.constraint_violation = Some(info.max_divergence);

@@ -688,6 +688,11 @@ impl<const D: usize> Solver for MpmSimulation<D> {
         let mut r = StepReport::at_time(self.time);
         r.iterations = stats.substeps;
         r.energy = Some(t.kinetic + t.elastic + t.potential);
+        r.energy_parts = Some(anim_core::solver::EnergyParts {
+            kinetic: t.kinetic,
+            gravity: t.potential,
+            elastic: t.elastic,
+        });
         r.linear_momentum = Some(t.momentum);
         r.angular_momentum = Some(t.angular_momentum);
         Ok(r)

@@ -352,11 +352,22 @@ impl PbdModel {
     /// If `x` or `v` has the wrong length.
     #[must_use]
     pub fn kinetic_and_gravity_energy(&self, x: &[f64], v: &[f64]) -> f64 {
+        let (kinetic, gravity) = self.kinetic_and_gravity_parts(x, v);
+        kinetic + gravity
+    }
+
+    /// Kinetic and gravitational energy apart: `(sum m |v|^2 / 2, -sum m g . x)`.
+    ///
+    /// # Panics
+    /// If `x` or `v` is not 3 per particle.
+    #[must_use]
+    pub fn kinetic_and_gravity_parts(&self, x: &[f64], v: &[f64]) -> (f64, f64) {
         assert!(x.len() == 3 * self.num_particles() && v.len() == x.len(), "energy: wrong length");
-        let mut e = 0.0;
+        let (mut kinetic, mut gravity) = (0.0, 0.0);
         for (i, part) in self.particles.iter().enumerate() {
-            e += part.mass * (0.5 * load(v, i).length_squared() - self.gravity.dot(load(x, i)));
+            kinetic += part.mass * 0.5 * load(v, i).length_squared();
+            gravity -= part.mass * self.gravity.dot(load(x, i));
         }
-        e
+        (kinetic, gravity)
     }
 }

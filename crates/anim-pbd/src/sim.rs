@@ -359,7 +359,10 @@ impl Solver for PbdSimulation {
         let h = dt / info.substeps as f64;
         report.residual = Some(self.residual(&state.x, h));
         let elastic = if self.params.method == Method::Xpbd { self.elastic_energy(&state.x) } else { 0.0 };
-        report.energy = Some(self.model.kinetic_and_gravity_energy(&state.x, &state.v) + elastic);
+        let (kinetic, gravity) = self.model.kinetic_and_gravity_parts(&state.x, &state.v);
+        let parts = anim_core::solver::EnergyParts { kinetic, gravity, elastic };
+        report.energy = Some(parts.total());
+        report.energy_parts = Some(parts);
         report.linear_momentum = Some(self.model.linear_momentum(&state.v));
         report.angular_momentum = Some(self.model.angular_momentum(&state.x, &state.v));
         report.constraint_violation = Some(self.max_violation(&state.x));

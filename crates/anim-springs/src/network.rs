@@ -454,4 +454,15 @@ impl EnergyParts {
     pub fn total(&self) -> f64 {
         self.kinetic + self.spring + self.gravity + self.contact
     }
+
+    /// As the workspace's [`anim_core::solver::EnergyParts`]: springs and contact are its
+    /// `elastic` part.
+    #[must_use]
+    pub fn split(&self) -> anim_core::solver::EnergyParts {
+        anim_core::solver::EnergyParts {
+            kinetic: self.kinetic,
+            gravity: self.gravity,
+            elastic: self.spring + self.contact,
+        }
+    }
 }

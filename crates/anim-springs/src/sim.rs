@@ -253,7 +253,9 @@ impl Solver for SpringSimulation {
         let mut report = StepReport::at_time(state.t);
         report.iterations = info.newton_iterations;
         report.residual = (info.newton_iterations > 0).then_some(info.residual);
-        report.energy = Some(self.network.energy_parts(&state.x, &state.v).total());
+        let parts = self.network.energy_parts(&state.x, &state.v);
+        report.energy = Some(parts.total());
+        report.energy_parts = Some(parts.split());
         report.linear_momentum = Some(self.network.linear_momentum(&state.v));
         report.angular_momentum = Some(self.network.angular_momentum(&state.x, &state.v));
         Ok(report)

@@ -109,6 +109,13 @@ pub trait SecondOrderSystem {
         let _ = (t, x, v);
         None
     }
+
+    /// The parts of [`SecondOrderSystem::energy`] (kinetic, gravitational, the rest), where the
+    /// system tells them apart.
+    fn energy_parts(&mut self, t: f64, x: &[f64], v: &[f64]) -> Option<crate::solver::EnergyParts> {
+        let _ = (t, x, v);
+        None
+    }
 }
 
 /// A system `M x'' = f(t, x, v)` with diagonal mass and force Jacobians: what implicit methods need.
@@ -627,6 +634,7 @@ impl<S: SecondOrderSystem + ?Sized> crate::solver::Solver for Simulation<S> {
         report.iterations = info.newton_iterations;
         report.residual = (info.newton_iterations > 0).then_some(info.residual);
         report.energy = self.system.energy(state.t, &state.x, &state.v);
+        report.energy_parts = self.system.energy_parts(state.t, &state.x, &state.v);
         Ok(report)
     }
 }

@@ -8,6 +8,7 @@
 
 use super::{MechanicalSystem, SecondOrderSystem};
 use crate::linalg::CsrMatrix;
+use crate::solver::EnergyParts;
 
 /// A 1-D damped harmonic oscillator `m x'' = -k x - c x'`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -82,6 +83,11 @@ impl SecondOrderSystem for HarmonicOscillator {
 
     fn energy(&mut self, _t: f64, x: &[f64], v: &[f64]) -> Option<f64> {
         Some(0.5 * self.mass * v[0] * v[0] + 0.5 * self.stiffness * x[0] * x[0])
+    }
+
+    fn energy_parts(&mut self, _t: f64, x: &[f64], v: &[f64]) -> Option<EnergyParts> {
+        let kinetic = 0.5 * self.mass * v[0] * v[0];
+        Some(EnergyParts { kinetic, gravity: 0.0, elastic: 0.5 * self.stiffness * x[0] * x[0] })
     }
 }
 
@@ -204,6 +210,11 @@ impl SecondOrderSystem for KeplerOrbit {
 
     fn energy(&mut self, _t: f64, x: &[f64], v: &[f64]) -> Option<f64> {
         Some(self.energy_of(x, v))
+    }
+
+    fn energy_parts(&mut self, _t: f64, x: &[f64], v: &[f64]) -> Option<EnergyParts> {
+        let kinetic = 0.5 * (v[0] * v[0] + v[1] * v[1]);
+        Some(EnergyParts { kinetic, gravity: 0.0, elastic: -self.mu / (x[0] * x[0] + x[1] * x[1]).sqrt() })
     }
 }
 
@@ -340,16 +351,21 @@ impl SecondOrderSystem for LinearChain {
         }
     }
 
-    fn energy(&mut self, _t: f64, x: &[f64], v: &[f64]) -> Option<f64> {
-        let mut e = 0.0;
+    fn energy(&mut self, t: f64, x: &[f64], v: &[f64]) -> Option<f64> {
+        self.energy_parts(t, x, v).map(|e| e.total())
+    }
+
+    fn energy_parts(&mut self, _t: f64, x: &[f64], v: &[f64]) -> Option<EnergyParts> {
+        let mut parts = EnergyParts::default();
         for i in 0..self.n {
-            e += 0.5 * self.mass * v[i] * v[i] + self.mass * self.gravity * x[i];
+            parts.kinetic += 0.5 * self.mass * v[i] * v[i];
+            parts.gravity += self.mass * self.gravity * x[i];
         }
         for i in 0..self.n - 1 {
             let s = x[i] - x[i + 1] - self.rest_length;
-            e += 0.5 * self.stiffness * s * s;
+            parts.elastic += 0.5 * self.stiffness * s * s;
         }
-        Some(e)
+        Some(parts)
     }
 }
 

@@ -633,7 +633,13 @@ impl Solver for RigidSimulation {
         report.residual =
             matches!(self.integrator, RigidIntegrator::ImplicitMidpoint | RigidIntegrator::FreeBodyMidpoint)
                 .then_some(residual);
-        report.energy = Some(self.system.energy_of(&state.q, &state.v).total());
+        let energy = self.system.energy_of(&state.q, &state.v);
+        report.energy = Some(energy.total());
+        report.energy_parts = Some(anim_core::solver::EnergyParts {
+            kinetic: energy.kinetic,
+            gravity: energy.gravity,
+            elastic: energy.limits,
+        });
         let h = self.system.momentum_of(&state.q, &state.v);
         report.linear_momentum = Some(h.linear.to_array());
         report.angular_momentum = Some(h.angular.to_array());

@@ -210,6 +210,10 @@ impl SecondOrderSystem for SpringNetwork {
     fn energy(&mut self, _t: f64, x: &[f64], v: &[f64]) -> Option<f64> {
         Some(self.energy_parts(x, v).total())
     }
+
+    fn energy_parts(&mut self, _t: f64, x: &[f64], v: &[f64]) -> Option<anim_core::solver::EnergyParts> {
+        Some(self.energy_parts(x, v).split())
+    }
 }
 
 impl MechanicalSystem for SpringNetwork {
