@@ -299,6 +299,7 @@ impl View for FemSimulation {
         out.time = state.t;
         out.points.clone_from(&state.x);
         out.field_mut("velocity", 3).extend_from_slice(&state.v);
+        self.model().nodal_strain(&state.x, out.field_mut("strain", 1));
     }
 }
 

@@ -620,6 +620,26 @@ impl FemModel {
         }
     }
 
+    /// A strain measure per node, for pictures: at each node the largest, over the elements
+    /// around it, of the Frobenius norm of the Green-Lagrange strain `E = (F^T F - I) / 2` at
+    /// the element's [`FemModel::deformation_gradient`]. 0 at rest, `|E|` of a uniform stretch
+    /// everywhere under one; dimensionless. `out` is overwritten, one value per node.
+    pub fn nodal_strain(&self, x: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.resize(self.vertices(), 0.0);
+        for e in 0..self.elements() {
+            let f = self.deformation_gradient(e, x);
+            let strain = 0.5 * (f.transpose() * f - Matrix3::identity()).norm();
+            let nodes: &[usize] = match &self.tet10 {
+                None => &self.mesh.tets[e],
+                Some(q) => &q.elements[e],
+            };
+            for &v in nodes {
+                out[v] = out[v].max(strain);
+            }
+        }
+    }
+
     /// The elastic nodal forces of element `e` into `out` (3 per element node, `3 x 4` or
     /// `3 x 10` values): Sifakis & Barbič's `H = -W P(F) Dm^-T`, `f_4 = -(f_1 + f_2 + f_3)` for linear
     /// elements, `-sum_q w_q P(F_q) grad N_a(X_q)` for 10-node elements.

@@ -394,3 +394,24 @@ fn an_overflowing_load_is_reported_by_vertex_and_the_step_undone() {
         other => panic!("expected NonFiniteState, got {other}"),
     }
 }
+
+/// The nodal strain of a uniform stretch by `s` along x is `(s^2 - 1) / 2` at every node (the
+/// Green-Lagrange strain `diag((s^2 - 1) / 2, 0, 0)`), and 0 after a rigid rotation.
+#[test]
+fn nodal_strain_is_the_green_strain_of_a_uniform_stretch_and_zero_for_a_rotation() {
+    let mesh = box_mesh([0.0; 3], [1.0, 0.5, 0.5], [3, 2, 2]).unwrap();
+    let m = FemModel::new(mesh, material(MaterialModel::NeoHookean)).unwrap();
+    let rest = m.rest_positions();
+    let s = 1.2;
+    let stretched: Vec<f64> =
+        rest.iter().enumerate().map(|(i, &x)| if i % 3 == 0 { s * x } else { x }).collect();
+    let mut strain = Vec::new();
+    m.nodal_strain(&stretched, &mut strain);
+    assert_eq!(strain.len(), m.vertices());
+    let expected = (s * s - 1.0) / 2.0;
+    assert!(strain.iter().all(|e| (e - expected).abs() < 1e-12), "{strain:?} vs {expected}");
+    // A quarter turn about z: (x, y, z) -> (-y, x, z).
+    let turned: Vec<f64> = rest.chunks_exact(3).flat_map(|p| [-p[1], p[0], p[2]]).collect();
+    m.nodal_strain(&turned, &mut strain);
+    assert!(strain.iter().all(|e| e.abs() < 1e-12), "{strain:?}");
+}

@@ -501,6 +501,10 @@ impl<const D: usize> View for MpmRun<D> {
         for u in state.v.chunks_exact(D) {
             v.extend_from_slice(&widen::<D>(u));
         }
+        // The material's index in the scene (the order of its bodies or the preset's materials).
+        out.field_mut("material", 1).extend(state.material.iter().map(|&m| f64::from(m)));
+        let strain = out.field_mut("strain", 1);
+        strain.extend((0..state.len()).map(|p| state.strain(p)));
     }
 
     fn reference_error(&self, _: &Particles<D>) -> Option<f64> {

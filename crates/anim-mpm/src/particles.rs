@@ -133,6 +133,15 @@ impl<const D: usize> Particles<D> {
         Mat::<D>::from_column_slice(&self.f[p * D * D..(p + 1) * D * D])
     }
 
+    /// The Frobenius norm of the Green-Lagrange strain `(F^T F - I) / 2` of particle `p`'s
+    /// deformation gradient (its elastic part for snow and sand): 0 at rest, dimensionless; a
+    /// strain measure for pictures.
+    #[must_use]
+    pub fn strain(&self, p: usize) -> f64 {
+        let f = self.deformation(p).cast::<f64>();
+        0.5 * (f.transpose() * f - nalgebra::SMatrix::<f64, D, D>::identity()).norm()
+    }
+
     /// Sets the velocity of every particle with material `material` to `v`.
     pub fn set_velocity(&mut self, material: u16, v: [f32; D]) {
         for p in 0..self.len() {
@@ -223,5 +232,21 @@ impl<const D: usize> Particles<D> {
             k += 1;
         }
         self.resize(k);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Particles;
+
+    /// `F = diag(s, 1)` has Green strain `diag((s^2 - 1) / 2, 0)`; a rotation has none.
+    #[test]
+    fn the_strain_is_the_green_strain_norm_of_f() {
+        let mut p = Particles::<2>::new();
+        let (c, s) = (0.6f32, 0.8f32);
+        // Column-major: a stretch by 1.5 along x, then a rotation.
+        p.f = vec![1.5, 0.0, 0.0, 1.0, c, s, -s, c];
+        assert!((p.strain(0) - (1.5f64 * 1.5 - 1.0) / 2.0).abs() < 1e-6, "{}", p.strain(0));
+        assert!(p.strain(1).abs() < 1e-6, "{}", p.strain(1));
     }
 }
