@@ -106,6 +106,9 @@ pub enum Geometry {
     Particles {
         /// Surface triangles (drawn shaded when present).
         triangles: Vec<[usize; 3]>,
+        /// Tetrahedra of a volume mesh: what `.vtu` frames hold (their boundary is `triangles`,
+        /// what the other formats and the preview show).
+        tetrahedra: Vec<[usize; 4]>,
         /// Line segments (springs), drawn when there is no surface.
         edges: Vec<[usize; 2]>,
         /// Particle disc radius in world units (0: none drawn).
@@ -171,6 +174,7 @@ impl Geometry {
         }
         Geometry::Particles {
             triangles: context.triangles.clone(),
+            tetrahedra: context.tetrahedra.clone(),
             edges: context.lines.clone(),
             radius: context.point_radius,
             ground,
@@ -265,7 +269,7 @@ impl View {
                     UnstructuredGrid::new(&p).vertices(&[0]).point_field(DataArray::vectors("velocity", &v));
                 io(frames.write(s.t, &grid)).map(|_| ())
             }
-            Geometry::Particles { triangles, edges, .. } => {
+            Geometry::Particles { triangles, tetrahedra, edges, .. } => {
                 triples(&s.x, &mut self.positions);
                 triples(&s.v, &mut self.velocities);
                 if self.vertices.len() != self.positions.len() {
@@ -273,7 +277,13 @@ impl View {
                 }
                 let mut grid = UnstructuredGrid::new(&self.positions)
                     .point_field(DataArray::vectors("velocity", &self.velocities));
-                grid = if !triangles.is_empty() {
+                // Every other field of the frame (material ids, strain), as it is.
+                for f in s.fields.iter().filter(|f| f.name != "velocity") {
+                    grid = grid.point_field(DataArray::new(f.name, f.components, f.values.as_slice()));
+                }
+                grid = if !tetrahedra.is_empty() && frames.format() == FrameFormat::Vtu {
+                    grid.tetrahedra(tetrahedra)
+                } else if !triangles.is_empty() {
                     grid.triangles(triangles)
                 } else if frames.format() == FrameFormat::Ply || edges.is_empty() {
                     grid.vertices(&self.vertices)
@@ -340,7 +350,9 @@ impl View {
                 }
                 io(canvas.draw_particles(camera, &[p], 0.03 * scale, Colors::Uniform([60, 110, 200])))
             }
-            Geometry::Particles { triangles, edges, radius, ground, obstacles, meshes, frame_box } => {
+            Geometry::Particles {
+                triangles, edges, radius, ground, obstacles, meshes, frame_box, ..
+            } => {
                 triples(&s.x, &mut self.positions);
                 for prop in obstacles {
                     draw_obstacle(canvas, camera, prop)?;

@@ -392,3 +392,24 @@ fn the_energy_change_is_relative_to_the_energy_in_play() {
     assert!(metrics["energy_scale_is"].as_str().unwrap().contains("kinetic"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// FEM `.vtu` frames hold the volume (the tetrahedra, 6 per cell of the cube's 3 x 3 x 3 box
+/// mesh) and a strain measure; MPM frames hold each particle's material and strain.
+#[test]
+fn frames_carry_the_volume_strain_and_materials() {
+    let dir = temp("volume");
+    let d = dir.to_str().unwrap();
+    let (ok, err) =
+        anim(&["run", "cube", "--resolution", "3", "--frames", "2", "--out", d, "--quiet", "--no-preview"]);
+    assert!(ok, "{err}");
+    let vtu = std::fs::read_to_string(dir.join("frames/frame_00001.vtu")).unwrap();
+    assert!(vtu.contains("NumberOfPoints=\"64\" NumberOfCells=\"162\""), "{vtu:.300}");
+    assert!(vtu.contains("Name=\"strain\""));
+    std::fs::remove_dir_all(&dir).ok();
+    let (ok, err) =
+        anim(&["run", "mpm", "--resolution", "32", "--frames", "1", "--out", d, "--quiet", "--no-preview"]);
+    assert!(ok, "{err}");
+    let vtu = std::fs::read_to_string(dir.join("frames/frame_00000.vtu")).unwrap();
+    assert!(vtu.contains("Name=\"material\"") && vtu.contains("Name=\"strain\""), "{vtu:.300}");
+    std::fs::remove_dir_all(&dir).ok();
+}
