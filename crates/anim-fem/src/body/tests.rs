@@ -38,33 +38,13 @@ fn tetgen(test: &str, inverted: bool) -> PathBuf {
     dir
 }
 
-/// The OBJ text of the box `[0, size]^3` as 12 outward triangles, without the triangles listed
-/// in `missing` (0-based).
+/// The OBJ text of the box `[0, size]^3` as 12 outward triangles (anim-core's `cuboid`: corner
+/// `k` at the bits of `k`), without the triangles listed in `missing` (0-based).
 pub(crate) fn cube_obj(size: f64, missing: &[usize]) -> String {
-    let mut text = String::from("# a cube\n");
-    for k in 0..8 {
-        let c = [k & 1, (k >> 1) & 1, (k >> 2) & 1].map(|b| size * b as f64);
-        text.push_str(&format!("v {} {} {}\n", c[0], c[1], c[2]));
-    }
-    // Corners numbered by their (x, y, z) bits, from 1.
-    let faces = [
-        [1, 3, 4],
-        [1, 4, 2],
-        [5, 6, 8],
-        [5, 8, 7],
-        [1, 2, 6],
-        [1, 6, 5],
-        [3, 7, 8],
-        [3, 8, 4],
-        [1, 5, 7],
-        [1, 7, 3],
-        [2, 4, 8],
-        [2, 8, 6],
-    ];
-    for (t, f) in faces.iter().enumerate() {
-        if !missing.contains(&t) {
-            text.push_str(&format!("f {} {} {}\n", f[0], f[1], f[2]));
-        }
+    let (p, t) = anim_core::surface::cuboid([0.0; 3], [size; 3]);
+    let mut text: String = p.iter().map(|v| format!("v {} {} {}\n", v[0], v[1], v[2])).collect();
+    for (_, f) in t.iter().enumerate().filter(|(k, _)| !missing.contains(k)) {
+        text += &format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1);
     }
     text
 }
