@@ -130,7 +130,7 @@ fn refusals_name_the_field_and_the_file() {
     if let Some(region) = pinned.pin.as_mut().and_then(|p| p.region.as_mut()) {
         region.max[2] = f64::NAN;
     }
-    assert_eq!(refuse(pinned, &cube_file).field, "pin");
+    assert_eq!(refuse(pinned, &cube_file).field, "pin.box");
     // `cell` is for surfaces only.
     let e = refuse(cube(serde_json::json!({ "cell": 0.1 })), &cube_file);
     assert_eq!(e.field, "cell");
@@ -229,6 +229,7 @@ fn pin_refusals_name_the_field_and_the_cause() {
     let dir = folder("pin-refusals");
     std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
     let cube_file = testdata().join("cube_v41.msh");
+    // The field at fault, and the message.
     let refuse = |pin: serde_json::Value, file: &Path| {
         let mut extra = serde_json::json!({ "pin": pin });
         if file.extension().is_some_and(|e| e == "obj") {
@@ -236,25 +237,29 @@ fn pin_refusals_name_the_field_and_the_cause() {
             extra["cell"] = 0.5.into();
         }
         let e = cube(extra).load(file).expect_err("refused");
-        assert_eq!(e.field, "pin", "{e}");
-        e.message
+        (e.field, e.message)
     };
-    let m = refuse(serde_json::json!({ "vertices": [0, 8] }), &cube_file);
-    assert!(
-        m.contains("vertex 8 is out of range") && m.contains("cube_v41.msh has 8 vertices (0 to 7)"),
-        "{m}"
-    );
-    let m = refuse(serde_json::json!({ "vertices": [0] }), &dir.join("cube.obj"));
+    let (f, m) = refuse(serde_json::json!({ "vertices": [0, 8] }), &cube_file);
+    assert_eq!(f, "pin.vertices[1]");
+    assert_eq!(m, format!("vertex 8 is out of range: {} has 8 vertices (0 to 7)", cube_file.display()));
+    let (f, m) = refuse(serde_json::json!({ "vertices": [0] }), &dir.join("cube.obj"));
+    assert_eq!(f, "pin");
     assert!(m.contains("cube.obj") && m.contains("pin them with a `box`"), "{m}");
-    let m =
+    let (f, m) =
         refuse(serde_json::json!({ "box": { "min": [0.0, 1.0, 0.0], "max": [1.0, 0.0, 1.0] } }), &cube_file);
-    assert!(m.contains("min <= max"), "{m}");
-    assert!(refuse(serde_json::json!({}), &cube_file).contains("pins nothing"));
+    assert_eq!(f, "pin.box");
+    assert!(m.starts_with("the box needs finite corners with min <= max"), "{m}");
+    // An empty table: the table, with the message every kind gives.
+    assert_eq!(
+        refuse(serde_json::json!({}), &cube_file),
+        ("pin".into(), "give `vertices`, `box` or both".into())
+    );
     // A vertex in no tetrahedron: a fifth, unused vertex in a TetGen mesh.
     std::fs::write(dir.join("tet.node"), "5 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 2 2 2\n")
         .expect("node");
     std::fs::write(dir.join("tet.ele"), "1 4 0\n1 1 2 3 4\n").expect("ele");
-    let m = refuse(serde_json::json!({ "vertices": [4] }), &dir.join("tet.node"));
+    let (f, m) = refuse(serde_json::json!({ "vertices": [4] }), &dir.join("tet.node"));
+    assert_eq!(f, "pin");
     assert!(m.contains("vertex 4 of") && m.contains("tet.node") && m.contains("no tetrahedron"), "{m}");
     // The box alone, as fem spelled it before: an unknown field.
     let old = serde_json::json!({
