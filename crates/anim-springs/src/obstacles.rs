@@ -35,7 +35,7 @@ pub(crate) fn mesh_colliders(
             .field(&surface, contact.thickness)
             .map_err(|e| BuildError::invalid(format!("{table}.cell"), format!("{}: {e}", path.display())))?;
         out.push(MeshCollider {
-            field,
+            shape: field,
             stiffness: contact.stiffness,
             damping: contact.damping,
             friction: contact.friction,
