@@ -17,14 +17,26 @@
 //! is generated with `q` the closest surface point and `n` the outward normal at `q`, both frozen
 //! for the step (Müller et al. 2007, section 3.4, the "static" case; the shapes are solid, so the
 //! closest point also resolves a particle that crossed the surface during the step, unless it
-//! passed through a shape thinner than its motion). A contact is always rigid (compliance 0) and
-//! inactive while `C >= 0`; the margin lets it catch a particle that the internal constraints push
-//! into the shape during the iterations.
+//! passed through a shape thinner than its motion: a box of half-thickness `b` is crossed by a
+//! particle whose substep motion exceeds `b + thickness` when the substep ends past its middle).
+//! A contact is always rigid (compliance 0) and inactive while `C >= 0`; the margin lets it catch
+//! a particle that the internal constraints push into the shape during the iterations.
 //!
 //! A mesh collider reads `phi` and `n` from its distance field (trilinear between the lattice's
 //! nodes, `n` the normalised gradient) and takes `q = p - phi n`; it is solid too, and a particle
 //! outside the field's lattice gets no contact. The model's normal is frozen for the substep, so
-//! no derivative of `n` (no curvature term) enters the projection.
+//! no derivative of `n` (no curvature term) enters the projection. Its contact is **continuous**:
+//! a particle whose motion over the substep is longer than its distance to the surface has its
+//! path from `x` to `p` marched through the field by conservative advancement, and where the
+//! path first comes within the thickness, at `y`, the contact takes `q = y - phi(y) n(y)` and
+//! `n(y)` (a speculative contact from the start of the motion, as Bridson et al. 2002 stop cloth
+//! before a collision rather than after it; `collide/sweep.rs`). A plate thinner than the motion
+//! then stops the particle on its near side: particles and a cloth thrown at a 1 cm mesh plate
+//! stay on it at 20 to 50 m/s and, measured by `cargo xtask stability`, at every speed tried up
+//! to 10 km/s (the analytic box of the same plate lets particles through from 2 m/s at a
+//! substep of 1/240 s). The field still has to see the plate: a plate thinner than the field's
+//! spacing may have no node inside it and read as a dip of the distance, caught only within the
+//! thickness of its top.
 //!
 //! **Friction** is positional (Macklin et al. 2014, "Unified particle physics", eq. 24): after a
 //! projection that pushed the particle out by `d`, its tangential motion relative to the obstacle
@@ -69,8 +81,10 @@ use serde::{Deserialize, Serialize};
 mod mesh;
 #[cfg(test)]
 mod mesh_tests;
+mod sweep;
 
 pub use mesh::MeshCollider;
+pub(crate) use sweep::first_touch;
 
 /// A rigid pose: `world = position + rotation * local`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -11,9 +11,12 @@ use anim_core::surface::DistanceField;
 /// or [`DistanceField::around`]), on an optional kinematic body: a [`Collider`] whose `shape`
 /// is the field, with the same contact parameters, setters and checks as a shape's.
 ///
-/// A particle gets a contact exactly as against a shape: the field's interpolated distance
-/// `phi(p)` and its normalised gradient `n` stand for the shape's signed distance and outward
-/// normal, and the closest surface point is `q = p - phi n`. Where the field has no value (the
+/// A particle gets a contact as against a shape: the field's interpolated distance `phi(p)` and
+/// its normalised gradient `n` stand for the shape's signed distance and outward normal, and the
+/// closest surface point is `q = p - phi n`. Unlike a shape's, the contact is continuous: a
+/// particle that moves farther over the substep than its distance to the surface has its path
+/// followed through the field, and the contact is taken where the path first comes within the
+/// thickness (see [`crate::collide`]), so that a surface thinner than the motion is not crossed. Where the field has no value (the
 /// point lies outside its lattice) the particle is far outside the obstacle and gets no contact;
 /// so does a point where the interpolated gradient vanishes. The field is solid: a particle deep
 /// inside is pushed out along the gradient, which points away from the surface everywhere in the
