@@ -37,9 +37,9 @@ use crate::model::{EARTH_GRAVITY, ElementOrder, FemModel};
 use crate::scenes::FemScene;
 use crate::sim::FemParams;
 use anim_core::integrate::State;
-use anim_core::scene::{BuildError, ObstacleMesh};
-use anim_core::surface::{ClosedSurface, DistanceField};
-use anim_io::obj::{Polygons, read_obj};
+use anim_core::scene::ObstacleMesh;
+use anim_core::surface::DistanceField;
+use anim_io::surface::read_closed_surface;
 
 /// The most linear tetrahedra the bodies of a scene may have together: 2^18 = 262,144. At this
 /// size the model and its simulation take about 0.8 GB, and the first backward-Euler step with
@@ -231,35 +231,13 @@ fn build_within(
     })
 }
 
-/// The distance field of a mesh obstacle read from `path`: placed, checked closed, sampled at
-/// its `cell`. Errors name the field of the table (`mesh`, `cell`, `scale`, ...).
+/// The distance field of a mesh obstacle read from `path`: placed, checked closed
+/// ([`read_closed_surface`]), sampled at its `cell`. Errors name the field of the table (`mesh`,
+/// `cell`, `scale`, ...).
 fn mesh_field(m: &ObstacleMesh, path: &Path) -> Result<DistanceField, BodyError> {
-    let placement = m.placement();
-    placement.check().map_err(|e| match e {
-        BuildError::Invalid { field, message } => BodyError::new(field, message),
-        other => BodyError::new("scale", other),
-    })?;
-    let file = path.display();
-    if !path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
-        return Err(BodyError::new(
-            "mesh",
-            format!("{file}: a mesh obstacle is a Wavefront OBJ surface (.obj)"),
-        ));
-    }
-    let obj = read_obj(path, Polygons::Triangulate).map_err(|e| {
-        let text = e.to_string();
-        BodyError::new(
-            "mesh",
-            if text.contains(&file.to_string()) { text } else { format!("{file}: {text}") },
-        )
-    })?;
-    let mut positions = obj.positions;
-    placement.apply_all(&mut positions);
-    let surface = ClosedSurface::new(positions, obj.triangles).map_err(|e| {
-        BodyError::new("mesh", format!("{file}: {e} (vertices and triangles numbered from 0 in file order)"))
-    })?;
+    let surface = read_closed_surface(path, &m.placement()).map_err(|e| BodyError::new(e.field(), &e))?;
     // Contact needs the field where `phi < 0` only: no margin beyond the two cells `field` adds.
-    m.field(&surface, 0.0).map_err(|e| BodyError::new("cell", format!("{file}: {e}")))
+    m.field(&surface, 0.0).map_err(|e| BodyError::new("cell", format!("{}: {e}", path.display())))
 }
 
 /// The body of every node of `model`: a corner vertex by the range of its body (`starts[k]..

@@ -297,13 +297,10 @@ impl BodySpec {
     }
 }
 
-/// A refusal of the `pin` table, as a [`BodyError`] of `field`; a table that pins nothing says
-/// so first.
+/// A refusal of the `pin` table `field`, as a [`BodyError`] of the field at fault
+/// ([`PinError::field_under`]: `field`, or its part `vertices[k]`, `box`).
 pub(crate) fn pin_error(field: impl Into<String>, e: &PinError) -> BodyError {
-    match e {
-        PinError::Nothing => BodyError::new(field, format!("pins nothing: {e}")),
-        e => BodyError::new(field, e),
-    }
+    BodyError::new(e.field_under(&field.into()), e)
 }
 
 /// The listed vertices of `pin` of the mesh read from `file`, checked in range and in an element.

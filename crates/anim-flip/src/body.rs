@@ -224,7 +224,7 @@ fn obstacles<const D: usize>(
         let prefix = format!("obstacle_meshes[{k}]");
         m.refuse_cell().map_err(|e| invalid(format!("{prefix}.cell"), e))?;
         let place = placement(&prefix, m.scale, m.rotate, m.translate, D)?;
-        let region = Region::mesh(&m.mesh, place, context, &format!("{prefix}.mesh"))?;
+        let region = Region::mesh(&m.mesh, place, context, &prefix)?;
         out.push((prefix, region));
     }
     Ok(out)
@@ -308,7 +308,7 @@ fn seed<const D: usize>(
                 }
                 Region::shape(*shape, place, D)
             }
-            (None, Some(mesh)) => Region::mesh(mesh, place, context, &format!("{name}.mesh"))?,
+            (None, Some(mesh)) => Region::mesh(mesh, place, context, &name)?,
             (Some(_), Some(_)) => return Err(invalid(name, "give a `shape` or a `mesh`, not both")),
             (None, None) => {
                 return Err(invalid(name, "give a `shape` (box, sphere, capsule) or a closed OBJ `mesh`"));

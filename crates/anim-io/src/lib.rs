@@ -10,6 +10,7 @@
 //! | [`vtk`] | VTK XML `.vtu` (points; vertex, line, triangle, tetrahedron cells; point and cell fields), `.vti` (2-D/3-D grids), `.pvd` (time series) | ParaView, VisIt, PyVista, meshio; Blender and Houdini through their VTK importers |
 //! | [`ply`] | binary little-endian `.ply`: points with named attributes, triangles | Blender, Houdini, MeshLab, CloudCompare |
 //! | [`obj`] | `.obj` triangle meshes and polylines, read and written | Blender, Houdini, Maya, every DCC tool |
+//! | `surface` | a closed `.obj` surface read, placed and checked closed, manifold and oriented as anim-core's `ClosedSurface` (feature `surface`: `read_closed_surface`) | the scene kinds' closed meshes: bodies, mesh obstacles, fluid sources |
 //! | [`gmsh`] | Gmsh `.msh` ASCII 2.2 and 4.1, read: nodes, tetrahedra, triangles, physical tags | written by Gmsh, meshio, many meshers |
 //! | [`tetgen`] | TetGen `.node` + `.ele`, read | written by TetGen, meshio |
 //! | [`frames`] | numbered sequences `frame_00000.vtu ...` in any of the writers' formats | ParaView (with the `.pvd`), Blender and Houdini sequence importers |
@@ -74,6 +75,8 @@ pub mod obj;
 pub mod ply;
 #[cfg(feature = "output")]
 pub mod preview;
+#[cfg(feature = "surface")]
+pub mod surface;
 pub mod tetgen;
 mod text;
 #[cfg(feature = "output")]

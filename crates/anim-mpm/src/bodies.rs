@@ -35,12 +35,12 @@
 //! ```
 
 use anim_core::scene::unit_scale;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anim_core::glam::DVec3;
 use anim_core::scene::{BuildContext, BuildError, Placement, is_default};
 use anim_core::surface::ClosedSurface;
-use anim_io::obj::{Polygons, read_obj};
+use anim_io::surface::read_closed_surface;
 use serde::{Deserialize, Serialize};
 
 use crate::kind::MpmSceneParams;
@@ -226,10 +226,8 @@ fn obstacle_meshes<const D: usize>(
     for (k, m) in p.obstacle_meshes.iter().enumerate() {
         let at = |field: &str| format!("obstacle_meshes[{k}].{field}");
         m.refuse_cell().map_err(|e| BuildError::invalid(at("cell"), e))?;
-        let placement = m.placement();
-        placement.check().map_err(|e| e.within(&format!("obstacle_meshes[{k}]")))?;
-        let surface = read_surface(&context.resolve(&m.mesh), &placement)
-            .map_err(|e| BuildError::invalid(at("mesh"), e))?;
+        let surface = read_closed_surface(&context.resolve(&m.mesh), &m.placement())
+            .map_err(|e| e.within(&format!("obstacle_meshes[{k}]")))?;
         let collider = MeshCollider::new(&surface, params, boundary)
             .map_err(|e| BuildError::invalid(format!("obstacle_meshes[{k}]"), e))?;
         out.push(collider);
@@ -326,7 +324,7 @@ impl Region {
             (None, Some(mesh)) if D == 3 => {
                 let path = context.resolve(mesh);
                 Ok(Region::Surface(
-                    read_surface(&path, &placement).map_err(|e| BuildError::invalid(at("mesh"), e))?,
+                    read_closed_surface(&path, &placement).map_err(|e| e.within(&format!("bodies[{k}]")))?,
                 ))
             }
             (None, Some(_)) => Err(BuildError::invalid(
@@ -419,21 +417,6 @@ impl Region {
         }
         Ok(out)
     }
-}
-
-/// Reads an OBJ surface, places it and checks that it is closed.
-fn read_surface(path: &Path, placement: &Placement) -> Result<ClosedSurface, String> {
-    let file = path.display();
-    if !path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
-        return Err(format!("{file}: a mesh is a Wavefront OBJ surface (.obj)"));
-    }
-    let obj = read_obj(path, Polygons::Triangulate).map_err(|e| {
-        let text = e.to_string();
-        if text.contains(&file.to_string()) { text } else { format!("{file}: {text}") }
-    })?;
-    let mut positions = obj.positions;
-    placement.apply_all(&mut positions);
-    ClosedSurface::new(positions, obj.triangles).map_err(|e| format!("{file}: {e}"))
 }
 
 /// The particle lattice of a scene and the region between the walls.

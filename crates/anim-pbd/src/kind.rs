@@ -298,7 +298,7 @@ impl View for PbdSimulation {
                 .mesh_colliders()
                 .iter()
                 .filter(|c| c.body.is_none())
-                .map(|c| MeshProp::from(c.field.surface())),
+                .map(|c| MeshProp::from(c.shape.surface())),
         );
         context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
         context

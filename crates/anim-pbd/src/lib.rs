@@ -22,8 +22,10 @@
 //!   k_pressure V_0` over a closed mesh (balloons);
 //! - **attachment** `|x_i - t| - d` to a fixed point or a point of a moving [`KinematicBody`];
 //! - **contacts**, inequality constraints against [`Collider`]s (shapes) and [`MeshCollider`]s
-//!   (closed triangle meshes as signed distance fields) generated every step (line 8 of the
-//!   loop), with static and kinetic **friction** and **restitution** ([`collide`]);
+//!   (closed triangle meshes as signed distance fields, with continuous contact: a particle's
+//!   path over a substep is marched through the field, so a surface thinner than its motion is
+//!   not crossed) generated every step (line 8 of the loop), with static and kinetic
+//!   **friction** and **restitution** ([`collide`]);
 //!   between bodies ([`ContactBody`], [`PbdBuilder::contact_body`]), a particle of one body
 //!   against the closest surface triangle of another, with friction (no self-collision).
 //!

@@ -310,24 +310,14 @@ fn add_body(
 }
 
 /// The vertices `pin` holds ([`PinSpec::resolve`]), its refusal on `field` or the part of the
-/// table at fault (`pin.vertices[k]`, `pin.box`).
+/// table at fault ([`PinError::field_under`]: `pin.vertices[k]`, `pin.box`).
 fn pinned_vertices(
     pin: &PinSpec,
     positions: &[[f64; 3]],
     field: &str,
     file: &str,
 ) -> Result<Vec<usize>, SceneError> {
-    pin.resolve(positions, file).map_err(|e| {
-        let field = e.field().map_or_else(|| field.to_string(), |part| format!("{field}.{part}"));
-        let message = match e {
-            PinError::OutOfRange { vertex, count, .. } => format!(
-                "vertex {vertex} does not exist: {file} has {count} vertices (0-based indices 0 to {})",
-                count.saturating_sub(1)
-            ),
-            e => e.to_string(),
-        };
-        SceneError::invalid(field, message)
-    })
+    pin.resolve(positions, file).map_err(|e| SceneError::invalid(e.field_under(field), e.to_string()))
 }
 
 fn check_contact(c: &ContactSpec) -> Result<(), SceneError> {

@@ -42,6 +42,11 @@
 //!   (`mu = tau_t |v_t|`). It stops sliding without the non-smooth stick/slip switch of exact
 //!   Coulomb friction, which Newton's method and a symmetric Jacobian cannot represent.
 //!
+//! For a mesh ([`MeshCollider`]) `phi` is a sampled field whose gradient is not exactly of unit
+//! length, and the whole bracket is multiplied by `|grad phi|`: the elastic force is then the
+//! exact negative gradient `-dE/dx = e(p) grad phi` of the energy `E(p)` that the network
+//! counts (for a shape `|grad phi| = 1`).
+//!
 //! # The Jacobians
 //!
 //! `D = df/dv = -e(p) [tau_n n n^T + tau_t (I - n n^T)]` is exact, symmetric and negative
@@ -54,10 +59,13 @@
 //! beside a capsule's axis (`a` the unit axis, `r` the distance to it) and beside a box's edge
 //! within the thickness, zero in a plane and inside a box or beside its faces (its normal is
 //! constant on each face's side of the inner ridges, where it jumps). For a mesh, `phi` is the
-//! field's trilinear interpolant, `n` its normalised gradient, `dp/dx = -|grad phi| n` (about
-//! `-n`) and `dn/dx = (I - n n^T) H / |grad phi|` with `H` the field's Hessian. In the default
+//! field's trilinear interpolant, `n` its normalised gradient, and the elastic force is the
+//! energy's exact negative gradient `e(p) |grad phi| n` (`|grad phi|` is 1 for a shape, about
+//! 1 for a field): with `a = e(p) |grad phi|`, `K = g (grad a)^T + a (dg/dn)(dn/dx)`,
+//! `grad a = -e'(p) |grad phi|^2 n + e(p) H n` and `a dn/dx = e(p) (I - n n^T) H`, `H` the
+//! field's Hessian. In the default
 //! [`JacobianMode::Definite`](crate::JacobianMode::Definite) only the normal stiffness is kept,
-//! with `1 - tau_n v_n` clamped at 0: symmetric and negative semi-definite, as conjugate gradients
+//! with `1 - tau_n v_n` clamped at 0 (times `|grad phi|^2` for a mesh): symmetric and negative semi-definite, as conjugate gradients
 //! and Cholesky need, while the force itself is unchanged (Newton converges to the same step, a
 //! little more slowly while particles slide). [`JacobianMode::Exact`](crate::JacobianMode::Exact)
 //! keeps every term (finite differences check it).
@@ -92,13 +100,13 @@ pub(crate) enum Bend {
         /// otherwise.
         axis: DVec3,
     },
-    /// A distance field's ([`MeshCollider`]): `|grad phi| = slope` (about 1) and
-    /// `dn/dx = (I - n n^T) H / |grad phi|`, `H` the field's Hessian.
+    /// A distance field's ([`MeshCollider`]): the gradient is `slope n` (`slope` about 1) and
+    /// its derivative the field's Hessian `H`.
     Field {
         /// `|grad phi|`.
         slope: f64,
-        /// `dn/dx`.
-        dn_dx: DMat3,
+        /// The field's Hessian `H` (symmetric).
+        hessian: DMat3,
     },
 }
 
@@ -109,15 +117,37 @@ impl Bend {
     fn round(curvature: f64) -> Self {
         Bend::Turn { curvature, axis: DVec3::ZERO }
     }
+
+    /// `|grad phi|`: 1 for a shape, about 1 for a field.
+    #[inline]
+    fn slope(&self) -> f64 {
+        match *self {
+            Bend::Turn { .. } => 1.0,
+            Bend::Field { slope, .. } => slope,
+        }
+    }
+}
+
+/// What a collider's geometry gives the penalty law: the penetration of a point into it grown by
+/// a thickness, with the outward normal and how both change ([`Bend`]).
+pub(crate) trait Geometry {
+    /// Penetration `p = thickness - phi(x) > 0`, outward unit normal and [`Bend`], or `None`
+    /// when `x` is outside the grown geometry.
+    fn probe(&self, x: DVec3, thickness: f64) -> Option<(f64, DVec3, Bend)>;
+
+    /// Checks the geometry; a description of the problem.
+    fn check(&self) -> Result<(), String>;
 }
 
 /// A rigid, fixed obstacle acting on every particle through a penalty force (see the
-/// [module docs](self)).
+/// [module docs](self)). The geometry is a [`Shape`] (the default, `Collider`) or the signed
+/// distance field of a closed triangle mesh ([`MeshCollider`], `Collider<DistanceField>`); the
+/// penalty parameters, their setters and their checks are the same for both.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Collider {
-    /// The geometry.
-    pub shape: Shape,
+pub struct Collider<G = Shape> {
+    /// The geometry: a [`Shape`], or a mesh's [`DistanceField`](anim_core::surface::DistanceField).
+    pub shape: G,
     /// Penalty stiffness `k_c` (N/m, > 0).
     pub stiffness: f64,
     /// Normal damping `tau_n` (s/m, >= 0): the damping force is `tau_n |v_n|` times the elastic one.
@@ -128,41 +158,21 @@ pub struct Collider {
     /// 0 gives the plain penalty `k_c p`.
     #[serde(default)]
     pub smoothing: f64,
-    /// Distance `t` (m, >= 0) outside the shape at which particles are held: the penalty acts on
-    /// `phi - t`, the signed distance to the shape grown by `t` (a plane moved out along its
+    /// Distance `t` (m, >= 0) outside the geometry at which particles are held: the penalty acts
+    /// on `phi - t`, the signed distance to the geometry grown by `t` (a plane moved out along its
     /// normal, a sphere's or capsule's radius plus `t`, a box with its edges and corners rounded
-    /// to radius `t`). A cloth's thickness: its triangles then lie clear of a curved obstacle
-    /// instead of cutting its surface between their vertices. Default 0.
+    /// to radius `t`, a mesh offset by `t`). A cloth's thickness: its triangles then lie clear of
+    /// a curved obstacle instead of cutting its surface between their vertices. Default 0.
     #[serde(default, skip_serializing_if = "is_default")]
     pub thickness: f64,
 }
 
-impl Collider {
-    /// The ground plane `z = height` with outward normal `+z`, penalty stiffness `stiffness`, no
-    /// damping, friction or smoothing (add them with the `with_` methods).
+impl<G> Collider<G> {
+    /// The geometry `shape` with penalty stiffness `stiffness`, no damping, friction, smoothing
+    /// or thickness (add them with the `with_` methods).
     #[must_use]
-    pub fn ground(height: f64, stiffness: f64) -> Self {
-        Self {
-            shape: Shape::ground(height),
-            stiffness,
-            damping: 0.0,
-            friction: 0.0,
-            smoothing: 0.0,
-            thickness: 0.0,
-        }
-    }
-
-    /// A solid sphere with penalty stiffness `stiffness`, no damping, friction or smoothing.
-    #[must_use]
-    pub fn sphere(center: [f64; 3], radius: f64, stiffness: f64) -> Self {
-        Self {
-            shape: Shape::Sphere { center, radius },
-            stiffness,
-            damping: 0.0,
-            friction: 0.0,
-            smoothing: 0.0,
-            thickness: 0.0,
-        }
+    pub fn new(shape: G, stiffness: f64) -> Self {
+        Self { shape, stiffness, damping: 0.0, friction: 0.0, smoothing: 0.0, thickness: 0.0 }
     }
 
     /// Sets the normal damping `tau_n` (s/m).
@@ -186,23 +196,16 @@ impl Collider {
         self
     }
 
-    /// Sets the thickness `t` (m) at which particles are held outside the shape.
+    /// Sets the thickness `t` (m) at which particles are held outside the geometry.
     #[must_use]
     pub fn with_thickness(mut self, t: f64) -> Self {
         self.thickness = t;
         self
     }
 
-    /// Checks the parameters; returns a description of the first problem (a shape's names the
-    /// shape).
-    pub(crate) fn check(&self) -> Result<(), String> {
-        self.law().check(self.thickness)?;
-        self.shape.check()
-    }
-
     /// The penalty law of the collider's parameters.
     #[inline]
-    fn law(&self) -> Law {
+    pub(crate) fn law(&self) -> Law {
         Law {
             stiffness: self.stiffness,
             damping: self.damping,
@@ -210,19 +213,73 @@ impl Collider {
             smoothing: self.smoothing,
         }
     }
+}
+
+// Every method here is crate-private: the trait bound is the crate's own business.
+#[allow(private_bounds)]
+impl<G: Geometry> Collider<G> {
+    /// Checks the parameters and the geometry; returns a description of the first problem (a
+    /// shape's names the shape).
+    pub(crate) fn check(&self) -> Result<(), String> {
+        self.law().check(self.thickness)?;
+        self.shape.check()
+    }
+
+    /// Penetration `p > 0` of the geometry grown by the thickness, outward normal and how the
+    /// normal turns (see [`Bend`]), or `None` when the particle is outside.
+    #[inline]
+    pub(crate) fn probe(&self, x: DVec3) -> Option<(f64, DVec3, Bend)> {
+        self.shape.probe(x, self.thickness)
+    }
+
+    /// Force on a particle at `(x, v)`.
+    #[inline]
+    pub(crate) fn force(&self, x: DVec3, v: DVec3) -> DVec3 {
+        self.law().force(self.probe(x), v)
+    }
+
+    /// Penalty energy `E(p)`.
+    #[inline]
+    pub(crate) fn energy(&self, x: DVec3) -> f64 {
+        self.law().energy(self.probe(x))
+    }
+
+    /// Adds the Jacobians `df/dx` (definite or exact) and `df/dv` at `(x, v)` to `k` and `d`.
+    #[inline]
+    pub(crate) fn jacobians(&self, x: DVec3, v: DVec3, exact: bool, k: &mut DMat3, d: &mut DMat3) {
+        self.law().jacobians(self.probe(x), v, exact, k, d);
+    }
+}
+
+impl Collider {
+    /// The ground plane `z = height` with outward normal `+z`, penalty stiffness `stiffness`, no
+    /// damping, friction or smoothing (add them with the `with_` methods).
+    #[must_use]
+    pub fn ground(height: f64, stiffness: f64) -> Self {
+        Self::new(Shape::ground(height), stiffness)
+    }
+
+    /// A solid sphere with penalty stiffness `stiffness`, no damping, friction or smoothing.
+    #[must_use]
+    pub fn sphere(center: [f64; 3], radius: f64, stiffness: f64) -> Self {
+        Self::new(Shape::Sphere { center, radius }, stiffness)
+    }
 
     /// A copy with a unit plane normal (called once the parameters are checked).
     pub(crate) fn normalized(mut self) -> Self {
         self.shape = self.shape.normalized();
         self
     }
+}
 
-    /// Penetration `p > 0` of the shape grown by the thickness, outward normal and how the
-    /// normal turns (see [`Bend`]), or `None` when the particle is outside.
+impl Geometry for Shape {
+    fn check(&self) -> Result<(), String> {
+        Shape::check(self)
+    }
+
     #[inline]
-    pub(crate) fn probe(&self, x: DVec3) -> Option<(f64, DVec3, Bend)> {
-        let thickness = self.thickness;
-        match self.shape {
+    fn probe(&self, x: DVec3, thickness: f64) -> Option<(f64, DVec3, Bend)> {
+        match *self {
             Shape::Plane { point, normal } => {
                 let n = DVec3::from_array(normal);
                 let phi = (x - DVec3::from_array(point)).dot(n) - thickness;
@@ -243,7 +300,7 @@ impl Collider {
                 }
             }
             Shape::Box { center, half_extents } => {
-                let (distance, n) = self.shape.signed_distance(x);
+                let (distance, n) = self.signed_distance(x);
                 let phi = distance - thickness;
                 if phi >= 0.0 {
                     return None;
@@ -264,7 +321,7 @@ impl Collider {
                 Some((-phi, n, bend))
             }
             Shape::Capsule { a, b, radius } => {
-                let (distance, n) = self.shape.signed_distance(x);
+                let (distance, n) = self.signed_distance(x);
                 let phi = distance - thickness;
                 if phi >= 0.0 {
                     return None;
@@ -285,24 +342,6 @@ impl Collider {
                 Some((-phi, n, bend))
             }
         }
-    }
-
-    /// Force on a particle at `(x, v)`.
-    #[inline]
-    pub(crate) fn force(&self, x: DVec3, v: DVec3) -> DVec3 {
-        self.law().force(self.probe(x), v)
-    }
-
-    /// Penalty energy `E(p)`.
-    #[inline]
-    pub(crate) fn energy(&self, x: DVec3) -> f64 {
-        self.law().energy(self.probe(x))
-    }
-
-    /// Adds the Jacobians `df/dx` (definite or exact) and `df/dv` at `(x, v)` to `k` and `d`.
-    #[inline]
-    pub(crate) fn jacobians(&self, x: DVec3, v: DVec3, exact: bool, k: &mut DMat3, d: &mut DMat3) {
-        self.law().jacobians(self.probe(x), v, exact, k, d);
     }
 }
 
@@ -349,16 +388,17 @@ impl Law {
         }
     }
 
-    /// Force on a particle of velocity `v` at a probe's result.
+    /// Force on a particle of velocity `v` at a probe's result: the elastic force
+    /// `-dE/dx = e(p) |grad phi| n` with its damping and friction.
     #[inline]
     fn force(&self, probe: Option<(f64, DVec3, Bend)>, v: DVec3) -> DVec3 {
         match probe {
             None => DVec3::ZERO,
-            Some((p, n, _)) => {
-                let (phi, _, _) = self.elastic(p);
+            Some((p, n, bend)) => {
+                let push = self.elastic(p).0 * bend.slope();
                 let vn = n.dot(v);
                 let vt = v - vn * n;
-                phi * (n - self.damping * vn * n - self.friction * vt)
+                push * (n - self.damping * vn * n - self.friction * vt)
             }
         }
     }
@@ -383,35 +423,37 @@ impl Law {
         let Some((p, n, bend)) = probe else {
             return;
         };
-        let (phi, dphi, _) = self.elastic(p);
-        // dp/dx = -|grad phi| n: 1 for a shape, about 1 for a field.
-        let slope = match bend {
-            Bend::Turn { .. } => 1.0,
-            Bend::Field { slope, .. } => slope,
-        };
+        let (e, de, _) = self.elastic(p);
+        // grad phi = s n, dp/dx = -s n: s = 1 for a shape, about 1 for a field. The force's
+        // magnitude is a = e(p) s.
+        let s = bend.slope();
+        let a = e * s;
         let (tn, tt) = (self.damping, self.friction);
         let nn = outer(n, n);
         let proj = DMat3::IDENTITY - nn;
         let vn = n.dot(v);
-        *d -= phi * (tn * nn + tt * proj);
+        *d -= a * (tn * nn + tt * proj);
         if !exact {
-            // The symmetric normal part of -phi' |grad phi| g n^T (g . n = 1 - tau_n v_n),
-            // clamped to stay negative semi-definite when the particle separates fast.
-            *k -= (dphi * slope * (1.0 - tn * vn).max(0.0)) * nn;
+            // The symmetric normal part of -e' s^2 g n^T (g . n = 1 - tau_n v_n), clamped to
+            // stay negative semi-definite when the particle separates fast.
+            *k -= (de * s * s * (1.0 - tn * vn).max(0.0)) * nn;
             return;
         }
-        // f = phi(p) g(n, v), g = n + (tau_t - tau_n)(n . v) n - tau_t v;
-        // df/dx = -phi' |grad phi| g n^T + phi (dg/dn) (dn/dx).
+        // f = a(x) g(n, v), g = n + (tau_t - tau_n)(n . v) n - tau_t v;
+        // df/dx = g (grad a)^T + a (dg/dn) (dn/dx).
         let g = n + (tt - tn) * vn * n - tt * v;
-        *k -= (dphi * slope) * outer(g, n);
+        *k -= (de * s * s) * outer(g, n);
         let dg_dn = || DMat3::IDENTITY + (tt - tn) * (vn * DMat3::IDENTITY + outer(n, v));
         match bend {
             Bend::Turn { curvature, axis } if curvature > 0.0 => {
-                // dn/dx = curvature (I - n n^T - a a^T); a = 0 but beside a capsule's axis.
+                // s = 1; dn/dx = curvature (I - n n^T - a a^T); a = 0 but beside a capsule's axis.
                 let turn = if axis == DVec3::ZERO { proj } else { proj - outer(axis, axis) };
-                *k += (phi * curvature) * (dg_dn() * turn);
+                *k += (e * curvature) * (dg_dn() * turn);
             }
-            Bend::Field { dn_dx, .. } => *k += phi * (dg_dn() * dn_dx),
+            Bend::Field { hessian, .. } => {
+                // grad a = -e' s^2 n + e H n (grad s = H n), and a dn/dx = e (I - n n^T) H.
+                *k += e * (outer(g, hessian * n) + dg_dn() * proj * hessian);
+            }
             Bend::Turn { .. } => {}
         }
     }

@@ -258,7 +258,7 @@ impl View for SpringSimulation {
         context.props.extend(colliders.iter().filter_map(|c| Prop::of_shape(&c.shape)));
         context
             .mesh_props
-            .extend(network.model().mesh_colliders().iter().map(|c| MeshProp::from(c.field.surface())));
+            .extend(network.model().mesh_colliders().iter().map(|c| MeshProp::from(c.shape.surface())));
         context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
         context
     }

@@ -8,11 +8,13 @@
 pub mod core;
 pub mod float;
 mod soak;
+mod sweep;
 mod threads;
 
 pub use soak::{
     Budget, Clock, ENERGY_STRIDE, Soak, SoakCase, drive, energy_above, energy_exceeds, finish, rejected,
 };
+pub use sweep::Sweep;
 pub use threads::{across_threads, differing_bits};
 
 use std::time::Instant;

@@ -9,7 +9,9 @@
 //! refusing, with one [`PinError`] in every kind, a table that pins nothing, an index past the
 //! mesh's vertices, a box that is not finite with `min <= max` or that holds no vertex of the
 //! placed body. A kind adds its own refusals to what it returns (a vertex that belongs to no
-//! element, indices on a mesh whose vertices are not the file's).
+//! element, indices on a mesh whose vertices are not the file's). Every kind names a refusal
+//! alike: the error's message, on the field [`PinError::field_under`] gives (`bodies[0].pin`,
+//! or the part at fault, `bodies[0].pin.vertices[1]`, `bodies[0].pin.box`).
 //!
 //! ```
 //! use anim_core::scene::PinBox;
@@ -120,6 +122,23 @@ impl PinError {
             PinError::InvalidBox { .. } => Some("box".into()),
             PinError::Nothing | PinError::EmptyBox { .. } => None,
         }
+    }
+
+    /// The scene-file field at fault, under the kind's `pin` table `pin` (`bodies[0].pin`):
+    /// `bodies[0].pin.vertices[1]`, `bodies[0].pin.box`, or `pin` itself when the table as a
+    /// whole is at fault ([`field`](Self::field)). Every kind names a refusal by this field and
+    /// the error's own message.
+    ///
+    /// ```
+    /// use anim_core::scene::{PinBox, PinError, PinSpec};
+    ///
+    /// let e = PinSpec { vertices: vec![0, 7], region: None }.resolve(&[[0.0; 3]; 3], "tri.obj").unwrap_err();
+    /// assert_eq!(e.field_under("bodies[2].pin"), "bodies[2].pin.vertices[1]");
+    /// assert_eq!(PinError::Nothing.field_under("bodies[2].pin"), "bodies[2].pin");
+    /// ```
+    #[must_use]
+    pub fn field_under(&self, pin: &str) -> String {
+        self.field().map_or_else(|| pin.to_string(), |part| format!("{pin}.{part}"))
     }
 }
 

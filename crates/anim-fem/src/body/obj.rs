@@ -1,16 +1,17 @@
-//! A body from a closed triangle surface in an OBJ file: read with anim-io's OBJ reader
-//! (polygons split into fans of triangles), checked closed, manifold and consistently oriented
-//! by [`ClosedSurface::new`], and filled with tetrahedra of edge about `cell` by
-//! [`ClosedSurface::tetrahedralize`] (a lattice of that spacing over the surface's bounds, its
-//! boundary vertices moved onto the surface). `cell` is in metres of the placed body: the
-//! surface is filled in its own coordinates with `cell / scale`, so the lattice follows the
-//! body and not its rotation. The lattice is counted first: a surface that would
-//! be filled with more tetrahedra than the scene takes is refused before anything is allocated.
+//! A body from a closed triangle surface in an OBJ file: read with anim-io's
+//! [`read_closed_surface`] (polygons split into fans of triangles, checked closed, manifold and
+//! consistently oriented by anim-core's `ClosedSurface::new`), and filled with tetrahedra of
+//! edge about `cell` by `ClosedSurface::tetrahedralize` (a lattice of that spacing over the
+//! surface's bounds, its boundary vertices moved onto the surface). `cell` is in metres of the
+//! placed body: the surface is filled in its own coordinates with `cell / scale`, so the lattice
+//! follows the body and not its rotation. The lattice is counted first: a surface that would be
+//! filled with more tetrahedra than the scene takes is refused before anything is allocated.
 
 use std::path::Path;
 
-use anim_core::surface::{ClosedSurface, SurfaceError};
-use anim_io::obj::{Polygons, read_obj};
+use anim_core::scene::Placement;
+use anim_core::surface::SurfaceError;
+use anim_io::surface::read_closed_surface;
 
 use super::{BodyError, Budget};
 use crate::mesh::TetMesh;
@@ -26,18 +27,8 @@ use crate::mesh::TetMesh;
 /// the lattice could hold more tetrahedra than `budget` leaves.
 pub(super) fn fill(path: &Path, cell: f64, scale: f64, budget: &Budget) -> Result<TetMesh, BodyError> {
     let file = path.display();
-    let obj = read_obj(path, Polygons::Triangulate).map_err(|e| {
-        let text = e.to_string();
-        let named = if text.contains(&file.to_string()) { text } else { format!("{file}: {text}") };
-        BodyError::new("mesh", named)
-    })?;
-    let numbering = if obj.triangulated_polygons > 0 {
-        "vertices and triangles numbered from 0 in file order, polygons split into fans of triangles"
-    } else {
-        "vertices and triangles numbered from 0 in file order"
-    };
-    let surface = ClosedSurface::new(obj.positions, obj.triangles)
-        .map_err(|e| BodyError::new("mesh", format!("{file}: {e} ({numbering})")))?;
+    let surface =
+        read_closed_surface(path, &Placement::default()).map_err(|e| BodyError::new(e.field(), &e))?;
     // The lattice `tetrahedralize` lays: ceil(extent / own) cubes on each axis, six tetrahedra
     // per cube at most.
     let own = cell / scale;

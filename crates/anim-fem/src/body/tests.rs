@@ -38,33 +38,13 @@ fn tetgen(test: &str, inverted: bool) -> PathBuf {
     dir
 }
 
-/// The OBJ text of the box `[0, size]^3` as 12 outward triangles, without the triangles listed
-/// in `missing` (0-based).
+/// The OBJ text of the box `[0, size]^3` as 12 outward triangles (anim-core's `cuboid`: corner
+/// `k` at the bits of `k`), without the triangles listed in `missing` (0-based).
 pub(crate) fn cube_obj(size: f64, missing: &[usize]) -> String {
-    let mut text = String::from("# a cube\n");
-    for k in 0..8 {
-        let c = [k & 1, (k >> 1) & 1, (k >> 2) & 1].map(|b| size * b as f64);
-        text.push_str(&format!("v {} {} {}\n", c[0], c[1], c[2]));
-    }
-    // Corners numbered by their (x, y, z) bits, from 1.
-    let faces = [
-        [1, 3, 4],
-        [1, 4, 2],
-        [5, 6, 8],
-        [5, 8, 7],
-        [1, 2, 6],
-        [1, 6, 5],
-        [3, 7, 8],
-        [3, 8, 4],
-        [1, 5, 7],
-        [1, 7, 3],
-        [2, 4, 8],
-        [2, 8, 6],
-    ];
-    for (t, f) in faces.iter().enumerate() {
-        if !missing.contains(&t) {
-            text.push_str(&format!("f {} {} {}\n", f[0], f[1], f[2]));
-        }
+    let (p, t) = anim_core::surface::cuboid([0.0; 3], [size; 3]);
+    let mut text: String = p.iter().map(|v| format!("v {} {} {}\n", v[0], v[1], v[2])).collect();
+    for (_, f) in t.iter().enumerate().filter(|(k, _)| !missing.contains(k)) {
+        text += &format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1);
     }
     text
 }
@@ -150,7 +130,7 @@ fn refusals_name_the_field_and_the_file() {
     if let Some(region) = pinned.pin.as_mut().and_then(|p| p.region.as_mut()) {
         region.max[2] = f64::NAN;
     }
-    assert_eq!(refuse(pinned, &cube_file).field, "pin");
+    assert_eq!(refuse(pinned, &cube_file).field, "pin.box");
     // `cell` is for surfaces only.
     let e = refuse(cube(serde_json::json!({ "cell": 0.1 })), &cube_file);
     assert_eq!(e.field, "cell");
@@ -249,6 +229,7 @@ fn pin_refusals_name_the_field_and_the_cause() {
     let dir = folder("pin-refusals");
     std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
     let cube_file = testdata().join("cube_v41.msh");
+    // The field at fault, and the message.
     let refuse = |pin: serde_json::Value, file: &Path| {
         let mut extra = serde_json::json!({ "pin": pin });
         if file.extension().is_some_and(|e| e == "obj") {
@@ -256,25 +237,29 @@ fn pin_refusals_name_the_field_and_the_cause() {
             extra["cell"] = 0.5.into();
         }
         let e = cube(extra).load(file).expect_err("refused");
-        assert_eq!(e.field, "pin", "{e}");
-        e.message
+        (e.field, e.message)
     };
-    let m = refuse(serde_json::json!({ "vertices": [0, 8] }), &cube_file);
-    assert!(
-        m.contains("vertex 8 is out of range") && m.contains("cube_v41.msh has 8 vertices (0 to 7)"),
-        "{m}"
-    );
-    let m = refuse(serde_json::json!({ "vertices": [0] }), &dir.join("cube.obj"));
+    let (f, m) = refuse(serde_json::json!({ "vertices": [0, 8] }), &cube_file);
+    assert_eq!(f, "pin.vertices[1]");
+    assert_eq!(m, format!("vertex 8 is out of range: {} has 8 vertices (0 to 7)", cube_file.display()));
+    let (f, m) = refuse(serde_json::json!({ "vertices": [0] }), &dir.join("cube.obj"));
+    assert_eq!(f, "pin");
     assert!(m.contains("cube.obj") && m.contains("pin them with a `box`"), "{m}");
-    let m =
+    let (f, m) =
         refuse(serde_json::json!({ "box": { "min": [0.0, 1.0, 0.0], "max": [1.0, 0.0, 1.0] } }), &cube_file);
-    assert!(m.contains("min <= max"), "{m}");
-    assert!(refuse(serde_json::json!({}), &cube_file).contains("pins nothing"));
+    assert_eq!(f, "pin.box");
+    assert!(m.starts_with("the box needs finite corners with min <= max"), "{m}");
+    // An empty table: the table, with the message every kind gives.
+    assert_eq!(
+        refuse(serde_json::json!({}), &cube_file),
+        ("pin".into(), "give `vertices`, `box` or both".into())
+    );
     // A vertex in no tetrahedron: a fifth, unused vertex in a TetGen mesh.
     std::fs::write(dir.join("tet.node"), "5 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 2 2 2\n")
         .expect("node");
     std::fs::write(dir.join("tet.ele"), "1 4 0\n1 1 2 3 4\n").expect("ele");
-    let m = refuse(serde_json::json!({ "vertices": [4] }), &dir.join("tet.node"));
+    let (f, m) = refuse(serde_json::json!({ "vertices": [4] }), &dir.join("tet.node"));
+    assert_eq!(f, "pin");
     assert!(m.contains("vertex 4 of") && m.contains("tet.node") && m.contains("no tetrahedron"), "{m}");
     // The box alone, as fem spelled it before: an unknown field.
     let old = serde_json::json!({

@@ -3,7 +3,8 @@
 //! momentum conservation of the internal forces, a cantilever against Euler-Bernoulli theory with
 //! its mesh-convergence table (linear and quadratic tetrahedra), Cook's membrane against
 //! Elguedj et al. (2008) with the locking linear element beside the quadratic one; hard cases
-//! (fully inverted mesh, E = 1e8 at dt = 1/24 s, nu = 0.49, 10:1 grading, explicit divergence);
+//! (fully inverted mesh, E = 1e8 at dt = 1/24 s, nu = 0.49, 10:1 grading, explicit divergence,
+//! the speed up to which the penalty contact catches cubes thrown at a 1 cm mesh plate);
 //! and the beam work-precision study (explicit vs implicit, per material).
 //!
 //! The determinism check runs the benchmark beam on 1, 2 and 4 threads; the soak run steps the
@@ -15,6 +16,7 @@ mod hard_cases;
 mod soak;
 mod static_problems;
 mod study;
+mod thin_plate;
 
 pub use study::study_problem;
 
@@ -93,6 +95,12 @@ pub fn register(r: &mut Registry) {
         name: "FEM 10:1 mesh-size grading",
         expected: stable,
         run: graded,
+    });
+    r.stability.push(StabilityCase {
+        crate_name: CRATE,
+        name: "FEM cubes thrown at a 1 cm mesh plate: the speed the penalty catches",
+        expected: stable,
+        run: thin_plate::thin_mesh_plate,
     });
     r.stability.push(StabilityCase {
         crate_name: CRATE,

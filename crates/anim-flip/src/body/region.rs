@@ -9,6 +9,7 @@ use anim_core::geometry::Shape;
 use anim_core::glam::{DMat3, DVec3};
 use anim_core::scene::{BuildContext, BuildError, Placement};
 use anim_core::surface::ClosedSurface;
+use anim_io::surface::read_closed_surface;
 use std::path::Path;
 
 /// A region of space: the inside of a shape or of a closed surface.
@@ -51,26 +52,21 @@ impl Region {
     }
 
     /// The inside of the closed surface of the OBJ file `mesh` (as the scene file names it,
-    /// resolved by `context`), placed. `field` is the scene-file field of the mesh
-    /// (`bodies[0].mesh`), for errors.
+    /// resolved by `context`), placed. `table` is the scene-file table of the mesh
+    /// (`bodies[0]`), for errors.
     ///
     /// # Errors
-    /// [`BuildError::Invalid`] naming `field` and the file: a file that does not read (the line),
-    /// or a surface that is not closed, manifold and consistently oriented after the placement
-    /// (the triangle, edge or vertex at fault).
+    /// [`BuildError::Invalid`] naming the file and `table.mesh` for a file that does not read
+    /// (the line) or a surface that is not closed, manifold and consistently oriented after the
+    /// placement (the triangle, edge or vertex at fault), `table.scale` for a surface placed too
+    /// large to measure ([`read_closed_surface`]).
     pub(crate) fn mesh(
         mesh: &Path,
         placement: Placement,
         context: &BuildContext<'_>,
-        field: &str,
+        table: &str,
     ) -> Result<Self, BuildError> {
-        let path = context.resolve(mesh);
-        let obj = anim_io::obj::read_obj(&path, anim_io::obj::Polygons::Triangulate)
-            .map_err(|e| BuildError::invalid(field, e.to_string()))?;
-        let mut positions = obj.positions;
-        placement.apply_all(&mut positions);
-        let surface = ClosedSurface::new(positions, obj.triangles)
-            .map_err(|e| BuildError::invalid(field, format!("{}: {e}", path.display())))?;
+        let surface = read_closed_surface(&context.resolve(mesh), &placement).map_err(|e| e.within(table))?;
         let (lo, hi) = surface.bounds();
         Ok(Region { kind: Kind::Surface(Box::new(surface)), lo, hi })
     }

@@ -7,7 +7,7 @@ use std::path::Path;
 use anim_core::geometry::Shape;
 use anim_core::scene::{BuildContext, BuildError, Placement};
 use anim_core::surface::ClosedSurface;
-use anim_io::obj::{Polygons, read_obj};
+use anim_io::surface::read_closed_surface;
 
 use crate::mac::MacFluid;
 
@@ -31,34 +31,20 @@ impl Region {
     }
 
     /// The closed surface of the OBJ file `mesh` (relative to the scene file), placed by
-    /// `placement`.
+    /// `placement` ([`read_closed_surface`]).
     ///
     /// # Errors
     /// [`BuildError::Invalid`] naming `field.scale` (`rotate`, `translate`) for a bad placement
-    /// and `field.mesh` for a file that cannot be read or is not a closed surface (the message
-    /// names the file and the line, triangle, edge or vertex).
+    /// or a surface placed too large to measure, and `field.mesh` for a file that cannot be read
+    /// or is not a closed surface (the message names the file and the line, triangle, edge or
+    /// vertex).
     pub(super) fn mesh(
         mesh: &Path,
         placement: Placement,
         context: &BuildContext<'_>,
         field: &str,
     ) -> Result<Self, BuildError> {
-        placement.check().map_err(|e| e.within(field))?;
-        let path = context.resolve(mesh);
-        let obj = read_obj(&path, Polygons::Triangulate)
-            .map_err(|e| BuildError::invalid(format!("{field}.mesh"), e.to_string()))?;
-        let mut positions = obj.positions;
-        placement.apply_all(&mut positions);
-        let surface = ClosedSurface::new(positions, obj.triangles).map_err(|e| {
-            BuildError::invalid(
-                format!("{field}.mesh"),
-                format!(
-                    "{}: {e} (triangles and vertices counted from 0, in file order, polygons split into \
-                     triangles)",
-                    path.display()
-                ),
-            )
-        })?;
+        let surface = read_closed_surface(&context.resolve(mesh), &placement).map_err(|e| e.within(field))?;
         Ok(Region::Surface(Box::new(surface)))
     }
 

@@ -2,7 +2,7 @@
 //! MLS-MPM, quadratic and cubic, 2D and 3D), determinism across thread counts, a resting elastic
 //! block over 10 s, two colliding elastic disks, and the 2D dam break against Martin & Moyce
 //! (1952); hard cases (CFL above 1, particles leaving the domain, extreme snow compression,
-//! zero-mass nodes, an injected divergence, bad input); the dam-break work-precision study
+//! zero-mass nodes, an injected divergence, bad input, a block thrown at a 1 cm mesh plate); the dam-break work-precision study
 //! (resolution and particles per cell, APIC vs MLS-MPM, quadratic vs cubic); and the timed runs
 //! of `cargo xtask bench --peers`.
 //!
@@ -15,6 +15,7 @@ mod determinism;
 mod hard_cases;
 mod peers;
 mod soak;
+mod thin_plate;
 
 pub use dam_break::{DamBreak, MARTIN_MOYCE, dam_break, front_errors, shifted_errors};
 pub use peers::{PeerRun, peer_benchmark};
@@ -71,6 +72,12 @@ pub fn register(r: &mut Registry) {
         name: "MPM soft block (E 1e4) hitting a wall at 40 m/s",
         expected: || Outcome::Diverged(String::new()),
         run: wall_impact,
+    });
+    r.stability.push(StabilityCase {
+        crate_name: CRATE,
+        name: "MPM elastic block thrown at a 1 cm mesh plate at 20 and 50 m/s",
+        expected: || Outcome::Stable(String::new()),
+        run: thin_plate::thin_mesh_plate,
     });
     r.stability.push(StabilityCase {
         crate_name: CRATE,

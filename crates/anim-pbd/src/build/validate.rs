@@ -79,7 +79,7 @@ impl PbdBuilder {
             })
             .collect::<Result<Vec<_>, _>>()?;
         for (k, c) in self.mesh_colliders.iter().enumerate() {
-            c.validate(self.bodies.len())
+            c.check_contact(self.bodies.len())
                 .map_err(|reason| BuildError::BadMeshCollider { collider: k, reason })?;
         }
         if let Some(w) = self.wind

@@ -7,7 +7,8 @@
 //! thread counts (`conformance`, on the chain of `chain`; the cloth drape, over the analytic
 //! sphere and over a mesh sphere, on 1, 2 and 4 threads: `determinism`); hard cases (1000:1 mass ratio, 10x
 //! over-stretch, pins next to free particles, zero compliance, coincident and degenerate
-//! stencils, bad input, an injected NaN: `hard_cases`); a work-precision study on the hanging
+//! stencils, bad input, an injected NaN: `hard_cases`; particles and a cloth thrown at a 1 cm
+//! mesh plate at 20-50 m/s and faster, held by continuous contact: `thin_plate`); a work-precision study on the hanging
 //! cloth (PBD vs XPBD, iterations vs substeps: `study`); and the timed runs of
 //! `cargo xtask bench --peers` (`peer`); a soak run of the cloth drape (`soak`).
 
@@ -18,6 +19,7 @@ mod hard_cases;
 mod peer;
 mod soak;
 mod study;
+mod thin_plate;
 
 use anim_core::cases::{ConformanceCase, Outcome, Registry, StabilityCase, Study, StudyUse};
 use conformance::{CRATE, determinism, gradients, momentum, pbd_stiffness, xpbd_chain};
@@ -102,6 +104,12 @@ pub fn register(r: &mut Registry) {
         name: "PBD invalid input (mass, k, compliance, index)",
         expected: rejected,
         run: invalid_input,
+    });
+    r.stability.push(StabilityCase {
+        crate_name: CRATE,
+        name: "PBD particles and a cloth thrown at a 1 cm mesh plate at 20-50 m/s",
+        expected: stable,
+        run: thin_plate::thin_mesh_plate,
     });
     r.stability.push(StabilityCase {
         crate_name: CRATE,

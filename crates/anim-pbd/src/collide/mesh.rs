@@ -2,18 +2,21 @@
 //! signed distance and the outward normal where a shape would give them analytically; the
 //! contact model is the shapes' ([`crate::collide`]).
 
-use super::check_contact;
+use super::Collider;
 use anim_core::glam::DVec3;
 use anim_core::surface::DistanceField;
 
 /// A collider whose geometry is a closed triangle mesh, sampled as a signed distance field
 /// ([`DistanceField`], e.g. from [`ObstacleMesh::field`](anim_core::scene::ObstacleMesh::field)
-/// or [`DistanceField::around`]), on an optional kinematic body, with the same contact
-/// parameters as a shape [`Collider`](crate::Collider).
+/// or [`DistanceField::around`]), on an optional kinematic body: a [`Collider`] whose `shape`
+/// is the field, with the same contact parameters, setters and checks as a shape's.
 ///
-/// A particle gets a contact exactly as against a shape: the field's interpolated distance
-/// `phi(p)` and its normalised gradient `n` stand for the shape's signed distance and outward
-/// normal, and the closest surface point is `q = p - phi n`. Where the field has no value (the
+/// A particle gets a contact as against a shape: the field's interpolated distance `phi(p)` and
+/// its normalised gradient `n` stand for the shape's signed distance and outward normal, and the
+/// closest surface point is `q = p - phi n`. Unlike a shape's, the contact is continuous: a
+/// particle that moves farther over the substep than its distance to the surface has its path
+/// followed through the field, and the contact is taken where the path first comes within the
+/// thickness (see [`crate::collide`]), so that a surface thinner than the motion is not crossed. Where the field has no value (the
 /// point lies outside its lattice) the particle is far outside the obstacle and gets no contact;
 /// so does a point where the interpolated gradient vanishes. The field is solid: a particle deep
 /// inside is pushed out along the gradient, which points away from the surface everywhere in the
@@ -51,85 +54,16 @@ use anim_core::surface::DistanceField;
 /// assert!((state.x[2] - 0.31).abs() < 1e-3, "z = {}", state.x[2]);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-#[derive(Debug, Clone)]
-pub struct MeshCollider {
-    /// The signed distance of the surface (in the body's frame when `body` is set).
-    pub field: DistanceField,
-    /// The kinematic body carrying it, if any.
-    pub body: Option<usize>,
-    /// Distance kept between particle centres and the surface (m, >= 0; a particle radius).
-    pub thickness: f64,
-    /// Static friction coefficient `mu_s >= 0`.
-    pub static_friction: f64,
-    /// Kinetic friction coefficient `mu_k >= 0`.
-    pub kinetic_friction: f64,
-    /// Coefficient of restitution `e` in `[0, 1]`.
-    pub restitution: f64,
-}
+pub type MeshCollider = Collider<DistanceField>;
 
 impl MeshCollider {
-    /// A collider of the surface whose signed distance is `field`, fixed in world space, with no
-    /// thickness, no friction and no restitution.
-    #[must_use]
-    pub fn new(field: DistanceField) -> Self {
-        Self {
-            field,
-            body: None,
-            thickness: 0.0,
-            static_friction: 0.0,
-            kinetic_friction: 0.0,
-            restitution: 0.0,
-        }
-    }
-
-    /// Sets the thickness.
-    #[must_use]
-    pub fn with_thickness(mut self, thickness: f64) -> Self {
-        self.thickness = thickness;
-        self
-    }
-
-    /// Sets static and kinetic friction.
-    #[must_use]
-    pub fn with_friction(mut self, static_friction: f64, kinetic_friction: f64) -> Self {
-        self.static_friction = static_friction;
-        self.kinetic_friction = kinetic_friction;
-        self
-    }
-
-    /// Sets the restitution.
-    #[must_use]
-    pub fn with_restitution(mut self, e: f64) -> Self {
-        self.restitution = e;
-        self
-    }
-
-    /// Puts the collider on kinematic body `body` (the field is then in the body's frame).
-    #[must_use]
-    pub fn on_body(mut self, body: usize) -> Self {
-        self.body = Some(body);
-        self
-    }
-
     /// The signed distance (m, negative inside) and outward unit normal at `local` (in the
     /// collider's frame); `None` outside the field's lattice or where its gradient vanishes.
     #[inline]
     #[must_use]
     pub fn signed_distance(&self, local: DVec3) -> Option<(f64, DVec3)> {
-        let s = self.field.sample(local)?;
+        let s = self.shape.sample(local)?;
         let n = s.normal();
         (n != DVec3::ZERO).then_some((s.distance, n))
-    }
-
-    /// Checks the parameters; the reason on failure.
-    pub(crate) fn validate(&self, bodies: usize) -> Result<(), String> {
-        check_contact(
-            self.thickness,
-            self.static_friction,
-            self.kinetic_friction,
-            self.restitution,
-            self.body,
-            bodies,
-        )
     }
 }

@@ -7,6 +7,7 @@ use crate::{
     Collider, EARTH_GRAVITY, MeshCollider, Method, PbdBuilder, PbdParams, PbdSimulation, Shape, SolverKind,
 };
 use anim_core::glam::DVec3;
+use anim_core::integrate::State;
 use anim_core::surface::{ClosedSurface, DistanceField, icosphere};
 
 /// A closed surface from `(positions, triangles)` scaled by `scale` and moved by `shift`.
@@ -41,15 +42,18 @@ fn directions() -> Vec<DVec3> {
     .collect()
 }
 
-/// Runs particles of mass 0.1 kg at `start` with constant forces `force` (no gravity) against
-/// `collider` or `mesh` for 1 s (60 steps of 4 substeps, 5 XPBD iterations); the end positions.
-fn rest(
+/// Particles of mass 0.1 kg at `start`, with gravity or without, against `collider` or `mesh`,
+/// started at rest, with XPBD's 5 iterations of 4 substeps.
+fn particles(
     start: &[DVec3],
-    force: &[DVec3],
+    gravity: bool,
     collider: Option<Collider>,
     mesh: Option<MeshCollider>,
-) -> Vec<DVec3> {
+) -> (PbdSimulation, State) {
     let mut b = PbdBuilder::new();
+    if gravity {
+        b.gravity(EARTH_GRAVITY);
+    }
     for p in start {
         b.particle(p.to_array(), 0.1);
     }
@@ -63,9 +67,20 @@ fn rest(
         b.mesh_collider(m);
     }
     let model = b.build().expect("builds");
-    let mut state = model.rest_state();
+    let state = model.rest_state();
     let params = PbdParams::new(Method::Xpbd, SolverKind::GaussSeidel, 5, 4);
-    let mut sim = PbdSimulation::new(model, params).expect("params");
+    (PbdSimulation::new(model, params).expect("params"), state)
+}
+
+/// Runs particles of mass 0.1 kg at `start` with constant forces `force` (no gravity) against
+/// `collider` or `mesh` for 1 s (60 steps of 4 substeps, 5 XPBD iterations); the end positions.
+fn rest(
+    start: &[DVec3],
+    force: &[DVec3],
+    collider: Option<Collider>,
+    mesh: Option<MeshCollider>,
+) -> Vec<DVec3> {
+    let (mut sim, mut state) = particles(start, false, collider, mesh);
     for (i, f) in force.iter().enumerate() {
         sim.set_external_force(i, (*f * 0.1).to_array());
     }
@@ -163,28 +178,13 @@ fn particles_on_a_mesh_box_move_as_on_the_analytic_box() {
         .map(|p| DVec3::from_array(*p))
         .collect();
     let run = |collider: Option<Collider>, mesh: Option<MeshCollider>| {
-        let mut b = PbdBuilder::new();
-        b.gravity(EARTH_GRAVITY);
-        for p in &start {
-            b.particle(p.to_array(), 0.1);
-        }
-        b.collider(Collider::ground(-10.0));
-        if let Some(c) = collider {
-            b.collider(c);
-        }
-        if let Some(m) = mesh {
-            b.mesh_collider(m);
-        }
-        let model = b.build().expect("builds");
-        let mut state = model.rest_state();
+        let (mut sim, mut state) = particles(&start, true, collider, mesh);
         // Not at rest: a bounce from rest would return to the contact height exactly at a
         // substep's end (both speeds multiples of g h), where the two runs' 1e-10 apart
         // decide differently whether to touch.
         for i in 0..start.len() {
             state.v[3 * i..3 * i + 3].copy_from_slice(&[0.3, 0.1, -0.37]);
         }
-        let mut sim = PbdSimulation::new(model, PbdParams::new(Method::Xpbd, SolverKind::GaussSeidel, 5, 4))
-            .expect("ok");
         let mut path = Vec::new();
         for _ in 0..90 {
             sim.run(&mut state, 1.0 / 60.0, 1).expect("runs");
@@ -233,4 +233,125 @@ fn bad_mesh_collider_parameters_are_refused_by_index() {
         let msg = b.build().expect_err("refused").to_string();
         assert!(msg.starts_with("mesh collider 1: ") && msg.contains(words), "{msg}");
     }
+}
+
+/// A plate of 1 m x 1 m x 1 cm, its top face at `z = 0`, sampled every 5 mm over a margin of
+/// 5 cm: two layers of nodes inside it.
+pub(crate) fn thin_plate() -> DistanceField {
+    let (p, t) = anim_core::surface::cuboid([-0.5, -0.5, -0.01], [0.5, 0.5, 0.0]);
+    let plate = ClosedSurface::new(p, t).expect("closed");
+    DistanceField::around(&plate, 0.005, 0.05).expect("field")
+}
+
+/// The march finds where a path first comes within reach of the thin plate: on the near side
+/// for a path through the plate from either side, at the start for a start within reach,
+/// nowhere for a path that stays clear of it (beside it, above it, or outside the lattice), and
+/// within the lattice for a path that starts outside it. The plate's top face is flat, so the
+/// field there is exact and the point found lies within the march's stopping distance above
+/// `z = reach` (`TOUCH` spacings), whatever the speed.
+#[test]
+fn the_march_finds_the_near_side_of_a_thin_plate() {
+    use super::sweep::{TOUCH, first_touch};
+    let field = thin_plate();
+    let reach = 0.002;
+    let stop = TOUCH * field.spacing();
+    let on_segment = |a: DVec3, b: DVec3, y: DVec3| {
+        let s = (y - a).dot(b - a) / (b - a).length_squared();
+        (a + s * (b - a) - y).length() < 1e-9
+    };
+    for (a, b) in [
+        ([0.1, 0.2, 0.3], [0.1, 0.2, -0.3]),
+        ([0.1, 0.2, 0.05], [0.05, 0.15, -0.02]),
+        ([0.0, 0.0, 0.01], [0.0, 0.0, -0.02]),
+        // Starting outside the lattice, 100 m up (10 km/s over a substep of 1/100 s).
+        ([0.0, 0.0, 100.0], [0.0, 0.0, -0.5]),
+    ] {
+        let (a, b) = (DVec3::from_array(a), DVec3::from_array(b));
+        let y = first_touch(&field, a, b, reach).expect("touches");
+        assert!(y.z >= reach && y.z <= reach + stop + 1e-7, "{a} -> {b}: {y}");
+        assert!(on_segment(a, b, y), "{y} off the segment");
+    }
+    // A grazing path (13 degrees) closes a sixth of its gap per step: the steps run out short of
+    // the plate, at a point still above it whose closest point is on the top face (the contact's
+    // plane is the face's all the same).
+    let (a, b) = (DVec3::new(0.1, 0.2, 0.05), DVec3::new(-0.2, 0.1, -0.02));
+    let y = first_touch(&field, a, b, reach).expect("touches");
+    let s = field.sample(y).expect("in the field");
+    assert!(y.z > reach + stop && y.z < 0.02 && on_segment(a, b, y), "{y}");
+    assert!((s.distance - y.z).abs() < 1e-7 && (s.normal() - DVec3::Z).length() < 1e-6, "{s:?}");
+    // From below, through the bottom face at z = -0.01: stopped below it.
+    let y =
+        first_touch(&field, DVec3::new(0.0, 0.0, -0.2), DVec3::new(0.0, 0.0, 0.3), reach).expect("touches");
+    assert!(y.z <= -0.01 - reach && y.z >= -0.01 - reach - stop - 1e-7, "{y}");
+    // Starting within reach: the start.
+    let a = DVec3::new(0.2, 0.0, 0.001);
+    assert_eq!(first_touch(&field, a, DVec3::new(0.2, 0.0, -0.5), reach), Some(a));
+    // Clear of it: beside the plate, above it, outside the lattice altogether.
+    for (a, b) in [
+        ([0.6, 0.0, 0.2], [0.6, 0.0, -0.2]),
+        ([0.0, 0.0, 0.2], [0.1, 0.0, 0.01]),
+        ([2.0, 0.0, 0.2], [2.0, 1.0, -0.2]),
+    ] {
+        let (a, b) = (DVec3::from_array(a), DVec3::from_array(b));
+        assert_eq!(first_touch(&field, a, b, reach), None, "{a} -> {b}");
+    }
+}
+
+/// Particles thrown at a 1 cm plate at 20 to 50 m/s, each substep moving them 8 to 21 cm, from
+/// distances that put the end of the substep in which they reach it at every depth of the
+/// plate and below it, head on and at 45 and 80 degrees: none is ever below the top face
+/// (plus the thickness) while over the plate, and those thrown head on stop on it, at the
+/// thickness (no restitution). Against the analytic box of the same plate, where a particle's
+/// contact comes from its predicted position alone, most go through (the closest point of a
+/// position past the middle of the plate is on its bottom face).
+#[test]
+fn particles_thrown_at_a_thin_mesh_plate_stop_on_its_near_side() {
+    let t = 0.002;
+    let field = thin_plate();
+    let starts = 16;
+    // The positions after each of 12 steps of 1/60 s (4 substeps).
+    let run = |collider: Option<Collider>, mesh: Option<MeshCollider>, speed: f64, angle: f64| {
+        let dir = DVec3::new(angle.sin(), 0.0, -angle.cos());
+        let start: Vec<DVec3> = (0..starts)
+            .map(|k| {
+                let target = DVec3::new(if angle > 0.0 { -0.3 } else { 0.0 }, 0.02 * k as f64 - 0.15, 0.0);
+                target - (0.3 / angle.cos() + (k as f64 / starts as f64) * speed / 240.0) * dir
+            })
+            .collect();
+        let (mut sim, mut state) = particles(&start, true, collider, mesh);
+        for v in state.v.chunks_mut(3) {
+            v.copy_from_slice(&(speed * dir).to_array());
+        }
+        (0..12)
+            .map(|_| {
+                sim.run(&mut state, 1.0 / 60.0, 1).expect("runs");
+                state.x.chunks_exact(3).map(|p| DVec3::new(p[0], p[1], p[2])).collect::<Vec<_>>()
+            })
+            .collect::<Vec<_>>()
+    };
+    let over = |x: &DVec3| x.x.abs() < 0.5 && x.y.abs() < 0.5;
+    let mut through_box = 0;
+    for speed in [20.0, 35.0, 50.0] {
+        for angle in [0.0, 45f64.to_radians(), 80f64.to_radians()] {
+            let mesh = MeshCollider::new(field.clone()).with_thickness(t).with_friction(1.0, 1.0);
+            let path = run(None, Some(mesh), speed, angle);
+            for (step, xs) in path.iter().enumerate() {
+                for x in xs.iter().filter(|x| over(x)) {
+                    assert!(x.z > t - 1e-6, "{speed} m/s at {angle} rad, step {step}: a particle at {x}");
+                }
+            }
+            if angle == 0.0 {
+                for x in &path[11] {
+                    assert!((x.z - t).abs() < 1e-6 && over(x), "{speed} m/s head on: ended at {x}");
+                }
+            }
+            let plate = Collider::cuboid([0.0, 0.0, -0.005], [0.5, 0.5, 0.005])
+                .with_thickness(t)
+                .with_friction(1.0, 1.0);
+            let path = run(Some(plate), None, speed, angle);
+            through_box +=
+                (0..starts).filter(|&i| path.iter().any(|xs| over(&xs[i]) && xs[i].z < -0.01)).count();
+        }
+    }
+    assert!(through_box > 9 * starts / 2, "{through_box} of {} through the analytic box", 9 * starts);
 }

@@ -308,7 +308,7 @@ fn a_pin_out_of_range_names_the_field_the_index_and_the_vertex_count() {
     assert_eq!(
         msg,
         format!(
-            "field `bodies[1].pin`: vertex 16 is out of range: {} has 16 vertices (0 to 15)",
+            "field `bodies[1].pin.vertices[1]`: vertex 16 is out of range: {} has 16 vertices (0 to 15)",
             file.display()
         )
     );

@@ -401,8 +401,9 @@ impl BodySpec {
                  vertices of its own: pin it with a `box`"
             )));
         }
-        let pinned =
-            pin.resolve_among(positions, file, |i| map[i].is_some()).map_err(|e| fail(e.to_string()))?;
+        let pinned = pin
+            .resolve_among(positions, file, |i| map[i].is_some())
+            .map_err(|e| BuildError::invalid(e.field_under(&format!("bodies[{k}].pin")), e.to_string()))?;
         // The box took used vertices only; a listed one may be unused.
         pinned
             .iter()

@@ -49,7 +49,7 @@ fn a_cloth_lands_on_a_mesh_box_as_on_the_analytic_box() {
     // The picture draws the placed surface of the mesh obstacle.
     let drawn = anim_core::scene::View::context(&sim, &state).mesh_props;
     assert!(
-        drawn.len() == 1 && drawn[0].triangles.len() == mesh.field.surface().triangles().len(),
+        drawn.len() == 1 && drawn[0].triangles.len() == mesh.shape.surface().triangles().len(),
         "{drawn:?}"
     );
     let on_mesh = run(&mut sim, &mut state, 60);
@@ -110,7 +110,7 @@ fn a_cloth_stays_outside_a_mesh_sphere() {
                          "translate": [0.0, 0.0, 0.5] }],
         }),
     );
-    let field = sim.model().mesh_colliders()[0].field.clone();
+    let field = sim.model().mesh_colliders()[0].shape.clone();
     for step in 0..90 {
         sim.step(&mut state, 1.0 / 60.0).expect("step");
         for p in state.x.chunks(3) {

@@ -9,7 +9,12 @@
 //!
 //! A shape collider gives the signed distance and normal analytically; a mesh collider
 //! ([`MeshCollider`](crate::MeshCollider)) samples them from its distance field, and a particle
-//! outside the field's lattice gets no contact. The shape colliders come first, then the mesh
+//! outside the field's lattice gets no contact. Against a mesh the contact is continuous: a
+//! particle whose motion over the substep is longer than its distance to the surface has its
+//! path `x -> p` followed through the field, and where the path first comes within the
+//! thickness (a point `y`) the contact is built from `y`'s closest surface point and normal
+//! instead of `p`'s, so that a surface thinner than the motion stops the particle on its near
+//! side (`collide/sweep.rs` has the march). The shape colliders come first, then the mesh
 //! colliders, numbered on after them.
 //!
 //! Contacts are generated collider by collider, particles in increasing order, so each particle
@@ -17,9 +22,10 @@
 //! and Jacobi sweeps project in parallel.
 
 use super::scratch::Data;
-use crate::collide::{Contact, Pose};
+use crate::collide::{Contact, Pose, first_touch};
 use crate::model::PbdModel;
 use anim_core::glam::DVec3;
+use anim_core::surface::DistanceField;
 
 /// Line (8): fills `d.contacts` and their per-collider groups `d.contact_groups` for predicted
 /// positions `d.p`, with speculative margin `margin`, over a substep of length `h`.
@@ -28,17 +34,29 @@ pub(super) fn generate_contacts(model: &PbdModel, d: &mut Data, margin: f64, h: 
     d.contact_groups.clear();
     for (ci, col) in model.colliders.iter().enumerate() {
         let distance = |local| Some(col.shape.signed_distance(local));
-        collider_contacts(model, d, ci, col.body, col.thickness, margin, h, distance);
+        collider_contacts(model, d, ci, col.body, col.thickness, margin, h, distance, None);
     }
     let first = model.colliders.len();
     for (k, col) in model.mesh_colliders.iter().enumerate() {
         let distance = |local| col.signed_distance(local);
-        collider_contacts(model, d, first + k, col.body, col.thickness, margin, h, distance);
+        collider_contacts(
+            model,
+            d,
+            first + k,
+            col.body,
+            col.thickness,
+            margin,
+            h,
+            distance,
+            Some(&col.shape),
+        );
     }
 }
 
 /// The contacts of collider `ci` (on `body`, keeping `thickness`) as one group, its signed
-/// distance and outward normal in its own frame given by `distance` (`None`: no contact).
+/// distance and outward normal in its own frame given by `distance` (`None`: no contact); with
+/// `field` (a mesh collider's), a particle's path is followed through it first
+/// ([`first_touch`]) and the contact is built where the path first comes within the thickness.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn collider_contacts(
@@ -50,6 +68,7 @@ fn collider_contacts(
     margin: f64,
     h: f64,
     distance: impl Fn(DVec3) -> Option<(f64, DVec3)>,
+    field: Option<&DistanceField>,
 ) {
     let w = &model.inv_mass;
     let start = d.contacts.len();
@@ -63,14 +82,24 @@ fn collider_contacts(
         }
         let p = d.p[i];
         let local = pose.inverse_apply(p);
-        let Some((phi, nl)) = distance(local) else {
-            continue;
+        // The path in the collider's frame: from the start in the substep's first pose to the
+        // prediction in its last.
+        let touch = field.and_then(|f| first_touch(f, prev.inverse_apply(d.x[i]), local, thickness));
+        let (normal, q) = if let Some(y) = touch {
+            let Some((phi, nl)) = distance(y) else {
+                continue;
+            };
+            (pose.rotation * nl, pose.apply(y - nl * phi))
+        } else {
+            let Some((phi, nl)) = distance(local) else {
+                continue;
+            };
+            if !(phi < thickness + margin + (p - d.x[i]).length()) {
+                continue;
+            }
+            let normal = pose.rotation * nl;
+            (normal, p - normal * phi)
         };
-        if !(phi < thickness + margin + (p - d.x[i]).length()) {
-            continue;
-        }
-        let normal = pose.rotation * nl;
-        let q = p - normal * phi;
         let ql = pose.inverse_apply(q);
         let obstacle_dx = q - prev.apply(ql);
         let vn_pre = normal.dot(d.v[i] - obstacle_dx / h);

@@ -298,7 +298,7 @@ fn refusals_name_the_field_the_file_and_the_element() {
     // A pin index out of range names the index and the vertex count.
     let (field, message) = refusal(&dir, with("pin", serde_json::json!({ "vertices": [8, 9] })));
     assert_eq!(field, "bodies[0].pin.vertices[1]");
-    assert_eq!(message, format!("vertex 9 does not exist: {grid} has 9 vertices (0-based indices 0 to 8)"));
+    assert_eq!(message, format!("vertex 9 is out of range: {grid} has 9 vertices (0 to 8)"));
     // An empty pin box, and a pin table without either.
     let (field, message) =
         refusal(&dir, with("pin", serde_json::json!({ "box": { "min": [2, 2, 2], "max": [3, 3, 3] } })));

@@ -4,7 +4,8 @@
 //! The two-particle spring against its closed form, convergence orders of every integrator, the
 //! hanging chain's static stretch, the force Jacobian against finite differences; stability
 //! bounds `dt <= c sqrt(m/k)` of the explicit methods, stiff backward Euler, degenerate springs,
-//! a detected divergence; a work-precision study on the cloth; determinism across thread counts
+//! a detected divergence, the speed up to which the penalty contact catches particles thrown at a
+//! 1 cm mesh plate (`thin_plate`); a work-precision study on the cloth; determinism across thread counts
 //! and a soak run of the stiff cloth.
 
 mod conformance;
@@ -13,6 +14,7 @@ mod hard_cases;
 mod peer;
 mod soak;
 mod study;
+mod thin_plate;
 
 pub use peer::{PeerRun, peer_symplectic_cloth};
 pub use study::study_problem;
@@ -101,6 +103,12 @@ pub fn register(r: &mut Registry) {
         name: "symplectic Euler on a chain at dt = 3 sqrt(m/k)",
         expected: || Outcome::Diverged(String::new()),
         run: hard_cases::explicit_divergence,
+    });
+    r.stability.push(StabilityCase {
+        crate_name: CRATE,
+        name: "particles thrown at a 1 cm mesh plate: the speed the penalty catches",
+        expected: || Outcome::Stable(String::new()),
+        run: thin_plate::thin_mesh_plate,
     });
     r.stability.push(StabilityCase {
         crate_name: CRATE,

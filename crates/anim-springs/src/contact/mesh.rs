@@ -1,16 +1,20 @@
 //! A collider bounded by a closed triangle mesh, sampled on anim-core's [`DistanceField`].
 
-use anim_core::glam::{DMat3, DVec3};
+use anim_core::glam::DVec3;
 use anim_core::surface::DistanceField;
 
-use super::{Bend, Collider, Law};
-use crate::geom::{MIN_LENGTH, outer};
+use super::{Bend, Collider, Geometry};
+use crate::geom::MIN_LENGTH;
 
 /// A rigid, fixed obstacle bounded by a closed triangle mesh, acting on every particle through
-/// the same penalty force as a [`Collider`] (see the [module docs](super)), with `phi` the
-/// signed distance of the mesh's [`DistanceField`] (trilinear between its nodes) and `n` its
-/// normalised gradient. The exact Jacobian's curvature term uses the field's Hessian `H`:
-/// `dn/dx = (I - n n^T) H / |grad phi|`.
+/// the same penalty as a shape [`Collider`] (see the [module docs](super)): a [`Collider`] whose
+/// `shape` is the mesh's [`DistanceField`], `phi` its trilinear interpolant and `n` its
+/// normalised gradient. The energy is the shapes' `E(p)`, `p = t - phi`, and the elastic force
+/// its exact negative gradient `e(p) grad phi = e(p) |grad phi| n`: the interpolant's gradient
+/// is not of unit length between the nodes (up to `sqrt(3)` in principle, off by a few percent
+/// beyond the exact band), and the force follows it so that the network's energy is the
+/// potential of its forces. The exact Jacobian's terms in the field's Hessian `H` come from
+/// `d|grad phi|/dx = H n` and `dn/dx = (I - n n^T) H / |grad phi|`.
 ///
 /// The field must cover every point within `thickness` of the mesh: a particle outside its
 /// lattice feels nothing (make it with a margin of at least the thickness, as
@@ -35,123 +39,39 @@ use crate::geom::{MIN_LENGTH, outer};
 /// assert_eq!(net.model().mesh_colliders().len(), 1);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-#[derive(Debug, Clone)]
-pub struct MeshCollider {
-    /// The signed distance of the placed mesh (negative inside).
-    pub field: DistanceField,
-    /// Penalty stiffness `k_c` (N/m, > 0).
-    pub stiffness: f64,
-    /// Normal damping `tau_n` (s/m, >= 0).
-    pub damping: f64,
-    /// Friction `tau_t` (s/m, >= 0).
-    pub friction: f64,
-    /// Width `delta` (m, >= 0) of the zone where the penalty stiffness ramps up.
-    pub smoothing: f64,
-    /// Distance `t` (m, >= 0) outside the mesh at which particles are held: the penalty acts on
-    /// `phi - t`.
-    pub thickness: f64,
-}
+pub type MeshCollider = Collider<DistanceField>;
 
 impl MeshCollider {
-    /// The mesh of `field` with penalty stiffness `stiffness`, no damping, friction, smoothing
-    /// or thickness (add them with the `with_` methods).
-    #[must_use]
-    pub fn new(field: DistanceField, stiffness: f64) -> Self {
-        Self { field, stiffness, damping: 0.0, friction: 0.0, smoothing: 0.0, thickness: 0.0 }
-    }
-
     /// The mesh of `field` with the contact parameters (stiffness, damping, friction, smoothing,
     /// thickness) of `collider`.
     #[must_use]
     pub fn like(field: DistanceField, collider: &Collider) -> Self {
-        Self {
-            field,
-            stiffness: collider.stiffness,
-            damping: collider.damping,
-            friction: collider.friction,
-            smoothing: collider.smoothing,
-            thickness: collider.thickness,
-        }
+        let Collider { shape: _, stiffness, damping, friction, smoothing, thickness } = *collider;
+        Collider { shape: field, stiffness, damping, friction, smoothing, thickness }
+    }
+}
+
+impl Geometry for DistanceField {
+    /// Any field: its lattice was checked when it was sampled.
+    fn check(&self) -> Result<(), String> {
+        Ok(())
     }
 
-    /// Sets the normal damping `tau_n` (s/m).
-    #[must_use]
-    pub fn with_damping(mut self, tau_n: f64) -> Self {
-        self.damping = tau_n;
-        self
-    }
-
-    /// Sets the friction `tau_t` (s/m).
-    #[must_use]
-    pub fn with_friction(mut self, tau_t: f64) -> Self {
-        self.friction = tau_t;
-        self
-    }
-
-    /// Sets the smoothing width `delta` (m).
-    #[must_use]
-    pub fn with_smoothing(mut self, delta: f64) -> Self {
-        self.smoothing = delta;
-        self
-    }
-
-    /// Sets the thickness `t` (m) at which particles are held outside the mesh.
-    #[must_use]
-    pub fn with_thickness(mut self, t: f64) -> Self {
-        self.thickness = t;
-        self
-    }
-
-    /// Checks the parameters; returns a description of the first problem.
-    pub(crate) fn check(&self) -> Result<(), String> {
-        self.law().check(self.thickness)
-    }
-
+    /// Penetration `p = t - phi > 0`, outward normal and the field's slope and Hessian (see
+    /// [`Bend::Field`]), or `None` outside (or outside the field's lattice). Where the field's
+    /// gradient vanishes (on its medial axis) the normal is `+z` and the slope 0: no force, as
+    /// the energy is stationary there.
     #[inline]
-    pub(super) fn law(&self) -> Law {
-        Law {
-            stiffness: self.stiffness,
-            damping: self.damping,
-            friction: self.friction,
-            smoothing: self.smoothing,
-        }
-    }
-
-    /// Penetration `p = t - phi > 0`, outward normal and how the distance changes (see
-    /// [`Bend::Field`]), or `None` outside (or outside the field's lattice). Where the
-    /// field's gradient vanishes (on its medial axis) the push is along `+z`, without
-    /// derivatives.
-    #[inline]
-    pub(crate) fn probe(&self, x: DVec3) -> Option<(f64, DVec3, Bend)> {
-        let s = self.field.sample(x)?;
-        let phi = s.distance - self.thickness;
+    fn probe(&self, x: DVec3, thickness: f64) -> Option<(f64, DVec3, Bend)> {
+        let s = self.sample(x)?;
+        let phi = s.distance - thickness;
         if phi >= 0.0 {
             return None;
         }
         let slope = s.gradient.length();
         if !(slope > MIN_LENGTH) {
-            return Some((-phi, DVec3::Z, Bend::Field { slope: 0.0, dn_dx: DMat3::ZERO }));
+            return Some((-phi, DVec3::Z, Bend::Field { slope: 0.0, hessian: s.hessian }));
         }
-        let n = s.gradient / slope;
-        let dn_dx = (DMat3::IDENTITY - outer(n, n)) * s.hessian * (1.0 / slope);
-        Some((-phi, n, Bend::Field { slope, dn_dx }))
-    }
-
-    /// Force on a particle at `(x, v)`.
-    #[inline]
-    pub(crate) fn force(&self, x: DVec3, v: DVec3) -> DVec3 {
-        self.law().force(self.probe(x), v)
-    }
-
-    /// Penalty energy `E(p)`.
-    #[inline]
-    pub(crate) fn energy(&self, x: DVec3) -> f64 {
-        self.law().energy(self.probe(x))
-    }
-
-    /// Adds the Jacobians `df/dx` (definite or exact) and `df/dv` at `(x, v)` to `k` and `d`.
-    #[inline]
-    pub(crate) fn jacobians(&self, x: DVec3, v: DVec3, exact: bool, k: &mut DMat3, d: &mut DMat3) {
-        self.law().jacobians(self.probe(x), v, exact, k, d);
+        Some((-phi, s.gradient / slope, Bend::Field { slope, hessian: s.hessian }))
     }
 }

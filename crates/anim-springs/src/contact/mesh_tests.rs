@@ -2,6 +2,7 @@
 //! finite differences, a particle resting on a mesh sphere and on a mesh box where it rests on
 //! the analytic shapes, and thread-count determinism of a cloth over a mesh.
 
+use super::tests::{finite_differences, jacobians, max_abs};
 use super::*;
 use crate::{EARTH_GRAVITY, NetworkBuilder, SpringNetwork, scenes};
 use anim_core::integrate::{IntegratorKind, NewtonParams, SecondOrderSystem, State, study::advance};
@@ -44,10 +45,6 @@ fn top_face(surface: &ClosedSurface) -> DVec3 {
         .expect("faces")
 }
 
-fn max_abs(m: DMat3) -> f64 {
-    m.to_cols_array().iter().fold(0.0f64, |a, v| a.max(v.abs()))
-}
-
 /// The exact Jacobians of a mesh collider (the normal stiffness with `|grad phi|`, the friction
 /// coupling, and the curvature term `e(p) (dg/dn) (I - n n^T) H / |grad phi|`) match central
 /// differences of the force, away from the lattice's cell faces (where the trilinear field's
@@ -84,32 +81,18 @@ fn mesh_jacobians_match_central_finite_differences() {
                 continue;
             }
             let v = DVec3::from_array(std::array::from_fn(|_| rng.random_range(-1.0..1.0)));
-            let (mut k, mut d) = (DMat3::ZERO, DMat3::ZERO);
-            c.jacobians(x, v, true, &mut k, &mut d);
-            let step = 1e-7;
-            let fd = |wrt_x: bool| {
-                let cols = DVec3::AXES.map(|e| {
-                    let (plus, minus) = if wrt_x {
-                        (c.force(x + step * e, v), c.force(x - step * e, v))
-                    } else {
-                        (c.force(x, v + step * e), c.force(x, v - step * e))
-                    };
-                    (plus - minus) / (2.0 * step)
-                });
-                DMat3::from_cols(cols[0], cols[1], cols[2])
-            };
-            let (k_fd, d_fd) = (fd(true), fd(false));
+            let (k, d) = jacobians(&c, x, v, true);
+            let (k_fd, d_fd) = (finite_differences(&c, x, v, true), finite_differences(&c, x, v, false));
             let scale = max_abs(k_fd).max(1e-3);
             assert!(max_abs(k - k_fd) < 1e-5 * scale, "K at {x} (t {thickness}):\n{k}\nvs\n{k_fd}");
             assert!(max_abs(d - d_fd) < 1e-5 * max_abs(d_fd).max(1e-3), "D at {x}");
             // The curvature term's share of K.
-            let Some((_, _, Bend::Field { dn_dx, .. })) = c.probe(x) else { panic!("a field's bend") };
-            if max_abs(dn_dx) * Law::elastic(&c.law(), p).0 > 1e-2 * scale {
+            let Some((_, _, Bend::Field { hessian, .. })) = c.probe(x) else { panic!("a field's bend") };
+            if max_abs(hessian) * Law::elastic(&c.law(), p).0 > 1e-2 * scale {
                 curved += 1;
             }
             // Definite: symmetric, negative semi-definite.
-            let (mut kd, mut dd) = (DMat3::ZERO, DMat3::ZERO);
-            c.jacobians(x, v, false, &mut kd, &mut dd);
+            let (kd, _) = jacobians(&c, x, v, false);
             assert!(max_abs(kd - kd.transpose()) < 1e-12 * max_abs(kd).max(1.0));
             let w = DVec3::from_array(std::array::from_fn(|_| rng.random_range(-1.0..1.0)));
             assert!(w.dot(kd * w) <= 1e-12 * max_abs(kd).max(1.0));
@@ -285,4 +268,57 @@ fn a_cloth_on_a_mesh_is_bitwise_identical_for_any_thread_count() {
             );
         }
     }
+}
+
+/// The elastic force of a mesh collider is the exact negative gradient of the penalty energy the
+/// network counts, also where the field's gradient is not of unit length: on a coarse field
+/// (spacing 0.1 m over a ball of radius 0.5 m) between its nodes, where the trilinear gradient
+/// is shorter or longer than 1, and beyond its exact band, where the swept distance is only
+/// first-order. Central differences of the energy (no velocity, so no damping or friction) give
+/// the force to the differences' error at every sample whose `|grad phi|` is more than 1% off
+/// 1, away from the cell faces where the interpolant's gradient has a kink; a force `e(p) n`
+/// without the factor `|grad phi|` would be off by that 1% or more.
+#[test]
+fn mesh_force_is_minus_the_gradient_of_its_energy() {
+    let (ball, _) = mesh_ball(3);
+    let h = 0.1;
+    let thickness = 0.45;
+    let field = DistanceField::around(&ball, h, thickness + 0.1).expect("field");
+    let c = MeshCollider::new(field.clone(), 40.0).with_smoothing(0.02).with_thickness(thickness);
+    let mut rng = ChaCha8Rng::seed_from_u64(0x656e6572);
+    let (mut checked, mut off_band, mut short, mut long) = (0, 0, 0, 0);
+    while checked < 300 {
+        let x = DVec3::from_array(std::array::from_fn(|_| rng.random_range(-0.9..0.9)));
+        let cell = (x - field.origin()) / h;
+        if cell.to_array().iter().any(|s| (s - s.round()).abs() < 1e-3) {
+            continue;
+        }
+        let Some((p, _, Bend::Field { slope, .. })) = c.probe(x) else { continue };
+        if (slope - 1.0).abs() < 0.01 || p < 1e-3 || (p - c.smoothing).abs() < 1e-3 {
+            continue;
+        }
+        let step = 1e-6;
+        let de = DVec3::AXES.map(|e| (c.energy(x + step * e) - c.energy(x - step * e)) / (2.0 * step));
+        let minus_grad = -DVec3::new(de[0], de[1], de[2]);
+        let f = c.force(x, DVec3::ZERO);
+        assert!(
+            (f - minus_grad).length() < 1e-6 * f.length().max(1e-3),
+            "at {x} (|grad phi| = {slope}): force {f}, -dE/dx {minus_grad}"
+        );
+        let s = field.sample(x).expect("in the field");
+        if s.distance.abs() > 3.0 * h {
+            off_band += 1;
+        }
+        if slope < 1.0 {
+            short += 1;
+        } else {
+            long += 1;
+        }
+        checked += 1;
+    }
+    // Both kinds of slope, and points beyond the exact band, were among the samples.
+    assert!(
+        off_band > 20 && short > 20 && long > 20,
+        "{off_band} beyond the band, {short} short, {long} long"
+    );
 }

@@ -57,14 +57,14 @@ fn region(c: &Collider, x: DVec3) -> Option<&'static str> {
 }
 
 /// The Jacobians at `(x, v)`: `(K, D)`.
-fn jacobians(c: &Collider, x: DVec3, v: DVec3, exact: bool) -> (DMat3, DMat3) {
+pub(super) fn jacobians<G: Geometry>(c: &Collider<G>, x: DVec3, v: DVec3, exact: bool) -> (DMat3, DMat3) {
     let (mut k, mut d) = (DMat3::ZERO, DMat3::ZERO);
     c.jacobians(x, v, exact, &mut k, &mut d);
     (k, d)
 }
 
 /// Central differences of the force in `x` (`wrt_x`) or in `v`, column by column.
-fn finite_differences(c: &Collider, x: DVec3, v: DVec3, wrt_x: bool) -> DMat3 {
+pub(super) fn finite_differences<G: Geometry>(c: &Collider<G>, x: DVec3, v: DVec3, wrt_x: bool) -> DMat3 {
     let h = 1e-7;
     let cols = DVec3::AXES.map(|e| {
         let (plus, minus) = if wrt_x {
@@ -77,7 +77,7 @@ fn finite_differences(c: &Collider, x: DVec3, v: DVec3, wrt_x: bool) -> DMat3 {
     DMat3::from_cols(cols[0], cols[1], cols[2])
 }
 
-fn max_abs(m: DMat3) -> f64 {
+pub(super) fn max_abs(m: DMat3) -> f64 {
     m.to_cols_array().iter().fold(0.0f64, |a, v| a.max(v.abs()))
 }
 
