@@ -1,11 +1,66 @@
 //! The output of a run: frame files, CSV rows and the preview, written on a thread of their own
 //! so that the run loop keeps stepping while a frame is encoded.
+//!
+//! The preview frames whole run: the writer keeps the points of the frames it will draw (as
+//! `f32`, at most [`PREVIEW_BYTES`]) and the bounding box of every frame's points, and draws the
+//! GIF and the last frame's PNG when the run ends, with a camera built then.
 
 use crate::view::{Geometry, OutputFormat, Snapshot, View};
 use anim_core::scene::{DynScene, Frame};
 use anim_io::FrameWriter;
 use anim_io::preview::{Canvas, GifWriter};
 use anim_io::viewer::{Viewer, ViewerField};
+
+/// The most memory the points of the preview's frames may take until the run ends (`f32`
+/// each): a scene too large for about 100 of them keeps fewer.
+pub(crate) const PREVIEW_BYTES: usize = 256 << 20;
+
+/// The stride of the preview's frames for a run of `frames` frames of `values` numbers each:
+/// about 100 frames whatever the run's length, fewer when that many would not fit in
+/// [`PREVIEW_BYTES`].
+pub(crate) fn preview_every(frames: usize, values: usize) -> usize {
+    let fit = (PREVIEW_BYTES / (4 * values.max(1))).max(1);
+    frames.div_ceil(100).max(frames.div_ceil(fit)).max(1)
+}
+
+/// `--preview-size WxH`: the width and height in pixels, each in `[16, 4096]`.
+///
+/// # Errors
+/// Not two numbers joined by `x`, or a side out of that range, named with the value.
+pub(crate) fn parse_preview_size(arg: &str) -> Result<(u32, u32), String> {
+    let size =
+        arg.split_once(['x', 'X']).and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
+    match size {
+        Some((w, h)) if (16..=4096).contains(&w) && (16..=4096).contains(&h) => Ok((w, h)),
+        Some(_) => Err(format!("{arg}: width and height must each lie in [16, 4096] pixels")),
+        None => Err(format!("{arg}: expected WIDTHxHEIGHT in pixels, such as 640x480")),
+    }
+}
+
+/// The size of a preview of at most `width x height` pixels: that size, or for a picture of
+/// width over height `aspect` (a grid's cross-section) the largest of those proportions that
+/// fits in it (at least 16 pixels a side).
+pub(crate) fn preview_size((width, height): (u32, u32), aspect: Option<f64>) -> (u32, u32) {
+    match aspect.filter(|a| a.is_finite() && *a > 0.0) {
+        Some(a) if f64::from(width) / f64::from(height) > a => {
+            ((f64::from(height) * a).round().clamp(16.0, f64::from(width)) as u32, height)
+        }
+        Some(a) => (width, (f64::from(width) / a).round().clamp(16.0, f64::from(height)) as u32),
+        None => (width, height),
+    }
+}
+
+/// The animated preview: the frames it will draw, kept until the run ends.
+struct Preview {
+    gif: GifWriter,
+    canvas: Canvas,
+    /// Every `every`-th frame is drawn.
+    every: usize,
+    /// The kept frames' values (positions, or a grid's density), one after another.
+    kept: Vec<f32>,
+    /// The number of values of each kept frame.
+    lengths: Vec<usize>,
+}
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -35,7 +90,7 @@ struct Writer {
     view: View,
     frames: Option<FrameWriter>,
     csv: Option<std::io::BufWriter<std::fs::File>>,
-    gif: Option<(GifWriter, Canvas, anim_io::preview::Camera, usize)>,
+    preview: Option<Preview>,
     viewer: Option<RunViewer>,
 }
 
@@ -87,17 +142,17 @@ impl Writer {
             };
             result.map_err(|e| e.to_string())?;
         }
-        if let Some((gif, canvas, camera, every)) = &mut self.gif
-            && index.is_multiple_of(*every)
-        {
-            canvas.clear();
-            self.view.draw(canvas, camera, s)?;
-            gif.push(canvas).map_err(|e| e.to_string())?;
+        if let Some(preview) = &mut self.preview {
+            self.view.see(s);
+            if index.is_multiple_of(preview.every) {
+                preview.kept.extend(s.x.iter().map(|&v| v as f32));
+                preview.lengths.push(s.x.len());
+            }
         }
         Ok(())
     }
 
-    fn finish(self) -> Result<Vec<String>, String> {
+    fn finish(mut self) -> Result<Vec<String>, String> {
         let mut files = Vec::new();
         if let Some(frames) = &self.frames {
             // The frames in this folder (a run resumed into a new folder has only its own).
@@ -121,7 +176,19 @@ impl Writer {
             csv.flush().map_err(|e| e.to_string())?;
             files.push(self.dir.join("frames.csv").display().to_string());
         }
-        if let Some((gif, canvas, _, _)) = self.gif {
+        if let Some(Preview { mut gif, mut canvas, kept, lengths, .. }) = self.preview.take() {
+            // The camera of the whole run, now that it has been seen.
+            let camera = self.view.camera(f64::from(canvas.width()) / f64::from(canvas.height()));
+            let mut snapshot = Snapshot::default();
+            let mut at = 0;
+            for n in lengths {
+                snapshot.x.clear();
+                snapshot.x.extend(kept[at..at + n].iter().map(|&v| f64::from(v)));
+                at += n;
+                canvas.clear();
+                self.view.draw(&mut canvas, &camera, &snapshot)?;
+                gif.push(&canvas).map_err(|e| e.to_string())?;
+            }
             let png = self.dir.join("preview.png");
             canvas.save_png(&png).map_err(|e| e.to_string())?;
             let path = gif.finish().map_err(|e| e.to_string())?;
@@ -133,21 +200,29 @@ impl Writer {
 }
 
 impl Output {
-    /// The writer of a run; `continuing` holds the times of the frame files an earlier part of
-    /// the run wrote (resumed runs continue the numbering and append to `frames.csv`).
+    /// The writer of a run; `preview` the preview's largest size and the run's number of
+    /// frames; `continuing` holds the times of the frame files an earlier part of the run wrote
+    /// (resumed runs continue the numbering and append to `frames.csv`).
     pub(crate) fn new(
         dir: &Path,
         format: OutputFormat,
         stride: usize,
-        preview: Option<(u32, usize)>,
+        preview: Option<((u32, u32), usize)>,
         (geometry, dof): (&Geometry, usize),
         continuing: Option<&[f64]>,
         viewer: Option<ViewerSpec<'_>>,
     ) -> Result<Self, String> {
         let grid = matches!(geometry, Geometry::Grid { .. });
         let view = View::new(geometry.clone());
-        let mut writer =
-            Writer { dir: dir.to_path_buf(), stride, view, frames: None, csv: None, gif: None, viewer: None };
+        let mut writer = Writer {
+            dir: dir.to_path_buf(),
+            stride,
+            view,
+            frames: None,
+            csv: None,
+            preview: None,
+            viewer: None,
+        };
         let point_dim = viewer.as_ref().map_or(3, |spec| spec.context.point_dim);
         if let Some(spec) = viewer {
             let json = serde_json::to_value(spec.context).map_err(|e| format!("viewer context: {e}"))?;
@@ -177,16 +252,18 @@ impl Output {
                 .map_err(|e| format!("{}: {e}", path.display()))?;
             writer.csv = Some(csv);
         }
-        if let Some((width, every)) = preview {
-            // A grid is shown at its own proportions; everything else at 4:3.
-            let height = match writer.view.aspect() {
-                Some(a) => (f64::from(width) / a).round().clamp(16.0, 4096.0) as u32,
-                None => (width * 3 / 4).max(1),
-            };
+        if let Some((size, frames)) = preview {
+            // A grid is shown at its own proportions; everything else at the size asked for.
+            let (width, height) = preview_size(size, writer.view.aspect());
             let path = dir.join("preview.gif");
             let gif = GifWriter::create(&path, width, height, 4, true).map_err(|e| e.to_string())?;
-            let camera = writer.view.camera(f64::from(width) / f64::from(height));
-            writer.gif = Some((gif, Canvas::new(width, height, [248, 248, 250]), camera, every));
+            writer.preview = Some(Preview {
+                gif,
+                canvas: Canvas::new(width, height, [248, 248, 250]),
+                every: preview_every(frames, dof),
+                kept: Vec::new(),
+                lengths: Vec::new(),
+            });
         }
         let (sender, receiver) = std::sync::mpsc::sync_channel::<(usize, Snapshot)>(4);
         let (give_back, returned) = std::sync::mpsc::channel::<Snapshot>();

@@ -67,9 +67,10 @@ pub struct RunArgs {
     /// Skip the browser viewer (`viewer.html` and `viewer/` beside the frames).
     #[arg(long)]
     pub no_viewer: bool,
-    /// Preview width in pixels (height is 3/4 of it).
-    #[arg(long, default_value_t = 320)]
-    pub preview_width: u32,
+    /// Preview size in pixels, `WIDTHxHEIGHT` (each 16 to 4096); a grid scene's preview keeps
+    /// the grid's proportions within it.
+    #[arg(long, value_name = "WxH", default_value = "640x480", value_parser = crate::output::parse_preview_size)]
+    pub preview_size: (u32, u32),
     /// No progress bar or summary on the terminal.
     #[arg(long)]
     pub quiet: bool,
@@ -147,6 +148,8 @@ struct Metrics {
     steps_per_second: f64,
     /// Steps over the time spent stepping alone.
     stepping_steps_per_second: f64,
+    /// The axis that points up in the frames and the preview: `"y"`.
+    up: &'static str,
     energy_initial: Option<f64>,
     energy_final: Option<f64>,
     /// `(energy_final - energy_initial) / energy_scale`.
@@ -187,6 +190,10 @@ struct RunCheckpoint {
     /// Whether the run writes the browser viewer (checkpoints written before it existed: yes).
     #[serde(default = "yes")]
     viewer: bool,
+    /// The preview's height; absent in checkpoints of runs from before `--preview-size`, whose
+    /// previews were 3/4 as high as wide.
+    #[serde(default)]
+    preview_height: Option<u32>,
     checkpoint_every: Option<usize>,
     /// Frames completed.
     frame: usize,
@@ -264,7 +271,8 @@ struct Session {
     out: PathBuf,
     format: OutputFormat,
     stride: usize,
-    preview_width: Option<u32>,
+    /// The preview's size in pixels, or none.
+    preview_size: Option<(u32, u32)>,
     viewer: bool,
     checkpoint_every: Option<usize>,
     quiet: bool,
@@ -302,9 +310,6 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
     }
     if args.stride == 0 {
         return Err("--stride must be at least 1".into());
-    }
-    if args.preview_width < 16 || args.preview_width > 4096 {
-        return Err(format!("--preview-width must lie in [16, 4096], got {}", args.preview_width));
     }
     if args.checkpoint_every == Some(0) {
         return Err("--checkpoint-every must be at least 1".into());
@@ -386,8 +391,8 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
         out,
         format,
         stride: args.stride,
-        preview_width: (!args.no_preview).then_some(args.preview_width),
         viewer: !args.no_viewer,
+        preview_size: (!args.no_preview).then_some(args.preview_size),
         checkpoint_every: args.checkpoint_every,
         quiet: args.quiet,
         runner,
@@ -440,7 +445,7 @@ fn resumed(args: &ResumeArgs) -> Result<Session, String> {
         out: args.out.clone().unwrap_or(ckpt.out),
         format: ckpt.format,
         stride: ckpt.stride,
-        preview_width: ckpt.preview_width,
+        preview_size: ckpt.preview_width.map(|w| (w, ckpt.preview_height.unwrap_or((w * 3 / 4).max(1)))),
         viewer: ckpt.viewer,
         checkpoint_every: ckpt.checkpoint_every,
         quiet: args.quiet,
@@ -468,7 +473,8 @@ impl Session {
             out: self.out.clone(),
             format: self.format,
             stride: self.stride,
-            preview_width: self.preview_width,
+            preview_width: self.preview_size.map(|s| s.0),
+            preview_height: self.preview_size.map(|s| s.1),
             viewer: self.viewer,
             checkpoint_every: self.checkpoint_every,
             frame,
@@ -496,8 +502,7 @@ fn execute(mut s: Session) -> Result<(), String> {
     std::fs::create_dir_all(&out)
         .map_err(|e| format!("{}: cannot create output folder: {e}", out.display()))?;
     let run = s.file.run;
-    // At most about 100 preview frames, whatever the run's length.
-    let preview = s.preview_width.map(|w| (w, run.frames.div_ceil(100)));
+    let preview = s.preview_size.map(|size| (size, run.frames));
     let continuing = s.resumed.then_some(s.written_times.as_slice());
     let dof = {
         let mut snap = Snapshot::default();
@@ -616,6 +621,7 @@ fn execute(mut s: Session) -> Result<(), String> {
         writer_busy_seconds: writer_seconds,
         steps_per_second: steps_here as f64 / wall.max(1e-12),
         stepping_steps_per_second: steps_here as f64 / step_seconds.max(1e-12),
+        up: anim_io::frames::UP,
         energy_initial: energy0,
         energy_final: energy,
         relative_energy_change: energy0.zip(energy).and_then(|(e0, e)| s.energy_scale.relative(e - e0)),

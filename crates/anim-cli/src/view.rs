@@ -1,6 +1,14 @@
 //! What a scene looks like, apart from how it is stepped: its [`Geometry`] (fixed for the run)
 //! and per-frame [`Snapshot`]s. A [`View`] turns the two into frame files and preview images; it
 //! is `Send`, so the run loop hands snapshots to a writer thread and keeps stepping.
+//!
+//! Scenes are y up (anim-core's view contract): a 3-D scene is seen from the front (`+z`), a
+//! little from the left and from above, y up on the picture; a 2-D scene (the xy plane) is drawn
+//! as it is, orthographic, x right and y up. The camera of a 3-D or 2-D particle scene frames
+//! everything the run's points reached ([`View::see`] on every frame, then [`View::camera`]),
+//! the obstacles and the ground; the region the context names is the fallback of a run that
+//! saw no finite point (its guess of the motion, widened sideways and downward, would leave
+//! most of the picture empty once the motion is known).
 
 use anim_core::scene::{Context, DynScene, Frame, MeshProp, Prop};
 use anim_io::preview::{Camera, Canvas, Colors, MeshStyle, Shading};
@@ -113,15 +121,18 @@ pub enum Geometry {
         edges: Vec<[usize; 2]>,
         /// Particle disc radius in world units (0: none drawn).
         radius: f64,
-        /// Height of a ground plane `z = h`, if any.
+        /// Height of a ground plane `y = h`, if any.
         ground: Option<f64>,
         /// What surrounds the bodies: spheres, boxes and capsules (colliders) drawn solid, a
         /// tank's walls drawn as its edges.
         obstacles: Vec<Prop>,
         /// Obstacles of triangles (the user's closed surfaces), drawn solid.
         meshes: Vec<MeshProp>,
-        /// Region kept in view.
+        /// The region the context names ([`Context::bounds`]): what the picture frames when no
+        /// point was seen; otherwise the points of the whole run and the obstacles are.
         frame_box: ([f64; 3], [f64; 3]),
+        /// A 2-D scene in the xy plane ([`Context::planar`]), drawn as such.
+        planar: bool,
     },
     /// Fields on a regular grid of cells (a fluid): the snapshot's `x` holds the density per
     /// cell and `v` the velocity per cell, x fastest, then y, then z. Frames are `.vti` image
@@ -181,6 +192,7 @@ impl Geometry {
             obstacles,
             meshes: context.mesh_props.clone(),
             frame_box: bounds,
+            planar: context.planar,
         }
     }
 
@@ -215,6 +227,13 @@ impl Geometry {
     }
 }
 
+/// The direction a 3-D scene is seen along: toward `-z` (from the front), a little to the
+/// right and down (from the left and above).
+const VIEW_DIRECTION: [f64; 3] = [0.55, -0.45, -1.0];
+
+/// The world's up, y.
+const UP: [f64; 3] = [0.0, 1.0, 0.0];
+
 /// Frame files and preview images from snapshots.
 pub struct View {
     geometry: Geometry,
@@ -224,6 +243,10 @@ pub struct View {
     positions: Vec<[f64; 3]>,
     velocities: Vec<[f64; 3]>,
     vertices: Vec<usize>,
+    /// The bounding box of every finite point seen so far ([`View::see`]).
+    seen: Option<([f64; 3], [f64; 3])>,
+    /// The region the last [`View::camera`] framed (the ground is drawn under it).
+    framed: ([f64; 3], [f64; 3]),
 }
 
 fn triples(flat: &[f64], out: &mut Vec<[f64; 3]>) {
@@ -249,7 +272,65 @@ impl View {
             positions: Vec::new(),
             velocities: Vec::new(),
             vertices: Vec::new(),
+            seen: None,
+            framed: ([-1.0; 3], [1.0; 3]),
         }
+    }
+
+    /// Takes in the points of a snapshot of a particle scene: the camera frames every finite
+    /// point seen ([`View::camera`]). Other geometries have fixed pictures.
+    pub fn see(&mut self, s: &Snapshot) {
+        if !matches!(self.geometry, Geometry::Particles { .. }) {
+            return;
+        }
+        for p in s.x.chunks_exact(3) {
+            if p.iter().all(|c| c.is_finite()) {
+                let (lo, hi) = self.seen.get_or_insert(([p[0], p[1], p[2]], [p[0], p[1], p[2]]));
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+        }
+    }
+
+    /// The region a particle scene's picture frames: every point seen, a particle's radius
+    /// around them, the obstacles (spheres, boxes, capsules, tanks, meshes) and the ground's
+    /// height; the context's region when no point was seen.
+    fn region(&self) -> ([f64; 3], [f64; 3]) {
+        let Geometry::Particles { frame_box, radius, ground, obstacles, meshes, .. } = &self.geometry else {
+            return self.framed;
+        };
+        let Some((a, b)) = self.seen else { return *frame_box };
+        let (mut lo, mut hi) = (a.map(|v| v - radius), b.map(|v| v + radius));
+        let mut take = |p: [f64; 3], r: f64| {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k] - r);
+                hi[k] = hi[k].max(p[k] + r);
+            }
+        };
+        for prop in obstacles {
+            match *prop {
+                Prop::Sphere { center, radius } => take(center, radius),
+                Prop::Capsule { a, b, radius } => {
+                    take(a, radius);
+                    take(b, radius);
+                }
+                Prop::Cuboid { lo: corner, hi: other } | Prop::Tank { lo: corner, hi: other } => {
+                    take(corner, 0.0);
+                    take(other, 0.0);
+                }
+                _ => {}
+            }
+        }
+        for p in meshes.iter().flat_map(|m| &m.positions) {
+            take(*p, 0.0);
+        }
+        if let Some(y) = *ground {
+            lo[1] = lo[1].min(y);
+            hi[1] = hi[1].max(y);
+        }
+        (lo, hi)
     }
 
     /// Width over height of the picture the geometry wants, if any ([`Geometry::aspect`]).
@@ -307,15 +388,24 @@ impl View {
         }
     }
 
-    /// A camera that keeps the whole motion in view.
-    pub fn camera(&self, aspect: f64) -> Camera {
+    /// A camera that keeps the whole motion in view, for an image of width over height
+    /// `aspect`: for particles, everything seen so far ([`View::see`]) and the context's region,
+    /// from the front and above (y up), or face on for a 2-D scene.
+    pub fn camera(&mut self, aspect: f64) -> Camera {
         match &self.geometry {
-            Geometry::Planar { extent, .. } => Camera::top_down_2d(extent.0, extent.1, aspect),
-            Geometry::Particles { frame_box, .. } => {
-                Camera::framing(frame_box.0, frame_box.1, [0.55, 1.0, -0.45], [0.0, 0.0, 1.0])
+            Geometry::Planar { extent, .. } => Camera::xy_plane(extent.0, extent.1, aspect),
+            Geometry::Particles { planar, .. } => {
+                let planar = *planar;
+                let (lo, hi) = self.region();
+                self.framed = (lo, hi);
+                if planar {
+                    Camera::xy_plane([lo[0], lo[1]], [hi[0], hi[1]], aspect)
+                } else {
+                    Camera::fitting(lo, hi, VIEW_DIRECTION, UP, aspect)
+                }
             }
             Geometry::Grid { dims, spacing, .. } => {
-                Camera::top_down_2d([0.0, 0.0], [dims[0] as f64 * spacing, dims[1] as f64 * spacing], aspect)
+                Camera::xy_plane([0.0, 0.0], [dims[0] as f64 * spacing, dims[1] as f64 * spacing], aspect)
             }
         }
     }
@@ -350,9 +440,7 @@ impl View {
                 }
                 io(canvas.draw_particles(camera, &[p], 0.03 * scale, Colors::Uniform([60, 110, 200])))
             }
-            Geometry::Particles {
-                triangles, edges, radius, ground, obstacles, meshes, frame_box, ..
-            } => {
+            Geometry::Particles { triangles, edges, radius, ground, obstacles, meshes, planar, .. } => {
                 triples(&s.x, &mut self.positions);
                 for prop in obstacles {
                     draw_obstacle(canvas, camera, prop)?;
@@ -360,12 +448,11 @@ impl View {
                 for mesh in meshes {
                     io(canvas.draw_mesh(camera, &mesh.positions, &mesh.triangles, &OBSTACLE_STYLE))?;
                 }
-                if let Some(z) = ground {
+                if let Some(y) = ground.filter(|_| !planar) {
                     // A floor under the framed region (not beyond it: corners behind the
                     // camera would clip the whole quad).
-                    let (lo, hi) = frame_box;
-                    let quad =
-                        [[lo[0], lo[1], *z], [hi[0], lo[1], *z], [hi[0], hi[1], *z], [lo[0], hi[1], *z]];
+                    let (lo, hi) = self.framed;
+                    let quad = [[lo[0], y, lo[2]], [hi[0], y, lo[2]], [hi[0], y, hi[2]], [lo[0], y, hi[2]]];
                     let style = MeshStyle {
                         color: [200, 200, 195],
                         back_color: [200, 200, 195],
@@ -514,7 +601,7 @@ mod tests {
     /// middle empty; a ground or attractor is not an obstacle.
     #[test]
     fn obstacles_are_drawn_solid_and_tanks_as_edges() {
-        let camera = Camera::framing([-1.0; 3], [1.0; 3], [0.55, 1.0, -0.45], [0.0, 0.0, 1.0]);
+        let camera = Camera::framing([-1.0; 3], [1.0; 3], VIEW_DIRECTION, UP);
         let grey =
             |p: [u8; 3]| p != [255, 255, 255] && p[0].abs_diff(p[1]) <= 12 && p[1].abs_diff(p[2]) <= 12;
         for prop in [
@@ -541,6 +628,90 @@ mod tests {
         assert_eq!((ground, obstacles.len()), (Some(0.0), 2));
     }
 
+    /// The painted pixels' bounding box, `(x0, y0, x1, y1)`, `y` down.
+    fn extent(canvas: &Canvas) -> (u32, u32, u32, u32) {
+        painted(canvas).iter().fold((u32::MAX, u32::MAX, 0, 0), |(a, b, c, d), &(x, y)| {
+            (a.min(x), b.min(y), c.max(x), d.max(y))
+        })
+    }
+
+    /// A particle context whose region is the unit cube about the origin.
+    fn particles(planar: bool) -> View {
+        let mut context = Context::default();
+        context.point_dim = 3;
+        context.point_radius = 0.05;
+        context.planar = planar;
+        context.bounds = Some(([-1.0; 3], [1.0; 3]));
+        View::new(Geometry::from_context(&context))
+    }
+
+    /// The camera frames every point the run reached, not only the context's region: a body
+    /// that leaves that region (the snowball flying off) stays in the picture, drawn inside the
+    /// canvas; with the camera of the region alone it would be off the picture.
+    #[test]
+    fn the_camera_frames_the_whole_run() {
+        let far = Snapshot { x: vec![6.0, 0.0, 0.0], ..Snapshot::default() };
+        let mut view = particles(false);
+        let hint = view.camera(4.0 / 3.0);
+        let mut canvas = Canvas::new(160, 120, [255, 255, 255]);
+        view.draw(&mut canvas, &hint, &far).unwrap();
+        assert!(painted(&canvas).is_empty(), "the far point is outside the region's picture");
+        view.see(&Snapshot { x: vec![0.0; 3], ..Snapshot::default() });
+        view.see(&far);
+        view.see(&Snapshot { x: vec![f64::NAN, 1e300, 0.0], ..Snapshot::default() });
+        let camera = view.camera(4.0 / 3.0);
+        view.draw(&mut canvas, &camera, &far).unwrap();
+        let (x0, y0, x1, y1) = extent(&canvas);
+        assert!(x0 > 0 && y0 > 0 && x1 < 159 && y1 < 119, "{:?}", extent(&canvas));
+    }
+
+    /// A 3-D scene stands y up in the picture: a point above another (greater y) is drawn
+    /// higher; the ground `y = 0` is drawn below the points above it.
+    #[test]
+    fn a_3d_scene_is_drawn_y_up() {
+        let mut context = Context::default();
+        context.point_dim = 3;
+        context.point_radius = 0.1;
+        context.bounds = Some(([-1.0, 0.0, -1.0], [1.0, 2.0, 1.0]));
+        let mut view = View::new(Geometry::from_context(&context));
+        let camera = view.camera(1.0);
+        let row = |view: &mut View, y: f64| {
+            let mut canvas = Canvas::new(100, 100, [255, 255, 255]);
+            view.draw(&mut canvas, &camera, &Snapshot { x: vec![0.0, y, 0.0], ..Snapshot::default() })
+                .unwrap();
+            let (_, y0, _, y1) = extent(&canvas);
+            (y0 + y1) / 2
+        };
+        let (low, high) = (row(&mut view, 0.5), row(&mut view, 1.5));
+        assert!(high + 10 < low, "y = 1.5 drawn at row {high}, y = 0.5 at row {low}");
+        context.props = vec![Prop::Ground { height: 0.0 }];
+        let mut view = View::new(Geometry::from_context(&context));
+        let camera = view.camera(1.0);
+        let mut canvas = Canvas::new(100, 100, [255, 255, 255]);
+        view.draw(&mut canvas, &camera, &Snapshot::default()).unwrap();
+        let (_, top, _, bottom) = extent(&canvas);
+        assert!(bottom > low && top > high, "the ground spans rows {top} to {bottom}");
+    }
+
+    /// A 2-D scene is drawn face on: x to the right, y up, orthographic (a point's place does
+    /// not depend on its depth, which a 2-D scene does not have anyway).
+    #[test]
+    fn a_2d_scene_is_drawn_in_its_plane() {
+        let mut view = particles(true);
+        let camera = view.camera(1.0);
+        let at = |view: &mut View, p: [f64; 3]| {
+            let mut canvas = Canvas::new(100, 100, [255, 255, 255]);
+            view.draw(&mut canvas, &camera, &Snapshot { x: p.to_vec(), ..Snapshot::default() }).unwrap();
+            let (x0, y0, x1, y1) = extent(&canvas);
+            ((x0 + x1) / 2, (y0 + y1) / 2)
+        };
+        let (x, y) = at(&mut view, [0.0; 3]);
+        assert!(x.abs_diff(50) <= 1 && y.abs_diff(50) <= 1, "{x} {y}");
+        let (x, y) = at(&mut view, [0.8, 0.8, 0.0]);
+        assert!(x > 85 && y < 15, "{x} {y}");
+        assert_eq!(at(&mut view, [0.8, 0.8, 0.7]), (x, y), "orthographic");
+    }
+
     /// A mesh obstacle of the context (a tetrahedron around the view's centre) is drawn solid
     /// in the obstacle grey where it covers the picture, and nowhere else.
     #[test]
@@ -553,7 +724,7 @@ mod tests {
             positions: vec![[s, s, s], [s, -s, -s], [-s, s, -s], [-s, -s, s]],
             triangles: vec![[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]],
         }];
-        let camera = Camera::framing([-1.0; 3], [1.0; 3], [0.55, 1.0, -0.45], [0.0, 0.0, 1.0]);
+        let camera = Camera::framing([-1.0; 3], [1.0; 3], VIEW_DIRECTION, UP);
         let mut view = View::new(Geometry::from_context(&context));
         let mut canvas = Canvas::new(120, 120, [255, 255, 255]);
         view.draw(&mut canvas, &camera, &Snapshot::default()).unwrap();

@@ -14,13 +14,25 @@ fn anim(args: &[&str]) -> (bool, String) {
 fn bad_flags_and_names_are_refused_with_the_value_named() {
     let dir = std::env::temp_dir().join(format!("anim-cli-flags-{}", std::process::id()));
     let out = dir.to_str().unwrap();
-    let cases: [(&[&str], &str); 14] = [
+    let cases: [(&[&str], &str); 17] = [
         (&["run", "kepler", "--frames", "0"], "--frames must be at least 1"),
         (&["run", "kepler", "--dt", "0"], "--dt must be a positive finite number, got 0"),
         (&["run", "kepler", "--dt", "-1e-3"], "got -0.001"),
         (&["run", "kepler", "--dt", "NaN"], "got NaN"),
         (&["run", "kepler", "--stride", "0"], "--stride must be at least 1"),
-        (&["run", "kepler", "--preview-width", "8"], "--preview-width must lie in [16, 4096], got 8"),
+        (
+            &["run", "kepler", "--preview-size", "8x8"],
+            "8x8: width and height must each lie in [16, 4096] pixels",
+        ),
+        (
+            &["run", "kepler", "--preview-size", "0x480"],
+            "'--preview-size <WxH>': 0x480: width and height must",
+        ),
+        (&["run", "kepler", "--preview-size", "640x100000"], "640x100000: width and height must each lie in"),
+        (
+            &["run", "kepler", "--preview-size", "wide"],
+            "wide: expected WIDTHxHEIGHT in pixels, such as 640x480",
+        ),
         (&["run", "kepler", "--checkpoint-every", "0"], "--checkpoint-every must be at least 1"),
         (&["run", "warp-drive"], "warp-drive: no such scene file, and no built-in scene of that name"),
         (&["resume", "no-such-checkpoint.anim"], "no-such-checkpoint.anim"),
@@ -101,8 +113,8 @@ fn a_fluid_run_writes_vti_frames_a_series_and_a_density_preview() {
             "--out",
             d,
             "--quiet",
-            "--preview-width",
-            "48",
+            "--preview-size",
+            "48x48",
         ];
         let (ok, err) = anim(&args);
         assert!(ok, "{scene}: {err}");
@@ -411,5 +423,37 @@ fn frames_carry_the_volume_strain_and_materials() {
     assert!(ok, "{err}");
     let vtu = std::fs::read_to_string(dir.join("frames/frame_00000.vtu")).unwrap();
     assert!(vtu.contains("Name=\"material\"") && vtu.contains("Name=\"strain\""), "{vtu:.300}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A run says that its output is y up: `"up": "y"` in `metrics.json`, and the field data `up`
+/// holding `(0, 1, 0)` in its `.vtu` frames; the default preview is 640 x 480 pixels.
+#[test]
+fn a_run_states_that_y_is_up() {
+    let dir = temp("up");
+    let (ok, err) = anim(&[
+        "run",
+        "cloth",
+        "--resolution",
+        "4",
+        "--frames",
+        "2",
+        "--quiet",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let metrics: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(metrics["up"], "y", "{metrics}");
+    let frame = std::fs::read_to_string(dir.join("frames").join("frame_00001.vtu")).unwrap();
+    let field = frame.split("<FieldData>").nth(1).and_then(|f| f.split("</FieldData>").next()).unwrap_or("");
+    assert!(field.contains("Name=\"up\"") && field.contains(">\n0 1 0\n<"), "{field}");
+    let png = std::fs::read(dir.join("preview.png")).unwrap();
+    // The PNG header's width and height (big-endian, after the IHDR tag).
+    assert_eq!(
+        (&png[12..16], &png[16..20], &png[20..24]),
+        (&b"IHDR"[..], &640u32.to_be_bytes()[..], &480u32.to_be_bytes()[..])
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

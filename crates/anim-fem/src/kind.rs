@@ -18,8 +18,10 @@
 //! with each other. A preset refuses these fields, and `bodies` refuses
 //! `resolution`.
 //!
-//! A frame holds every node (for 10-node bodies, the corners then the edge nodes) and its
-//! velocity, in the scenes' own z-up frame; the [`Context`] gives the outward boundary
+//! The scenes work z up (gravity along `-z`, the scene file's coordinates); what they show is
+//! y up like every view's: a frame holds every node (for 10-node bodies, the corners then the
+//! edge nodes) and its velocity turned by `(x, y, z) -> (x, z, -y)`
+//! ([`anim_core::scene::turn_z_up`]); the [`Context`], turned alike, gives the outward boundary
 //! triangles, the (corner) tetrahedra, the pinned and kinematic nodes as pins, the ground and the
 //! sphere, box and capsule obstacles.
 //!
@@ -47,8 +49,8 @@ use anim_core::integrate::State;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, MeshProp, ObstacleMesh,
-    Preset, Prop, RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
-    save_state_and_memory,
+    Preset, Prop, RunDefaults, SceneKind, Simulated, Up, View, ground_height, params,
+    restore_state_and_memory, save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
 
@@ -271,13 +273,12 @@ impl View for FemSimulation {
 
     /// The boundary triangles, the (corner) tetrahedra, as pins the nodes whose three
     /// coordinates are held (pinned or moved kinematically), the ground (the first obstacle
-    /// plane `z >= h`) and the sphere, box and capsule obstacles, and the region the body stays
-    /// in: its bounding box at
-    /// `state`, widened sideways by a third of its size and extended down by its size or to
-    /// the ground.
+    /// plane `z >= h`, drawn `y >= h`) and the sphere, box and capsule obstacles, and the region
+    /// the body stays in: its bounding box at `state`, widened sideways by a third of its size
+    /// and extended down by its size or to the ground; all of it turned y up.
     fn context(&self, state: &State) -> Context {
         let model = self.model();
-        let ground = ground_height(model.obstacles());
+        let ground = ground_height(model.obstacles(), Up::Z);
         // Every obstacle but the planes (a ground is drawn as `Prop::Ground`).
         let solids: Vec<Prop> = model.obstacles().iter().filter_map(Prop::of_shape).collect();
         let fixed = model.fixed();
@@ -288,10 +289,12 @@ impl View for FemSimulation {
         context.tetrahedra.clone_from(&model.mesh().tets);
         context.pins =
             (0..model.vertices()).filter(|&i| fixed[3 * i..3 * i + 3].iter().all(|&f| f)).collect();
-        context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
+        context.bounds = Some(anim_core::scene::frame_box(&state.x, Up::Z, ground, true));
         context.props.extend(ground.map(|height| Prop::Ground { height }));
         context.props.extend(solids);
         context.mesh_props.extend(model.mesh_obstacles().iter().map(|f| MeshProp::from(f.surface())));
+        // Built z up, the model's frame; drawn y up.
+        context.turn_z_up();
         context
     }
 
@@ -300,6 +303,7 @@ impl View for FemSimulation {
         out.points.clone_from(&state.x);
         out.field_mut("velocity", 3).extend_from_slice(&state.v);
         self.model().nodal_strain(&state.x, out.field_mut("strain", 1));
+        out.turn_z_up(3, &["velocity"]);
     }
 }
 

@@ -98,11 +98,12 @@ fn the_context_names_surface_tetrahedra_pins_and_ground() {
     for &pin in &c.pins {
         assert!(f.points[3 * pin].abs() < 1e-9, "pin {pin} is not on the clamped face");
     }
-    // The region: the rest box (x in [0, 1], y in [-0.05, 0.05], z in [0.5, 0.6]) widened by
-    // a third of its size (1 m) sideways and reaching 1.3 sizes below its top.
+    // The region: the rest box (x in [0, 1], y in [-0.05, 0.05], z in [0.5, 0.6], z up)
+    // widened by a third of its size (1 m) sideways and reaching 1.3 sizes below its top, drawn
+    // y up: (x, y, z) -> (x, z, -y).
     let (lo, hi) = c.bounds.expect("bounds");
     let third = 1.0 / 3.0;
-    let expected = ([-third, -0.05 - third, 0.6 - 1.3], [1.0 + third, 0.05 + third, 0.6]);
+    let expected = ([-third, 0.6 - 1.3, -0.05 - third], [1.0 + third, 0.6, 0.05 + third]);
     for k in 0..3 {
         assert!(
             (lo[k] - expected.0[k]).abs() < 1e-12 && (hi[k] - expected.1[k]).abs() < 1e-12,
@@ -121,13 +122,13 @@ fn the_context_names_surface_tetrahedra_pins_and_ground() {
     assert_eq!(c10.tetrahedra, c.tetrahedra);
     assert_eq!(c10.pins.len(), 25);
     assert!(frame_of(beam10.as_ref()).points.len() > f.points.len());
-    // The twisted bar holds both ends; the cube is free above the ground z = 0.
+    // The twisted bar holds both ends; the cube is free above the ground z = 0, drawn y = 0.
     let bar = build(&json!({ "preset": "twisted-bar", "resolution": 2 })).context();
     assert_eq!(bar.pins.len(), 18);
     let cube = build(&json!({ "preset": "soft-cube-drop", "resolution": 2 })).context();
     assert!(cube.pins.is_empty());
     assert_eq!(cube.props, [Prop::Ground { height: 0.0 }]);
-    assert_eq!(cube.bounds.expect("bounds").0[2], 0.0);
+    assert_eq!(cube.bounds.expect("bounds").0[1], 0.0);
 }
 
 #[test]

@@ -290,10 +290,11 @@ fn the_scene_files_obstacle_meshes() {
         b
     };
     let scene = |meshes: serde_json::Value| serde_json::json!({ "bodies": [body], "obstacle_meshes": meshes, "rayleigh": 0.01 });
-    // The picture draws the block's twelve triangles where it is placed.
+    // The picture draws the block's twelve triangles where it is placed, its height (z in the
+    // scene file) along y in the picture.
     let drawn = build(scene(serde_json::json!([block]))).expect("builds").context().mesh_props;
     assert!(drawn.len() == 1 && drawn[0].triangles.len() == 12, "{drawn:?}");
-    let lowest = drawn[0].positions.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min);
+    let lowest = drawn[0].positions.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
     assert_eq!(lowest, block["translate"][2].as_f64().unwrap());
     let rest = |params: serde_json::Value| {
         let mut s = build(params).expect("builds");
@@ -308,7 +309,8 @@ fn the_scene_files_obstacle_meshes() {
     let boxed =
         serde_json::json!([{ "box": { "center": [-0.25, 0.4, -0.2], "half_extents": [0.5, 0.5, 0.5] } }]);
     let on_box = rest(serde_json::json!({ "bodies": [body], "obstacles": boxed, "rayleigh": 0.01 }));
-    let bottom = on_mesh.chunks(3).map(|p| p[2]).fold(f64::INFINITY, f64::min);
+    // The frames' y is the scene's z.
+    let bottom = on_mesh.chunks(3).map(|p| p[1]).fold(f64::INFINITY, f64::min);
     assert!((bottom - 0.3).abs() < 1e-3, "resting on the block's top: {bottom}");
     assert!(largest_difference(&on_mesh, &on_box) <= 1e-6);
 

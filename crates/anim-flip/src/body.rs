@@ -48,14 +48,13 @@ mod tests;
 
 pub use scene::BodyScene;
 
-use crate::kind::{FlipSceneParams, z_up};
+use crate::kind::FlipSceneParams;
 use crate::mac::{flatten, unflatten};
 use crate::particles::Particles;
 use crate::sim::{FlipParams, FlipSimulation};
 use anim_core::geometry::Shape;
 use anim_core::scene::unit_scale;
 use anim_core::scene::{BuildContext, BuildError, MeshProp, Placement, is_default};
-use anim_core::surface::ClosedSurface;
 use region::Region;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -194,19 +193,10 @@ pub fn build<const D: usize>(
     let shapes = params.obstacles.clone();
     // In 2D a mesh obstacle is its cross-section z = 0, which the preview does not draw.
     let meshes = match D {
-        3 => obstacles.iter().filter_map(|(_, region)| region.surface()).map(mesh_prop).collect(),
+        3 => obstacles.iter().filter_map(|(_, region)| region.surface()).map(MeshProp::from).collect(),
         _ => Vec::new(),
     };
     Ok((BodyScene::new(sim, origin, shapes, meshes), particles))
-}
-
-/// A mesh obstacle as drawn: the surface of the scene file's frame turned z up (a rotation,
-/// which keeps the triangles' orientation).
-fn mesh_prop(surface: &ClosedSurface) -> MeshProp {
-    MeshProp {
-        positions: surface.positions().iter().map(|p| z_up::<3>(&p.to_array())).collect(),
-        triangles: surface.triangles().to_vec(),
-    }
 }
 
 /// The regions of `obstacles` and `obstacle_meshes`, each with its field.

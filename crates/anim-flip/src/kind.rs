@@ -18,13 +18,12 @@
 //! [`FlipSceneParams`] and [`crate::body`]; such a scene is a [`body::BodyScene`].
 //!
 //! A preset scene is the [`FlipSimulation`] itself, a [`Solver`](anim_core::solver::Solver) of
-//! its [`Particles`]. anim-flip has y
-//! up; frames have z up like the workspace's other scenes: a fluid point `(x, y, z)` is shown
-//! at `(x, -z, y)`, a 2D one `(x, y)` at `(x, 0, y)` (2D scenes lie in the plane y = 0). The
-//! sloshing tank is simulated in its own frame; its frames are in the world frame, the tank's
-//! displacement added to the positions and its velocity to the velocities. The context has
-//! the tank's inner walls at rest as a [`Prop::Tank`] and, as its bounds, the region the
-//! moving tank sweeps.
+//! its [`Particles`]. anim-flip works y up, the frame of every view's frames: a fluid point
+//! `(x, y, z)` is written as it is, a 2D one `(x, y)` at `(x, y, 0)` (2D scenes lie in the
+//! plane z = 0, [`Context::planar`]). The sloshing tank is simulated in its own frame; its
+//! frames are in the world frame, the tank's displacement added to the positions and its
+//! velocity to the velocities. The context has the tank's inner walls at rest as a
+//! [`Prop::Tank`] and, as its bounds, the region the moving tank sweeps.
 //!
 //! ```
 //! use anim_core::scene::Frame;
@@ -36,8 +35,8 @@
 //! scene.step(preset.run.dt)?;
 //! let mut frame = Frame::default();
 //! scene.frame(&mut frame);
-//! // Every particle in the plane y = 0, z up.
-//! assert!(frame.points.chunks_exact(3).all(|p| p[1] == 0.0 && p[2] > 0.0));
+//! // Every particle in the plane z = 0, above the tank's floor (y up).
+//! assert!(frame.points.chunks_exact(3).all(|p| p[2] == 0.0 && p[1] > 0.0));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
@@ -270,17 +269,15 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
     })
 }
 
-/// A y-up fluid vector as a z-up one: `(x, y, z) -> (x, -z, y)` (a rotation about x),
-/// `(x, y) -> (x, 0, y)`.
-pub(crate) fn z_up<const D: usize>(p: &[f64; D]) -> [f64; 3] {
-    let z = if D == 3 { -p[D - 1] } else { 0.0 };
-    [p[0], z, p[1]]
+/// A fluid point or vector in the frames' three coordinates: as it is in 3D (both y up),
+/// `(x, y) -> (x, y, 0)` in 2D.
+pub(crate) fn widened<const D: usize>(p: &[f64; D]) -> [f64; 3] {
+    std::array::from_fn(|k| if k < D { p[k] } else { 0.0 })
 }
 
-/// The corners of the box with corners `lo` and `hi` (y up), z up.
-pub(crate) fn box_z_up<const D: usize>(lo: &[f64; D], hi: &[f64; D]) -> ([f64; 3], [f64; 3]) {
-    let (a, b) = (z_up(lo), z_up(hi));
-    (std::array::from_fn(|k| a[k].min(b[k])), std::array::from_fn(|k| a[k].max(b[k])))
+/// The corners `lo` and `hi` of a box in the frames' three coordinates ([`widened`]).
+pub(crate) fn widened_box<const D: usize>(lo: &[f64; D], hi: &[f64; D]) -> ([f64; 3], [f64; 3]) {
+    (widened(lo), widened(hi))
 }
 
 /// Saved as `{"dim", "cells", "particles", "simulation"}`: the dimension and grid it belongs
@@ -362,7 +359,7 @@ impl<const D: usize> View for FlipSimulation<D> {
     /// bounds the region the (moving) tank sweeps.
     fn context(&self, _: &Particles<D>) -> Context {
         let (lo, hi) = self.fluid_box();
-        let tank = box_z_up(&lo, &hi);
+        let tank = widened_box(&lo, &hi);
         let (mut reach_lo, mut reach_hi) = (lo, hi);
         if let Some(m) = self.params().tank_motion {
             // The oscillation's reach (the presets' tanks do not accelerate steadily).
@@ -371,9 +368,10 @@ impl<const D: usize> View for FlipSimulation<D> {
         }
         let mut context = Context::default();
         context.point_dim = 3;
+        context.planar = D == 2;
         context.point_radius = 0.25 * self.grid().h();
         context.props.push(Prop::Tank { lo: tank.0, hi: tank.1 });
-        context.bounds = Some(box_z_up(&reach_lo, &reach_hi));
+        context.bounds = Some(widened_box(&reach_lo, &reach_hi));
         context
     }
 
@@ -386,13 +384,13 @@ impl<const D: usize> View for FlipSimulation<D> {
         for p in &particles.x {
             let mut x = *p;
             x[axis] += dx;
-            out.points.extend(z_up(&x));
+            out.points.extend(widened(&x));
         }
         let velocity = out.field_mut("velocity", 3);
         for u in &particles.v {
             let mut v = *u;
             v[axis] += dv;
-            velocity.extend(z_up(&v));
+            velocity.extend(widened(&v));
         }
     }
 }

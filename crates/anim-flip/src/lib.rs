@@ -67,8 +67,8 @@
 //! [`KIND`] registers the presets `dam-break-2d`, `dam-break-3d`, `drop-2d`, `drop-3d` and
 //! `sloshing-tank` as the `flip` scene kind ([`kind`]): built from their scene-file parameters
 //! ([`kind::FlipSceneParams`]: preset, resolution, transfer, or bodies of fluid and obstacles
-//! instead of a preset, [`body`]), checkpointed, and drawn as z-up particles in the world frame
-//! with the tank as a prop.
+//! instead of a preset, [`body`]), checkpointed, and drawn as particles in the world frame, y
+//! up as the solver works, with the tank as a prop.
 //!
 //! The sloshing tank's first mode oscillates with the period of linear theory,
 //! `omega^2 = g k tanh(k d)`, to within 3.3% at 64 cells per metre (`tests/scenes.rs`; the

@@ -3,6 +3,12 @@
 //! chosen format, plus the `.pvd` that lets ParaView play a `.vtu` or `.vti` sequence against
 //! simulation time. Blender's and Houdini's
 //! importers recognise the numbered names of `.ply`/`.obj` sequences.
+//!
+//! Frames are **y up** (gravity along `-y`), the frame of every scene's view, and each frame
+//! file says so where its format keeps metadata ([`UP`]): a `FieldData` array `up` holding the
+//! direction `(0, 1, 0)` in `.vtu` and `.vti` (ParaView lists it in its Information panel), a
+//! `comment up y` header line in `.ply` and a `# up y` line in `.obj` (comments every importer
+//! skips).
 
 use crate::IoError;
 use crate::data::{DataArray, Values};
@@ -10,6 +16,19 @@ use crate::ply::Ply;
 use crate::vtk::{CellKind, ImageData, UnstructuredGrid, VtkEncoding, write_pvd};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
+
+/// The axis that points up in every frame file (and run summary) the workspace writes: `"y"`.
+pub const UP: &str = "y";
+
+/// The direction that points up, as the one tuple of the `up` field data of `.vtu`/`.vti`
+/// frames.
+const UP_DIRECTION: [[f64; 3]; 1] = [[0.0, 1.0, 0.0]];
+
+/// The line that states the up axis in a `.ply` header (after `comment`) and an `.obj` file
+/// (after `#`).
+fn up_comment() -> String {
+    format!("up {UP}")
+}
 
 /// Numbered file names in one folder, and the time of each frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -123,7 +142,7 @@ impl FromStr for FrameFormat {
 }
 
 /// Writes one file per frame into a folder; for `.vtu` and `.vti`, [`finish`](Self::finish)
-/// adds `frames.pvd`.
+/// adds `frames.pvd`. Every frame states that it is y up ([`UP`], the module's documentation).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameWriter {
     sequence: FrameSequence,
@@ -167,19 +186,28 @@ impl FrameWriter {
         let what = self.sequence.dir().join(&name);
         frame.check().map_err(|e| IoError::data(what.display(), e))?;
         match self.format {
-            FrameFormat::Vtu => frame.write(&what, self.encoding)?,
+            FrameFormat::Vtu => {
+                frame
+                    .clone()
+                    .field_data(DataArray::vectors("up", &UP_DIRECTION))
+                    .write(&what, self.encoding)?;
+            }
             FrameFormat::Vti => {
                 return Err(IoError::data(
                     what.display(),
                     "vti frames hold grids: write them with FrameWriter::write_image",
                 ));
             }
-            FrameFormat::Ply => ply_of(frame).map_err(|e| IoError::data(what.display(), e))?.write(&what)?,
+            FrameFormat::Ply => ply_of(frame)
+                .map_err(|e| IoError::data(what.display(), e))?
+                .comment(&up_comment())
+                .write(&what)?,
             FrameFormat::Obj => {
                 let (tris, lines) = surface(frame, true).map_err(|e| IoError::data(what.display(), e))?;
+                let up = [up_comment()];
                 let text = match frame.points {
-                    Values::F32(p) => crate::obj::obj_text(p.as_chunks::<3>().0, &tris, &lines),
-                    Values::F64(p) => crate::obj::obj_text(p.as_chunks::<3>().0, &tris, &lines),
+                    Values::F32(p) => crate::obj::obj_text(p.as_chunks::<3>().0, &tris, &lines, &up),
+                    Values::F64(p) => crate::obj::obj_text(p.as_chunks::<3>().0, &tris, &lines, &up),
                     Values::I32(_) => Err("integer point coordinates".to_string()),
                 }
                 .map_err(|e| IoError::data(what.display(), e))?;
@@ -202,7 +230,7 @@ impl FrameWriter {
                 format!("a grid frame in a {} sequence: grids are written as vti", self.format.extension()),
             ));
         }
-        frame.write(&what, self.encoding)?;
+        frame.clone().field_data(DataArray::vectors("up", &UP_DIRECTION)).write(&what, self.encoding)?;
         Ok(self.sequence.next_path(time))
     }
 
@@ -318,6 +346,53 @@ mod tests {
         assert_eq!("PLY".parse::<FrameFormat>(), Ok(FrameFormat::Ply));
         assert_eq!("vti".parse::<FrameFormat>(), Ok(FrameFormat::Vti));
         assert!("stl".parse::<FrameFormat>().is_err());
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    /// Every frame file says it is y up, read back as a reader sees it: the `up` field data of
+    /// a `.vtu` or `.vti` (an XML parser finds the one tuple `(0, 1, 0)`), the header comment of
+    /// a `.ply` (before `end_header`), the comment line of an `.obj`.
+    #[test]
+    fn every_frame_file_states_that_y_is_up() {
+        let dir = tmp("up");
+        let pts = [[0.0f64, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let tris = [[0, 1, 2]];
+        let grid = UnstructuredGrid::new(&pts).triangles(&tris);
+        let up_of_xml = |path: &Path| {
+            let text = std::fs::read_to_string(path).unwrap();
+            let doc = roxmltree::Document::parse(&text).unwrap();
+            let array = doc
+                .descendants()
+                .find(|n| n.has_tag_name("DataArray") && n.attribute("Name") == Some("up"))
+                .unwrap_or_else(|| panic!("no up array in {text:.400}"));
+            assert_eq!(array.parent_element().map(|p| p.tag_name().name()), Some("FieldData"));
+            assert_eq!(
+                (array.attribute("NumberOfTuples"), array.attribute("format")),
+                (Some("1"), Some("ascii"))
+            );
+            array
+                .text()
+                .unwrap_or("")
+                .split_whitespace()
+                .map(|t| t.parse::<f64>().unwrap())
+                .collect::<Vec<_>>()
+        };
+        let mut vtu = FrameWriter::new(dir.join("vtu"), FrameFormat::Vtu).unwrap();
+        assert_eq!(up_of_xml(&vtu.write(0.0, &grid).unwrap()), [0.0, 1.0, 0.0]);
+        let density = [1.0f64; 4];
+        let image = ImageData::from_cells_2d([2, 2], [0.0; 2], [0.5; 2])
+            .cell_field(DataArray::scalars("density", &density));
+        let mut vti = FrameWriter::new(dir.join("vti"), FrameFormat::Vti).unwrap();
+        assert_eq!(up_of_xml(&vti.write_image(0.0, &image).unwrap()), [0.0, 1.0, 0.0]);
+        let mut ply = FrameWriter::new(dir.join("ply"), FrameFormat::Ply).unwrap();
+        let bytes = std::fs::read(ply.write(0.0, &grid).unwrap()).unwrap();
+        let end = bytes.windows(11).position(|w| w == b"end_header\n").unwrap();
+        let header = String::from_utf8(bytes[..end].to_vec()).unwrap();
+        assert!(header.lines().any(|l| l == "comment up y"), "{header}");
+        let mut obj = FrameWriter::new(dir.join("obj"), FrameFormat::Obj).unwrap();
+        let text = std::fs::read_to_string(obj.write(0.0, &grid).unwrap()).unwrap();
+        assert!(text.lines().take_while(|l| l.starts_with('#')).any(|l| l == "# up y"), "{text}");
+        assert_eq!(UP, "y");
         std::fs::remove_dir_all(dir).unwrap();
     }
 

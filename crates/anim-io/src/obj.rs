@@ -158,15 +158,17 @@ pub fn write_obj<T: Real + std::fmt::Display>(
     lines: &[[usize; 2]],
 ) -> Result<(), IoError> {
     let path = path.as_ref();
-    let text = obj_text(positions, triangles, lines).map_err(|e| IoError::data(path.display(), e))?;
+    let text = obj_text(positions, triangles, lines, &[]).map_err(|e| IoError::data(path.display(), e))?;
     crate::vtk::write_file(path, &text)
 }
 
-/// The OBJ text of a mesh, or why it cannot be written.
+/// The OBJ text of a mesh, or why it cannot be written; `comments` are lines after the first
+/// (`# written by anim-io`), each written after `# `.
 pub(crate) fn obj_text<T: Real + std::fmt::Display>(
     positions: &[[T; 3]],
     triangles: &[[usize; 3]],
     lines: &[[usize; 2]],
+    comments: &[String],
 ) -> Result<String, String> {
     let n = positions.len();
     if let Some((i, t)) = triangles.iter().enumerate().find(|(_, t)| t.iter().any(|&v| v >= n)) {
@@ -177,6 +179,9 @@ pub(crate) fn obj_text<T: Real + std::fmt::Display>(
     }
     let mut out = String::with_capacity(n * 40 + triangles.len() * 24);
     out.push_str("# written by anim-io\n");
+    for c in comments {
+        let _ = writeln!(out, "# {c}");
+    }
     for p in positions {
         let _ = writeln!(out, "v {} {} {}", p[0], p[1], p[2]);
     }
@@ -239,11 +244,11 @@ mod tests {
     #[test]
     fn writer_output_reads_back_exactly() {
         let p = [[0.1f64, -2.5e-17, 3.0e300], [1.0 / 3.0, 0.0, -0.0], [7.0, 8.0, 9.0]];
-        let text = obj_text(&p, &[[0, 1, 2]], &[[2, 0]]).unwrap();
+        let text = obj_text(&p, &[[0, 1, 2]], &[[2, 0]], &[]).unwrap();
         let m = parse_obj(&text, "w.obj", Polygons::Reject).unwrap();
         assert_eq!(m.positions, p.to_vec());
         assert_eq!(m.triangles, vec![[0, 1, 2]]);
         assert_eq!(m.lines, vec![[2, 0]]);
-        assert!(obj_text(&p, &[[0, 1, 3]], &[]).unwrap_err().contains("triangle 0"));
+        assert!(obj_text(&p, &[[0, 1, 3]], &[], &[]).unwrap_err().contains("triangle 0"));
     }
 }

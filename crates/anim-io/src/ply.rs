@@ -26,6 +26,8 @@ pub struct Ply<'a> {
     /// component, named by `names`.
     attributes: Vec<(Vec<String>, DataArray<'a>)>,
     triangles: Cow<'a, [[usize; 3]]>,
+    /// Header comments after `comment written by anim-io`, one line each.
+    comments: Vec<String>,
 }
 
 impl<'a> Ply<'a> {
@@ -36,7 +38,7 @@ impl<'a> Ply<'a> {
 
     /// A point cloud of flat coordinates, 3 per point.
     pub(crate) fn from_values(positions: Values<'a>) -> Self {
-        Ply { positions, attributes: Vec::new(), triangles: Cow::Borrowed(&[]) }
+        Ply { positions, attributes: Vec::new(), triangles: Cow::Borrowed(&[]), comments: Vec::new() }
     }
 
     /// Adds a field with one property name per component.
@@ -65,6 +67,12 @@ impl<'a> Ply<'a> {
         self
     }
 
+    /// Adds a header line `comment {text}` (readers skip comments); `text` must fit one line.
+    pub fn comment(mut self, text: &str) -> Self {
+        self.comments.push(text.to_string());
+        self
+    }
+
     /// Adds triangles (0-based vertex indices).
     pub fn triangles(mut self, triangles: &'a [[usize; 3]]) -> Self {
         self.triangles = Cow::Borrowed(triangles);
@@ -75,6 +83,9 @@ impl<'a> Ply<'a> {
     pub fn check(&self) -> Result<(), String> {
         if !self.positions.len().is_multiple_of(3) {
             return Err(format!("{} coordinates, not a multiple of 3", self.positions.len()));
+        }
+        if let Some(c) = self.comments.iter().find(|c| c.contains(['\n', '\r'])) {
+            return Err(format!("comment {c:?} spans more than one line"));
         }
         let n = self.positions.len() / 3;
         let mut names: Vec<&str> = vec!["x", "y", "z"];
@@ -126,6 +137,9 @@ impl<'a> Ply<'a> {
     fn bytes(&self) -> Vec<u8> {
         let n = self.positions.len() / 3;
         let mut header = String::from("ply\nformat binary_little_endian 1.0\ncomment written by anim-io\n");
+        for c in &self.comments {
+            header.push_str(&format!("comment {c}\n"));
+        }
         header.push_str(&format!("element vertex {n}\n"));
         for axis in ["x", "y", "z"] {
             header.push_str(&format!("property {} {axis}\n", ply_type(&self.positions)));

@@ -97,6 +97,9 @@ pub struct UnstructuredGrid<'a> {
     pub point_data: Vec<DataArray<'a>>,
     /// Per-cell fields.
     pub cell_data: Vec<DataArray<'a>>,
+    /// Fields of the whole dataset (`FieldData`, any number of tuples): what the frame is, such
+    /// as the direction that points up. Written as decimal text whatever the encoding.
+    pub field_data: Vec<DataArray<'a>>,
 }
 
 impl<'a> UnstructuredGrid<'a> {
@@ -107,6 +110,7 @@ impl<'a> UnstructuredGrid<'a> {
             cells: Vec::new(),
             point_data: Vec::new(),
             cell_data: Vec::new(),
+            field_data: Vec::new(),
         }
     }
 
@@ -156,6 +160,12 @@ impl<'a> UnstructuredGrid<'a> {
         self
     }
 
+    /// Adds a field of the whole dataset ([`UnstructuredGrid::field_data`]).
+    pub fn field_data(mut self, field: DataArray<'a>) -> Self {
+        self.field_data.push(field);
+        self
+    }
+
     /// Checks lengths, indices and names; the message names the offending field or cell.
     pub fn check(&self) -> Result<(), String> {
         if !self.points.len().is_multiple_of(3) {
@@ -184,7 +194,8 @@ impl<'a> UnstructuredGrid<'a> {
             first_cell += block.connectivity.len() / k;
         }
         check_fields(&self.point_data, n, "points")?;
-        check_fields(&self.cell_data, self.num_cells(), "cells")
+        check_fields(&self.cell_data, self.num_cells(), "cells")?;
+        check_field_data(&self.field_data)
     }
 
     /// Writes the grid as a `.vtu` file.
@@ -199,6 +210,7 @@ impl<'a> UnstructuredGrid<'a> {
         let mut out = String::with_capacity(64 + self.points.len() * 12);
         header(&mut out, "UnstructuredGrid");
         out.push_str("<UnstructuredGrid>\n");
+        field_data(&mut out, &self.field_data);
         let _ = writeln!(
             out,
             "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
@@ -258,12 +270,21 @@ pub struct ImageData<'a> {
     /// Per-cell fields (one tuple per cell: the product of `dims[i] - 1` over the axes with
     /// more than one point).
     pub cell_data: Vec<DataArray<'a>>,
+    /// Fields of the whole dataset, as [`UnstructuredGrid::field_data`].
+    pub field_data: Vec<DataArray<'a>>,
 }
 
 impl<'a> ImageData<'a> {
     /// A grid of `dims` points.
     pub fn new(dims: [usize; 3], origin: [f64; 3], spacing: [f64; 3]) -> Self {
-        ImageData { dims, origin, spacing, point_data: Vec::new(), cell_data: Vec::new() }
+        ImageData {
+            dims,
+            origin,
+            spacing,
+            point_data: Vec::new(),
+            cell_data: Vec::new(),
+            field_data: Vec::new(),
+        }
     }
 
     /// A 2-D grid of `cells[0] x cells[1]` cells of size `spacing` with its corner at `origin`
@@ -302,6 +323,12 @@ impl<'a> ImageData<'a> {
         self
     }
 
+    /// Adds a field of the whole dataset ([`ImageData::field_data`]).
+    pub fn field_data(mut self, field: DataArray<'a>) -> Self {
+        self.field_data.push(field);
+        self
+    }
+
     /// Checks dimensions, spacing and field lengths.
     pub fn check(&self) -> Result<(), String> {
         if self.dims.contains(&0) {
@@ -311,7 +338,8 @@ impl<'a> ImageData<'a> {
             return Err("non-finite origin or spacing".into());
         }
         check_fields(&self.point_data, self.num_points(), "grid points")?;
-        check_fields(&self.cell_data, self.num_cells(), "grid cells")
+        check_fields(&self.cell_data, self.num_cells(), "grid cells")?;
+        check_field_data(&self.field_data)
     }
 
     /// Writes the grid as a `.vti` file.
@@ -328,6 +356,7 @@ impl<'a> ImageData<'a> {
             out,
             "<ImageData WholeExtent=\"{extent}\" Origin=\"{ox:e} {oy:e} {oz:e}\" Spacing=\"{sx:e} {sy:e} {sz:e}\">"
         );
+        field_data(&mut out, &self.field_data);
         let _ = writeln!(out, "<Piece Extent=\"{extent}\">");
         fields(&mut out, "PointData", &self.point_data, encoding);
         fields(&mut out, "CellData", &self.cell_data, encoding);
@@ -385,6 +414,48 @@ fn fields(out: &mut String, tag: &str, fields: &[DataArray<'_>], encoding: VtkEn
         data_array(out, Some(&f.name), f.components, &f.values, encoding);
     }
     let _ = writeln!(out, "</{tag}>");
+}
+
+/// Field data whose arrays hold whole tuples, named once each.
+fn check_field_data(fields: &[DataArray<'_>]) -> Result<(), String> {
+    for (i, f) in fields.iter().enumerate() {
+        if f.components == 0 || !f.values.len().is_multiple_of(f.components) {
+            return Err(format!(
+                "field data `{}` has {} values, not whole tuples of {}",
+                f.name,
+                f.values.len(),
+                f.components
+            ));
+        }
+        if fields[..i].iter().any(|g| g.name == f.name) {
+            return Err(format!("two field data arrays are named `{}`", f.name));
+        }
+    }
+    Ok(())
+}
+
+/// The dataset's `FieldData` (VTK reads its arrays' `NumberOfTuples`), as decimal text.
+fn field_data(out: &mut String, fields: &[DataArray<'_>]) {
+    if fields.is_empty() {
+        return;
+    }
+    out.push_str("<FieldData>\n");
+    for f in fields {
+        let components = f.components.max(1);
+        let _ = writeln!(
+            out,
+            "<DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{components}\" NumberOfTuples=\"{}\" format=\"ascii\">",
+            type_name(&f.values),
+            escape(&f.name),
+            f.values.len() / components
+        );
+        for i in 0..f.values.len() {
+            f.values.write_text(i, out);
+            out.push(if (i + 1) % components == 0 { '\n' } else { ' ' });
+        }
+        out.push_str("</DataArray>\n");
+    }
+    out.push_str("</FieldData>\n");
 }
 
 fn type_name(v: &Values<'_>) -> &'static str {
@@ -546,6 +617,40 @@ mod tests {
             xml.contains("Name=\"mass\" NumberOfComponents=\"1\" format=\"ascii\">\n1\n2\n3\n4\n"),
             "{xml}"
         );
+    }
+
+    /// Field data is the dataset's own `FieldData` element, before the piece, with its tuple
+    /// count; arrays of partial tuples or repeated names are refused.
+    #[test]
+    fn field_data_is_written_before_the_piece_with_its_tuple_count() {
+        let pts = [[0.0f64; 3]];
+        let up = [[0.0f64, 1.0, 0.0]];
+        let xml =
+            UnstructuredGrid::new(&pts).field_data(DataArray::vectors("up", &up)).to_xml(VtkEncoding::Base64);
+        let doc = roxmltree::Document::parse(&xml).unwrap();
+        let array =
+            doc.descendants().find(|n| n.has_tag_name("FieldData")).unwrap().first_element_child().unwrap();
+        assert_eq!(
+            array.parent_element().unwrap().parent_element().unwrap().tag_name().name(),
+            "UnstructuredGrid"
+        );
+        assert_eq!(
+            (
+                array.attribute("Name"),
+                array.attribute("NumberOfTuples"),
+                array.attribute("NumberOfComponents")
+            ),
+            (Some("up"), Some("1"), Some("3"))
+        );
+        assert_eq!(read_f64(array), [0.0, 1.0, 0.0]);
+        let half = [0.0f64, 1.0];
+        let e =
+            UnstructuredGrid::new(&pts).field_data(DataArray::new("up", 3, &half[..])).check().unwrap_err();
+        assert_eq!(e, "field data `up` has 2 values, not whole tuples of 3");
+        let img = ImageData::new([2, 2, 1], [0.0; 3], [1.0; 3])
+            .field_data(DataArray::vectors("up", &up))
+            .field_data(DataArray::vectors("up", &up));
+        assert_eq!(img.check().unwrap_err(), "two field data arrays are named `up`");
     }
 
     #[test]

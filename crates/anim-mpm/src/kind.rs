@@ -16,7 +16,7 @@
 //! `obstacles` (planes, boxes, spheres), `obstacle_meshes` (closed OBJ surfaces, 3D; level-set
 //! colliders, [`crate::mesh_collider`]), `boundary` (on the obstacles) and `wall` (on the
 //! domain's walls) ([`MpmSceneParams`], [`crate::bodies`]). Such a scene is framed by the
-//! domain's walls; mesh obstacles are not drawn.
+//! domain's walls; mesh obstacles are drawn as their surfaces.
 //!
 //! ```
 //! use anim_core::scene::BuildContext;
@@ -39,8 +39,9 @@
 //! ```
 //!
 //! **Frames.** One point per particle in the current (block-sorted) order of the particles,
-//! with its velocity, widened from `f32` to `f64`; 2D scenes lie in the `z = 0` plane. The
-//! scenes keep their own frame, the unit box with **y up** (gravity along `-y`). The
+//! with its velocity, widened from `f32` to `f64`; 2D scenes lie in the `z = 0` plane
+//! ([`Context::planar`]). The scenes keep their own frame, the unit box with **y up** (gravity
+//! along `-y` by default), which is the frame of every view's frames: nothing is turned. The
 //! [`Context`] draws particles as discs of half a cell, the domain's walls (their inner faces,
 //! [`MpmParams::wall_nodes`] cells in) as a [`Prop::Tank`], box colliders as
 //! [`Prop::Cuboid`]s and sphere colliders as [`Prop::Sphere`]s.
@@ -70,7 +71,7 @@ use crate::{Boundary, Kernel, MpmError, MpmParams, MpmSimulation, OutOfDomain, P
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, MeshProp, Preset, Prop,
-    RunDefaults, SceneKind, Simulated, View, params, saved_field,
+    RunDefaults, SceneKind, Simulated, Up, View, params, saved_field,
 };
 use anim_core::solver::{Solver, StepClock, StepReport};
 use serde::{Deserialize, Serialize};
@@ -311,8 +312,8 @@ impl<const D: usize> MpmRun<D> {
     }
 
     /// The same run viewed as a scene of bodies: framing the domain between its walls, where
-    /// all its matter stays, with the bottom wall drawn as the ground when gravity points down
-    /// along -z (see [`View::context`]).
+    /// all its matter stays, with the bottom wall drawn as the ground in 3D when gravity points
+    /// down along -y (see [`View::context`]).
     #[must_use]
     pub fn framed_by_walls(mut self) -> Self {
         self.walls_framed = true;
@@ -451,9 +452,10 @@ impl<const D: usize> View for MpmRun<D> {
 
     /// Particles as discs of half a cell; the tank of the domain's walls, the colliders; the
     /// region of the particles of `state`, widened sideways by a third of its size and extended
-    /// down along -z by its size. A scene of bodies ([`MpmRun::framed_by_walls`]) frames the
-    /// tank instead; in 3D with gravity mostly along -z only up to the highest apex a particle
-    /// thrown up reaches (plus a cell), with the bottom wall drawn as the ground.
+    /// down along -y by its size. A scene of bodies ([`MpmRun::framed_by_walls`]) frames the
+    /// tank instead; in 3D with gravity mostly along -y only up to the highest apex a particle
+    /// thrown up reaches (plus a cell), with the bottom wall drawn as the ground. The solver
+    /// works y up, the frame of views: nothing is turned. A 2D scene lies in the plane z = 0.
     fn context(&self, state: &Particles<D>) -> Context {
         let params = self.sim.params();
         let cell = params.size / params.resolution as f64;
@@ -462,27 +464,28 @@ impl<const D: usize> View for MpmRun<D> {
         // `Context` is non-exhaustive: filled field by field.
         let mut context = Context::default();
         context.point_dim = 3;
+        context.planar = D == 2;
         context.point_radius = 0.5 * cell;
         let tank = tank(params, D);
         let g = params.gravity;
-        let falls_along_z = D == 3 && -g[2] > g[0].abs().max(g[1].abs());
+        let falls_along_y = D == 3 && -g[1] > g[0].abs().max(g[2].abs());
         context.bounds = Some(match tank {
             Prop::Tank { lo, mut hi } if self.walls_framed => {
-                if falls_along_z {
+                if falls_along_y {
                     // Nothing rises above the highest apex of a particle thrown up.
                     let apex = display
                         .points
                         .chunks_exact(3)
                         .zip(state.v.chunks_exact(D))
-                        .map(|(x, v)| x[2] + f64::from(v[D - 1].max(0.0)).powi(2) / (-2.0 * g[2]))
-                        .fold(lo[2], f64::max);
-                    hi[2] = hi[2].min(apex + cell);
+                        .map(|(x, v)| x[1] + f64::from(v[1].max(0.0)).powi(2) / (-2.0 * g[1]))
+                        .fold(lo[1], f64::max);
+                    hi[1] = hi[1].min(apex + cell);
                 }
                 (lo, hi)
             }
-            _ => anim_core::scene::frame_box(&display.points, None, true),
+            _ => anim_core::scene::frame_box(&display.points, Up::Y, None, true),
         });
-        if self.walls_framed && falls_along_z {
+        if self.walls_framed && falls_along_y {
             context.props.push(Prop::Ground { height: params.wall_nodes as f64 * params.h() });
         }
         context.props.push(tank);

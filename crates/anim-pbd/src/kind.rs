@@ -42,7 +42,9 @@
 //! the simulation's memory: step count, external forces, pending body targets) and [`View`]
 //! (the particles and their velocities; the model's triangles, or the boundary of its
 //! tetrahedra, its edges and tetrahedra, the particles of zero inverse mass as pins, and the
-//! static shape colliders: ground, spheres, capsules and boxes; mesh colliders are not drawn).
+//! static colliders: ground, spheres, capsules, boxes and mesh colliders on no kinematic body).
+//! The model works z up (gravity along `-z`, the scene file's coordinates); its view turns all
+//! of it y up, the frame of every view ([`anim_core::scene::turn_z_up`]).
 
 use crate::scenes;
 use crate::sim::{Method, PbdSimulation};
@@ -50,8 +52,8 @@ use anim_core::integrate::State;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, MeshProp, ObstacleMesh,
-    Preset, Prop, RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
-    save_state_and_memory,
+    Preset, Prop, RunDefaults, SceneKind, Simulated, Up, View, ground_height, params,
+    restore_state_and_memory, save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
 
@@ -263,7 +265,7 @@ impl View for PbdSimulation {
             triangles = boundary_triangles(model.tets(), state.x.len() / 3);
         }
         let fixed = || model.colliders().iter().filter(|c| c.body.is_none()).map(|c| &c.shape);
-        let ground = ground_height(fixed());
+        let ground = ground_height(fixed(), Up::Z);
         // Spheres first, then capsules and boxes, each in collider order.
         let props: Vec<Prop> = fixed().filter_map(Prop::of_shape).collect();
         let (spheres, others): (Vec<Prop>, Vec<Prop>) =
@@ -300,7 +302,9 @@ impl View for PbdSimulation {
                 .filter(|c| c.body.is_none())
                 .map(|c| MeshProp::from(c.shape.surface())),
         );
-        context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
+        context.bounds = Some(anim_core::scene::frame_box(&state.x, Up::Z, ground, true));
+        // Built z up, the model's frame; drawn y up.
+        context.turn_z_up();
         context
     }
 
@@ -308,6 +312,7 @@ impl View for PbdSimulation {
         out.time = state.t;
         out.points.clone_from(&state.x);
         out.field_mut("velocity", 3).extend_from_slice(&state.v);
+        out.turn_z_up(3, &["velocity"]);
     }
 }
 

@@ -14,7 +14,9 @@
 //!
 //! A scene is drawn as the line segments its [`RigidScene::segments`] name: frame `k` holds the
 //! two end points of every segment (segment `s` joins points `2 s` and `2 s + 1`) and their
-//! velocities by finite difference over the last step.
+//! velocities by finite difference over the last step. The bodies work z up (gravity along
+//! `-z`, the URDF's and the scene file's coordinates); frames and context are turned y up, the
+//! frame of every view ([`anim_core::scene::turn_z_up`]).
 //!
 //! ```
 //! use anim_core::scene::{BuildContext, Frame};
@@ -32,7 +34,7 @@ use anim_core::glam::DVec3;
 use anim_core::integrate::State;
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, RunDefaults,
-    SceneKind, Simulated, View, params, saved_field, saved_state,
+    SceneKind, Simulated, Up, View, params, saved_field, saved_state,
 };
 use anim_core::solver::{Solver, StepReport};
 use serde::{Deserialize, Serialize};
@@ -359,7 +361,9 @@ impl View for RigidSegments {
         context.lines = lines;
         context.pins = self.pins();
         context.point_radius = 0.06 * longest.max(1e-3);
-        context.bounds = Some(anim_core::scene::frame_box(&self.display.x, None, true));
+        context.bounds = Some(anim_core::scene::frame_box(&self.display.x, Up::Z, None, true));
+        // Built z up, the robot's frame; drawn y up.
+        context.turn_z_up();
         context
     }
 
@@ -367,5 +371,6 @@ impl View for RigidSegments {
         out.time = self.display.t;
         out.points.clone_from(&self.display.x);
         out.field_mut("velocity", 3).extend_from_slice(&self.display.v);
+        out.turn_z_up(3, &["velocity"]);
     }
 }

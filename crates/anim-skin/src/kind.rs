@@ -29,7 +29,7 @@
 use anim_core::integrate::State;
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, Preset, RunDefaults,
-    SceneKind, Simulated, View, params, saved_state,
+    SceneKind, Simulated, Up, View, params, saved_state,
 };
 use anim_core::solver::{Solver, StepReport};
 use serde::{Deserialize, Serialize};
@@ -336,7 +336,7 @@ impl View for SkinPlayback {
         let mut context = Context::default();
         context.point_dim = 3;
         context.triangles.clone_from(&self.triangles);
-        context.bounds = Some(anim_core::scene::frame_box(&state.x, None, false));
+        context.bounds = Some(anim_core::scene::frame_box(&state.x, Up::Y, None, false));
         context.notes.clone_from(&self.scene.warnings);
         context
     }

@@ -18,7 +18,9 @@
 //! Bodies do not collide with each other. The scene is a [`SpringSimulation`] with its [`State`]: it implements
 //! [`Checkpoint`] (the state and the simulation's memory, the integrator's included) and
 //! [`View`] (the particles and their velocities; springs as lines, cloth triangles, pinned
-//! particles, the ground and the sphere, box and capsule colliders).
+//! particles, the ground and the sphere, box and capsule colliders). The network works z up
+//! (gravity along `-z`, the scene file's coordinates); its view turns all of it y up, the frame
+//! of every view ([`anim_core::scene::turn_z_up`]).
 
 use crate::EARTH_GRAVITY;
 use crate::body::{BodySpec, ContactSpec, build_bodies};
@@ -32,8 +34,8 @@ use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tole
 use anim_core::scene::systems::integrator;
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, MeshProp, ObstacleMesh,
-    Preset, Prop, RunDefaults, SceneKind, Simulated, View, ground_height, params, restore_state_and_memory,
-    save_state_and_memory,
+    Preset, Prop, RunDefaults, SceneKind, Simulated, Up, View, ground_height, params,
+    restore_state_and_memory, save_state_and_memory,
 };
 use serde::{Deserialize, Serialize};
 
@@ -240,7 +242,7 @@ impl View for SpringSimulation {
     fn context(&self, state: &State) -> Context {
         let network = self.network();
         let colliders = network.model().colliders();
-        let ground = ground_height(colliders.iter().map(|c| &c.shape));
+        let ground = ground_height(colliders.iter().map(|c| &c.shape), Up::Z);
         let springs = network.springs();
         let mean_length = if springs.is_empty() {
             0.01
@@ -259,7 +261,9 @@ impl View for SpringSimulation {
         context
             .mesh_props
             .extend(network.model().mesh_colliders().iter().map(|c| MeshProp::from(c.shape.surface())));
-        context.bounds = Some(anim_core::scene::frame_box(&state.x, ground, true));
+        context.bounds = Some(anim_core::scene::frame_box(&state.x, Up::Z, ground, true));
+        // Built z up, the network's frame; drawn y up.
+        context.turn_z_up();
         context
     }
 
@@ -267,6 +271,7 @@ impl View for SpringSimulation {
         out.time = state.t;
         out.points.clone_from(&state.x);
         out.field_mut("velocity", 3).extend_from_slice(&state.v);
+        out.turn_z_up(3, &["velocity"]);
     }
 }
 
@@ -391,6 +396,11 @@ mod tests {
         values.iter().map(|v| v.to_bits()).collect()
     }
 
+    /// Flat z-up triples `(x, y, z)` as the y-up `(x, z, -y)` every frame has.
+    fn y_up(values: &[f64]) -> Vec<f64> {
+        values.chunks_exact(3).flat_map(|p| [p[0], p[2], -p[1]]).collect()
+    }
+
     fn build_err(params: &serde_json::Value) -> String {
         (KIND.build)(params, &BuildContext::default()).err().expect("refused").to_string()
     }
@@ -434,6 +444,34 @@ mod tests {
         }
     }
 
+    /// The network works z up (gravity along -z); its frames are y up: a hanging cloth, held
+    /// at two corners, falls along -y in them (its mean height drops and its mean velocity
+    /// points down -y), while x, across the held edge, barely moves.
+    #[test]
+    fn a_hanging_cloth_falls_along_minus_y_in_its_frames() {
+        let mut scene = build_params(&serde_json::json!({ "preset": "hanging-cloth", "resolution": 8 }));
+        let mean = |values: &[f64], k: usize| {
+            values.chunks_exact(3).map(|p| p[k]).sum::<f64>() / (values.len() / 3) as f64
+        };
+        let start = frame_of(scene.as_ref());
+        for _ in 0..20 {
+            scene.step(0.01).expect("step");
+        }
+        let later = frame_of(scene.as_ref());
+        let v = &later.field("velocity").expect("velocity").values;
+        let (dx, dy) = (
+            mean(&later.points, 0) - mean(&start.points, 0),
+            mean(&later.points, 1) - mean(&start.points, 1),
+        );
+        assert!(dy < -0.05 && dx.abs() < 0.1 * dy.abs(), "moved by {dx} along x, {dy} along y");
+        assert!(
+            mean(v, 1) < 0.0 && mean(v, 1).abs() > mean(v, 0).abs(),
+            "mean velocity {}, {}",
+            mean(v, 0),
+            mean(v, 1)
+        );
+    }
+
     #[test]
     fn the_frame_and_context_are_the_simulation_state_and_its_picture() {
         let mut scene = build_params(&serde_json::json!({ "preset": "hanging-cloth", "resolution": 4 }));
@@ -447,23 +485,24 @@ mod tests {
         assert_eq!(context.lines.len(), sim.network().num_springs());
         assert_eq!(context.lines[0], [sim.network().springs()[0].i, sim.network().springs()[0].j]);
         // No ground, no sphere: the cloth falls, so the box reaches 1.3 sides below its top.
+        // The network's box from (-1/3, -1/3, 1 - 1.3) to (4/3, 4/3, 1), z up, drawn y up.
         assert!(context.props.is_empty());
-        assert_eq!(context.bounds, Some(([-1.0 / 3.0, -1.0 / 3.0, 1.0 - 1.3], [4.0 / 3.0, 4.0 / 3.0, 1.0])));
+        assert_eq!(context.bounds, Some(([-1.0 / 3.0, 1.0 - 1.3, -4.0 / 3.0], [4.0 / 3.0, 1.0, 1.0 / 3.0])));
         assert_eq!(scene.method(), "backward-euler / cholesky");
         for _ in 0..2 {
             scene.step(0.01).expect("step");
             anim_core::solver::Solver::step(&mut sim, &mut state, 0.01).expect("step");
         }
         let frame = frame_of(scene.as_ref());
-        assert_eq!(bits(&frame.points), bits(&state.x));
-        assert_eq!(bits(&frame.field("velocity").expect("v").values), bits(&state.v));
+        assert_eq!(bits(&frame.points), bits(&y_up(&state.x)));
+        assert_eq!(bits(&frame.field("velocity").expect("v").values), bits(&y_up(&state.v)));
         assert_eq!(frame.time.to_bits(), state.t.to_bits());
-        // The jelly has the ground, and the rope is explicit.
+        // The jelly has the ground (z = 0 in the network, y = 0 drawn), and the rope is explicit.
         let jelly = build_params(&preset("jelly").params);
         let context = jelly.context();
         assert_eq!(context.props, vec![Prop::Ground { height: 0.0 }]);
         assert!(context.pins.is_empty());
-        assert_eq!(context.bounds.expect("bounds").0[2], 0.0);
+        assert_eq!(context.bounds.expect("bounds").0[1], 0.0);
         let rope = build_params(&preset("rope").params);
         assert_eq!(rope.method(), "velocity-verlet");
         assert_eq!(rope.context().pins, vec![0]);

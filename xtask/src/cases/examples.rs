@@ -107,8 +107,8 @@ fn run(crate_name: &'static str, file: &Path, stem: &str, frames: usize) -> Vec<
         "--out".into(),
         out.display().to_string(),
         "--quiet".into(),
-        "--preview-width".into(),
-        "160".into(),
+        "--preview-size".into(),
+        "160x120".into(),
     ];
     let command = match <Command as clap::Parser>::try_parse_from(argv) {
         Ok(c) => c,

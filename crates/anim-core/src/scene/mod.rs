@@ -9,7 +9,8 @@
 //!   continues bit for bit;
 //! - [`View`]: what the scene looks like: its static [`Context`] once (topology, ground, pins,
 //!   colliders, tank walls, the region the motion stays in) and a [`Frame`] per output time
-//!   (points, or the cells of an image grid, with named fields).
+//!   (points, or the cells of an image grid, with named fields), y up whatever the solver's
+//!   own frame ([`turn_z_up`] turns a z-up solver's).
 //!
 //! Every type that implements the three, paired with its state in a [`Simulated`], is a
 //! [`DynScene`]: an object-safe scene the run loop can step, checkpoint and draw behind a
@@ -49,6 +50,7 @@ mod placement;
 mod preset;
 pub mod study;
 pub mod systems;
+mod turn;
 mod view;
 
 pub use checkpoint::{
@@ -59,4 +61,5 @@ pub use looped::Looped;
 pub use pin::{PinBox, PinError, PinSpec};
 pub use placement::{ObstacleMesh, Placement, is_unit_scale, unit_scale};
 pub use preset::{BuildContext, BuildError, BuildFn, Preset, RunDefaults, SceneKind, is_default, params};
-pub use view::{Context, Field, Frame, ImageGrid, MeshProp, Prop, View, frame_box, ground_height};
+pub use turn::turn_z_up;
+pub use view::{Context, Field, Frame, ImageGrid, MeshProp, Prop, Up, View, frame_box, ground_height};

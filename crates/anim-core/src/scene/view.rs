@@ -1,8 +1,13 @@
 //! [`View`]: what a scene looks like, apart from how it is stepped.
 //!
-//! Everything is in one world frame with **z up** and gravity along `-z`; a crate whose solver
-//! works in another frame (a fluid with y up, a 2D solver in its plane) turns its points into
-//! this one in [`View::frame`].
+//! Everything a view gives is in one right-handed world frame with **y up** and gravity along
+//! `-y`, as in glTF, three.js and Bevy: every [`Frame`] (points and vector fields) and every
+//! part of the [`Context`] (props, mesh props, bounds, image grids). A 2D scene lies in the xy
+//! plane (`z = 0`, [`Context::planar`]), x to the right and y up. A crate whose solver works z
+//! up (gravity along `-z`) builds its context and frames in its own frame and turns them at the
+//! end with [`Context::turn_z_up`] and [`Frame::turn_z_up`]: the rotation
+//! `(x, y, z) -> (x, z, -y)` about x ([`turn_z_up`]), which keeps lengths, angles and
+//! handedness. Scene files keep each solver's own coordinates.
 
 use crate::geometry::Shape;
 use crate::solver::Solver;
@@ -18,6 +23,9 @@ pub struct Context {
     /// plane (an oscillator, an orbit), 3 for particles and meshes. 0 for an image grid, whose
     /// frames have no points.
     pub point_dim: usize,
+    /// Whether the scene is 2D: its points (3 coordinates each) lie in the xy plane, `z = 0`,
+    /// and are drawn as such, looking along `-z` with x to the right and y up.
+    pub planar: bool,
     /// Line segments between points (springs, rope links, robot links).
     pub lines: Vec<[usize; 2]>,
     /// Surface triangles (cloth, the boundary of a solid), counter-clockwise seen from outside.
@@ -46,7 +54,7 @@ pub struct Context {
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 #[non_exhaustive]
 pub enum Prop {
-    /// The ground plane `z = height`.
+    /// The ground plane `y = height`.
     Ground {
         /// Height of the plane (m).
         height: f64,
@@ -116,8 +124,9 @@ impl From<&ClosedSurface> for MeshProp {
 }
 
 impl Prop {
-    /// The prop a collider shape is drawn as: a sphere, capsule or box (a cuboid). Planes are
-    /// `None`: the previews draw only the ground ([`ground_height`]).
+    /// The prop a collider shape is drawn as: a sphere, capsule or box (a cuboid), in the
+    /// shape's own frame (a z-up crate turns its context after, [`Context::turn_z_up`]). Planes
+    /// are `None`: the previews draw only the ground ([`ground_height`]).
     #[must_use]
     pub fn of_shape(shape: &Shape) -> Option<Self> {
         match *shape {
@@ -132,11 +141,36 @@ impl Prop {
     }
 }
 
-/// The height of the first plane among `shapes` whose normal points straight up (`+z`, any
-/// length): the ground a preview draws.
-pub fn ground_height<'a>(shapes: impl IntoIterator<Item = &'a Shape>) -> Option<f64> {
+/// The axis that points up in a solver's own frame: y in the frames every view gives and in the
+/// y-up solvers (MPM, FLIP, grid fluids), z in the z-up ones (springs, PBD, FEM, rigid bodies).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Up {
+    /// `+y` up, gravity along `-y`: the frame of every [`Frame`] and [`Context`].
+    Y,
+    /// `+z` up, gravity along `-z`: turned y up by [`turn_z_up`].
+    Z,
+}
+
+impl Up {
+    /// The index of the axis: 1 for y, 2 for z.
+    #[must_use]
+    pub fn axis(self) -> usize {
+        match self {
+            Up::Y => 1,
+            Up::Z => 2,
+        }
+    }
+}
+
+/// The height along `up` of the first plane among `shapes` whose normal points straight up
+/// along it (`+y` or `+z`, any length): the ground a preview draws, in the frame of `shapes`.
+/// The plane `z = h` of a z-up solver is the ground `y = h` once turned ([`turn_z_up`]).
+pub fn ground_height<'a>(shapes: impl IntoIterator<Item = &'a Shape>, up: Up) -> Option<f64> {
+    let a = up.axis();
     shapes.into_iter().find_map(|s| match *s {
-        Shape::Plane { point, normal: [nx, ny, nz] } if nx == 0.0 && ny == 0.0 && nz > 0.0 => Some(point[2]),
+        Shape::Plane { point, normal } if (0..3).all(|k| k == a || normal[k] == 0.0) && normal[a] > 0.0 => {
+            Some(point[a])
+        }
         _ => None,
     })
 }
@@ -220,12 +254,15 @@ impl Frame {
     }
 }
 
-/// The region the motion of a scene starting at `points` (flat, 3 per point, z up) stays in,
-/// for [`Context::bounds`]: their bounding box widened sideways (x, y) by a third of its size,
-/// when `falls` extended down along gravity (-z) to 1.3 times its size below its top, and down
-/// to the ground when there is one. `([-1; 3], [1; 3])` for no points.
+/// The region the motion of a scene starting at `points` (flat, 3 per point, `up` the axis that
+/// points up in their frame: y for a view's frames) stays in, for [`Context::bounds`]: their
+/// bounding box widened sideways (the two other axes) by a third of its size, when `falls`
+/// extended down along gravity (`-y`, or `-z` for [`Up::Z`]) to 1.3 times its size below its
+/// top, and down to the ground (the height along `up`) when there is one. `([-1; 3], [1; 3])`
+/// for no points. A z-up crate frames its own points and turns the box with its context
+/// ([`Context::turn_z_up`]).
 #[must_use]
-pub fn frame_box(points: &[f64], ground: Option<f64>, falls: bool) -> ([f64; 3], [f64; 3]) {
+pub fn frame_box(points: &[f64], up: Up, ground: Option<f64>, falls: bool) -> ([f64; 3], [f64; 3]) {
     let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
     for p in points.chunks_exact(3) {
         for k in 0..3 {
@@ -237,15 +274,16 @@ pub fn frame_box(points: &[f64], ground: Option<f64>, falls: bool) -> ([f64; 3],
         return ([-1.0; 3], [1.0; 3]);
     }
     let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-3);
-    for k in 0..2 {
+    let a = up.axis();
+    for k in (0..3).filter(|&k| k != a) {
         lo[k] -= size / 3.0;
         hi[k] += size / 3.0;
     }
     if falls {
-        lo[2] = (hi[2] - 1.3 * size).min(lo[2]);
+        lo[a] = (hi[a] - 1.3 * size).min(lo[a]);
     }
-    if let Some(z) = ground {
-        lo[2] = z;
+    if let Some(h) = ground {
+        lo[a] = h;
     }
     (lo, hi)
 }
@@ -272,7 +310,7 @@ pub trait View: Solver {
 
 #[cfg(test)]
 mod tests {
-    use super::{Prop, Shape, frame_box, ground_height};
+    use super::{Prop, Shape, Up, frame_box, ground_height};
 
     #[test]
     fn shapes_are_drawn_as_props_and_the_first_upward_plane_is_the_ground() {
@@ -292,17 +330,33 @@ mod tests {
             plane(-0.5, [0.0, 0.0, 2.0]),
             plane(3.0, [0.0, 0.0, 1.0]),
         ];
-        assert_eq!(ground_height(&shapes), Some(-0.5));
-        assert_eq!(ground_height(&shapes[..3]), None);
+        assert_eq!(ground_height(&shapes, Up::Z), Some(-0.5));
+        assert_eq!(ground_height(&shapes[..3], Up::Z), None);
+        // Up along y: the first plane of normal +y (any length), its point's y.
+        assert_eq!(ground_height(&shapes, Up::Y), None);
+        let at = |y: f64, normal: [f64; 3]| Shape::Plane { point: [5.0, y, 7.0], normal };
+        let y_up = [
+            at(1.0, [0.0, 0.0, 1.0]),
+            at(2.0, [0.0, -1.0, 0.0]),
+            at(3.0, [0.1, 1.0, 0.0]),
+            at(4.0, [0.0, 0.5, 0.0]),
+        ];
+        assert_eq!(ground_height(&y_up, Up::Y), Some(4.0));
     }
 
     #[test]
     fn the_frame_box_frames_the_points_and_reaches_the_ground() {
-        assert_eq!(frame_box(&[], None, true), ([-1.0; 3], [1.0; 3]));
-        // Points from (0, 0, 1) to (3, 0, 1): size 3, widened by 1 on each side in x and y.
+        assert_eq!(frame_box(&[], Up::Y, None, true), ([-1.0; 3], [1.0; 3]));
+        // Points from (0, 1, 0) to (3, 1, 0): size 3, widened by 1 on each side in x and z;
+        // falling, down along -y to 1.3 sizes below the top, or to the ground.
+        let x = [0.0, 1.0, 0.0, 3.0, 1.0, 0.0];
+        assert_eq!(frame_box(&x, Up::Y, None, false), ([-1.0, 1.0, -1.0], [4.0, 1.0, 1.0]));
+        assert_eq!(frame_box(&x, Up::Y, None, true).0, [-1.0, 1.0 - 1.3 * 3.0, -1.0]);
+        assert_eq!(frame_box(&x, Up::Y, Some(0.25), true).0, [-1.0, 0.25, -1.0]);
+        // The same points z up: from (0, 0, 1) to (3, 0, 1), widened in x and y, falling along -z.
         let x = [0.0, 0.0, 1.0, 3.0, 0.0, 1.0];
-        assert_eq!(frame_box(&x, None, false), ([-1.0, -1.0, 1.0], [4.0, 1.0, 1.0]));
-        assert_eq!(frame_box(&x, None, true).0[2], 1.0 - 1.3 * 3.0);
-        assert_eq!(frame_box(&x, Some(0.25), true).0[2], 0.25);
+        assert_eq!(frame_box(&x, Up::Z, None, false), ([-1.0, -1.0, 1.0], [4.0, 1.0, 1.0]));
+        assert_eq!(frame_box(&x, Up::Z, None, true).0[2], 1.0 - 1.3 * 3.0);
+        assert_eq!(frame_box(&x, Up::Z, Some(0.25), true).0[2], 0.25);
     }
 }

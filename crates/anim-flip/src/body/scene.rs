@@ -1,8 +1,8 @@
 //! [`BodyScene`]: a fluid of bodies in its tank, stepped and checkpointed as the
 //! [`FlipSimulation`] it holds, drawn in the scene file's frame (the tank's inside from the
-//! origin) turned z up, with its obstacles.
+//! origin, y up like every view's frames), with its obstacles.
 
-use crate::kind::{box_z_up, z_up};
+use crate::kind::{widened, widened_box};
 use crate::particles::Particles;
 use crate::sim::FlipSimulation;
 use anim_core::geometry::Shape;
@@ -20,7 +20,7 @@ pub struct BodyScene<const D: usize> {
     pub origin: [f64; D],
     /// The obstacle shapes, in the scene file's frame (drawn as props).
     pub obstacles: Vec<Shape>,
-    /// The mesh obstacles as drawn (z up).
+    /// The mesh obstacles as drawn (the scene file's frame).
     pub meshes: Vec<MeshProp>,
 }
 
@@ -41,15 +41,17 @@ impl<const D: usize> BodyScene<D> {
     }
 }
 
-/// The prop an obstacle shape of a `D`-dimensional scene is drawn as, z up; planes none.
+/// The prop an obstacle shape of a `D`-dimensional scene is drawn as; planes none.
 fn prop<const D: usize>(shape: &Shape) -> Option<Prop> {
     // The first `D` components (in 2D the plane z = 0).
     let cut = |v: [f64; 3]| -> [f64; D] { std::array::from_fn(|k| v[k]) };
     match *shape {
-        Shape::Sphere { center, radius } => Some(Prop::Sphere { center: z_up(&cut(center)), radius }),
-        Shape::Capsule { a, b, radius } => Some(Prop::Capsule { a: z_up(&cut(a)), b: z_up(&cut(b)), radius }),
+        Shape::Sphere { center, radius } => Some(Prop::Sphere { center: widened(&cut(center)), radius }),
+        Shape::Capsule { a, b, radius } => {
+            Some(Prop::Capsule { a: widened(&cut(a)), b: widened(&cut(b)), radius })
+        }
         Shape::Box { center, half_extents: e } => {
-            let (lo, hi) = box_z_up::<D>(
+            let (lo, hi) = widened_box::<D>(
                 &std::array::from_fn(|k| center[k] - e[k]),
                 &std::array::from_fn(|k| center[k] + e[k]),
             );
@@ -99,12 +101,13 @@ impl<const D: usize> View for BodyScene<D> {
     }
 
     /// Particles drawn as discs of a quarter cell, the tank's inner walls (from the origin to
-    /// 1 m, z up; they are also the bounds) and the obstacle shapes but planes.
+    /// 1 m; they are also the bounds) and the obstacle shapes but planes.
     fn context(&self, _: &Particles<D>) -> Context {
         let (lo, hi) = self.sim.fluid_box();
-        let tank = box_z_up(&self.to_scene(&lo), &self.to_scene(&hi));
+        let tank = widened_box(&self.to_scene(&lo), &self.to_scene(&hi));
         let mut context = Context::default();
         context.point_dim = 3;
+        context.planar = D == 2;
         context.point_radius = 0.25 * self.sim.grid().h();
         context.props.push(Prop::Tank { lo: tank.0, hi: tank.1 });
         context.props.extend(self.obstacles.iter().filter_map(prop::<D>));
@@ -117,11 +120,11 @@ impl<const D: usize> View for BodyScene<D> {
         out.time = self.sim.time();
         out.points.clear();
         for x in &particles.x {
-            out.points.extend(z_up(&self.to_scene(x)));
+            out.points.extend(widened(&self.to_scene(x)));
         }
         let velocity = out.field_mut("velocity", 3);
         for v in &particles.v {
-            velocity.extend(z_up(v));
+            velocity.extend(widened(v));
         }
     }
 }

@@ -181,40 +181,42 @@ fn obstacle_cells_are_solid_no_particle_enters_them_and_the_volume_is_kept() {
     assert!(p.x.iter().all(|x| x[1] - scene.origin[1] < 0.45), "the blob did not fall");
 }
 
-/// Frames are in the scene file's frame (the tank's inside from the origin), turned z up; the
-/// context draws the tank from the origin to 1 m and the sphere obstacle.
+/// Frames are in the scene file's frame (the tank's inside from the origin), y up as the file
+/// and every view's frames are; the context draws the tank from the origin to 1 m and the
+/// sphere obstacle; a 2D scene lies in the plane z = 0.
 #[test]
-fn frames_and_props_are_in_the_scene_files_frame_z_up() {
+fn frames_and_props_are_in_the_scene_files_frame_y_up() {
     let mut scene = (KIND.build)(&pool_around_a_sphere(3), &testdata()).expect("builds");
     let mut frame = Frame::default();
     scene.frame(&mut frame);
     let points: Vec<&[f64]> = frame.points.chunks_exact(3).collect();
-    // The pool's lowest particles a quarter spacing above the floor, y -> z; z -> -y.
+    // The pool's lowest particles half a spacing above the floor (y) and in from the wall z = 0.
     let spacing = 0.5 / 16.0;
+    let min_y = points.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
     let min_z = points.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min);
-    let max_y = points.iter().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max);
     assert!(
-        (min_z - spacing / 2.0).abs() < 1e-12 && (max_y + spacing / 2.0).abs() < 1e-12,
-        "{min_z} {max_y}"
+        (min_y - spacing / 2.0).abs() < 1e-12 && (min_z - spacing / 2.0).abs() < 1e-12,
+        "{min_y} {min_z}"
     );
     let velocity = &frame.field("velocity").expect("velocities").values;
-    assert!(velocity.chunks_exact(3).any(|v| v == [0.0, -0.0, -1.5]));
+    assert!(velocity.chunks_exact(3).any(|v| v == [0.0, -1.5, 0.0]));
     let context = scene.context();
     assert_eq!(
         context.props,
         vec![
-            Prop::Tank { lo: [0.0, -1.0, 0.0], hi: [1.0, 0.0, 1.0] },
-            Prop::Sphere { center: [0.5, -0.5, 0.12], radius: 0.16 },
+            Prop::Tank { lo: [0.0; 3], hi: [1.0; 3] },
+            Prop::Sphere { center: [0.5, 0.12, 0.5], radius: 0.16 },
         ]
     );
-    assert_eq!(context.bounds, Some(([0.0, -1.0, 0.0], [1.0, 0.0, 1.0])));
+    assert_eq!(context.bounds, Some(([0.0; 3], [1.0; 3])));
+    assert!(!context.planar);
     scene.step(0.02).expect("step");
-    // 2D: the plane y = 0 of the pictures.
+    // 2D: the plane z = 0.
     let scene = (KIND.build)(&pool_around_a_sphere(2), &testdata()).expect("builds");
     scene.frame(&mut frame);
-    assert!(frame.points.chunks_exact(3).all(|p| p[1] == 0.0 && p[0] > 0.0 && p[2] > 0.0));
-    assert_eq!(scene.context().props[1], Prop::Sphere { center: [0.5, 0.0, 0.12], radius: 0.16 });
-    assert!(scene.context().mesh_props.is_empty());
+    assert!(frame.points.chunks_exact(3).all(|p| p[2] == 0.0 && p[0] > 0.0 && p[1] > 0.0));
+    assert_eq!(scene.context().props[1], Prop::Sphere { center: [0.5, 0.12, 0.0], radius: 0.16 });
+    assert!(scene.context().mesh_props.is_empty() && scene.context().planar);
 }
 
 /// A scene of bodies resumes from its checkpoint bit for bit.
@@ -390,7 +392,7 @@ fn an_obstacle_mesh_makes_the_cells_of_the_equal_box_solid() {
             .expect("builds");
     assert_eq!(by_mesh.sim.solid(), by_box.sim.solid());
     assert_eq!(by_mesh.sim.solid().iter().filter(|s| **s).count(), 18 * 18 * 18 - 16 * 16 * 16 + 4 * 4 * 4);
-    // Drawn where the box is, z up (the box prop's corners), the shape obstacle as a prop.
+    // Drawn where the box is (the box prop's corners), the shape obstacle as a prop.
     assert!(by_mesh.meshes.len() == 1 && by_box.meshes.is_empty());
     let corners = |p: &[[f64; 3]]| {
         let lo = p.iter().fold([f64::INFINITY; 3], |a, q| std::array::from_fn(|k| a[k].min(q[k])));

@@ -95,10 +95,11 @@ fn every_preset_builds_steps_and_draws() {
 }
 
 /// The frame is the old display state: the preset's particles after the same steps, in the
-/// world frame (the moving tank's displacement and velocity added along x) with z up, and the
-/// context the tank, a quarter-cell radius and the swept region as bounds.
+/// world frame (the moving tank's displacement and velocity added along x) with y up as the
+/// solver has it, 2D scenes in the plane z = 0, and the context the tank, a quarter-cell radius
+/// and the swept region as bounds.
 #[test]
-fn frames_are_the_particles_z_up_in_the_world_frame() {
+fn frames_are_the_particles_y_up_in_the_world_frame() {
     for name in scenes::NAMES {
         let (mut scene, dt) = quick(name);
         let dim = if name.ends_with("3d") { 3 } else { 2 };
@@ -150,22 +151,19 @@ fn frames_are_the_particles_z_up_in_the_world_frame() {
         if name == "sloshing-tank" {
             assert!(shift != 0.0 && dv != 0.0, "the tank does not move");
         }
-        // (x, y, z) y up -> (x + shift, -z, y) z up; in 2D z = 0 (shown as +0.0).
-        let z_up = |a: &[f64], s: f64| -> Vec<f64> {
-            a.chunks_exact(3).flat_map(|c| [c[0] + s, if dim == 3 { -c[2] } else { 0.0 }, c[1]]).collect()
+        // (x, y, z) y up -> (x + shift, y, z), unturned; in 2D z = 0.
+        let moved = |a: &[f64], s: f64| -> Vec<f64> {
+            a.chunks_exact(3).flat_map(|c| [c[0] + s, c[1], c[2]]).collect()
         };
-        let expected = Frame { time: t, points: z_up(&x, shift), ..Frame::default() };
+        let expected = Frame { time: t, points: moved(&x, shift), ..Frame::default() };
         let mut expected = expected;
-        expected.field_mut("velocity", 3).extend(z_up(&v, dv));
+        expected.field_mut("velocity", 3).extend(moved(&v, dv));
         assert_eq!(bits(&f), bits(&expected), "{name}");
         assert_eq!(f.fields.len(), 1);
-        // The tank at rest, z up; the bounds reach as far as the tank moves.
+        // The tank at rest, y up; the bounds reach as far as the tank moves.
         let amplitude = motion.map_or(0.0, |m| m.amplitude);
-        let corners = |lo: &[f64], hi: &[f64]| {
-            let (zl, zh) = if dim == 3 { (-hi[2], -lo[2]) } else { (0.0, 0.0) };
-            ([lo[0], zl, lo[1]], [hi[0], zh, hi[1]])
-        };
-        let tank = corners(&lo, &hi);
+        let tank: ([f64; 3], [f64; 3]) = (std::array::from_fn(|k| lo[k]), std::array::from_fn(|k| hi[k]));
+        assert_eq!(context.planar, dim == 2, "{name}");
         assert_eq!(context.props, vec![Prop::Tank { lo: tank.0, hi: tank.1 }], "{name}");
         let (mut blo, mut bhi) = tank;
         blo[0] -= amplitude;

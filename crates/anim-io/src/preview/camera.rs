@@ -1,4 +1,6 @@
-//! A look-at camera with perspective or orthographic projection.
+//! A look-at camera with perspective or orthographic projection. The workspace's scenes are
+//! y up: [`Camera::framing`] with up `(0, 1, 0)` shows a 3-D scene standing, and
+//! [`Camera::xy_plane`] a 2-D one (the xy plane, x right and y up).
 
 use glam::DVec3;
 
@@ -70,10 +72,45 @@ impl Camera {
         Camera::look_at(eye.into(), centre.into(), up).perspective(fov)
     }
 
-    /// An orthographic camera looking down the z axis at the rectangle `[min, max]` of the xy
-    /// plane (y up), with a 5 % margin, for 2-D simulations. `aspect` is the image's width over
-    /// height.
-    pub fn top_down_2d(min: [f64; 2], max: [f64; 2], aspect: f64) -> Self {
+    /// A perspective camera (40 degree vertical field of view) looking along `direction` at
+    /// the centre of the box `[min, max]`, as near as it can be with every corner of the box in
+    /// an image of width over height `aspect` (5 % in from its edges): the box fills the picture
+    /// along its tighter side.
+    pub fn fitting(min: [f64; 3], max: [f64; 3], direction: [f64; 3], up: [f64; 3], aspect: f64) -> Self {
+        let (min, max) = (DVec3::from(min), DVec3::from(max));
+        let centre = 0.5 * (min + max);
+        let fov: f64 = 40.0;
+        let aspect = if aspect > 0.0 && aspect.is_finite() { aspect } else { 1.0 };
+        let ty = 0.95 * (0.5 * fov.to_radians()).tan();
+        let tx = aspect * ty;
+        let forward = DVec3::from(direction).try_normalize().unwrap_or(DVec3::NEG_Z);
+        let right = forward
+            .cross(DVec3::from(up))
+            .try_normalize()
+            .or_else(|| forward.cross(DVec3::X).try_normalize())
+            .unwrap_or(DVec3::Y);
+        let true_up = right.cross(forward);
+        // A corner at (x, y) across the view and z along it from the centre is in the picture
+        // when |x| <= tx (d + z) and |y| <= ty (d + z), d the eye's distance to the centre.
+        let mut dist = 1e-9_f64;
+        for i in 0..8 {
+            let corner = DVec3::new(
+                if i & 1 == 1 { max.x } else { min.x },
+                if i & 2 == 2 { max.y } else { min.y },
+                if i & 4 == 4 { max.z } else { min.z },
+            );
+            let v = corner - centre;
+            let (x, y, z) = (v.dot(right), v.dot(true_up), v.dot(forward));
+            dist = dist.max(x.abs() / tx - z).max(y.abs() / ty - z);
+        }
+        let eye = centre - forward * dist;
+        Camera::look_at(eye.into(), centre.into(), up).perspective(fov)
+    }
+
+    /// An orthographic camera looking along `-z` at the rectangle `[min, max]` of the xy plane,
+    /// x to the right and y up, with a 5 % margin: the view of a 2-D scene. `aspect` is the
+    /// image's width over height.
+    pub fn xy_plane(min: [f64; 2], max: [f64; 2], aspect: f64) -> Self {
         let cx = 0.5 * (min[0] + max[0]);
         let cy = 0.5 * (min[1] + max[1]);
         let w = (max[0] - min[0]).abs();
@@ -207,11 +244,47 @@ mod tests {
     }
 
     #[test]
-    fn top_down_2d_fits_the_rectangle() {
-        let cam = Camera::top_down_2d([0.0, 0.0], [2.0, 1.0], 2.0);
+    fn the_xy_plane_camera_fits_the_rectangle() {
+        let cam = Camera::xy_plane([0.0, 0.0], [2.0, 1.0], 2.0);
         let v = cam.view(200, 100);
+        // The upper right corner (x right, y up) near the image's top right, the lower left
+        // near its bottom left.
         let p = v.project(DVec3::new(2.0, 1.0, 0.0)).unwrap();
         assert!(p.x <= 200.0 && p.x > 190.0 && p.y >= 0.0 && p.y < 10.0, "{p:?}");
+        let q = v.project(DVec3::new(0.0, 0.0, 0.0)).unwrap();
+        assert!(q.x >= 0.0 && q.x < 10.0 && q.y <= 100.0 && q.y > 90.0, "{q:?}");
+    }
+
+    /// Every corner of the box lands inside the picture, and one touches the 5 % margin of
+    /// the picture's tighter side: the box is as large as it can be.
+    #[test]
+    fn a_fitting_camera_shows_the_whole_box_as_large_as_it_fits() {
+        for (min, max, aspect) in [
+            ([-1.0, 0.0, -1.0], [1.0, 2.0, 1.0], 4.0 / 3.0),
+            ([0.0, 0.0, 0.0], [3.0, 0.5, 0.2], 4.0 / 3.0),
+            ([0.0, -5.0, 0.0], [0.1, 5.0, 0.1], 1.0),
+        ] {
+            let (w, h) = ((400.0 * aspect) as u32, 400);
+            let v = Camera::fitting(min, max, [0.55, -0.45, -1.0], [0.0, 1.0, 0.0], aspect).view(w, h);
+            let mut slack = f64::INFINITY;
+            for i in 0..8 {
+                let p = DVec3::new(
+                    if i & 1 == 1 { max[0] } else { min[0] },
+                    if i & 2 == 2 { max[1] } else { min[1] },
+                    if i & 4 == 4 { max[2] } else { min[2] },
+                );
+                let q = v.project(p).unwrap();
+                let (mx, my) = (0.025 * f64::from(w), 0.025 * f64::from(h));
+                assert!(q.x >= mx - 1e-6 && q.x <= f64::from(w) - mx + 1e-6, "{min:?} {max:?}: {q:?}");
+                assert!(q.y >= my - 1e-6 && q.y <= f64::from(h) - my + 1e-6, "{min:?} {max:?}: {q:?}");
+                slack = slack
+                    .min((q.x - mx).min(f64::from(w) - mx - q.x).min(q.y - my).min(f64::from(h) - my - q.y));
+            }
+            assert!(
+                slack.abs() < 1e-6,
+                "{min:?} {max:?}: the nearest corner is {slack} px in from the margin"
+            );
+        }
     }
 
     #[test]

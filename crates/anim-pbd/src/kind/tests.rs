@@ -21,6 +21,11 @@ fn frame_of(scene: &dyn DynScene) -> Frame {
     frame
 }
 
+/// Flat z-up triples `(x, y, z)` as the y-up `(x, z, -y)` every frame has.
+fn y_up(values: &[f64]) -> Vec<f64> {
+    values.chunks_exact(3).flat_map(|p| [p[0], p[2], -p[1]]).collect()
+}
+
 fn bits(values: &[f64]) -> Vec<u64> {
     values.iter().map(|v| v.to_bits()).collect()
 }
@@ -80,9 +85,10 @@ fn the_frame_is_the_simulation_state() {
         scene.step(DT).expect("step");
         sim.step(&mut state, DT).expect("step");
     }
+    // The model's z-up state, drawn y up.
     let frame = frame_of(scene.as_ref());
-    assert_eq!(bits(&frame.points), bits(&state.x));
-    assert_eq!(bits(&frame.field("velocity").expect("v").values), bits(&state.v));
+    assert_eq!(bits(&frame.points), bits(&y_up(&state.x)));
+    assert_eq!(bits(&frame.field("velocity").expect("v").values), bits(&y_up(&state.v)));
     assert_eq!(frame.time.to_bits(), state.t.to_bits());
     assert!(scene.reference_error().is_none());
 }
@@ -97,24 +103,26 @@ fn the_context_draws_the_model_its_pins_and_its_static_colliders() {
     assert_eq!(c.triangles.len(), 2 * 13 * 13);
     assert!(c.lines.is_empty() && c.tetrahedra.is_empty() && c.props.is_empty());
     assert_eq!(c.point_radius, 0.2 * 0.01);
-    // Falling, no ground: 1.3 sides below the top.
+    // Falling, no ground: 1.3 sides below the top. The model's box from (-1/6, -1/6, 0.35)
+    // to (2/3, 2/3, 1), z up, drawn y up.
     assert_eq!(
         c.bounds,
-        Some(([-0.5 / 3.0, -0.5 / 3.0, 1.0 - 1.3 * 0.5], [0.5 + 0.5 / 3.0, 0.5 + 0.5 / 3.0, 1.0]))
+        Some(([-0.5 / 3.0, 1.0 - 1.3 * 0.5, -(0.5 + 0.5 / 3.0)], [0.5 + 0.5 / 3.0, 1.0, 0.5 / 3.0]))
     );
     assert_eq!(cloth.method(), "xpbd / gaussseidel, 1 iteration x 8 substeps");
-    // The drape: ground and sphere, nothing pinned.
+    // The drape: ground and sphere (at (0.05, 0, 0.35) z up), nothing pinned.
     let drape = build_params(&preset("drape").params);
     let c = drape.context();
     assert_eq!(
         c.props,
-        vec![Prop::Ground { height: 0.0 }, Prop::Sphere { center: [0.05, 0.0, 0.35], radius: 0.35 }]
+        vec![Prop::Ground { height: 0.0 }, Prop::Sphere { center: [0.05, 0.35, 0.0], radius: 0.35 }]
     );
     assert!(c.pins.is_empty());
-    assert_eq!(c.bounds.expect("bounds").0[2], 0.0);
+    assert_eq!(c.bounds.expect("bounds").0[1], 0.0);
     assert_eq!(drape.method(), "xpbd / coloredgaussseidel, 5 iterations x 4 substeps");
     // The rope: 100 links as lines of mean length 2 cm, pinned at its start, the capsule and
-    // the box after the ground.
+    // the box after the ground: z up the capsule runs from (0.7, -0.5, 0.9) to (0.7, 0.5, 0.9)
+    // and the box spans (0.65, -0.4, 0) to (1.15, 0.4, 0.3).
     let rope = build_params(&preset("pbd-rope").params);
     let c = rope.context();
     assert_eq!(c.lines.len(), 100);
@@ -126,8 +134,8 @@ fn the_context_draws_the_model_its_pins_and_its_static_colliders() {
         c.props,
         vec![
             Prop::Ground { height: 0.0 },
-            Prop::Capsule { a: [0.7, -0.5, 0.9], b: [0.7, 0.5, 0.9], radius: 0.08 },
-            Prop::Cuboid { lo: [0.9 - 0.25, 0.0 - 0.4, 0.15 - 0.15], hi: [0.9 + 0.25, 0.4, 0.15 + 0.15] },
+            Prop::Capsule { a: [0.7, 0.9, 0.5], b: [0.7, 0.9, -0.5], radius: 0.08 },
+            Prop::Cuboid { lo: [0.9 - 0.25, 0.15 - 0.15, 0.0 - 0.4], hi: [0.9 + 0.25, 0.15 + 0.15, 0.4] },
         ]
     );
     assert_eq!(rope.method(), "xpbd / gaussseidel, 2 iterations x 16 substeps");

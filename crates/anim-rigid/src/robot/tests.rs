@@ -40,12 +40,13 @@ fn build_kind(value: serde_json::Value, base: &Path) -> Result<Box<dyn DynScene>
     (KIND.build)(&value, &BuildContext { base: Some(base) })
 }
 
-/// The hinge angle from the drawn tip (the segment hinge -> tip ends at (cos q, sin q, 0)).
+/// The hinge angle from the drawn tip (the segment hinge -> tip ends at (cos q, sin q, 0) in
+/// the robot's z-up frame, drawn y up at (cos q, 0, -sin q)).
 fn tip_angle(scene: &dyn DynScene) -> f64 {
     let mut frame = Frame::default();
     scene.frame(&mut frame);
     assert_eq!(frame.points.len(), 6, "one segment: the hinge and the tip");
-    frame.points[4].atan2(frame.points[3])
+    (-frame.points[5]).atan2(frame.points[3])
 }
 
 #[test]
@@ -263,14 +264,15 @@ fn a_single_floating_body_is_drawn_at_its_origin_and_falls() {
     std::fs::write(dir.join("ball.urdf"), urdf).expect("write the URDF");
     let params = serde_json::json!({ "robot": { "urdf": "ball.urdf", "base": "floating", "base_position": [0.0, 0.0, 2.0] } });
     let mut scene = build_kind(params, &dir).expect("builds");
+    // At (0, 0, 2) in the robot's z-up frame, drawn y up at (0, 2, 0).
     let mut frame = Frame::default();
     scene.frame(&mut frame);
-    assert_eq!(frame.points, [0.0, 0.0, 2.0, 0.0, 0.0, 2.0]);
+    assert_eq!(frame.points, [0.0, 2.0, 0.0, 0.0, 2.0, 0.0]);
     for _ in 0..100 {
         scene.step(1e-3).expect("step");
     }
     scene.frame(&mut frame);
-    // Free fall for 0.1 s: z = 2 - g t^2 / 2 (RK4 is exact on it up to rounding).
-    assert!((frame.points[2] - (2.0 - 0.5 * 9.81 * 0.01)).abs() < 1e-12, "z = {}", frame.points[2]);
+    // Free fall for 0.1 s along -y: y = 2 - g t^2 / 2 (RK4 is exact on it up to rounding).
+    assert!((frame.points[1] - (2.0 - 0.5 * 9.81 * 0.01)).abs() < 1e-12, "y = {}", frame.points[1]);
     let _ = std::fs::remove_dir_all(dir);
 }

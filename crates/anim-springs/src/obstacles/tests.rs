@@ -69,10 +69,11 @@ fn a_cloth_rests_on_a_mesh_block_and_refusals_name_the_field_and_the_file() {
     };
     let contact = serde_json::json!({ "stiffness": 1e3, "thickness": 0.01 });
     let scene = |meshes: serde_json::Value| serde_json::json!({ "bodies": [cloth], "obstacle_meshes": meshes, "contact": contact });
-    // The picture draws the block's twelve triangles where it is placed.
+    // The picture draws the block's twelve triangles where it is placed, its height (z in the
+    // scene file) along y in the picture.
     let drawn = build(scene(serde_json::json!([block]))).expect("builds").context().mesh_props;
     assert!(drawn.len() == 1 && drawn[0].triangles.len() == 12, "{drawn:?}");
-    let lowest = drawn[0].positions.iter().map(|p| p[2]).fold(f64::INFINITY, f64::min);
+    let lowest = drawn[0].positions.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
     assert_eq!(lowest, block["translate"][2].as_f64().unwrap());
     let rest = |params: serde_json::Value| {
         let mut s = build(params).expect("builds");
@@ -87,8 +88,8 @@ fn a_cloth_rests_on_a_mesh_block_and_refusals_name_the_field_and_the_file() {
     let boxed =
         serde_json::json!([{ "box": { "center": [0.0, 0.0, 0.0], "half_extents": [0.5, 0.5, 0.5] } }]);
     let on_box = rest(serde_json::json!({ "bodies": [cloth], "obstacles": boxed, "contact": contact }));
-    // Resting on the top, held 1 cm off it.
-    assert!(on_mesh.chunks(3).all(|p| (p[2] - 0.51).abs() < 2e-3), "{on_mesh:?}");
+    // Resting on the top, held 1 cm off it (the frames' y is the scene's z).
+    assert!(on_mesh.chunks(3).all(|p| (p[1] - 0.51).abs() < 2e-3), "{on_mesh:?}");
     // The top face is flat: the field is exact there, to the f32 of its nodes.
     let apart = on_mesh.iter().zip(&on_box).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
     assert!(apart < 1e-6, "{apart}");
