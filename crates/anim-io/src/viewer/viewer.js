@@ -454,7 +454,9 @@ async function main() {
   options.forEach((o, k) => select.add(new Option(o.label, String(k))));
   const asked = hash.get("color");
   let pick = asked ? options.findIndex((o) => o.label === asked || o.name === asked) : -1;
-  if (pick < 0) pick = options.findIndex((o) => o.categorical);
+  // Materials by default where there are several; one material shows nothing.
+  const several = (o) => { const v = first && first.parts[o.name] ? first.parts[o.name].values : []; return v.some((x) => x !== v[0]); };
+  if (pick < 0) pick = options.findIndex((o) => o.categorical && several(o));
   if (pick < 0 && !triangles.length && !lines.length) pick = options.findIndex((o) => o.name === "velocity");
   if (pick < 0 && haveImage) pick = options.findIndex((o) => o.range && o.name);
   select.value = String(Math.max(pick, 0));
