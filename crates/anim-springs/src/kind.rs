@@ -59,7 +59,9 @@ pub struct SpringsParams {
     pub preset: Option<String>,
     /// Particles per side of a preset (the preset's default when absent: 32 for the cloth, 40
     /// for the rope, 6 for the jelly, 128 for the benchmark cloth); at least 2 (3 for the
-    /// rope), at most 4096. Not with `bodies` (a body's resolution is its mesh's).
+    /// rope), and no more than the memory holds: the scene's estimate ([`crate::memory`]) is
+    /// checked against the memory available before building. Not with `bodies` (a body's
+    /// resolution is its mesh's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
     /// Integrator override (the preset's when absent; backward Euler for bodies); a
@@ -140,6 +142,7 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
                     ));
                 }
             }
+            crate::memory::check_scene(name, p.resolution, p.integrator, p.linear_solver)?;
             preset_scene(name, p.resolution)?
         }
         (None, false) => {
