@@ -314,6 +314,8 @@ fn tolerance_adapter(
 ) -> Result<Box<dyn StudyAdapter>, String> {
     let p: SpringsParams = params(value).map_err(study::unreadable)?;
     let preset = p.preset.ok_or("--tolerance: a springs scene of bodies has no study, only the presets")?;
+    crate::memory::check_scene(&preset, p.resolution, p.integrator, p.linear_solver)
+        .map_err(study::unreadable)?;
     let scene = scenes::by_name(&preset, p.resolution)
         .ok_or_else(|| format!("--tolerance: unknown springs preset `{preset}`"))?
         .map_err(study::unreadable)?;
