@@ -10,7 +10,7 @@
 //! | springs | 184 | the spring, its compact ends and `[l, k, c]`, two incidences, the force and linearisation scratch, the pattern slots |
 //! | triangles | 24 | the triangles drawn (the cloth, the jelly's faces) |
 //! | matrix blocks | 144 | a 3x3 block of the assembled Jacobian (values and column indices), one per particle and two per spring, with an implicit integrator and a solver on the assembled matrix |
-//! | factor blocks | 144 | a 3x3 block of the sparse Cholesky factor (anim-core's [`cholesky_factor_blocks`]: the cloth a 2D mesh, the jelly a 3D one) |
+//! | factor blocks | 144 | a 3x3 block of the sparse Cholesky factor (anim-core's [`cholesky_factor_blocks`] of the lattice: the cloth's 2D grid, the jelly's 3D one) |
 
 use crate::network::{MAX_PARTICLES, MAX_SPRINGS};
 use crate::scenes;
@@ -27,9 +27,9 @@ pub struct NetworkSize {
     pub springs: f64,
     /// Triangles (cloth).
     pub triangles: f64,
-    /// The dimension of the mesh the springs connect (1 for a chain, 2 for a cloth, 3 for a
-    /// lattice): how a Cholesky factor fills.
-    pub dim: usize,
+    /// The particles along each side of the lattice the springs connect (one side for a
+    /// chain, two for a cloth, three for a lattice): how a Cholesky factor fills.
+    pub sides: [f64; 3],
     /// Whether the network has a collider (contact Jacobians per particle).
     pub contact: bool,
 }
@@ -46,11 +46,11 @@ impl NetworkSize {
                 particles: n * n,
                 springs: 2.0 * n * (n - 1.0) + 2.0 * (n - 1.0) * (n - 1.0) + 2.0 * n * (n - 2.0).max(0.0),
                 triangles: 2.0 * (n - 1.0) * (n - 1.0),
-                dim: 2,
+                sides: [n, n, 1.0],
                 contact: false,
             },
             "swinging-rope" => {
-                Self { particles: n, springs: n - 1.0, triangles: 0.0, dim: 1, contact: false }
+                Self { particles: n, springs: n - 1.0, triangles: 0.0, sides: [n, 1.0, 1.0], contact: false }
             }
             // Edges 3 n^2 (n - 1), face diagonals 6 n (n - 1)^2, body diagonals 4 (n - 1)^3;
             // two triangles per cell of the six faces.
@@ -58,7 +58,7 @@ impl NetworkSize {
                 particles: n * n * n,
                 springs: 3.0 * n * n * (n - 1.0) + 6.0 * n * (n - 1.0).powi(2) + 4.0 * (n - 1.0).powi(3),
                 triangles: 12.0 * (n - 1.0) * (n - 1.0),
-                dim: 3,
+                sides: [n, n, n],
                 contact: true,
             },
             _ => return None,
@@ -78,7 +78,15 @@ impl NetworkSize {
         if implicit && assembled {
             need.add(self.particles + 2.0 * self.springs, "matrix blocks", 144.0);
             if linear == LinearSolverKind::Cholesky {
-                need.add(cholesky_factor_blocks(self.particles, self.dim), "Cholesky factor blocks", 144.0);
+                let sides: Vec<f64> = self.sides.into_iter().filter(|&s| s > 1.0).collect();
+                // The stencil's constant: 7.75 for the cloth (George's), 14 for the jelly's
+                // 27-point lattice, 2 for the chain's band (measured against faer's factor).
+                let c = match sides.len() {
+                    0 | 1 => 2.0,
+                    2 => 7.75,
+                    _ => 14.0,
+                };
+                need.add(cholesky_factor_blocks(&sides, c), "Cholesky factor blocks", 144.0);
             }
         }
         need
@@ -175,7 +183,7 @@ mod tests {
         let cholesky = size.need(IntegratorKind::BackwardEuler, LinearSolverKind::Cholesky).bytes();
         assert_eq!(cg - explicit, 80.0 * 100.0, "only the implicit integrator's vectors");
         assert_eq!(jacobi - cg, 144.0 * (100.0 + 2.0 * size.springs));
-        assert_eq!(cholesky - jacobi, 144.0 * cholesky_factor_blocks(100.0, 2));
+        assert_eq!(cholesky - jacobi, 144.0 * cholesky_factor_blocks(&[10.0, 10.0], 7.75));
     }
 
     #[test]

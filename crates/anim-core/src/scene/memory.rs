@@ -133,25 +133,29 @@ impl MemoryNeed {
 }
 
 /// The nonzero blocks of the sparse Cholesky factor (faer's, AMD ordering) of a matrix whose
-/// graph is a `dim`-dimensional mesh of `nodes` block rows with a few neighbours each, for
-/// estimating a direct solver's memory before the matrix exists:
+/// graph is a mesh filling a lattice of `dims` nodes (1, 2 or 3 of them; a block row per node,
+/// edges between near neighbours), for estimating a direct solver's memory before the matrix
+/// exists. With `N` the nodes and `a <= b` the smallest sides:
 ///
-/// - 1D (a chain): `2 N`, the band;
-/// - 2D: `7.75 N log2 N`, George's count for nested dissection on a square grid
-///   (`31/4 N log2 N`, George 1973), which faer's AMD ordering of the cloth of anim-springs
-///   matches within 10% from 32 x 32 to 192 x 192 particles;
-/// - 3D: `14 N^(4/3)`, the order of nested dissection on 3D grids (Lipton, Rose & Tarjan 1979),
-///   the constant measured on the jelly lattice of anim-springs (8^3 to 24^3 particles);
+/// - 1D (a chain): `c N`, the band;
+/// - 2D: `c N min(log2 N, a)`: nested dissection's `N log2 N` on a square (George 1973: `c =
+///   31/4` on a 5-point grid), the band `N a` on a strip;
+/// - 3D: `c N sqrt(a b)`: nested dissection's `N^(4/3)` on a cube (Lipton, Rose & Tarjan 1979),
+///   `N a` on a bar of side `a`;
 ///
-/// at most the dense triangle `N (N + 1) / 2`. A scalar factor has `b^2` times as many
-/// nonzeros for blocks of `b` unknowns.
+/// at most the dense triangle `N (N + 1) / 2`. The constant `c` depends on the stencil and is
+/// measured by the caller against faer's factor (anim-springs' cloth: 7.75 in 2D, its jelly's
+/// 27-point lattice: 14; anim-fem's tetrahedra of six per cube: 9). A scalar factor has `k^2`
+/// times as many nonzeros for blocks of `k` unknowns.
 #[must_use]
-pub fn cholesky_factor_blocks(nodes: f64, dim: usize) -> f64 {
-    let n = nodes.max(1.0);
-    let fill = match dim {
-        0 | 1 => 2.0 * n,
-        2 => 7.75 * n * n.log2().max(1.0),
-        _ => 14.0 * n * n.cbrt(),
+pub fn cholesky_factor_blocks(dims: &[f64], c: f64) -> f64 {
+    let mut sides: Vec<f64> = dims.iter().map(|d| d.max(1.0)).collect();
+    sides.sort_by(f64::total_cmp);
+    let n: f64 = sides.iter().product();
+    let fill = match sides.as_slice() {
+        [] | [_] => c * n,
+        [a, _] => c * n * n.log2().max(1.0).min(*a),
+        [a, b, ..] => c * n * (a * b).sqrt(),
     };
     fill.min(0.5 * n * (n + 1.0))
 }
@@ -338,6 +342,18 @@ mod tests {
         let empty = MemoryNeed::new().with(0.0, "cells", 8.0);
         assert_eq!(empty.breakdown(), "");
         assert!(empty.check_within("f", "x", Some(0.0)).is_ok());
+    }
+
+    #[test]
+    fn the_factor_fill_follows_nested_dissection_and_never_passes_the_dense_triangle() {
+        // A square: c N log2 N; a strip: the band c N a; a cube: c N^(4/3); a bar: c N a.
+        assert_eq!(cholesky_factor_blocks(&[64.0, 64.0], 7.75), 7.75 * 4096.0 * 12.0);
+        assert_eq!(cholesky_factor_blocks(&[1000.0, 4.0], 7.75), 7.75 * 4000.0 * 4.0);
+        assert_eq!(cholesky_factor_blocks(&[16.0, 16.0, 16.0], 14.0), 14.0 * 4096.0 * 16.0);
+        assert_eq!(cholesky_factor_blocks(&[81.0, 9.0, 9.0], 9.0), 9.0 * 6561.0 * 9.0);
+        assert_eq!(cholesky_factor_blocks(&[100.0], 2.0), 200.0);
+        assert_eq!(cholesky_factor_blocks(&[3.0, 3.0, 3.0], 14.0), 27.0 * 28.0 / 2.0, "dense");
+        assert!(cholesky_factor_blocks(&[1e9, 1e9, 1e9], 14.0).is_finite());
     }
 
     #[test]
