@@ -206,6 +206,7 @@ fn build_error(e: BuildError, origin: &Path, text: Option<&str>) -> SceneError {
     let (field, message) = match e {
         BuildError::Schema { field, message } => (field, message),
         BuildError::Invalid { field, message } => (field, message),
+        BuildError::Memory { field, message, .. } => (field, message),
         other => (String::new(), other.to_string()),
     };
     let at = text.and_then(|t| locate(t, &field));

@@ -19,22 +19,47 @@
 //! Every request is forwarded unchanged to the system allocator; only allocations and
 //! reallocations made while a [`CountingAllocator::count`] closure runs are counted (on any
 //! thread: rayon workers included).
+//!
+//! [`CountingAllocator::peak_bytes`] measures the other way round: the most bytes a closure
+//! held at once beyond what was held when it started, what a scene's memory estimate
+//! (`anim_core::scene::MemoryNeed`) is compared with.
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicIsize, AtomicUsize, Ordering};
 
 /// The system allocator with a switchable allocation counter.
 #[derive(Debug)]
 pub struct CountingAllocator {
     on: AtomicBool,
     count: AtomicUsize,
+    /// Bytes allocated minus bytes freed since [`CountingAllocator::peak_bytes`] began.
+    live: AtomicIsize,
+    /// The most `live` has been.
+    peak: AtomicIsize,
 }
 
 impl CountingAllocator {
     /// A counter that is off.
     #[must_use]
     pub const fn new() -> Self {
-        Self { on: AtomicBool::new(false), count: AtomicUsize::new(0) }
+        Self {
+            on: AtomicBool::new(false),
+            count: AtomicUsize::new(0),
+            live: AtomicIsize::new(0),
+            peak: AtomicIsize::new(0),
+        }
+    }
+
+    /// Runs `f` and returns the most bytes it held at once (allocated and not yet freed, by any
+    /// thread, beyond what was held when it started): the peak of its heap, what a memory
+    /// estimate is compared with. Memory freed while `f` runs that was allocated before counts
+    /// against it, so concurrent work elsewhere in the process can only lower the figure.
+    /// Allocations are counted as by [`count`](Self::count) meanwhile.
+    pub fn peak_bytes(&self, f: impl FnOnce()) -> usize {
+        self.live.store(0, Ordering::SeqCst);
+        self.peak.store(0, Ordering::SeqCst);
+        let _ = self.count(f);
+        usize::try_from(self.peak.load(Ordering::SeqCst)).unwrap_or(0)
     }
 
     /// Runs `f` and returns how many allocations and reallocations were made, by any thread,
@@ -52,6 +77,14 @@ impl CountingAllocator {
             self.count.fetch_add(1, Ordering::Relaxed);
         }
     }
+
+    /// `bytes` more (or fewer, when negative) held, while counting.
+    fn hold(&self, bytes: isize) {
+        if self.on.load(Ordering::Relaxed) {
+            let now = self.live.fetch_add(bytes, Ordering::Relaxed) + bytes;
+            self.peak.fetch_max(now, Ordering::Relaxed);
+        }
+    }
 }
 
 impl Default for CountingAllocator {
@@ -67,16 +100,25 @@ unsafe impl GlobalAlloc for CountingAllocator {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         self.note();
         // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
+        let ptr = unsafe { System.alloc(layout) };
+        if !ptr.is_null() {
+            self.hold(size(layout.size()));
+        }
+        ptr
     }
 
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
         self.note();
         // SAFETY: same contract as the caller's.
-        unsafe { System.alloc_zeroed(layout) }
+        let ptr = unsafe { System.alloc_zeroed(layout) };
+        if !ptr.is_null() {
+            self.hold(size(layout.size()));
+        }
+        ptr
     }
 
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        self.hold(-size(layout.size()));
         // SAFETY: `ptr` came from `System` with this layout.
         unsafe { System.dealloc(ptr, layout) }
     }
@@ -84,8 +126,17 @@ unsafe impl GlobalAlloc for CountingAllocator {
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         self.note();
         // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
+        let moved = unsafe { System.realloc(ptr, layout, new_size) };
+        if !moved.is_null() {
+            self.hold(size(new_size) - size(layout.size()));
+        }
+        moved
     }
+}
+
+/// A size in bytes as a signed count (sizes of allocations never exceed `isize::MAX`).
+fn size(bytes: usize) -> isize {
+    isize::try_from(bytes).unwrap_or(isize::MAX)
 }
 
 /// What [`preset_step_allocations`] counted for one preset.
@@ -160,6 +211,33 @@ pub fn step_allocations(
         }
     }
     Ok(blocks)
+}
+
+/// The most bytes building a scene of `kind` from `params` and stepping it once by `dt` hold at
+/// once ([`CountingAllocator::peak_bytes`]), what a kind's memory estimate is compared with.
+/// The scene is built and stepped twice and the second time measured, so that what a process
+/// allocates once for all its scenes (the rayon pool, a solver library's first use) is not
+/// counted. `alloc` must be the process's global allocator.
+///
+/// # Errors
+/// The message when the scene cannot be built or its step fails.
+pub fn build_and_step_peak(
+    alloc: &CountingAllocator,
+    kind: &crate::scene::SceneKind,
+    params: &serde_json::Value,
+    dt: f64,
+) -> Result<usize, String> {
+    let run = || -> Result<(), String> {
+        let mut scene =
+            (kind.build)(params, &crate::scene::BuildContext::default()).map_err(|e| e.to_string())?;
+        scene.step(dt).map_err(|e| e.to_string())?;
+        drop(std::hint::black_box(scene));
+        Ok(())
+    };
+    run()?;
+    let mut result = Ok(());
+    let peak = alloc.peak_bytes(|| result = run());
+    result.map(|()| peak)
 }
 
 /// The test that every preset of a scene kind steps without allocating once its first step is

@@ -32,33 +32,15 @@ use std::path::{Path, PathBuf};
 
 use crate::body::{BodyError, BodySpec, Budget, finite3, pin_error};
 use crate::boundary::Obstacle;
+use crate::memory::MeshSize;
 use crate::mesh::TetMesh;
 use crate::model::{EARTH_GRAVITY, ElementOrder, FemModel};
 use crate::scenes::FemScene;
-use crate::sim::FemParams;
+use crate::sim::{FemParams, LinearSolverChoice, TimeIntegrator};
 use anim_core::integrate::State;
 use anim_core::scene::ObstacleMesh;
 use anim_core::surface::DistanceField;
 use anim_io::surface::read_closed_surface;
-
-/// The most linear tetrahedra the bodies of a scene may have together: 2^18 = 262,144. At this
-/// size the model and its simulation take about 0.8 GB, and the first backward-Euler step with
-/// the Cholesky solver about 3.4 GB (its factor grows faster than the mesh).
-pub const MAX_ELEMENTS: usize = 1 << 18;
-
-/// What a 10-node element counts against [`MAX_ELEMENTS`]: its mass blocks, quadrature data and
-/// larger stiffness pattern take about 14 times the memory of a linear element.
-pub const TET10_WEIGHT: usize = 16;
-
-/// The most elements of `order` the bodies of a scene may have together: [`MAX_ELEMENTS`]
-/// linear tetrahedra, or 16,384 10-node ones.
-#[must_use]
-pub fn max_elements(order: ElementOrder) -> usize {
-    match order {
-        ElementOrder::Linear => MAX_ELEMENTS,
-        ElementOrder::Quadratic => MAX_ELEMENTS / TET10_WEIGHT,
-    }
-}
 
 /// What the bodies of a scene share.
 #[derive(Debug, Clone, PartialEq)]
@@ -132,8 +114,9 @@ impl World {
 /// [`BodyError`] naming the field of the `[scene]` table: `bodies` for an empty list;
 /// `bodies[k].mesh`, `bodies[k].cell`, `bodies[k].material`, ... for the errors of
 /// [`BodySpec::load`], and `bodies[k].cell` (an OBJ surface, refused before it is filled) or
-/// `bodies[k].mesh` (a mesh file) for the body that takes the scene past
-/// [`max_elements`]`(order)`; `bodies[k].pin` for a pin box that holds no vertex of body `k`
+/// `bodies[k].mesh` (a mesh file) for the body that takes the scene past the memory available
+/// (the scene's estimate, [`crate::memory`], with [`BodyError::memory`]; backward Euler with
+/// Cholesky, the scene's method); `bodies[k].pin` for a pin box that holds no vertex of body `k`
 /// (and the pin errors of [`BodySpec::load`]);
 /// `gravity`, `contact_stiffness`, `friction`, `rayleigh` for a value out of range;
 /// `obstacles[i]` for an invalid shape; `obstacle_meshes[k].mesh` for a file that does not read
@@ -146,17 +129,36 @@ pub fn build(
     order: ElementOrder,
     resolve: impl Fn(&Path) -> PathBuf,
 ) -> Result<FemScene, BodyError> {
-    build_within(bodies, world, order, resolve, max_elements(order))
+    let p = FemParams::default();
+    build_with(bodies, world, order, (p.integrator, p.linear_solver), resolve)
 }
 
-/// As [`build`], with at most `max` elements.
-fn build_within(
+/// As [`build`], the scene stepped by `method` (its time integrator and linear solver), whose
+/// memory the bodies are checked against.
+///
+/// # Errors
+/// As [`build`].
+pub fn build_with(
     bodies: &[BodySpec],
     world: &World,
     order: ElementOrder,
+    method: (TimeIntegrator, LinearSolverChoice),
     resolve: impl Fn(&Path) -> PathBuf,
-    max: usize,
 ) -> Result<FemScene, BodyError> {
+    let mut scene = build_within(bodies, world, resolve, Budget::new(order, method.0, method.1))?;
+    scene.params.integrator = method.0;
+    scene.params.linear_solver = method.1;
+    Ok(scene)
+}
+
+/// As [`build`], within the memory of `budget` (its order and method the scene's).
+fn build_within(
+    bodies: &[BodySpec],
+    world: &World,
+    resolve: impl Fn(&Path) -> PathBuf,
+    budget: Budget,
+) -> Result<FemScene, BodyError> {
+    let order = budget.order;
     if bodies.is_empty() {
         return Err(BodyError::new("bodies", "give at least one body (a `[[scene.bodies]]` table)"));
     }
@@ -170,9 +172,10 @@ fn build_within(
     // The vertices each body's `pin` lists, numbered in the merged mesh.
     let mut listed = Vec::with_capacity(bodies.len());
     for (k, body) in bodies.iter().enumerate() {
-        let budget = Budget { max, used: tets.len(), order };
-        let loaded =
-            body.load_within(&resolve(&body.mesh), &budget).map_err(|e| e.within(&format!("bodies[{k}]")))?;
+        let used = MeshSize::mesh(positions.len() as f64, tets.len() as f64);
+        let loaded = body
+            .load_within(&resolve(&body.mesh), &Budget { used, ..budget })
+            .map_err(|e| e.within(&format!("bodies[{k}]")))?;
         let offset = positions.len();
         let id = u32::try_from(k).map_err(|_| BodyError::new("bodies", "too many bodies"))?;
         element_material.extend(std::iter::repeat_n(id, loaded.mesh.tets.len()));

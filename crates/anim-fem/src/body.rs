@@ -24,14 +24,15 @@
 use anim_core::scene::{is_unit_scale, unit_scale};
 use std::path::{Path, PathBuf};
 
-use anim_core::scene::{BuildError, Placement, is_default};
+use anim_core::scene::{BuildError, Placement, available_memory, is_default};
 use serde::{Deserialize, Deserializer, Serialize};
 
-use crate::bodies::max_elements;
 use crate::error::FemError;
 use crate::material::{Material, MaterialModel};
+use crate::memory::MeshSize;
 use crate::mesh::{TetMesh, read_gmsh, read_tetgen, validate};
 use crate::model::ElementOrder;
+use crate::sim::{FemParams, LinearSolverChoice, TimeIntegrator};
 
 mod obj;
 
@@ -121,46 +122,82 @@ pub struct BodyError {
     pub field: String,
     /// What is wrong; for the mesh, the file and line or element.
     pub message: String,
+    /// For a body that takes its scene past the memory available: the scene's estimate and the
+    /// memory it was checked against (bytes; anim-core's [`MemoryNeed`](anim_core::scene::MemoryNeed)).
+    pub memory: Option<(f64, f64)>,
 }
 
 impl BodyError {
     pub(crate) fn new(field: impl Into<String>, message: impl std::fmt::Display) -> Self {
-        BodyError { field: field.into(), message: message.to_string() }
+        BodyError { field: field.into(), message: message.to_string(), memory: None }
     }
 
     /// The same error with its field inside `prefix` (`bodies[2]` makes `mesh`
     /// `bodies[2].mesh`).
     #[must_use]
     pub fn within(self, prefix: &str) -> Self {
-        BodyError { field: format!("{prefix}.{}", self.field), message: self.message }
+        BodyError { field: format!("{prefix}.{}", self.field), ..self }
+    }
+
+    /// The same error as anim-core's [`BuildError`]: [`BuildError::Memory`] for a refusal of
+    /// memory, [`BuildError::Invalid`] otherwise.
+    #[must_use]
+    pub fn into_build_error(self) -> BuildError {
+        match self.memory {
+            Some((bytes, available)) => {
+                BuildError::Memory { field: self.field, message: self.message, bytes, available }
+            }
+            None => BuildError::invalid(self.field, self.message),
+        }
     }
 }
 
-/// How many elements a body may still add to its scene.
+/// The memory a body may still take in its scene.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Budget {
-    /// The most elements of the scene, of `order`.
-    pub(crate) max: usize,
-    /// The elements of the bodies before this one.
-    pub(crate) used: usize,
+    /// The memory the scene is checked against (bytes; `None`: unknown, anim-core's bound).
+    pub(crate) available: Option<f64>,
+    /// The meshes of the bodies before this one.
+    pub(crate) used: MeshSize,
     /// The scene's elements.
     pub(crate) order: ElementOrder,
+    /// The scene's time integrator.
+    pub(crate) integrator: TimeIntegrator,
+    /// The scene's linear solver.
+    pub(crate) solver: LinearSolverChoice,
 }
 
 impl Budget {
-    /// The elements left for this body.
-    pub(crate) fn left(&self) -> usize {
-        self.max.saturating_sub(self.used)
+    /// The budget of a scene of `order` elements stepped by `integrator` and `solver`: nothing
+    /// used, the memory available now.
+    pub(crate) fn new(order: ElementOrder, integrator: TimeIntegrator, solver: LinearSolverChoice) -> Self {
+        Self { available: available_memory(), used: MeshSize::mesh(0.0, 0.0), order, integrator, solver }
     }
 
-    /// The limit, for an error message.
-    pub(crate) fn describe(&self) -> String {
-        let before = if self.used > 0 {
-            format!(" ({} of them taken by the bodies before)", self.used)
+    /// Refuses a body of mesh `added` (`what` describes it) whose scene, with the bodies before
+    /// it, would need more memory than the budget ([`MeshSize::need`]); `advice` says what to
+    /// change.
+    pub(crate) fn check(
+        &self,
+        field: &str,
+        what: &str,
+        added: MeshSize,
+        advice: &str,
+    ) -> Result<(), BodyError> {
+        let before = if self.used.elements > 0.0 {
+            format!(", with the {} tetrahedra of the bodies before,", self.used.elements)
         } else {
             String::new()
         };
-        format!("a scene takes at most {} {} elements{before}", self.max, self.order.name())
+        let need = self.used.and(added).need(self.order, self.integrator, self.solver);
+        need.check_within(field, &format!("{what}{before}"), self.available).map_err(|e| match e {
+            BuildError::Memory { message, bytes, available, .. } => BodyError {
+                field: field.to_string(),
+                message: format!("{message}: {advice}"),
+                memory: Some((bytes, available)),
+            },
+            other => BodyError::new(field, other),
+        })
     }
 }
 
@@ -215,15 +252,16 @@ impl BodySpec {
     /// inverted element after the placement (the file and the element), `cell` missing for an
     /// OBJ or given for a tetrahedral mesh or not positive, a bad material or placement, a
     /// non-finite velocity; a `pin` with neither `vertices` nor `box`, a box that is not finite
-    /// with `min <= max`, `vertices` on an OBJ surface or out of range or in no element; a body of more tetrahedra than a scene of linear
-    /// elements takes ([`max_elements`]): `cell` for an OBJ surface whose lattice could hold
-    /// more (refused before it is filled), `mesh` for a mesh file.
+    /// with `min <= max`, `vertices` on an OBJ surface or out of range or in no element; a body
+    /// whose scene of linear elements (backward Euler, Cholesky) would need more memory than
+    /// is available ([`crate::memory`], with [`BodyError::memory`]): `cell` for an OBJ surface
+    /// whose lattice could hold that many (refused before it is filled), `mesh` for a mesh file.
     pub fn load(&self, mesh: &Path) -> Result<LoadedBody, BodyError> {
-        let order = ElementOrder::Linear;
-        self.load_within(mesh, &Budget { max: max_elements(order), used: 0, order })
+        let p = FemParams::default();
+        self.load_within(mesh, &Budget::new(ElementOrder::Linear, p.integrator, p.linear_solver))
     }
 
-    /// As [`load`](Self::load), with at most the elements `budget` leaves.
+    /// As [`load`](Self::load), within the memory `budget` leaves.
     pub(crate) fn load_within(&self, mesh: &Path, budget: &Budget) -> Result<LoadedBody, BodyError> {
         let placement = self.placement();
         placement.check().map_err(|e| match e {
@@ -273,17 +311,9 @@ impl BodySpec {
                 ));
             }
             let tets = read_mesh(mesh).map_err(|e| BodyError::new("mesh", mesh_message(mesh, &e)))?;
-            if tets.tets.len() > budget.left() {
-                return Err(BodyError::new(
-                    "mesh",
-                    format!(
-                        "{} has {} tetrahedra; {}: take a coarser mesh",
-                        mesh.display(),
-                        tets.tets.len(),
-                        budget.describe()
-                    ),
-                ));
-            }
+            let size = MeshSize::mesh(tets.positions.len() as f64, tets.tets.len() as f64);
+            let what = format!("{} ({} tetrahedra)", mesh.display(), tets.tets.len());
+            budget.check("mesh", &what, size, "take a coarser mesh")?;
             (tets, mesh.display().to_string())
         };
         let pinned = match &self.pin {

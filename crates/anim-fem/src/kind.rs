@@ -101,7 +101,9 @@ pub struct FemSceneParams {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rayleigh: Option<f64>,
     /// With `preset`: cells across the beam or bar (4 by default; the length gets 10 times as
-    /// many), or along the cube's side (6 by default); absent: the scene's default.
+    /// many), or along the cube's side (6 by default); absent: the scene's default. No more
+    /// than the memory holds: the scene's estimate ([`crate::memory`]) is checked against the
+    /// memory available before the mesh is made.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
     /// Time integrator, `"backward-euler"` or `"symplectic-euler"`; absent: the scene's
@@ -190,6 +192,10 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
                     format!("a preset brings its own `{field}`; the field goes with `bodies`"),
                 ));
             }
+            let own = crate::sim::FemParams::default();
+            let integrator = p.integrator.unwrap_or(own.integrator);
+            let solver = p.linear_solver.unwrap_or(own.linear_solver);
+            crate::memory::check_preset(name, p.resolution, order, integrator, solver)?;
             scenes::by_name_with_order(name, p.resolution, order)
                 .ok_or_else(|| {
                     BuildError::invalid(
@@ -206,8 +212,11 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
                     "a preset's field: the resolution of bodies is their meshes' (or `cell` for an OBJ surface)",
                 ));
             }
-            bodies::build(bodies, &p.world(), order, |path| context.resolve(path))
-                .map_err(|e| BuildError::invalid(e.field, e.message))?
+            let own = crate::sim::FemParams::default();
+            let method =
+                (p.integrator.unwrap_or(own.integrator), p.linear_solver.unwrap_or(own.linear_solver));
+            bodies::build_with(bodies, &p.world(), order, method, |path| context.resolve(path))
+                .map_err(crate::body::BodyError::into_build_error)?
         }
         (Some(_), Some(_)) => {
             return Err(BuildError::invalid("bodies", "give a built-in `preset` or `bodies`, not both"));
@@ -379,6 +388,11 @@ fn tolerance_adapter(
     let p: FemSceneParams = params(value).map_err(study::unreadable)?;
     let preset =
         p.preset.as_deref().ok_or("--tolerance: the report's studies cover the fem presets, not bodies")?;
+    let own = crate::sim::FemParams::default();
+    let (integrator, solver) =
+        (p.integrator.unwrap_or(own.integrator), p.linear_solver.unwrap_or(own.linear_solver));
+    crate::memory::check_preset(preset, p.resolution, ElementOrder::Linear, integrator, solver)
+        .map_err(study::unreadable)?;
     let scene = scenes::by_name(preset, p.resolution)
         .ok_or_else(|| format!("--tolerance: unknown fem preset `{preset}`"))?
         .map_err(study::unreadable)?;

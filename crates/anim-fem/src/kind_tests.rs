@@ -316,18 +316,34 @@ mod tolerance {
     }
 }
 
-/// A preset's resolution past the elements a scene may hold is refused before the mesh is made,
-/// naming the field; the largest linear beam that fits (16 cubes across, 245,760 tetrahedra)
-/// is not refused by it.
+/// A preset's resolution past the memory available is refused before the mesh is made, naming
+/// the field, the estimate and the memory; one that fits is built.
 #[test]
-fn a_preset_resolution_past_the_element_limit_is_refused() {
-    for (preset, resolution, element) in
-        [("soft-cube-drop", 100_000, "tet4"), ("cantilever-beam", 17, "tet4"), ("twisted-bar", 7, "tet10")]
-    {
-        let msg = refused(&json!({ "preset": preset, "resolution": resolution, "element": element }));
-        assert!(msg.starts_with("field `resolution`: ") && msg.contains("2^18 linear"), "{preset}: {msg}");
+fn a_preset_resolution_past_the_memory_is_refused() {
+    for (preset, resolution, element) in [
+        ("soft-cube-drop", 100_000, "tet4"),
+        ("cantilever-beam", 1_000_000_000, "tet4"),
+        ("twisted-bar", 50_000, "tet10"),
+    ] {
+        let start = std::time::Instant::now();
+        let e = (KIND.build)(
+            &json!({ "preset": preset, "resolution": resolution, "element": element }),
+            &Default::default(),
+        )
+        .err()
+        .expect("refused");
+        assert!(start.elapsed().as_secs_f64() < 1.0, "{preset}: {:?}", start.elapsed());
+        let msg = e.to_string();
+        assert!(matches!(e, anim_core::scene::BuildError::Memory { .. }), "{preset}: {msg}");
+        assert!(
+            msg.starts_with(&format!("field `resolution`: {resolution} cells across needs about "))
+                && msg.contains(" available"),
+            "{preset}: {msg}"
+        );
     }
-    let fits =
-        crate::scenes::by_name_with_order("cantilever-beam", Some(16), crate::model::ElementOrder::Linear);
-    assert!(fits.is_some_and(|r| r.is_ok()));
+    let fits = (KIND.build)(
+        &json!({ "preset": "cantilever-beam", "resolution": 3, "element": "tet10" }),
+        &Default::default(),
+    );
+    assert!(fits.is_ok());
 }

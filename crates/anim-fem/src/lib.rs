@@ -91,6 +91,7 @@ pub mod generate;
 pub mod kind;
 pub mod ldlt;
 pub mod material;
+pub mod memory;
 pub mod mesh;
 pub mod model;
 pub mod newton;

@@ -90,30 +90,26 @@ pub fn by_name_with_order(
     resolution: Option<usize>,
     order: ElementOrder,
 ) -> Option<Result<FemScene, FemError>> {
-    // A resolution past the elements a scene may hold is refused before the mesh is made (six
-    // tetrahedra per cube; the beam and the bar are ten cubes long per cube across).
-    let length = match name {
-        "cantilever-beam" | "twisted-bar" => 10,
-        "soft-cube-drop" => 1,
-        _ => return None,
-    };
-    if let Some(n) = resolution {
-        let tets = n.checked_pow(3).and_then(|c| c.checked_mul(6 * length));
-        if tets.is_none_or(|t| t > crate::bodies::max_elements(order)) {
-            return Some(Err(FemError::BadParameter {
-                name: "resolution",
-                value: n as f64,
-                reason: "makes more tetrahedra than a scene may hold (2^18 linear, 2^14 quadratic: \
-                         anim_fem::bodies::max_elements)",
-            }));
-        }
-    }
+    // No upper bound here: the `fem` kind refuses a resolution whose memory
+    // (`crate::memory`) the machine does not have before the mesh is made.
+    let n = resolution_default(name).map(|default| resolution.unwrap_or(default))?;
     Some(match name {
-        "cantilever-beam" => cantilever_beam_of(resolution.unwrap_or(4), order),
-        "soft-cube-drop" => soft_cube_drop_of(resolution.unwrap_or(6), order),
-        "twisted-bar" => twisted_bar_of(resolution.unwrap_or(4), order),
+        "cantilever-beam" => cantilever_beam_of(n, order),
+        "soft-cube-drop" => soft_cube_drop_of(n, order),
+        "twisted-bar" => twisted_bar_of(n, order),
         _ => return None,
     })
+}
+
+/// The cells across a preset when none is given (4 for the beam and the bar, 6 for the cube);
+/// `None` for an unknown name.
+#[must_use]
+pub fn resolution_default(name: &str) -> Option<usize> {
+    match name {
+        "cantilever-beam" | "twisted-bar" => Some(4),
+        "soft-cube-drop" => Some(6),
+        _ => None,
+    }
 }
 
 fn initial_state(model: &FemModel) -> State {

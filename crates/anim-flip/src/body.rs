@@ -18,8 +18,10 @@
 //!   (`bodies[k]`), a body with no lattice point inside it at this resolution or none left once
 //!   earlier bodies and solid cells have taken theirs (`bodies[k]`), a mesh that does not read or
 //!   is not a closed, consistently oriented surface (`bodies[k].mesh`, the file and the line,
-//!   triangle or edge), an obstacle that covers no cell centre (`obstacles[k]`), and in 2D any
-//!   motion out of the plane.
+//!   triangle or edge), an obstacle that covers no cell centre (`obstacles[k]`), in 2D any
+//!   motion out of the plane, and a scene whose memory, its particles counted over the bodies'
+//!   bounding boxes, exceeds the memory available (`resolution`, [`crate::memory`]), refused
+//!   before the grid or a particle is made.
 //!
 //! A 2D scene reads the first two components of each shape (a sphere is a disk, a box a
 //! rectangle) and cuts a mesh by the plane `z = 0` after its placement; rotations there are yaw
@@ -50,6 +52,7 @@ pub use scene::BodyScene;
 
 use crate::kind::FlipSceneParams;
 use crate::mac::{flatten, unflatten};
+use crate::memory;
 use crate::particles::Particles;
 use crate::sim::{FlipParams, FlipSimulation};
 use anim_core::geometry::Shape;
@@ -96,12 +99,6 @@ pub use anim_core::scene::ObstacleMesh;
 #[must_use]
 pub fn default_resolution(dim: usize) -> usize {
     if dim == 3 { 32 } else { 64 }
-}
-
-/// Largest cells across the tank: 1024 in 2D, 128 in 3D (as the presets).
-#[must_use]
-pub fn max_resolution(dim: usize) -> usize {
-    if dim == 3 { 128 } else { 1024 }
 }
 
 /// Default gravity of a scene of bodies (m/s^2), y up.
@@ -170,11 +167,10 @@ pub fn build<const D: usize>(
     context: &BuildContext<'_>,
 ) -> Result<(BodyScene<D>, Particles<D>), BuildError> {
     let res = params.resolution.unwrap_or_else(|| default_resolution(D));
-    let limit = max_resolution(D);
-    if !(4..=limit).contains(&res) {
+    if res < 4 {
         return Err(invalid(
             "resolution",
-            format!("a {D}D scene takes 4 to {limit} cells across its 1 m tank, got {res}"),
+            format!("a {D}D scene takes at least 4 cells across its 1 m tank, got {res}"),
         ));
     }
     let mut flip = FlipParams::<D>::default();
@@ -184,12 +180,14 @@ pub fn build<const D: usize>(
     flip.volume_correction = VOLUME_CORRECTION;
     flip.gravity = vector::<D>("gravity", params.gravity.unwrap_or(GRAVITY))?;
     let h = 1.0 / res as f64;
+    let bodies = body_regions::<D>(params, context)?;
+    check_memory::<D>(res, &bodies)?;
     let mut sim =
         FlipSimulation::new([res + 2; D], h, flip).map_err(|e| invalid("resolution", e.to_string()))?;
     let (origin, _) = sim.fluid_box();
     let obstacles = obstacles::<D>(params, context)?;
     mark_solid(&mut sim, &obstacles)?;
-    let particles = seed(&sim, params, context, origin)?;
+    let particles = seed(&sim, &bodies, origin)?;
     let shapes = params.obstacles.clone();
     // In 2D a mesh obstacle is its cross-section z = 0, which the preview does not draw.
     let meshes = match D {
@@ -269,22 +267,19 @@ fn index_box<const D: usize>(region: &Region, spacing: f64, len: [usize; D]) -> 
     (start, counts)
 }
 
-/// The particles of the bodies: the lattice points of the presets inside each body, each point
-/// seeded once (by the first body that holds it), none in solid cells.
-fn seed<const D: usize>(
-    sim: &FlipSimulation<D>,
+/// A body of the scene: its field (`bodies[k]`), its placed region and its velocity.
+struct Body<const D: usize> {
+    name: String,
+    region: Region,
+    velocity: [f64; D],
+}
+
+/// The bodies' regions, placed and checked inside the tank.
+fn body_regions<const D: usize>(
     params: &FlipSceneParams,
     context: &BuildContext<'_>,
-    origin: [f64; D],
-) -> Result<Particles<D>, BuildError> {
-    let n = sim.grid().cells();
-    let h = sim.grid().h();
-    let res = n[0] - 2;
-    let per_axis = 2;
-    let spacing = h / per_axis as f64;
-    let counts = [per_axis * res; D];
-    let mut taken = vec![false; counts.iter().product()];
-    let mut particles = Particles::new();
+) -> Result<Vec<Body<D>>, BuildError> {
+    let mut out = Vec::with_capacity(params.bodies.len());
     for (k, body) in params.bodies.iter().enumerate() {
         let name = format!("bodies[{k}]");
         let place = placement(&name, body.scale, body.rotate, body.translate, D)?;
@@ -315,8 +310,54 @@ fn seed<const D: usize>(
                 ),
             ));
         }
-        let (start, box_counts) = index_box::<D>(&region, spacing, counts);
-        let lattice = region.inside_lattice(start, box_counts, spacing).map_err(|e| invalid(&name, e))?;
+        out.push(Body { name, region, velocity });
+    }
+    Ok(out)
+}
+
+/// Refuses a scene of `bodies` at `res` cells across whose memory exceeds what is available
+/// ([`crate::memory`]): the tank's `(res + 2)^D` cells, its lattice of `(2 res)^D` points and
+/// the particles, counted over the bodies' bounding boxes (an upper bound), before the grid or
+/// a particle is made.
+fn check_memory<const D: usize>(res: usize, bodies: &[Body<D>]) -> Result<(), BuildError> {
+    let side = 2.0 * res as f64;
+    let spacing = 1.0 / side;
+    let lattice = side.powi(D as i32);
+    let boxed: f64 = bodies
+        .iter()
+        .map(|b| {
+            (0..D)
+                .map(|a| ((b.region.hi[a] - b.region.lo[a]) / spacing + 1.0).ceil().clamp(1.0, side))
+                .product::<f64>()
+        })
+        .sum();
+    let particles = boxed.min(lattice);
+    let cells = (res as f64 + 2.0).powi(D as i32);
+    memory::need(D, cells, particles).with(lattice, "lattice points", 1.0).check(
+        "resolution",
+        &format!("{res} cells across ({particles:.3e} lattice points in the bodies' bounding boxes)"),
+    )
+}
+
+/// The particles of the bodies: the lattice points of the presets inside each body, each point
+/// seeded once (by the first body that holds it), none in solid cells.
+fn seed<const D: usize>(
+    sim: &FlipSimulation<D>,
+    bodies: &[Body<D>],
+    origin: [f64; D],
+) -> Result<Particles<D>, BuildError> {
+    let n = sim.grid().cells();
+    let h = sim.grid().h();
+    let res = n[0] - 2;
+    let per_axis = 2;
+    let spacing = h / per_axis as f64;
+    let counts = [per_axis * res; D];
+    let mut taken = vec![false; counts.iter().product()];
+    let mut particles = Particles::new();
+    for Body { name, region, velocity } in bodies {
+        let (name, velocity) = (name.as_str(), *velocity);
+        let (start, box_counts) = index_box::<D>(region, spacing, counts);
+        let lattice = region.inside_lattice(start, box_counts, spacing).map_err(|e| invalid(name, e))?;
         let (mut inside, mut earlier, mut solid) = (0usize, 0usize, 0usize);
         let before = particles.len();
         for (f, _) in lattice.iter().enumerate().filter(|(_, i)| **i) {

@@ -74,8 +74,9 @@ pub struct FlipSceneParams {
     /// `"sloshing-tank"`. Give this or `bodies`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub preset: Option<String>,
-    /// Cells across the 1 m tank: at most 1024 in 2D, 128 in 3D (at least 4, what the
-    /// solid border and the kernel need). Default: the preset's (64 in 2D, 32 in 3D); for
+    /// Cells across the 1 m tank: at least 4 (what the solid border and the kernel need), and
+    /// no more than the memory holds: the scene's estimate ([`crate::memory`]) is checked
+    /// against the memory available before the grid or a particle is made. Default: the preset's (64 in 2D, 32 in 3D); for
     /// bodies the same, across the tank's inside (the walls are outside it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
@@ -113,9 +114,10 @@ impl FlipSceneParams {
     /// Checks the parameters and builds the preset.
     ///
     /// # Errors
+    /// [`BuildError::Memory`] of `resolution` for a scene past the memory available;
     /// [`BuildError::Invalid`] naming the field: no preset or bodies as well, a field of bodies
-    /// only, an unknown preset, a FLIP blend outside `[0, 1]`, a resolution above the preset's
-    /// limit or one the simulation refuses.
+    /// only, an unknown preset, a FLIP blend outside `[0, 1]`, a resolution the simulation
+    /// refuses.
     pub fn scene(&self) -> Result<FlipScene, BuildError> {
         let Some(preset) = self.preset.as_deref() else {
             return Err(self.neither());
@@ -145,15 +147,7 @@ impl FlipSceneParams {
             return Err(unknown());
         }
         self.check_transfer()?;
-        let limit = if preset.ends_with("3d") { 128 } else { 1024 };
-        if let Some(r) = self.resolution
-            && r > limit
-        {
-            return Err(BuildError::invalid(
-                "resolution",
-                format!("{preset} takes at most {limit} cells across, got {r}"),
-            ));
-        }
+        crate::memory::check_preset(preset, self.resolution)?;
         scenes::by_name(preset, self.resolution, self.transfer)
             .ok_or_else(unknown)?
             .map_err(|e| BuildError::invalid("resolution", e.to_string()))

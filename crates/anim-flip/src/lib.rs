@@ -100,6 +100,7 @@ pub mod classify;
 pub mod error;
 pub mod kind;
 pub mod mac;
+pub mod memory;
 pub mod particles;
 pub mod project;
 pub mod reseed;

@@ -258,6 +258,17 @@ pub fn sloshing_tank<const D: usize>(
     Ok((sim, p))
 }
 
+/// The cells across the 1 m tank of a preset when none is given: 64 in 2D, 32 in 3D; `None`
+/// for an unknown name.
+#[must_use]
+pub fn resolution_default(name: &str) -> Option<usize> {
+    match name {
+        "dam-break-3d" | "drop-3d" => Some(32),
+        _ if NAMES.contains(&name) => Some(64),
+        _ => None,
+    }
+}
+
 /// The presets [`by_name`] builds, as the command line names them.
 pub const NAMES: [&str; 5] = ["dam-break-2d", "dam-break-3d", "drop-2d", "drop-3d", "sloshing-tank"];
 
@@ -346,17 +357,13 @@ pub fn by_name(
     let three = |r: Result<(FlipSimulation<3>, Particles<3>), FlipError>| {
         r.map(|(sim, particles)| FlipScene::Three(Preset { name, sim, particles }))
     };
+    let n = resolution.or_else(|| resolution_default(name))?;
     Some(match name {
-        "dam-break-2d" => {
-            two(dam_break(resolution.unwrap_or(64), 0.25, params(transfer, 0.5)).map(|(s, p, _)| (s, p)))
-        }
-        "dam-break-3d" => {
-            three(dam_break_3d(resolution.unwrap_or(32), 0.25, params(transfer, 0.5)).map(|(s, p, _)| (s, p)))
-        }
-        "drop-2d" => two(drop_into_pool(resolution.unwrap_or(64), params(transfer, 0.5))),
-        "drop-3d" => three(drop_into_pool(resolution.unwrap_or(32), params(transfer, 0.5))),
+        "dam-break-2d" => two(dam_break(n, 0.25, params(transfer, 0.5)).map(|(s, p, _)| (s, p))),
+        "dam-break-3d" => three(dam_break_3d(n, 0.25, params(transfer, 0.5)).map(|(s, p, _)| (s, p))),
+        "drop-2d" => two(drop_into_pool(n, params(transfer, 0.5))),
+        "drop-3d" => three(drop_into_pool(n, params(transfer, 0.5))),
         _ => {
-            let n = resolution.unwrap_or(64);
             let params = params::<2>(transfer, 0.0);
             // The tank's inner length, from the tank itself, for the resonant frequency.
             let at_rest = sloshing_tank(n, SLOSHING_DEPTH, 0.0, 0.0, params);

@@ -80,12 +80,10 @@ pub struct FluidSceneParams {
     /// Default: none, a smoke scene of the user's own (which then needs `sources`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub preset: Option<String>,
-    /// Cells across the domain: 2 to 2048 in 2D, 2 to 128 for `smoke-plume-3d`. Default: the
-    /// preset's (128, 32, 64). For a smoke scene of the user's own, the cells along x (the
-    /// other sides take cells of the same size), at most [`smoke::MAX_CELLS`] in all; default
-    /// 32.
-    ///
-    /// [`smoke::MAX_CELLS`]: crate::smoke::MAX_CELLS
+    /// Cells across the domain, at least 2. Default: the preset's (128, 32, 64). For a smoke
+    /// scene of the user's own, the cells along x (the other sides take cells of the same
+    /// size); default 32. No more than the memory holds: the scene's estimate
+    /// ([`crate::memory`]) is checked against the memory available before the grid is made.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
     /// Pressure solver of the MAC scenes (`"jacobi"`, `"rb-gauss-seidel"`, `"cg"`,
@@ -212,8 +210,9 @@ impl FluidSceneParams {
     /// Checks the parameters and builds the scene, reading mesh files relative to `context`.
     ///
     /// # Errors
-    /// [`BuildError::Invalid`] naming the field: an unknown preset, a resolution above the
-    /// preset's limit or one the solver refuses, a tolerance that is not positive and finite, a
+    /// [`BuildError::Memory`] of `resolution` for a grid past the memory available;
+    /// [`BuildError::Invalid`] naming the field: an unknown preset, a resolution the solver
+    /// refuses, a tolerance that is not positive and finite, a
     /// MAC setting given to Stam's solver, a smoke scene's field given to a preset; for a smoke
     /// scene of the user's own, a bad size or setting, a source or obstacle that covers no cell,
     /// a source inside obstacles, an OBJ file that does not parse or is not a closed surface
@@ -250,15 +249,7 @@ impl FluidSceneParams {
         if !scenes::NAMES.contains(&preset) {
             return Err(unknown());
         }
-        let limit = if preset == "smoke-plume-3d" { 128 } else { 2048 };
-        if let Some(r) = self.resolution
-            && r > limit
-        {
-            return Err(BuildError::invalid(
-                "resolution",
-                format!("{preset} takes at most {limit} cells across, got {r}"),
-            ));
-        }
+        crate::memory::check_preset(preset, self.resolution, self.splitting)?;
         let mut scene = scenes::by_name(preset, self.resolution)
             .ok_or_else(unknown)?
             .map_err(|e| BuildError::invalid("resolution", e.to_string()))?;
@@ -586,6 +577,7 @@ fn tolerance_adapter(
             pressure_tolerance: study::problem(family, "pressure_tolerance")?,
         }));
     }
+    crate::memory::check_preset(preset, p.resolution, p.splitting).map_err(study::unreadable)?;
     let scene = scenes::by_name(preset, p.resolution)
         .ok_or_else(|| format!("--tolerance: unknown fluid preset `{preset}`"))?
         .map_err(study::unreadable)?;

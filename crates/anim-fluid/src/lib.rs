@@ -160,6 +160,7 @@ pub mod cases;
 pub mod error;
 pub mod kind;
 pub mod mac;
+pub mod memory;
 pub mod pressure;
 pub mod scenes;
 pub mod smoke;

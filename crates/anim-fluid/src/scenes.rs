@@ -256,12 +256,25 @@ impl FluidScene {
 /// `None` for an unknown name.
 #[must_use]
 pub fn by_name(name: &str, resolution: Option<usize>) -> Option<Result<FluidScene, FluidError>> {
+    let n = resolution.or_else(|| resolution_default(name))?;
     Some(match name {
-        "smoke-box-2d" => smoke_box_2d(resolution.unwrap_or(128)),
-        "smoke-plume-3d" => smoke_plume_3d(resolution.unwrap_or(32)),
-        "lid-driven-cavity" => lid_driven_cavity(resolution.unwrap_or(64), 100.0, Advection::MacCormack),
+        "smoke-box-2d" => smoke_box_2d(n),
+        "smoke-plume-3d" => smoke_plume_3d(n),
+        "lid-driven-cavity" => lid_driven_cavity(n, 100.0, Advection::MacCormack),
         _ => return None,
     })
+}
+
+/// The cells across a scene when none is given (128 for the smoke box, 32 for the plume, 64
+/// for the cavity); `None` for an unknown name.
+#[must_use]
+pub fn resolution_default(name: &str) -> Option<usize> {
+    match name {
+        "smoke-box-2d" => Some(128),
+        "smoke-plume-3d" => Some(32),
+        "lid-driven-cavity" => Some(64),
+        _ => None,
+    }
 }
 
 /// Stam's smoke source in a closed `N x N` box ([`crate::stam::source_pattern`]), dt = 0.1,

@@ -47,9 +47,10 @@ use anim_core::geometry::Shape;
 use anim_core::scene::{BuildContext, BuildError, Placement, is_default};
 use serde::{Deserialize, Serialize};
 
-use crate::advection::Advection;
+use crate::advection::{Advection, Splitting};
 use crate::kind::FluidSceneParams;
 use crate::mac::{MacFluid, MacParams, RegionSource, Wall};
+use crate::memory::MacLayout;
 use crate::pressure::PressureMethod;
 use crate::scenes::{FluidScene, FluidSim};
 use region::Region;
@@ -81,9 +82,6 @@ pub mod defaults {
     /// A source's temperature.
     pub const SOURCE_TEMPERATURE: f64 = 1.0;
 }
-
-/// The largest grid of a smoke scene, in cells (2^22: 128 x 192 x 128 fits, as does 2048^2).
-pub const MAX_CELLS: usize = 1 << 22;
 
 fn source_density() -> f64 {
     defaults::SOURCE_DENSITY
@@ -156,8 +154,15 @@ impl Grid {
     }
 }
 
+/// The length of an optional list, as a count for the memory estimate.
+#[allow(clippy::ref_option)]
+fn count<T>(list: &Option<Vec<T>>) -> f64 {
+    list.as_ref().map_or(0, Vec::len) as f64
+}
+
 /// The grid from `dim`, `size` and `resolution`: `resolution` cells along x, and along y (and
-/// z) as many cells of the same size as cover the size.
+/// z) as many cells of the same size as cover the size, refused past the memory available
+/// ([`crate::memory`]).
 fn grid(p: &FluidSceneParams) -> Result<Grid, BuildError> {
     let dim = p.dim.unwrap_or(defaults::DIM);
     if dim != 2 && dim != 3 {
@@ -182,41 +187,32 @@ fn grid(p: &FluidSceneParams) -> Result<Grid, BuildError> {
         return Err(BuildError::invalid("resolution", format!("must be at least 2 cells across, got {n}")));
     }
     let h = size[0] / n as f64;
-    let mut dims = [n, 1, 1];
+    let mut cells = [n as f64, 1.0, 1.0];
     for a in 1..dim {
         // The smallest whole number of cells covering the size (the plume's ceil(3n/2)),
         // forgiving the rounding of the division.
-        let cells = (size[a] / h * (1.0 - 1e-12)).ceil();
-        if !(cells >= 2.0) {
+        cells[a] = (size[a] / h * (1.0 - 1e-12)).ceil();
+        if !(cells[a] >= 2.0) {
             return Err(BuildError::invalid(
                 "size",
                 format!("size[{a}] = {} m is less than two cells of {h} m (size[0] / resolution)", size[a]),
             ));
         }
-        if cells > MAX_CELLS as f64 {
-            // The size of the domain or the fineness of its cells, whichever the file gave.
-            let field = if p.size.is_some() { "size" } else { "resolution" };
-            return Err(BuildError::invalid(
-                field,
-                format!(
-                    "size[{a}] = {} m is {cells} cells of {h} m (size[0] / resolution); a smoke scene \
-                     takes at most {MAX_CELLS} cells",
-                    size[a]
-                ),
-            ));
-        }
-        dims[a] = cells as usize;
     }
-    let total = dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]);
-    if total > MAX_CELLS {
-        return Err(BuildError::invalid(
-            "resolution",
-            format!(
-                "{} x {} x {} = {total} cells; a smoke scene takes at most {MAX_CELLS}",
-                dims[0], dims[1], dims[2]
-            ),
-        ));
-    }
+    // The memory of the grid, in `f64` before any count becomes a `usize`: the fluid, each
+    // source's masks and region (8 bytes a cell), each obstacle's mask (1 byte a cell).
+    let layout = MacLayout {
+        dim,
+        pressure: p.pressure_solver.unwrap_or(PressureMethod::Mgpcg),
+        splitting: p.splitting.unwrap_or(Splitting::AdvectProject),
+        obstacles: count(&p.obstacles) + count(&p.obstacle_meshes) > 0.0,
+    };
+    let masks = 8.0 * count(&p.sources) + count(&p.obstacles) + count(&p.obstacle_meshes);
+    let total: f64 = cells.iter().product();
+    let shown: Vec<String> = cells[..dim].iter().map(|c| format!("{c}")).collect();
+    let what = format!("{} cells of {h:.4} m (resolution {n})", shown.join(" x "));
+    layout.need(total, masks).check("resolution", &what)?;
+    let dims = cells.map(|c| c as usize);
     Ok(Grid { dims, dim, h })
 }
 

@@ -37,6 +37,7 @@
 use anim_core::scene::unit_scale;
 use std::path::PathBuf;
 
+use crate::memory::{self, Matter};
 use anim_core::glam::DVec3;
 use anim_core::scene::{BuildContext, BuildError, Placement, is_default};
 use anim_core::surface::ClosedSurface;
@@ -54,10 +55,11 @@ pub const DEFAULT_RESOLUTION: usize = 64;
 /// Particles per cell and axis of a scene of bodies without `particles_per_cell`.
 pub const DEFAULT_PARTICLES_PER_CELL: usize = 2;
 
-/// The most particles a scene of bodies may seed (`2^25`): about 3.8 GB of particle state in 3D
-/// (114 bytes a particle), which a step holds three times (the state, the next state and the
-/// backup it restores when a substep fails), about 11 GB.
-pub const MAX_PARTICLES: usize = 1 << 25;
+/// The most particles a scene may hold: their ids and the sort's slots are `u32`. Long before
+/// that the memory runs out: a scene's memory, its particles counted over the bodies' bounding
+/// boxes, is checked against the memory available before the grid or a particle is made
+/// ([`crate::memory`]).
+pub const MAX_PARTICLES: usize = u32::MAX as usize;
 
 /// One body of an `mpm` scene file (a `[[scene.bodies]]` table): its region, given by exactly
 /// one of `shape` and `mesh`, its material, its placement and its initial velocity.
@@ -105,9 +107,11 @@ impl BodySpec {
 /// beside them), in 2D or 3D as its `dim` says; mesh files are read relative to `context`.
 ///
 /// # Errors
+/// [`BuildError::Memory`] of `resolution` for a scene whose memory, its particles counted over
+/// the bodies' bounding boxes, exceeds the memory available ([`crate::memory`]);
 /// [`BuildError::Invalid`] naming the field: `dim`, `resolution`, `particles_per_cell`,
 /// `gravity`, `wall`, `boundary`, `obstacles[k]` (a capsule or a bad shape), `bodies[k]` (no or
-/// two regions, outside the walls, no particle at this resolution, too many particles, particles
+/// two regions, outside the walls, no particle at this resolution, particles
 /// inside an obstacle or a mesh obstacle), `obstacle_meshes` (in 2D), `obstacle_meshes[k]` (a
 /// table past [`crate::mesh_collider::MAX_NODES`], outside the domain, no grid node inside),
 /// `obstacle_meshes[k].mesh` and `.scale`/`.rotate`/`.translate`, `bodies[k].mesh` (the file
@@ -140,10 +144,6 @@ fn build_in<const D: usize>(p: &MpmSceneParams, context: &BuildContext<'_>) -> R
     for (k, body) in p.bodies.iter().enumerate() {
         body.material.compile(k).map_err(|e| material_error(k, &body.material, e))?;
     }
-    let materials = p.bodies.iter().map(|b| b.material).collect();
-    let mut sim = MpmSimulation::<D>::new(params.clone(), materials).map_err(simulation_error)?;
-    let meshes = obstacle_meshes::<D>(p, &params, context)?;
-    sim.set_mesh_colliders(meshes).map_err(|e| BuildError::invalid("obstacle_meshes", reason(e)))?;
     let lattice = Lattice {
         spacing: params.h() / per_cell as f64,
         per_cell,
@@ -152,10 +152,46 @@ fn build_in<const D: usize>(p: &MpmSceneParams, context: &BuildContext<'_>) -> R
         hi: params.size - params.wall_nodes as f64 * params.h(),
         wall_nodes: params.wall_nodes,
     };
+    let regions = p
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(k, body)| Region::of::<D>(body, k, context))
+        .collect::<Result<Vec<_>, _>>()?;
+    // The memory of the scene before the grid's tables or a particle exist: the particles
+    // counted over the bodies' bounding boxes (an upper bound), the grid over the domain.
+    let mut matter = Matter::default();
+    for (k, region) in regions.iter().enumerate() {
+        let counts = lattice.counts::<D>(region, k)?;
+        let extent: Vec<f64> = counts.iter().map(|&c| c / per_cell as f64).collect();
+        matter = matter.and(Matter::in_box(counts.iter().product(), &extent));
+    }
+    let n = params.resolution;
+    memory::need(D, n as f64, &matter).check(
+        "resolution",
+        &format!(
+            "{n} cells per axis with {per_cell} particles per cell and axis ({:.3e} lattice points in the \
+             bodies' bounding boxes)",
+            matter.particles
+        ),
+    )?;
+    if matter.particles > MAX_PARTICLES as f64 {
+        return Err(BuildError::invalid(
+            "bodies",
+            format!(
+                "their bounding boxes hold {:.3e} lattice points at resolution {n} with {per_cell} particles per \
+                 cell and axis, more than the {MAX_PARTICLES} particles a scene indexes",
+                matter.particles
+            ),
+        ));
+    }
+    let materials = p.bodies.iter().map(|b| b.material).collect();
+    let mut sim = MpmSimulation::<D>::new(params.clone(), materials).map_err(simulation_error)?;
+    let meshes = obstacle_meshes::<D>(p, &params, context)?;
+    sim.set_mesh_colliders(meshes).map_err(|e| BuildError::invalid("obstacle_meshes", reason(e)))?;
     let mut state = Particles::<D>::new();
-    for (k, body) in p.bodies.iter().enumerate() {
-        let region = Region::of::<D>(body, k, context)?;
-        let points = lattice.fill::<D>(&region, k, MAX_PARTICLES - state.len())?;
+    for (k, (body, region)) in p.bodies.iter().zip(&regions).enumerate() {
+        let points = lattice.fill::<D>(region, k)?;
         seed(&mut state, body, k, &points, lattice.spacing)?;
     }
     check_obstacles(&params, &state)?;
@@ -166,6 +202,7 @@ fn build_in<const D: usize>(p: &MpmSceneParams, context: &BuildContext<'_>) -> R
 /// The simulation parameters of the scene-wide fields, each checked.
 fn sim_params<const D: usize>(p: &MpmSceneParams) -> Result<MpmParams, BuildError> {
     let n = p.resolution.unwrap_or(DEFAULT_RESOLUTION);
+    // The grid's `u32` block keys; the memory is checked once the matter is counted.
     let max = crate::sim::max_resolution(D);
     if !(8..=max).contains(&n) {
         return Err(BuildError::invalid("resolution", format!("must lie in [8, {max}] in {D}D, got {n}")));
@@ -432,14 +469,9 @@ struct Lattice {
 }
 
 impl Lattice {
-    /// The lattice points of body `k`'s region, which must lie between the walls and get
-    /// between 1 and `room` points.
-    fn fill<const D: usize>(
-        &self,
-        region: &Region,
-        k: usize,
-        room: usize,
-    ) -> Result<Vec<[f64; D]>, BuildError> {
+    /// The lattice cells along each axis over body `k`'s region's bounding box (in `f64`: a
+    /// region of any size counts), the region checked between the walls.
+    fn counts<const D: usize>(&self, region: &Region, k: usize) -> Result<[f64; D], BuildError> {
         let body = format!("bodies[{k}]");
         let (lo, hi) = region.bounds();
         for a in 0..D {
@@ -458,19 +490,15 @@ impl Lattice {
                 }
             }
         }
-        let counts: [usize; D] =
-            std::array::from_fn(|a| ((hi[a] - lo[a]) / self.spacing).ceil().max(1.0) as usize);
-        let cells: f64 = counts.iter().map(|&c| c as f64).product();
-        if cells > room as f64 {
-            return Err(BuildError::invalid(
-                body,
-                format!(
-                    "its bounding box holds {cells:.3e} lattice points at resolution {} with {} particles \
-                     per cell and axis, more than the {room} particles left of the scene's {MAX_PARTICLES}",
-                    self.resolution, self.per_cell
-                ),
-            ));
-        }
+        Ok(std::array::from_fn(|a| ((hi[a] - lo[a]) / self.spacing).ceil().max(1.0)))
+    }
+
+    /// The lattice points of body `k`'s region, which must lie between the walls and get at
+    /// least one point; the scene's memory is checked before ([`Lattice::counts`]).
+    fn fill<const D: usize>(&self, region: &Region, k: usize) -> Result<Vec<[f64; D]>, BuildError> {
+        let body = format!("bodies[{k}]");
+        let (lo, _) = region.bounds();
+        let counts: [usize; D] = self.counts::<D>(region, k)?.map(|c| c as usize);
         let points =
             region.points::<D>(lo, counts, self.spacing).map_err(|e| BuildError::invalid(body.clone(), e))?;
         if points.is_empty() {

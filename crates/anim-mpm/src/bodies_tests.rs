@@ -505,15 +505,35 @@ fn a_2d_body_ignores_the_third_components_of_its_shape() {
     assert_eq!(rectangle(1e308).state.x, rectangle(0.1).state.x);
 }
 
-/// A resolution past the grid's limit in 3D (2048 cells per axis) is refused before anything is
-/// allocated, for bodies and presets alike; 2D takes up to 16384.
+/// A resolution past the memory available is refused before anything is allocated, for bodies
+/// (their particles counted over their bounding boxes) and presets alike, naming the field,
+/// the estimate and the memory; past the grid's `u32` block keys (6495 cells per axis in 3D,
+/// 262135 in 2D) the scene refuses it whatever the memory.
 #[test]
-fn a_3d_resolution_past_the_grid_limit_is_refused() {
+fn a_resolution_past_the_memory_is_refused() {
+    let memory = |params: serde_json::Value| {
+        let start = std::time::Instant::now();
+        let e = (KIND.build)(&params, &BuildContext::default()).err().expect("refused");
+        assert!(start.elapsed().as_secs_f64() < 1.0, "{:?}", start.elapsed());
+        match e {
+            BuildError::Memory { field, message, bytes, available } => {
+                assert_eq!(field, "resolution");
+                assert!(bytes > available && message.contains(" available"), "{message}");
+                message
+            }
+            other => panic!("{other:?}"),
+        }
+    };
     let body = json!([{ "shape": cube([0.5, 0.5, 0.5], 0.1), "material": jelly() }]);
-    let (field, message) = refused(json!({ "bodies": body, "resolution": 4096 }));
-    assert!(field == "resolution" && message.contains("[8, 2048] in 3D"), "{field}: {message}");
-    let (field, message) = refused(json!({ "preset": "snowball", "resolution": 16384 }));
-    assert!(field == "resolution" && message.contains("[8, 2048] in 3D"), "{field}: {message}");
-    let (field, message) = refused(json!({ "preset": "dam-break-2d", "resolution": 16385 }));
-    assert!(field == "resolution" && message.contains("[8, 16384] in 2D"), "{field}: {message}");
+    let m = memory(json!({ "bodies": body, "resolution": 6000 }));
+    assert!(m.starts_with("6000 cells per axis with 2 particles per cell and axis (1.38"), "{m}");
+    assert!(m.contains("e10 lattice points in the bodies' bounding boxes) needs about "), "{m}");
+    let m = memory(json!({ "preset": "snowball", "resolution": 6000 }));
+    assert!(m.starts_with("6000 cells per axis needs about "), "{m}");
+    let m = memory(json!({ "preset": "dam-break-2d", "resolution": 200_000, "particles_per_cell": 8 }));
+    assert!(m.starts_with("200000 cells per axis needs about "), "{m}");
+    let (field, message) = refused(json!({ "bodies": body, "resolution": 6496 }));
+    assert!(field == "resolution" && message.contains("[8, 6495] in 3D"), "{field}: {message}");
+    let e = crate::scenes::by_name("dam-break-2d", Some(262_136)).expect("known").expect_err("refused");
+    assert!(e.to_string().contains("[8, 262135] in 2D"), "{e}");
 }

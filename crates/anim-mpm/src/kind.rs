@@ -98,7 +98,10 @@ pub struct MpmSceneParams {
     /// [`scenes`]). Absent when the scene has `bodies`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub preset: Option<String>,
-    /// Grid cells per axis, 8 to 16384 in 2D and 8 to 2048 in 3D; absent: the preset's default, 64 for bodies.
+    /// Grid cells per axis, at least 8 (and at most what the grid's `u32` block keys address:
+    /// [`crate::max_resolution`]); absent: the preset's default, 64 for bodies. No more than the
+    /// memory holds: the scene's estimate ([`crate::memory`]) is checked against the memory
+    /// available before the grid or a particle is made.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
     /// Particle-grid transfer, `"mls-mpm"` or `"apic"`; absent: the scene's (MLS-MPM).
@@ -262,6 +265,7 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
             ));
         }
     }
+    crate::memory::check_preset(preset, p.resolution, p.particles_per_cell)?;
     let found = scenes::by_name_with(preset, p.resolution, p.particles_per_cell).ok_or_else(|| {
         BuildError::invalid(
             "preset",

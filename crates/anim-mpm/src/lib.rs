@@ -127,6 +127,7 @@ pub mod hencky;
 pub mod kernel;
 pub mod kind;
 pub mod material;
+pub mod memory;
 pub mod mesh_collider;
 mod particle_transfer;
 mod particles;

@@ -207,30 +207,57 @@ impl MpmScene {
 /// cells per axis (`None`: the scene's default).
 #[must_use]
 pub fn by_name(name: &str, resolution: Option<usize>) -> Option<Result<MpmScene, MpmError>> {
-    // A resolution past the grid's limit is refused before the particles are laid out (their
-    // number grows as the resolution to the power of the dimension).
-    let dim = match name {
-        "three-materials" | "dam-break-2d" | "benchmark-2d" => 2,
-        _ if NAMES.contains(&name) => 3,
-        _ => return None,
-    };
-    if let Some(n) = resolution.filter(|&n| n > crate::sim::max_resolution(dim)) {
-        return Some(Err(MpmError::BadParameter {
-            name: "resolution",
-            reason: format!("{n} must lie in [8, {}] in {dim}D", crate::sim::max_resolution(dim)),
-        }));
+    let n = resolution.or_else(|| resolution_default(name))?;
+    if let Err(e) = check_resolution(name, n) {
+        return Some(Err(e));
     }
     Some(match name {
-        "three-materials" => three_materials(resolution.unwrap_or(128)).map(MpmScene::Two),
-        "dam-break-2d" => {
-            dam_break_2d(resolution.unwrap_or(64), 2, Transfer::Mls, Kernel::Quadratic).map(MpmScene::Two)
-        }
-        "dam-break-3d" => dam_break_3d(resolution.unwrap_or(48)).map(MpmScene::Three),
-        "snowball" => snowball(resolution.unwrap_or(64)).map(MpmScene::Three),
-        "benchmark-2d" => benchmark_2d(resolution.unwrap_or(128)).map(MpmScene::Two),
-        "benchmark-3d" => benchmark_3d(resolution.unwrap_or(64)).map(MpmScene::Three),
+        "three-materials" => three_materials(n).map(MpmScene::Two),
+        "dam-break-2d" => dam_break_2d(n, 2, Transfer::Mls, Kernel::Quadratic).map(MpmScene::Two),
+        "dam-break-3d" => dam_break_3d(n).map(MpmScene::Three),
+        "snowball" => snowball(n).map(MpmScene::Three),
+        "benchmark-2d" => benchmark_2d(n).map(MpmScene::Two),
+        "benchmark-3d" => benchmark_3d(n).map(MpmScene::Three),
         _ => return None,
     })
+}
+
+/// The grid cells per axis of a scene when none is given; `None` for an unknown name.
+#[must_use]
+pub fn resolution_default(name: &str) -> Option<usize> {
+    Some(match name {
+        "three-materials" | "benchmark-2d" => 128,
+        "dam-break-2d" => 64,
+        "dam-break-3d" => 48,
+        "snowball" | "benchmark-3d" => 64,
+        _ => return None,
+    })
+}
+
+/// The dimension of a scene, 2 or 3; `None` for an unknown name.
+#[must_use]
+pub fn dim(name: &str) -> Option<usize> {
+    match name {
+        "three-materials" | "dam-break-2d" | "benchmark-2d" => Some(2),
+        _ if NAMES.contains(&name) => Some(3),
+        _ => None,
+    }
+}
+
+/// Refuses a resolution past what the grid's `u32` block keys address
+/// ([`max_resolution`](crate::max_resolution)) before the particles are laid out (their number
+/// grows as the resolution to the power of the dimension). The memory a resolution takes is
+/// the `mpm` kind's to check ([`crate::memory`]).
+fn check_resolution(name: &str, n: usize) -> Result<(), MpmError> {
+    let Some(dim) = dim(name) else { return Ok(()) };
+    let max = crate::sim::max_resolution(dim);
+    if n > max {
+        return Err(MpmError::BadParameter {
+            name: "resolution",
+            reason: format!("{n} must lie in [8, {max}] in {dim}D"),
+        });
+    }
+    Ok(())
 }
 
 /// [`by_name`] with the particles per cell and axis of the scenes that take it (`dam-break-2d`;
@@ -243,9 +270,13 @@ pub fn by_name_with(
 ) -> Option<Result<MpmScene, MpmError>> {
     match (name, per_cell) {
         (_, None) => by_name(name, resolution),
-        ("dam-break-2d", Some(k)) => Some(
-            dam_break_2d(resolution.unwrap_or(64), k, Transfer::Mls, Kernel::Quadratic).map(MpmScene::Two),
-        ),
+        ("dam-break-2d", Some(k)) => {
+            let n = resolution.unwrap_or(64);
+            Some(
+                check_resolution(name, n)
+                    .and_then(|()| dam_break_2d(n, k, Transfer::Mls, Kernel::Quadratic).map(MpmScene::Two)),
+            )
+        }
         (_, Some(_)) if NAMES.contains(&name) => Some(Err(MpmError::BadParameter {
             name: "particles per cell",
             reason: format!("{name} places its own particles; only dam-break-2d takes a count"),

@@ -699,10 +699,12 @@ impl<const D: usize> Solver for MpmSimulation<D> {
     }
 }
 
-/// The finest grid in `D` dimensions: 16384 cells per axis in 2D, 2048 in 3D. The sparse grid
-/// keeps a dense table of its 4-cell blocks, `(n / 4 + 2)^D` entries: 2048 cells per axis in 3D
-/// already make 1.6 GB of tables before any matter is added.
+/// The finest grid in `D` dimensions that the sparse grid's `u32` block keys address: its dense
+/// tables hold `(n / 4 + 2)^D` blocks, at most `u32::MAX`, so 262,135 cells per axis in 2D and
+/// 6,495 in 3D. Long before that the memory runs out (the tables take 12 bytes a block, 2048
+/// cells per axis in 3D 1.6 GB before any matter): the `mpm` kind checks the memory a scene
+/// will take against the memory available ([`crate::memory`]).
 #[must_use]
 pub const fn max_resolution(dim: usize) -> usize {
-    if dim >= 3 { 2048 } else { 16384 }
+    if dim >= 3 { 6495 } else { 262_135 }
 }

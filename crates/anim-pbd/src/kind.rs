@@ -88,10 +88,12 @@ pub struct PbdSceneParams {
     /// given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub preset: Option<String>,
-    /// Resolution (the preset's default when absent): the cloth's side (2 to 1024, default 32;
-    /// 14 for the hanging cloth; 50 for the benchmark cloth), the flag's width (3 to 512,
-    /// default 24), the rope's links (2 to 100,000, default 100), the blob's cells (2 to 40,
-    /// default 6), the balloon's subdivisions (0 to 6, default 3). Presets only.
+    /// Resolution (the preset's default when absent): the cloth's side (at least 2, default 32;
+    /// 14 for the hanging cloth; 50 for the benchmark cloth), the flag's width (at least 3,
+    /// default 24), the rope's links (at least 2, default 100), the blob's cells (at least 2,
+    /// default 6), the balloon's subdivisions (default 3). No more than the memory holds: the
+    /// scene's estimate ([`crate::memory`]) is checked against the memory available before
+    /// building. Presets only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
     /// `"pbd"` (stiffness) or `"xpbd"` (compliance); the preset's when absent, `"xpbd"` for
@@ -196,6 +198,7 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
         (Some(preset), true) => preset,
     };
     bodies::refuse_body_fields(&p)?;
+    crate::memory::check_scene(preset, p.resolution)?;
     let mut scene = match scenes::by_name(preset, p.resolution) {
         Some(Ok(scene)) => scene,
         Some(Err(e)) => return Err(BuildError::invalid("resolution", e.to_string())),
@@ -426,6 +429,7 @@ fn tolerance_adapter(
     let Some(preset) = &p.preset else {
         return Err("--tolerance: the pbd studies measured the presets, not a scene of its own bodies".into());
     };
+    crate::memory::check_scene(preset, p.resolution).map_err(study::unreadable)?;
     let scene = scenes::by_name(preset, p.resolution)
         .ok_or_else(|| format!("--tolerance: unknown pbd preset `{preset}`"))?
         .map_err(study::unreadable)?;

@@ -178,6 +178,7 @@ pub mod cases;
 pub mod collide;
 pub mod constraint;
 pub mod kind;
+pub mod memory;
 mod model;
 mod project;
 pub mod scenes;

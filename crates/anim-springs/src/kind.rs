@@ -61,7 +61,9 @@ pub struct SpringsParams {
     pub preset: Option<String>,
     /// Particles per side of a preset (the preset's default when absent: 32 for the cloth, 40
     /// for the rope, 6 for the jelly, 128 for the benchmark cloth); at least 2 (3 for the
-    /// rope), at most 4096. Not with `bodies` (a body's resolution is its mesh's).
+    /// rope), and no more than the memory holds: the scene's estimate ([`crate::memory`]) is
+    /// checked against the memory available before building. Not with `bodies` (a body's
+    /// resolution is its mesh's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution: Option<usize>,
     /// Integrator override (the preset's when absent; backward Euler for bodies); a
@@ -142,6 +144,7 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
                     ));
                 }
             }
+            crate::memory::check_scene(name, p.resolution, p.integrator, p.linear_solver)?;
             preset_scene(name, p.resolution)?
         }
         (None, false) => {
@@ -316,6 +319,8 @@ fn tolerance_adapter(
 ) -> Result<Box<dyn StudyAdapter>, String> {
     let p: SpringsParams = params(value).map_err(study::unreadable)?;
     let preset = p.preset.ok_or("--tolerance: a springs scene of bodies has no study, only the presets")?;
+    crate::memory::check_scene(&preset, p.resolution, p.integrator, p.linear_solver)
+        .map_err(study::unreadable)?;
     let scene = scenes::by_name(&preset, p.resolution)
         .ok_or_else(|| format!("--tolerance: unknown springs preset `{preset}`"))?
         .map_err(study::unreadable)?;

@@ -137,6 +137,7 @@ pub mod contact;
 mod error;
 mod geom;
 pub mod kind;
+pub mod memory;
 mod mesh;
 pub mod network;
 mod obstacles;

@@ -87,6 +87,30 @@ pub fn by_name(name: &str, resolution: Option<usize>) -> Option<Result<SpringSce
     })
 }
 
+/// The resolution a scene takes when none is given and its smallest: particles per side (of
+/// the rope: particles), `None` for an unknown name.
+#[must_use]
+pub fn resolution_range(name: &str) -> Option<(usize, usize)> {
+    Some(match name {
+        "hanging-cloth" => (32, 2),
+        "swinging-rope" => (40, 3),
+        "jelly-drop" => (6, 2),
+        "benchmark-cloth" => (128, 2),
+        _ => return None,
+    })
+}
+
+/// The integrator and linear solver a scene suggests, `None` for an unknown name.
+#[must_use]
+pub fn method(name: &str) -> Option<(IntegratorKind, LinearSolverKind)> {
+    Some(match name {
+        "hanging-cloth" | "jelly-drop" => (IntegratorKind::BackwardEuler, LinearSolverKind::Cholesky),
+        "swinging-rope" => (IntegratorKind::VelocityVerlet, LinearSolverKind::Cg),
+        "benchmark-cloth" => (IntegratorKind::SymplecticEuler, LinearSolverKind::JacobiPcg),
+        _ => return None,
+    })
+}
+
 /// Newton settings for animation: the linearised implicit step (one Newton iteration,
 /// `[M - h^2 K(x0) - h D(x0)] dv = h f(x0) + h^2 K v0`, Baraff and Witkin's scheme), with the
 /// linear solve to a relative residual of `1e-6`.
@@ -103,18 +127,17 @@ pub fn animation_newton() -> NewtonParams {
     p
 }
 
-fn resolution(
-    shape: &'static str,
-    n: Option<usize>,
-    default: usize,
-    min: usize,
-) -> Result<usize, BuildError> {
+/// The resolution `n` of the scene `shape`, its default when `None` ([`resolution_range`]).
+/// There is no upper bound here: the `springs` kind's builder refuses a size whose memory
+/// ([`crate::memory`]) the machine does not have before building.
+fn resolution(shape: &'static str, n: Option<usize>) -> Result<usize, BuildError> {
+    let (default, min) = resolution_range(shape).unwrap_or((2, 2));
     let n = n.unwrap_or(default);
-    if n < min || n > 4096 {
+    if n < min {
         return Err(BuildError::Input(InputError::BadParameter {
             shape,
             name: "resolution",
-            requirement: "must lie in [min, 4096] (min is 2 for cloth and jelly, 3 for the rope)",
+            requirement: "must be at least 2 for cloth and jelly, 3 for the rope",
             value: n.to_string(),
         }));
     }
@@ -126,9 +149,9 @@ fn resolution(
 /// structural, shear and bending springs of stiffness 1000, 200 and 20 N/m with light damping.
 ///
 /// # Errors
-/// [`InputError::BadParameter`] for a resolution outside `[2, 4096]`.
+/// [`InputError::BadParameter`] for a resolution below 2.
 pub fn hanging_cloth(n: Option<usize>) -> Result<SpringScene, BuildError> {
-    let n = resolution("hanging-cloth", n, 32, 2)?;
+    let n = resolution("hanging-cloth", n)?;
     let mut b = NetworkBuilder::new();
     b.gravity(EARTH_GRAVITY);
     let r = b.cloth(&Cloth {
@@ -162,9 +185,9 @@ pub fn hanging_cloth(n: Option<usize>) -> Result<SpringScene, BuildError> {
 /// released to swing like a pendulum. Total mass 0.1 kg, springs of 200 N/m.
 ///
 /// # Errors
-/// [`InputError::BadParameter`] for a resolution outside `[3, 4096]`.
+/// [`InputError::BadParameter`] for a resolution below 3.
 pub fn swinging_rope(n: Option<usize>) -> Result<SpringScene, BuildError> {
-    let n = resolution("swinging-rope", n, 40, 3)?;
+    let n = resolution("swinging-rope", n)?;
     let mut b = NetworkBuilder::new();
     b.gravity(EARTH_GRAVITY);
     let mass = 0.1 / n as f64;
@@ -199,9 +222,9 @@ pub fn swinging_rope(n: Option<usize>) -> Result<SpringScene, BuildError> {
 /// along the edges, face diagonals and body diagonals.
 ///
 /// # Errors
-/// [`InputError::BadParameter`] for a resolution outside `[2, 4096]`.
+/// [`InputError::BadParameter`] for a resolution below 2.
 pub fn jelly_drop(n: Option<usize>) -> Result<SpringScene, BuildError> {
-    let n = resolution("jelly-drop", n, 6, 2)?;
+    let n = resolution("jelly-drop", n)?;
     let spacing = 0.25 / (n - 1) as f64;
     let mut b = NetworkBuilder::new();
     b.gravity(EARTH_GRAVITY);

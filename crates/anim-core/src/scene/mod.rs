@@ -39,12 +39,18 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
+//! A builder estimates the memory its scene will take from the parameters before allocating
+//! any of it ([`MemoryNeed`]: grids, particles, matrix nonzeros and factor fill) and refuses a
+//! size the machine cannot hold with [`BuildError::Memory`], which names the field, the
+//! estimate and the memory available.
+//!
 //! What the module is not: a renderer or a file writer. A [`Frame`] is plain arrays; the `anim`
 //! command turns frames into VTK, PLY, OBJ or CSV files and preview images.
 
 mod checkpoint;
 mod dynamic;
 mod looped;
+mod memory;
 mod pin;
 mod placement;
 mod preset;
@@ -58,6 +64,9 @@ pub use checkpoint::{
 };
 pub use dynamic::{DynScene, Simulated, StepError};
 pub use looped::Looped;
+pub use memory::{
+    MemoryNeed, UNKNOWN_LIMIT, available_memory, check_memory, cholesky_factor_blocks, format_bytes,
+};
 pub use pin::{PinBox, PinError, PinSpec};
 pub use placement::{ObstacleMesh, Placement, is_unit_scale, unit_scale};
 pub use preset::{BuildContext, BuildError, BuildFn, Preset, RunDefaults, SceneKind, is_default, params};

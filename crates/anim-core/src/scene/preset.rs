@@ -111,6 +111,20 @@ pub enum BuildError {
         /// What is wrong, with the valid range or names.
         message: String,
     },
+    /// The scene the parameters ask for needs more memory than is available
+    /// ([`MemoryNeed::check`](super::MemoryNeed::check)).
+    #[error("field `{field}`: {message}")]
+    Memory {
+        /// The parameter that sets the size (dotted for nested ones).
+        field: String,
+        /// What was asked, the estimate with its parts, and the memory available.
+        message: String,
+        /// The estimate (bytes).
+        bytes: f64,
+        /// The memory it was checked against (bytes): what was available, or
+        /// [`UNKNOWN_LIMIT`](super::UNKNOWN_LIMIT) when that is unknown.
+        available: f64,
+    },
 }
 
 impl BuildError {
@@ -139,6 +153,9 @@ impl BuildError {
         match self {
             Self::Schema { field, message } => Self::Schema { field: join(field), message },
             Self::Invalid { field, message } => Self::Invalid { field: join(field), message },
+            Self::Memory { field, message, bytes, available } => {
+                Self::Memory { field: join(field), message, bytes, available }
+            }
         }
     }
 }

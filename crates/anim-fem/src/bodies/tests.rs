@@ -227,11 +227,11 @@ fn pins_hold_their_own_body() {
     }
 }
 
-/// The elements of a scene are counted over its bodies: the body that takes the total past the
-/// limit is refused, naming its `cell` (an OBJ surface, before it is filled) or its `mesh`, with
-/// the elements the bodies before it took.
+/// The memory of a scene is counted over its bodies: the body that takes the estimate past the
+/// memory available is refused, naming its `cell` (an OBJ surface, counted from its lattice
+/// before it is filled) or its `mesh`, with the tetrahedra the bodies before it took.
 #[test]
-fn the_body_past_the_element_limit_is_refused() {
+fn the_body_past_the_memory_is_refused() {
     let dir = folder("bodies-limit");
     std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
     std::fs::copy(testdata().join("cube_v41.msh"), dir.join("cube_v41.msh")).expect("msh");
@@ -240,33 +240,60 @@ fn the_body_past_the_element_limit_is_refused() {
     // 6 x 4^3 = 384 tetrahedra.
     let obj = spec(serde_json::json!({ "mesh": "cube.obj", "cell": 0.25, "material": material }));
     let world = World::default();
-    let within = |bodies: &[BodySpec], max: usize| {
-        build_within(bodies, &world, ElementOrder::Linear, |p| dir.join(p), max)
+    let (be, cholesky) = (TimeIntegrator::BackwardEuler, LinearSolverChoice::Cholesky);
+    let budget =
+        |order, available: f64| Budget { available: Some(available), ..Budget::new(order, be, cholesky) };
+    let within = |bodies: &[BodySpec], order, available: f64| {
+        build_within(bodies, &world, |p| dir.join(p), budget(order, available))
     };
-    let scene = within(&[msh.clone(), obj.clone()], 6 + 384).expect("at the limit");
+    let linear = ElementOrder::Linear;
+    let msh_vertices =
+        crate::body::read_mesh(&dir.join("cube_v41.msh")).expect("reads").positions.len() as f64;
+    // The mesh file first: the OBJ is checked, before its fill, with the file's counts and the
+    // lattice's.
+    let need = |size: MeshSize| size.need(linear, be, cholesky).bytes();
+    let both = need(MeshSize::mesh(msh_vertices, 6.0).and(MeshSize::lattice([4.0; 3])));
+    let scene = within(&[msh.clone(), obj.clone()], linear, both).expect("at the limit");
     assert_eq!(scene.model.elements(), 6 + 384);
-    let e = within(&[msh.clone(), obj.clone()], 6 + 383).expect_err("past the limit");
+    let e = within(&[msh.clone(), obj.clone()], linear, both - 1.0).expect_err("past the limit");
     assert_eq!(e.field, "bodies[1].cell");
-    for part in
-        ["cube.obj", "4 x 4 x 4 lattice cubes", "up to 384 tetrahedra", "at most 389 tet4", "6 of them"]
-    {
+    assert_eq!(e.memory, Some((both, both - 1.0)));
+    for part in [
+        "cube.obj at a cell of 0.25 m (4 x 4 x 4 lattice cubes",
+        "up to 384 tetrahedra), with the 6 tetrahedra of the bodies before, needs about",
+        "available: take a larger cell",
+    ] {
         assert!(e.message.contains(part), "{part}: {e}");
     }
-    let e = within(&[obj, msh], 384 + 5).expect_err("past the limit");
+    // A mesh file is checked with its own counts once read: a second copy takes the scene past.
+    let two = need(MeshSize::mesh(msh_vertices, 6.0).and(MeshSize::mesh(msh_vertices, 6.0)));
+    assert!(within(&[msh.clone(), msh.clone()], linear, two).is_ok());
+    let e = within(&[msh.clone(), msh], linear, two - 1.0).expect_err("past the limit");
     assert_eq!(e.field, "bodies[1].mesh");
-    for part in ["cube_v41.msh has 6 tetrahedra", "at most 389 tet4", "384 of them"] {
-        assert!(e.message.contains(part), "{part}: {e}");
-    }
-    // Through the kind, 10-node elements count 16 times: a lattice of 15^3 cubes (up to 20,250
-    // tetrahedra) is refused for tet10 before the fill and built as tet4.
-    let fine = serde_json::json!({ "bodies": [{ "mesh": "cube.obj", "cell": 0.07, "material": material }] });
-    let mut tet10 = fine.clone();
-    tet10["element"] = "tet10".into();
+    let part = "cube_v41.msh (6 tetrahedra), with the 6 tetrahedra of the bodies before, needs about";
+    assert!(e.message.contains(part), "{part}: {e}");
+    assert!(e.message.ends_with("available: take a coarser mesh"), "{e}");
+    // 10-node elements take more: a lattice of 15^3 cubes (up to 20,250 tetrahedra) that fits
+    // as tet4 is refused as tet10 before the fill.
+    let fine = spec(serde_json::json!({ "mesh": "cube.obj", "cell": 0.07, "material": material }));
+    let lattice = MeshSize::lattice([15.0; 3]);
+    let tet4 = lattice.need(linear, be, cholesky).bytes();
+    assert!(lattice.need(ElementOrder::Quadratic, be, cholesky).bytes() > 4.0 * tet4);
+    let e = within(std::slice::from_ref(&fine), ElementOrder::Quadratic, tet4).expect_err("tet10 past");
+    assert_eq!(e.field, "bodies[0].cell");
+    assert!(e.message.contains("up to 20250 tetrahedra)"), "{e}");
+    assert!(within(&[fine], linear, tet4).is_ok());
+    // Through the kind, against the machine's memory: a cell of 10 microns on a 1 m cube (1e15
+    // lattice cubes) is refused on any machine, as a refusal of memory naming the field.
+    let tiny = serde_json::json!({ "bodies": [{ "mesh": "cube.obj", "cell": 1e-5, "material": material }] });
     let context = BuildContext { base: Some(&dir) };
-    let (f, m) = field((KIND.build)(&tet10, &context).err().expect("refused"));
-    assert_eq!(f, "bodies[0].cell");
-    assert!(m.contains("up to 20250 tetrahedra") && m.contains("at most 16384 tet10"), "{m}");
-    assert!((KIND.build)(&fine, &context).is_ok());
+    match (KIND.build)(&tiny, &context).err().expect("refused") {
+        BuildError::Memory { field, message, bytes, .. } => {
+            assert_eq!(field, "bodies[0].cell");
+            assert!(message.contains("100000 x 100000 x 100000 lattice cubes") && bytes > 1e18, "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
     let _ = std::fs::remove_dir_all(dir);
 }
 

@@ -202,22 +202,40 @@ fn the_cell_is_in_metres_of_the_placed_body() {
 }
 
 /// The unit cube at `cell = 0.0084` would lay 120^3 lattice cubes, up to 10,368,000 tetrahedra
-/// (12 GB of mass blocks alone, 75 GB as 10-node elements): refused at once, before the fill,
-/// naming `cell`, the counts and the limit.
+/// (18 GB of element buffers alone, some 300 GB with the Cholesky factor): refused at once,
+/// before the fill, naming `cell`, the counts, the estimate and the memory checked against.
 #[test]
-fn a_cell_too_fine_for_the_element_limit_is_refused_before_the_fill() {
+fn a_cell_too_fine_for_the_memory_is_refused_before_the_fill() {
     let dir = folder("obj-too-fine");
     std::fs::write(dir.join("cube.obj"), cube_obj(1.0, &[])).expect("obj");
+    let gib = 1024.0 * 1024.0 * 1024.0;
+    let budget = |available: f64| Budget {
+        available: Some(available),
+        ..Budget::new(ElementOrder::Linear, TimeIntegrator::BackwardEuler, LinearSolverChoice::Cholesky)
+    };
     let start = std::time::Instant::now();
-    let e = cube(serde_json::json!({ "mesh": "cube.obj", "cell": 0.0084 }))
-        .load(&dir.join("cube.obj"))
-        .expect_err("refused");
+    let spec = cube(serde_json::json!({ "mesh": "cube.obj", "cell": 0.0084 }));
+    let e = spec.load_within(&dir.join("cube.obj"), &budget(64.0 * gib)).expect_err("refused");
     assert!(start.elapsed().as_secs_f64() < 20.0, "refused after {:?}", start.elapsed());
     assert_eq!(e.field, "cell");
-    for part in ["cube.obj", "120 x 120 x 120", "10368000 tetrahedra", "at most 262144 tet4 elements"] {
+    for part in ["cube.obj", "120 x 120 x 120", "10368000 tetrahedra", "needs about", "64.0 GiB available"] {
         assert!(e.message.contains(part), "{part}: {e}");
     }
-    assert_eq!(crate::bodies::MAX_ELEMENTS, 262_144);
+    assert!(e.message.ends_with(": take a larger cell"), "{e}");
+    let (bytes, available) = e.memory.expect("a refusal of memory");
+    let elements = 10_368_000.0 * 1720.0;
+    assert!(bytes > elements && available == 64.0 * gib, "{bytes}");
+    // The same surface at a coarser cell fits, and the public `load` checks the machine's memory.
+    assert!(
+        cube(serde_json::json!({ "mesh": "cube.obj", "cell": 0.25 }))
+            .load_within(&dir.join("cube.obj"), &budget(gib))
+            .is_ok()
+    );
+    let e = cube(serde_json::json!({ "mesh": "cube.obj", "cell": 1e-5 }))
+        .load(&dir.join("cube.obj"))
+        .expect_err("refused");
+    assert_eq!(e.field, "cell");
+    assert!(e.memory.is_some(), "{e}");
     let _ = std::fs::remove_dir_all(dir);
 }
 

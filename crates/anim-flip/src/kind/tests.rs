@@ -275,14 +275,24 @@ fn bad_parameters_name_their_field() {
         err(json!({ "preset": "drop-4d" })),
         "field `preset`: unknown preset `drop-4d` (one of dam-break-2d, dam-break-3d, drop-2d, drop-3d, sloshing-tank)"
     );
-    assert_eq!(
-        err(json!({ "preset": "drop-3d", "resolution": 129 })),
-        "field `resolution`: drop-3d takes at most 128 cells across, got 129"
-    );
-    assert_eq!(
-        err(json!({ "preset": "sloshing-tank", "resolution": 1025 })),
-        "field `resolution`: sloshing-tank takes at most 1024 cells across, got 1025"
-    );
+    // A tank past the memory available is refused before it is made, with the estimate and the
+    // memory, for presets and bodies alike.
+    let body = json!({ "shape": { "sphere": { "center": [0.5, 0.5, 0.5], "radius": 0.1 } } });
+    for params in [
+        json!({ "preset": "drop-3d", "resolution": 1_000_000_000 }),
+        json!({ "preset": "sloshing-tank", "resolution": 1_000_000_000 }),
+        json!({ "bodies": [body], "resolution": 1_000_000_000 }),
+    ] {
+        let start = std::time::Instant::now();
+        let e = (KIND.build)(&params, &Default::default()).err().expect("refused");
+        assert!(start.elapsed().as_secs_f64() < 1.0, "{params}: {:?}", start.elapsed());
+        assert!(matches!(e, BuildError::Memory { .. }), "{params}: {e}");
+        let msg = e.to_string();
+        assert!(
+            msg.starts_with("field `resolution`: 1000000000 cells across ") && msg.contains("needs about "),
+            "{msg}"
+        );
+    }
     let msg = err(json!({ "preset": "drop-2d", "resolution": 2 }));
     assert!(msg.starts_with("field `resolution`: anim-flip: parameter `cells[0]`"), "{msg}");
     assert_eq!(

@@ -51,8 +51,8 @@ impl Region {
     /// Per cell of `fluid` (x fastest), whether its centre lies inside.
     ///
     /// # Errors
-    /// The surface's refusal of the lattice (never for a grid of at most
-    /// [`MAX_CELLS`](super::MAX_CELLS)).
+    /// The surface's refusal of the lattice (never for a grid whose memory the scene's check
+    /// let through: [`crate::memory`]).
     pub(super) fn cell_mask(&self, fluid: &MacFluid) -> Result<Vec<bool>, String> {
         self.mask(fluid.dims(), fluid.h(), |i, j, k| fluid.cell_centre(i, j, k))
     }
