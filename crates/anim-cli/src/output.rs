@@ -198,11 +198,20 @@ impl Output {
             let (width, height) = preview_size(size, writer.view.aspect());
             let path = dir.join("preview.gif");
             let gif = GifWriter::create(&path, width, height, 4, true).map_err(|e| e.to_string())?;
+            // What a kept frame holds: a grid's density per cell, or the coordinates.
+            let values = match geometry {
+                Geometry::Grid { dims, .. } => dims.iter().product(),
+                _ => dof,
+            };
+            let every = preview_every(frames, values);
             writer.preview = Some(Preview {
                 gif,
                 canvas: Canvas::new(width, height, [248, 248, 250]),
-                every: preview_every(frames, dof),
-                kept: Vec::new(),
+                every,
+                // Sized once: growing by doubling would hold twice the budget for a moment.
+                kept: Vec::with_capacity(
+                    frames.div_ceil(every).min(PREVIEW_BYTES / 4 / values.max(1)).max(1) * values,
+                ),
                 lengths: Vec::new(),
             });
         }
