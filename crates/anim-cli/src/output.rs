@@ -257,11 +257,20 @@ impl Output {
             let (width, height) = preview_size(size, writer.view.aspect());
             let path = dir.join("preview.gif");
             let gif = GifWriter::create(&path, width, height, 4, true).map_err(|e| e.to_string())?;
+            // What a kept frame holds: a grid's density per cell, or the coordinates.
+            let values = match geometry {
+                Geometry::Grid { dims, .. } => dims.iter().product(),
+                _ => dof,
+            };
+            let every = preview_every(frames, values);
             writer.preview = Some(Preview {
                 gif,
                 canvas: Canvas::new(width, height, [248, 248, 250]),
-                every: preview_every(frames, dof),
-                kept: Vec::new(),
+                every,
+                // Sized once: growing by doubling would hold twice the budget for a moment.
+                kept: Vec::with_capacity(
+                    frames.div_ceil(every).min(PREVIEW_BYTES / 4 / values.max(1)).max(1) * values,
+                ),
                 lengths: Vec::new(),
             });
         }
@@ -324,6 +333,55 @@ impl Output {
             Some(Ok(result)) => result,
             Some(Err(_)) => Err("the frame writer panicked".into()),
             None => Err("the frame writer was not started".into()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// About 100 preview frames whatever the run's length, and never more kept values than
+    /// fit the budget: the frames kept (every `every`-th of `frames`) times their bytes.
+    #[test]
+    fn the_preview_keeps_about_100_frames_within_its_memory() {
+        assert_eq!(preview_every(1, 3), 1);
+        assert_eq!(preview_every(100, 3), 1);
+        assert_eq!(preview_every(1000, 3), 10);
+        for (frames, values) in [(100, 3_000_000), (1000, 3_000_000), (75, 30_000_000), (10, 1 << 30)] {
+            let every = preview_every(frames, values);
+            let kept = frames.div_ceil(every);
+            assert!(kept <= 100, "{frames} frames of {values}: {kept} kept");
+            assert!(
+                kept == 1 || kept * 4 * values <= PREVIEW_BYTES,
+                "{frames} frames of {values}: {kept} kept"
+            );
+        }
+        // 3 million values (a million particles): 22 frames fit, so 100 frames keep every 5th.
+        assert_eq!(preview_every(100, 3_000_000), 5);
+    }
+
+    #[test]
+    fn a_grid_preview_keeps_its_proportions_inside_the_size() {
+        assert_eq!(preview_size((640, 480), None), (640, 480));
+        assert_eq!(preview_size((640, 480), Some(1.0)), (480, 480));
+        assert_eq!(preview_size((640, 480), Some(2.0)), (640, 320));
+        assert_eq!(preview_size((640, 480), Some(0.5)), (240, 480));
+        assert_eq!(preview_size((640, 480), Some(1e-6)), (16, 480));
+        assert_eq!(preview_size((640, 480), Some(f64::NAN)), (640, 480));
+    }
+
+    #[test]
+    fn preview_sizes_are_read_and_refused_with_the_value() {
+        assert_eq!(parse_preview_size("640x480"), Ok((640, 480)));
+        assert_eq!(parse_preview_size("16X4096"), Ok((16, 4096)));
+        for bad in ["8x8", "0x480", "640x4097"] {
+            let e = parse_preview_size(bad).unwrap_err();
+            assert_eq!(e, format!("{bad}: width and height must each lie in [16, 4096] pixels"));
+        }
+        for bad in ["wide", "640", "x480", "640x", "-1x480", "6.5x480"] {
+            let e = parse_preview_size(bad).unwrap_err();
+            assert_eq!(e, format!("{bad}: expected WIDTHxHEIGHT in pixels, such as 640x480"));
         }
     }
 }

@@ -628,8 +628,9 @@ mod tests {
         assert_eq!((ground, obstacles.len()), (Some(0.0), 2));
     }
 
-    /// The painted pixels' bounding box, `(x0, y0, x1, y1)`, `y` down.
+    /// The painted pixels' bounding box, `(x0, y0, x1, y1)`, `y` down; something must be.
     fn extent(canvas: &Canvas) -> (u32, u32, u32, u32) {
+        assert!(!painted(canvas).is_empty(), "nothing drawn");
         painted(canvas).iter().fold((u32::MAX, u32::MAX, 0, 0), |(a, b, c, d), &(x, y)| {
             (a.min(x), b.min(y), c.max(x), d.max(y))
         })
@@ -661,6 +662,7 @@ mod tests {
         view.see(&Snapshot { x: vec![f64::NAN, 1e300, 0.0], ..Snapshot::default() });
         let camera = view.camera(4.0 / 3.0);
         view.draw(&mut canvas, &camera, &far).unwrap();
+        assert!(painted(&canvas).len() > 4, "the far point is not drawn");
         let (x0, y0, x1, y1) = extent(&canvas);
         assert!(x0 > 0 && y0 > 0 && x1 < 159 && y1 < 119, "{:?}", extent(&canvas));
     }

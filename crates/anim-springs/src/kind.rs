@@ -458,17 +458,20 @@ mod tests {
         let mean = |values: &[f64], k: usize| {
             values.chunks_exact(3).map(|p| p[k]).sum::<f64>() / (values.len() / 3) as f64
         };
+        // It starts level: every point at the height y = 1.
         let start = frame_of(scene.as_ref());
+        assert!(start.points.chunks_exact(3).all(|p| p[1] == 1.0), "{:?}", &start.points[..6]);
         for _ in 0..20 {
             scene.step(0.01).expect("step");
         }
         let later = frame_of(scene.as_ref());
         let v = &later.field("velocity").expect("velocity").values;
-        let (dx, dy) = (
-            mean(&later.points, 0) - mean(&start.points, 0),
-            mean(&later.points, 1) - mean(&start.points, 1),
+        let moved = |k: usize| mean(&later.points, k) - mean(&start.points, k);
+        let (dx, dy, dz) = (moved(0), moved(1), moved(2));
+        assert!(
+            dy < -0.05 && dx.abs() < 0.1 * dy.abs() && dz.abs() < 0.5 * dy.abs(),
+            "moved by {dx} along x, {dy} along y, {dz} along z"
         );
-        assert!(dy < -0.05 && dx.abs() < 0.1 * dy.abs(), "moved by {dx} along x, {dy} along y");
         assert!(
             mean(v, 1) < 0.0 && mean(v, 1).abs() > mean(v, 0).abs(),
             "mean velocity {}, {}",

@@ -259,12 +259,12 @@ mod tests {
     /// the picture's tighter side: the box is as large as it can be.
     #[test]
     fn a_fitting_camera_shows_the_whole_box_as_large_as_it_fits() {
-        for (min, max, aspect) in [
-            ([-1.0, 0.0, -1.0], [1.0, 2.0, 1.0], 4.0 / 3.0),
-            ([0.0, 0.0, 0.0], [3.0, 0.5, 0.2], 4.0 / 3.0),
-            ([0.0, -5.0, 0.0], [0.1, 5.0, 0.1], 1.0),
+        for (min, max, (w, h)) in [
+            ([-1.0, 0.0, -1.0], [1.0, 2.0, 1.0], (400, 300)),
+            ([0.0, 0.0, 0.0], [3.0, 0.5, 0.2], (400, 300)),
+            ([0.0, -5.0, 0.0], [0.1, 5.0, 0.1], (300, 300)),
         ] {
-            let (w, h) = ((400.0 * aspect) as u32, 400);
+            let aspect = f64::from(w) / f64::from(h);
             let v = Camera::fitting(min, max, [0.55, -0.45, -1.0], [0.0, 1.0, 0.0], aspect).view(w, h);
             let mut slack = f64::INFINITY;
             for i in 0..8 {
