@@ -7,8 +7,9 @@
 //! | part | bytes | what |
 //! | --- | --- | --- |
 //! | particles | 320 (velocity Verlet, symplectic Euler), 400 (implicit), + 144 with a ground or collider | the model (mass, pin, rest position, inverse mass, incidence offsets), the state, the integrator's vectors, the contact Jacobians |
-//! | springs | 184 | the spring, its compact ends and `[l, k, c]`, two incidences, the force and linearisation scratch, the pattern slots |
-//! | triangles | 24 | the triangles drawn (the cloth, the jelly's faces) |
+//! | frame points | 96 | the frame a view fills (position and velocity, `f64`) and the copy a writer takes |
+//! | springs | 216 | the spring, its compact ends and `[l, k, c]`, two incidences, the force and linearisation scratch, the pattern slots; its line in the view's context and the drawing's copy |
+//! | triangles | 72 | the triangles drawn (the cloth, the jelly's faces), in the model, the view's context and the drawing's copy |
 //! | matrix blocks | 144 | a 3x3 block of the assembled Jacobian (values and column indices), one per particle and two per spring, with an implicit integrator and a solver on the assembled matrix |
 //! | factor blocks | 144 | a 3x3 block of the sparse Cholesky factor (anim-core's [`cholesky_factor_blocks`] of the lattice: the cloth's 2D grid, the jelly's 3D one) |
 
@@ -72,8 +73,9 @@ impl NetworkSize {
         let per_particle = if implicit { 400.0 } else { 320.0 } + if self.contact { 144.0 } else { 0.0 };
         let mut need = MemoryNeed::new()
             .with(self.particles, "particles", per_particle)
-            .with(self.springs, "springs", 184.0)
-            .with(self.triangles, "triangles", 24.0);
+            .with(self.particles, "frame points", 96.0)
+            .with(self.springs, "springs", 216.0)
+            .with(self.triangles, "triangles", 72.0);
         let assembled = !matches!(linear, LinearSolverKind::Cg | LinearSolverKind::JacobiPcg);
         if implicit && assembled {
             need.add(self.particles + 2.0 * self.springs, "matrix blocks", 144.0);

@@ -5,8 +5,11 @@
 //! estimate and the available memory in the message, instead of aborting on a failed
 //! allocation halfway through.
 //!
-//! The arithmetic is in `f64`, so a size of any magnitude gives a finite (or infinite) estimate
-//! and never an overflow.
+//! The memory available to a scene ([`available_memory`]) is the memory free (`MemAvailable`,
+//! a cgroup's limit, `ulimit -v`: [`free_memory`]) less a tenth, at least 256 MiB, kept for what
+//! no estimate counts (the process's threads and allocator, its code, the writer's buffers) and
+//! for the estimates' own error. The arithmetic is in `f64`, so a size of any magnitude gives a
+//! finite (or infinite) estimate and never an overflow.
 //!
 //! ```
 //! use anim_core::scene::{BuildError, MemoryNeed};
@@ -145,7 +148,7 @@ impl MemoryNeed {
 ///
 /// at most the dense triangle `N (N + 1) / 2`. The constant `c` depends on the stencil and is
 /// measured by the caller against faer's factor (anim-springs' cloth: 7.75 in 2D, its jelly's
-/// 27-point lattice: 14; anim-fem's tetrahedra of six per cube: 9). A scalar factor has `k^2`
+/// 27-point lattice: 14; anim-fem's tetrahedra of six per cube: 10). A scalar factor has `k^2`
 /// times as many nonzeros for blocks of `k` unknowns.
 #[must_use]
 pub fn cholesky_factor_blocks(dims: &[f64], c: f64) -> f64 {
@@ -220,6 +223,21 @@ pub fn format_bytes(bytes: f64) -> String {
     format!("{} B", count(bytes))
 }
 
+/// What the memory check keeps back from the memory free, for what no scene's estimate
+/// counts: the process's threads (their stacks and allocator arenas), its code, the writer's
+/// file buffers and the estimates' own error: a tenth of it, at least 256 MiB.
+fn reserve(free: f64) -> f64 {
+    (0.1 * free).max(256.0 * 1024.0 * 1024.0)
+}
+
+/// The memory a scene of this process may take, in bytes: the memory free ([`free_memory`])
+/// less a tenth of it (at least 256 MiB) kept for the process itself and the estimates' error;
+/// `None` when the memory free is unknown.
+#[must_use]
+pub fn available_memory() -> Option<f64> {
+    free_memory().map(|free| (free - reserve(free)).max(0.0))
+}
+
 /// The memory this process may still allocate, in bytes: on Linux the least of the system's
 /// `MemAvailable` (`/proc/meminfo`), the room left under the cgroup's limit
 /// (`/sys/fs/cgroup/memory.max` less `memory.current`, when the limit is a number) and the room
@@ -227,7 +245,7 @@ pub fn format_bytes(bytes: f64) -> String {
 /// less `VmSize` of `/proc/self/status`); `None` elsewhere or when `/proc/meminfo` cannot be
 /// read.
 #[must_use]
-pub fn available_memory() -> Option<f64> {
+pub fn free_memory() -> Option<f64> {
     let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
     let mut available = kib_field(&meminfo, "MemAvailable:")?;
     if let Some(max) = read_number("/sys/fs/cgroup/memory.max") {
@@ -358,10 +376,16 @@ mod tests {
 
     #[test]
     fn the_machine_reports_some_memory_on_linux() {
-        let available = available_memory();
+        let available = free_memory();
         if cfg!(target_os = "linux") {
             let a = available.expect("/proc/meminfo");
             assert!(a > 0.0 && a.is_finite() && a.fract() == 0.0, "{a}");
+            // A scene gets the free memory less a tenth, at least 256 MiB.
+            let mib = 1024.0 * 1024.0;
+            assert_eq!(reserve(10_000.0 * mib), 1000.0 * mib);
+            assert_eq!(reserve(1000.0 * mib), 256.0 * mib);
+            let scene = available_memory().expect("known");
+            assert!(scene < a && scene >= 0.0, "{scene} of {a}");
             let meminfo = std::fs::read_to_string("/proc/meminfo").expect("meminfo");
             let total = kib_field(&meminfo, "MemTotal:").expect("MemTotal");
             assert!(a <= total, "{a} > {total}");

@@ -64,6 +64,7 @@ pub use dynamic::{DynScene, Simulated, StepError};
 pub use looped::Looped;
 pub use memory::{
     MemoryNeed, UNKNOWN_LIMIT, available_memory, check_memory, cholesky_factor_blocks, format_bytes,
+    free_memory,
 };
 pub use pin::{PinBox, PinError, PinSpec};
 pub use placement::{ObstacleMesh, Placement, is_unit_scale, unit_scale};
