@@ -8,7 +8,7 @@
 //! | part | bytes | what |
 //! | --- | --- | --- |
 //! | nodes | 600 | positions, masses, loads and flags, the state, the step's and Newton's vectors, a contact block |
-//! | frame points, written points | 48, 220 | the frame a view fills (position and velocity, `f64`) and what a run holds to write it (anim-core's `FRAME_POINT_BYTES`, `WRITTEN_POINT_BYTES`) |
+//! | frame points, written points | 48, 330 | the frame a view fills (position and velocity, `f64`) and what a run holds to write it (anim-core's `FRAME_POINT_BYTES`, `WRITTEN_POINT_BYTES`) |
 //! | elements | 1,752 (tet4), 10,532 (tet10) | the element's 12x12 (30x30) stiffness and its force buffers, `Dm^-1`, volume, shape gradients (quadrature data), the assembly's gather lists and, while it is made, its sorted block pairs; its corners in the view's context |
 //! | matrix blocks | 960 | a 3x3 block of the pattern: six matrices share it (the consistent mass and its pinned copy, the stiffness, the stiffness at the step's start, the Newton matrix, the template), 144 B each, and its gather entries |
 //! | factor blocks | 144 | a 3x3 block of the Cholesky or LDLT factor of backward Euler's Newton matrix (anim-core's [`cholesky_factor_blocks`], constant 10: faer's factor measured 9 to 10 times `N sqrt(a b)` blocks on cubes of 12^3 to 36^3 cells and beams of 3 to 10 across) |

@@ -9,7 +9,7 @@
 //! | --- | --- | --- |
 //! | particles | 210, + 104 per collider | the particle, inverse mass and rest position, the state, the solver's positions, velocities and predictions, the external forces; a contact slot reserved per collider |
 //! | constraints | 360 (sequential Gauss-Seidel), 420 (coloured Gauss-Seidel) | the builder's and the model's constraint (112 B each), the compiled copy (112 B), the multiplier and the incidences; the coloured sweep's buffered corrections |
-//! | frame points, written points | 48, 220 | the frame a view fills (position and velocity, `f64`) and what a run holds to write it (anim-core's `FRAME_POINT_BYTES`, `WRITTEN_POINT_BYTES`) |
+//! | frame points, written points | 48, 330 | the frame a view fills (position and velocity, `f64`) and what a run holds to write it (anim-core's `FRAME_POINT_BYTES`, `WRITTEN_POINT_BYTES`) |
 //! | triangles | 84 (48 more in a global volume) | the triangle and its incidences; in the view's context and the drawing's copy |
 //! | edges | 32 | a rope's link in the view's context and the drawing's copy |
 //! | tetrahedra | 72 | the tetrahedron and its lattice cell's share while the blob is made; in the view's context |

@@ -7,7 +7,7 @@
 //! | part | bytes | what |
 //! | --- | --- | --- |
 //! | particles | 320 (velocity Verlet, symplectic Euler), 400 (implicit), + 144 with a ground or collider | the model (mass, pin, rest position, inverse mass, incidence offsets), the state, the integrator's vectors, the contact Jacobians |
-//! | frame points, written points | 48, 220 | the frame a view fills (position and velocity, `f64`) and what a run holds to write it (anim-core's `FRAME_POINT_BYTES`, `WRITTEN_POINT_BYTES`) |
+//! | frame points, written points | 48, 330 | the frame a view fills (position and velocity, `f64`) and what a run holds to write it (anim-core's `FRAME_POINT_BYTES`, `WRITTEN_POINT_BYTES`) |
 //! | springs | 216 | the spring, its compact ends and `[l, k, c]`, two incidences, the force and linearisation scratch, the pattern slots; its line in the view's context and the drawing's copy |
 //! | triangles | 72 | the triangles drawn (the cloth, the jelly's faces), in the model, the view's context and the drawing's copy |
 //! | matrix blocks | 144 | a 3x3 block of the assembled Jacobian (values and column indices), one per particle and two per spring, with an implicit integrator and a solver on the assembled matrix |

@@ -41,11 +41,14 @@ pub const UNKNOWN_LIMIT: f64 = 281_474_976_710_656.0;
 /// `f64`.
 pub const FRAME_POINT_BYTES: f64 = 48.0;
 
-/// Bytes per point a run holds to write a frame beyond the frame itself: the writer's snapshot
-/// of it (48) and what writing it as VTK holds, about 170 (its point arrays and vertex ids, the
-/// cell arrays and the file encoded in memory: `anim run` on 1.19 million MPM particles peaks
-/// 200 MB higher writing `vtu` frames than writing none).
-pub const WRITTEN_POINT_BYTES: f64 = 220.0;
+/// Bytes per point a run holds to write a frame beyond the frame itself, as `anim run` writes
+/// VTK: the writer's snapshot of the frame (48), its positions, velocities and vertex ids (56),
+/// the cell arrays (connectivity, offsets, types, 24) and the bytes of the array being encoded
+/// (24), and the file's text in memory, 88 characters of base64 a point in a string grown by
+/// doubling: up to 176. (Its resident part measured 170 bytes a point: `anim run` on 1.19
+/// million MPM particles peaks 200 MB higher writing `vtu` frames than writing none; the rest is
+/// address space reserved by the string's growth, which `ulimit -v` counts.)
+pub const WRITTEN_POINT_BYTES: f64 = 330.0;
 
 /// Bytes per cell of the [`Frame`](super::Frame) of an image grid: its density and velocity as
 /// `f64`.
