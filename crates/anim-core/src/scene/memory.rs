@@ -191,13 +191,14 @@ impl MemoryNeed {
 ///
 /// - 1D (a chain): `c N`, the band;
 /// - 2D: `c N min(log2 N, a)`: nested dissection's `N log2 N` on a square (George 1973: `c =
-///   31/4` on a 5-point grid), the band `N a` on a strip;
+///   31/4` on a 5-point grid; faer's AMD ordering fills a little more), the band `N a` on a
+///   strip;
 /// - 3D: `c N sqrt(a b)`: nested dissection's `N^(4/3)` on a cube (Lipton, Rose & Tarjan 1979),
 ///   `N a` on a bar of side `a`;
 ///
 /// at most the dense triangle `N (N + 1) / 2`. The constant `c` depends on the stencil and is
-/// measured by the caller against faer's factor (anim-springs' cloth: 7.75 in 2D, its jelly's
-/// 27-point lattice: 14; anim-fem's tetrahedra of six per cube: 10). A scalar factor has `k^2`
+/// measured by the caller against faer's factor (anim-springs' cloth: 9.5 in 2D, its jelly's
+/// 27-point lattice: 15; anim-fem's tetrahedra of six per cube: 10). A scalar factor has `k^2`
 /// times as many nonzeros for blocks of `k` unknowns.
 #[must_use]
 pub fn cholesky_factor_blocks(dims: &[f64], c: f64) -> f64 {
