@@ -37,7 +37,10 @@ fn bad_flags_and_names_are_refused_with_the_value_named() {
         (&["run", "warp-drive"], "warp-drive: no such scene file, and no built-in scene of that name"),
         (&["resume", "no-such-checkpoint.anim"], "no-such-checkpoint.anim"),
         (&["run", "lid-driven-cavity", "--resolution", "1"], "field `scene.resolution`: anim-fluid: grid"),
-        (&["run", "smoke-plume-3d", "--resolution", "100000"], "100000 cells across needs about 6.5e17 B"),
+        (
+            &["run", "smoke-plume-3d", "--resolution", "100000"],
+            "--resolution 100000: <built-in scene smoke-plume-3d>: field `scene.resolution`: 100000 cells across needs about",
+        ),
         (&["run", "kepler", "--resolution", "8"], "--resolution 8: a kepler-orbit scene has no resolution"),
         (
             &["run", "smoke-box-2d", "--format", "csv"],

@@ -213,11 +213,12 @@ pub fn step_allocations(
     Ok(blocks)
 }
 
-/// The most bytes building a scene of `kind` from `params` and stepping it once by `dt` hold at
-/// once ([`CountingAllocator::peak_bytes`]), what a kind's memory estimate is compared with.
-/// The scene is built and stepped twice and the second time measured, so that what a process
-/// allocates once for all its scenes (the rayon pool, a solver library's first use) is not
-/// counted. `alloc` must be the process's global allocator.
+/// The most bytes building a scene of `kind` from `params`, stepping it once by `dt` and taking
+/// its view (its [`Context`](crate::scene::Context) and a [`Frame`](crate::scene::Frame), what
+/// a run draws and writes) hold at once ([`CountingAllocator::peak_bytes`]): what a kind's
+/// memory estimate is compared with. This is done twice and the second time measured, so that
+/// what a process allocates once for all its scenes (the rayon pool, a solver library's first
+/// use) is not counted. `alloc` must be the process's global allocator.
 ///
 /// # Errors
 /// The message when the scene cannot be built or its step fails.
@@ -231,7 +232,10 @@ pub fn build_and_step_peak(
         let mut scene =
             (kind.build)(params, &crate::scene::BuildContext::default()).map_err(|e| e.to_string())?;
         scene.step(dt).map_err(|e| e.to_string())?;
-        drop(std::hint::black_box(scene));
+        let context = scene.context();
+        let mut frame = crate::scene::Frame::default();
+        scene.frame(&mut frame);
+        drop(std::hint::black_box((scene, context, frame)));
         Ok(())
     };
     run()?;

@@ -8,9 +8,10 @@
 //! | part | bytes | what |
 //! | --- | --- | --- |
 //! | nodes | 600 | positions, masses, loads and flags, the state, the step's and Newton's vectors, a contact block |
-//! | elements | 1,720 (tet4), 10,500 (tet10) | the element's 12x12 (30x30) stiffness and its force buffers, `Dm^-1`, volume, shape gradients (quadrature data), the assembly's gather lists and, while it is made, its sorted block pairs |
+//! | frame points, written points | 48, 330 | the frame a view fills (position and velocity, `f64`) and what a run holds to write it (anim-core's `FRAME_POINT_BYTES`, `WRITTEN_POINT_BYTES`) |
+//! | elements | 1,752 (tet4), 10,532 (tet10) | the element's 12x12 (30x30) stiffness and its force buffers, `Dm^-1`, volume, shape gradients (quadrature data), the assembly's gather lists and, while it is made, its sorted block pairs; its corners in the view's context |
 //! | matrix blocks | 960 | a 3x3 block of the pattern: six matrices share it (the consistent mass and its pinned copy, the stiffness, the stiffness at the step's start, the Newton matrix, the template), 144 B each, and its gather entries |
-//! | factor blocks | 144 | a 3x3 block of the Cholesky or LDLT factor of backward Euler's Newton matrix (anim-core's [`cholesky_factor_blocks`], constant 9: measured against faer's factor on the beam and the cube) |
+//! | factor blocks | 144 | a 3x3 block of the Cholesky or LDLT factor of backward Euler's Newton matrix (anim-core's [`cholesky_factor_blocks`], constant 10: faer's factor measured 9 to 10 times `N sqrt(a b)` blocks on cubes of 12^3 to 36^3 cells and beams of 3 to 10 across) |
 //!
 //! A tet4 mesh has a block per node and two per edge; a tet10 mesh about 26 per node (counted
 //! on Kuhn lattices of 6^3 to 12^3 cubes and 4 x 4 x 40).
@@ -21,7 +22,7 @@ use crate::sim::{LinearSolverChoice, TimeIntegrator};
 use anim_core::scene::{BuildError, MemoryNeed, cholesky_factor_blocks};
 
 /// The fill constant of a factor over tetrahedra six to a cube (see the module's table).
-const FILL: f64 = 9.0;
+const FILL: f64 = 10.0;
 
 /// The counts of a tetrahedral mesh that set its scene's memory.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -106,11 +107,12 @@ impl MeshSize {
     ) -> MemoryNeed {
         let nodes = self.nodes(order);
         let per_element = match order {
-            ElementOrder::Linear => 1720.0,
-            ElementOrder::Quadratic => 10_500.0,
+            ElementOrder::Linear => 1752.0,
+            ElementOrder::Quadratic => 10_532.0,
         };
         let mut need = MemoryNeed::new()
             .with(nodes, "nodes", 600.0)
+            .with_frame_points(nodes)
             .with(self.elements, &format!("{} elements", order.name()), per_element)
             .with(self.blocks(order), "matrix blocks", 960.0);
         if integrator == TimeIntegrator::BackwardEuler && solver != LinearSolverChoice::JacobiPcg {

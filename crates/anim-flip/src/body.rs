@@ -358,6 +358,7 @@ fn seed<const D: usize>(
         let (name, velocity) = (name.as_str(), *velocity);
         let (start, box_counts) = index_box::<D>(region, spacing, counts);
         let lattice = region.inside_lattice(start, box_counts, spacing).map_err(|e| invalid(name, e))?;
+        crate::scenes::reserve(&mut particles, lattice.iter().filter(|i| **i).count());
         let (mut inside, mut earlier, mut solid) = (0usize, 0usize, 0usize);
         let before = particles.len();
         for (f, _) in lattice.iter().enumerate().filter(|(_, i)| **i) {

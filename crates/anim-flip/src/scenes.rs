@@ -38,13 +38,27 @@ pub fn fill_region<const D: usize>(
     let spacing = h / per_axis as f64;
     let counts: [usize; D] = std::array::from_fn(|a| ((hi[a] - lo[a]) / spacing).round().max(0.0) as usize);
     let total: usize = counts.iter().product();
-    for f in 0..total {
+    let point = |f: usize| -> [f64; D] {
         let idx = crate::mac::unflatten(counts, f);
-        let x: [f64; D] = std::array::from_fn(|a| lo[a] + (idx[a] as f64 + 0.5) * spacing);
+        std::array::from_fn(|a| lo[a] + (idx[a] as f64 + 0.5) * spacing)
+    };
+    // Room for exactly the points kept: pushed one by one, the arrays would grow up to twice
+    // what they hold.
+    let kept = (0..total).filter(|&f| inside(point(f))).count();
+    reserve(particles, kept);
+    for f in 0..total {
+        let x = point(f);
         if inside(x) {
             particles.push(x, v(x));
         }
     }
+}
+
+/// Room for `additional` more particles in each of `particles`' arrays.
+pub(crate) fn reserve<const D: usize>(particles: &mut Particles<D>, additional: usize) {
+    particles.x.reserve_exact(additional);
+    particles.v.reserve_exact(additional);
+    particles.c.reserve_exact(additional);
 }
 
 /// Still water: a box of `n` cells per axis of size `1/n` m, filled to half its inner height

@@ -12,6 +12,7 @@
 //! | MAC, other pressure solvers | + 8 | the one scratch vector |
 //! | MAC, advection-reflection | + 8 D | the reflected velocity |
 //! | MAC with obstacles | + the pressure solver again | the solver rebuilt on the obstacles' labels while the first one lives |
+//! | both: frame cells, written cells | 32, 142 per cell drawn | the frame a view fills (density and velocity, `f64`) and what a run holds to write it (anim-core's `FRAME_CELL_BYTES`, `WRITTEN_CELL_BYTES`) |
 //!
 //! The counts are those of `MacFluid::new` (329.5 bytes a cell measured in 2D, 349 in 3D, with
 //! MGPCG) and of `set_solid` (97 and 89 more).
@@ -57,14 +58,14 @@ impl MacLayout {
     /// obstacles' masks.
     #[must_use]
     pub fn need(&self, cells: f64, masks: f64) -> MemoryNeed {
-        MemoryNeed::new().with(cells, "grid cells", self.per_cell() + masks)
+        MemoryNeed::new().with(cells, "grid cells", self.per_cell() + masks).with_frame_cells(cells)
     }
 }
 
 /// The memory of Stam's solver on an `n x n` grid (its fields are `(n + 2)^2`).
 #[must_use]
 pub fn stam_need(n: f64) -> MemoryNeed {
-    MemoryNeed::new().with((n + 2.0) * (n + 2.0), "grid cells", 48.0)
+    MemoryNeed::new().with((n + 2.0) * (n + 2.0), "grid cells", 48.0).with_frame_cells(n * n)
 }
 
 /// The cells of the preset `name` at `n` cells across, with its layout (`None` for Stam's

@@ -547,6 +547,7 @@ fn seed<const D: usize>(
         ));
     }
     let material = k as u16;
+    crate::scenes::reserve(state, points.len());
     for x in points {
         state
             .push(x.map(|c| c as f32), velocity, mass, volume as f32, material)

@@ -8,6 +8,7 @@
 //! | --- | --- | --- |
 //! | grid blocks | 12 | the dense tables over every `4^D`-node block of the domain, `(n / 4 + 2)^D` of them: the particle and grid block slots and the particle counts (`u32` each) |
 //! | particles | 210, 354 | three copies of the particle arrays (66 B, 114 B: position, velocity, affine matrix, deformation gradient, plastic state, mass, volume, material, id): the state, the step's output and the backup a substepped step restores; the sort's key, order and block (`u32` each) |
+//! | frame points, written points | 48, 330 | the frame a view fills (position and velocity, `f64`) and what a run holds to write it (anim-core's `FRAME_POINT_BYTES`, `WRITTEN_POINT_BYTES`) |
 //! | particle blocks | 1,024, 8,192 | the private window of `8^D` nodes (16 B each) of every block holding particles |
 //! | grid blocks with matter | 256, 1,024 | the `4^D` nodes (16 B each) of every grid block the particles touch |
 //!
@@ -68,6 +69,7 @@ pub fn need(dim: usize, n: f64, matter: &Matter) -> MemoryNeed {
     MemoryNeed::new()
         .with(table.powi(dim as i32), "grid blocks", 12.0)
         .with(matter.particles, "particles", if three { 354.0 } else { 210.0 })
+        .with_frame_points(matter.particles)
         .with(matter.blocks, "particle blocks", if three { 8192.0 } else { 1024.0 })
         .with(matter.grid_blocks, "grid blocks with matter", if three { 1024.0 } else { 256.0 })
 }

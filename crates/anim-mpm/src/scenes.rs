@@ -328,20 +328,41 @@ pub fn fill<const D: usize>(
     let vol = s.powi(D as i32);
     let counts: [usize; D] = std::array::from_fn(|a| ((hi[a] - lo[a]) / s).floor().max(0.0) as usize);
     let total: usize = counts.iter().product();
-    let mut added = 0;
-    for flat in 0..total {
+    let point = |flat: usize| {
         let mut r = flat;
         let mut x = [0.0f64; D];
         for a in 0..D {
             x[a] = lo[a] + (r % counts[a]) as f64 * s + 0.5 * s;
             r /= counts[a];
         }
+        x
+    };
+    // Room for exactly the points kept: pushed one by one, the arrays would grow up to twice
+    // what they hold.
+    reserve(particles, (0..total).filter(|&flat| inside(&point(flat))).count());
+    let mut added = 0;
+    for flat in 0..total {
+        let x = point(flat);
         if inside(&x) {
             particles.push(x.map(|c| c as f32), velocity, (density * vol) as f32, vol as f32, material)?;
             added += 1;
         }
     }
     Ok(added)
+}
+
+/// Room for `additional` more particles in each of `particles`' arrays.
+pub(crate) fn reserve<const D: usize>(particles: &mut Particles<D>, additional: usize) {
+    let p = particles;
+    p.x.reserve_exact(D * additional);
+    p.v.reserve_exact(D * additional);
+    p.c.reserve_exact(D * D * additional);
+    p.f.reserve_exact(D * D * additional);
+    for scalars in [&mut p.plastic, &mut p.mass, &mut p.volume] {
+        scalars.reserve_exact(additional);
+    }
+    p.material.reserve_exact(additional);
+    p.id.reserve_exact(additional);
 }
 
 /// The classic 2D scene: jelly, snow and water blocks fall into a box and interact.

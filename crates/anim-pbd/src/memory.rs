@@ -9,8 +9,10 @@
 //! | --- | --- | --- |
 //! | particles | 210, + 104 per collider | the particle, inverse mass and rest position, the state, the solver's positions, velocities and predictions, the external forces; a contact slot reserved per collider |
 //! | constraints | 360 (sequential Gauss-Seidel), 420 (coloured Gauss-Seidel) | the builder's and the model's constraint (112 B each), the compiled copy (112 B), the multiplier and the incidences; the coloured sweep's buffered corrections |
-//! | triangles | 36 (48 more in a global volume) | the triangle and its incidences |
-//! | tetrahedra | 40 | the tetrahedron and its lattice cell's share while the blob is made |
+//! | frame points, written points | 48, 330 | the frame a view fills (position and velocity, `f64`) and what a run holds to write it (anim-core's `FRAME_POINT_BYTES`, `WRITTEN_POINT_BYTES`) |
+//! | triangles | 84 (48 more in a global volume) | the triangle and its incidences; in the view's context and the drawing's copy |
+//! | edges | 32 | a rope's link in the view's context and the drawing's copy |
+//! | tetrahedra | 72 | the tetrahedron and its lattice cell's share while the blob is made; in the view's context |
 
 use crate::scenes;
 use anim_core::scene::{BuildError, MemoryNeed};
@@ -24,6 +26,8 @@ pub struct ModelSize {
     pub constraints: f64,
     /// Triangles (drawn; of a global volume as well for the balloon).
     pub triangles: f64,
+    /// Edges drawn (a rope's links).
+    pub edges: f64,
     /// Tetrahedra.
     pub tets: f64,
     /// Shape colliders (a contact slot each per particle).
@@ -51,6 +55,7 @@ impl ModelSize {
                 constraints: 6.0 * cells,
                 triangles: 2.0 * cells,
                 tets: 0.0,
+                edges: 0.0,
                 colliders,
                 coloured,
                 volume: false,
@@ -70,6 +75,7 @@ impl ModelSize {
                 constraints: n,
                 triangles: 0.0,
                 tets: 0.0,
+                edges: n,
                 colliders: 3.0,
                 coloured: false,
                 volume: false,
@@ -85,6 +91,7 @@ impl ModelSize {
                     constraints: 13.0 * cells + 11.8 * surface,
                     triangles: 0.0,
                     tets: 6.0 * cells,
+                    edges: 0.0,
                     colliders: 1.0,
                     coloured: true,
                     volume: false,
@@ -99,6 +106,7 @@ impl ModelSize {
                     constraints: 60.0 * k + 1.0,
                     triangles: 20.0 * k,
                     tets: 0.0,
+                    edges: 0.0,
                     colliders: 2.0,
                     coloured: true,
                     volume: true,
@@ -112,12 +120,14 @@ impl ModelSize {
     #[must_use]
     pub fn need(&self) -> MemoryNeed {
         let per_constraint = if self.coloured { 420.0 } else { 360.0 };
-        let per_triangle = if self.volume { 84.0 } else { 36.0 };
+        let per_triangle = if self.volume { 132.0 } else { 84.0 };
         MemoryNeed::new()
             .with(self.particles, "particles", 210.0 + 104.0 * self.colliders)
+            .with_frame_points(self.particles)
             .with(self.constraints, "constraints", per_constraint)
             .with(self.triangles, "triangles", per_triangle)
-            .with(self.tets, "tetrahedra", 40.0)
+            .with(self.edges, "edges", 32.0)
+            .with(self.tets, "tetrahedra", 72.0)
     }
 
     /// Refuses counts beyond the model's `u32` indices.
@@ -191,6 +201,7 @@ mod tests {
             assert_eq!(size.particles, m.num_particles() as f64, "{name}");
             assert_eq!(size.constraints, m.num_constraints() as f64, "{name}");
             assert_eq!(size.triangles, m.triangles().len() as f64, "{name}");
+            assert_eq!(size.edges, m.edges().len() as f64, "{name}");
             assert_eq!(size.colliders, m.colliders().len() as f64, "{name}");
             assert_eq!(size.coloured, scene.params.solver == crate::SolverKind::ColoredGaussSeidel, "{name}");
         }

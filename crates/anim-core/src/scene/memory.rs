@@ -5,8 +5,11 @@
 //! estimate and the available memory in the message, instead of aborting on a failed
 //! allocation halfway through.
 //!
-//! The arithmetic is in `f64`, so a size of any magnitude gives a finite (or infinite) estimate
-//! and never an overflow.
+//! The memory available to a scene ([`available_memory`]) is the memory free (`MemAvailable`,
+//! a cgroup's limit, `ulimit -v`: [`free_memory`]) less a tenth, at least 256 MiB, kept for what
+//! no estimate counts (the process's threads and allocator, its code, the writer's buffers) and
+//! for the estimates' own error. The arithmetic is in `f64`, so a size of any magnitude gives a
+//! finite (or infinite) estimate and never an overflow.
 //!
 //! ```
 //! use anim_core::scene::{BuildError, MemoryNeed};
@@ -33,6 +36,28 @@ use super::preset::BuildError;
 /// `/proc/meminfo` unreadable): 2^48 bytes (256 TiB), a bound no machine reaches, so that only
 /// sizes that cannot be meant are refused.
 pub const UNKNOWN_LIMIT: f64 = 281_474_976_710_656.0;
+
+/// Bytes per point of the [`Frame`](super::Frame) a view fills: its position and velocity as
+/// `f64`.
+pub const FRAME_POINT_BYTES: f64 = 48.0;
+
+/// Bytes per point a run holds to write a frame beyond the frame itself, as `anim run` writes
+/// VTK: the writer's snapshot of the frame (48), its positions, velocities and vertex ids (56),
+/// the cell arrays (connectivity, offsets, types, 24) and the bytes of the array being encoded
+/// (24), and the file's text in memory, 88 characters of base64 a point in a string grown by
+/// doubling: up to 176. (Its resident part measured 170 bytes a point: `anim run` on 1.19
+/// million MPM particles peaks 200 MB higher writing `vtu` frames than writing none; the rest is
+/// address space reserved by the string's growth, which `ulimit -v` counts.)
+pub const WRITTEN_POINT_BYTES: f64 = 330.0;
+
+/// Bytes per cell of the [`Frame`](super::Frame) of an image grid: its density and velocity as
+/// `f64`.
+pub const FRAME_CELL_BYTES: f64 = 32.0;
+
+/// Bytes per cell a run holds to write a grid frame beyond the frame itself: the writer's
+/// snapshot (32), the bytes of the array being encoded (24) and the `vti` file in memory (base64
+/// of the density and velocity, 43 characters, growing by doubling: up to 86).
+pub const WRITTEN_CELL_BYTES: f64 = 142.0;
 
 /// One part of a scene's memory: `count` items of `each` bytes.
 #[derive(Debug, Clone, PartialEq)]
@@ -69,6 +94,33 @@ impl MemoryNeed {
         if count != 0.0 && each != 0.0 {
             self.parts.push(Part { count, noun: noun.to_string(), each });
         }
+    }
+
+    /// This need and the view of `points` points: the frame ([`FRAME_POINT_BYTES`]) and what a
+    /// run holds to write it ([`WRITTEN_POINT_BYTES`]), as the parts `frame points` and
+    /// `written points`.
+    #[must_use]
+    pub fn with_frame_points(self, points: f64) -> Self {
+        self.with(points, "frame points", FRAME_POINT_BYTES).with(
+            points,
+            "written points",
+            WRITTEN_POINT_BYTES,
+        )
+    }
+
+    /// This need and the view of an image grid of `cells` cells: the frame
+    /// ([`FRAME_CELL_BYTES`]) and what a run holds to write it ([`WRITTEN_CELL_BYTES`]), as the
+    /// parts `frame cells` and `written cells`.
+    #[must_use]
+    pub fn with_frame_cells(self, cells: f64) -> Self {
+        self.with(cells, "frame cells", FRAME_CELL_BYTES).with(cells, "written cells", WRITTEN_CELL_BYTES)
+    }
+
+    /// The bytes of the parts named `noun` (0 when there is none): what a test that does not
+    /// write frames leaves out, `written points` or `written cells`.
+    #[must_use]
+    pub fn bytes_of(&self, noun: &str) -> f64 {
+        self.parts.iter().filter(|p| p.noun == noun).map(|p| p.count * p.each).sum()
     }
 
     /// Adds every part of `other`.
@@ -139,13 +191,14 @@ impl MemoryNeed {
 ///
 /// - 1D (a chain): `c N`, the band;
 /// - 2D: `c N min(log2 N, a)`: nested dissection's `N log2 N` on a square (George 1973: `c =
-///   31/4` on a 5-point grid), the band `N a` on a strip;
+///   31/4` on a 5-point grid; faer's AMD ordering fills a little more), the band `N a` on a
+///   strip;
 /// - 3D: `c N sqrt(a b)`: nested dissection's `N^(4/3)` on a cube (Lipton, Rose & Tarjan 1979),
 ///   `N a` on a bar of side `a`;
 ///
 /// at most the dense triangle `N (N + 1) / 2`. The constant `c` depends on the stencil and is
-/// measured by the caller against faer's factor (anim-springs' cloth: 7.75 in 2D, its jelly's
-/// 27-point lattice: 14; anim-fem's tetrahedra of six per cube: 9). A scalar factor has `k^2`
+/// measured by the caller against faer's factor (anim-springs' cloth: 9.5 in 2D, its jelly's
+/// 27-point lattice: 15; anim-fem's tetrahedra of six per cube: 10). A scalar factor has `k^2`
 /// times as many nonzeros for blocks of `k` unknowns.
 #[must_use]
 pub fn cholesky_factor_blocks(dims: &[f64], c: f64) -> f64 {
@@ -220,6 +273,21 @@ pub fn format_bytes(bytes: f64) -> String {
     format!("{} B", count(bytes))
 }
 
+/// What the memory check keeps back from the memory free, for what no scene's estimate
+/// counts: the process's threads (their stacks and allocator arenas), its code, the writer's
+/// file buffers and the estimates' own error: a tenth of it, at least 256 MiB.
+fn reserve(free: f64) -> f64 {
+    (0.1 * free).max(256.0 * 1024.0 * 1024.0)
+}
+
+/// The memory a scene of this process may take, in bytes: the memory free ([`free_memory`])
+/// less a tenth of it (at least 256 MiB) kept for the process itself and the estimates' error;
+/// `None` when the memory free is unknown.
+#[must_use]
+pub fn available_memory() -> Option<f64> {
+    free_memory().map(|free| (free - reserve(free)).max(0.0))
+}
+
 /// The memory this process may still allocate, in bytes: on Linux the least of the system's
 /// `MemAvailable` (`/proc/meminfo`), the room left under the cgroup's limit
 /// (`/sys/fs/cgroup/memory.max` less `memory.current`, when the limit is a number) and the room
@@ -227,7 +295,7 @@ pub fn format_bytes(bytes: f64) -> String {
 /// less `VmSize` of `/proc/self/status`); `None` elsewhere or when `/proc/meminfo` cannot be
 /// read.
 #[must_use]
-pub fn available_memory() -> Option<f64> {
+pub fn free_memory() -> Option<f64> {
     let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
     let mut available = kib_field(&meminfo, "MemAvailable:")?;
     if let Some(max) = read_number("/sys/fs/cgroup/memory.max") {
@@ -338,6 +406,11 @@ mod tests {
         let inf = MemoryNeed::new().with(f64::MAX, "cells", 1.0e10);
         assert!(inf.bytes().is_infinite());
         assert!(inf.check_within("resolution", "x", Some(1.0e12)).is_err());
+        // A part's bytes by name, the view's two parts.
+        let view = MemoryNeed::new().with(10.0, "particles", 100.0).with_frame_points(10.0);
+        assert_eq!(view.bytes_of("written points"), 10.0 * WRITTEN_POINT_BYTES);
+        assert_eq!(view.bytes() - view.bytes_of("written points"), 10.0 * (100.0 + FRAME_POINT_BYTES));
+        assert_eq!(view.bytes_of("cells"), 0.0);
         // Empty parts are left out; no parts at all print no parentheses.
         let empty = MemoryNeed::new().with(0.0, "cells", 8.0);
         assert_eq!(empty.breakdown(), "");
@@ -358,10 +431,16 @@ mod tests {
 
     #[test]
     fn the_machine_reports_some_memory_on_linux() {
-        let available = available_memory();
+        let available = free_memory();
         if cfg!(target_os = "linux") {
             let a = available.expect("/proc/meminfo");
             assert!(a > 0.0 && a.is_finite() && a.fract() == 0.0, "{a}");
+            // A scene gets the free memory less a tenth, at least 256 MiB.
+            let mib = 1024.0 * 1024.0;
+            assert_eq!(reserve(10_000.0 * mib), 1000.0 * mib);
+            assert_eq!(reserve(1000.0 * mib), 256.0 * mib);
+            let scene = available_memory().expect("known");
+            assert!(scene < a && scene >= 0.0, "{scene} of {a}");
             let meminfo = std::fs::read_to_string("/proc/meminfo").expect("meminfo");
             let total = kib_field(&meminfo, "MemTotal:").expect("MemTotal");
             assert!(a <= total, "{a} > {total}");

@@ -65,7 +65,8 @@ pub use checkpoint::{
 pub use dynamic::{DynScene, Simulated, StepError};
 pub use looped::Looped;
 pub use memory::{
-    MemoryNeed, UNKNOWN_LIMIT, available_memory, check_memory, cholesky_factor_blocks, format_bytes,
+    FRAME_CELL_BYTES, FRAME_POINT_BYTES, MemoryNeed, UNKNOWN_LIMIT, WRITTEN_CELL_BYTES, WRITTEN_POINT_BYTES,
+    available_memory, check_memory, cholesky_factor_blocks, format_bytes, free_memory,
 };
 pub use pin::{PinBox, PinError, PinSpec};
 pub use placement::{ObstacleMesh, Placement, is_unit_scale, unit_scale};

@@ -223,7 +223,7 @@ fn a_cell_too_fine_for_the_memory_is_refused_before_the_fill() {
     }
     assert!(e.message.ends_with(": take a larger cell"), "{e}");
     let (bytes, available) = e.memory.expect("a refusal of memory");
-    let elements = 10_368_000.0 * 1720.0;
+    let elements = 10_368_000.0 * 1752.0;
     assert!(bytes > elements && available == 64.0 * gib, "{bytes}");
     // The same surface at a coarser cell fits, and the public `load` checks the machine's memory.
     assert!(
