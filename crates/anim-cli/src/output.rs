@@ -5,7 +5,7 @@
 //! `f32`, at most [`PREVIEW_BYTES`]) and the bounding box of every frame's points, and draws the
 //! GIF and the last frame's PNG when the run ends, with a camera built then.
 
-use crate::view::{Geometry, OutputFormat, Snapshot, View};
+use crate::view::{Geometry, OutputFormat, Paint, SPEED, Snapshot, View};
 use anim_core::scene::{DynScene, Frame};
 use anim_io::FrameWriter;
 use anim_io::preview::{Canvas, GifWriter};
@@ -60,6 +60,40 @@ struct Preview {
     kept: Vec<f32>,
     /// The number of values of each kept frame.
     lengths: Vec<usize>,
+    /// What the points are coloured by ([`Paint::Plain`]: nothing kept); a grid keeps the
+    /// painted field in `kept` in place of its density.
+    paint: Paint,
+    /// The painted field's value per point of each kept frame of a particle scene.
+    painted: Vec<f32>,
+    /// The smallest and largest painted value kept.
+    range: (f64, f64),
+    /// Scratch for one frame's painted values.
+    scratch: Vec<f64>,
+}
+
+impl Preview {
+    /// Keeps a frame: its points (or a grid's painted cells) and painted values.
+    fn keep(&mut self, s: &Snapshot, grid: bool) {
+        self.scratch.clear();
+        if grid {
+            match &self.paint {
+                Paint::Field(name) if name == SPEED => {
+                    Paint::Field(name.clone()).values(&[], &s.v, &mut self.scratch);
+                }
+                _ => self.scratch.extend_from_slice(&s.x),
+            }
+            self.kept.extend(self.scratch.iter().map(|&v| v as f32));
+            self.lengths.push(self.scratch.len());
+        } else {
+            self.kept.extend(s.x.iter().map(|&v| v as f32));
+            self.lengths.push(s.x.len());
+            self.paint.values(&s.fields, &s.v, &mut self.scratch);
+            self.painted.extend(self.scratch.iter().map(|&v| v as f32));
+        }
+        for &v in self.scratch.iter().filter(|v| v.is_finite()) {
+            self.range = (self.range.0.min(v), self.range.1.max(v));
+        }
+    }
 }
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -92,6 +126,10 @@ struct Writer {
     csv: Option<std::io::BufWriter<std::fs::File>>,
     preview: Option<Preview>,
     viewer: Option<RunViewer>,
+    /// Whether the scene is a grid of cells.
+    grid: bool,
+    /// A grid's shown field and the fixed ends of its colour scale.
+    grid_range: Option<(&'static str, (f64, f64))>,
 }
 
 /// The browser viewer of a run.
@@ -145,8 +183,7 @@ impl Writer {
         if let Some(preview) = &mut self.preview {
             self.view.see(s);
             if index.is_multiple_of(preview.every) {
-                preview.kept.extend(s.x.iter().map(|&v| v as f32));
-                preview.lengths.push(s.x.len());
+                preview.keep(s, self.grid);
             }
         }
         Ok(())
@@ -176,38 +213,58 @@ impl Writer {
             csv.flush().map_err(|e| e.to_string())?;
             files.push(self.dir.join("frames.csv").display().to_string());
         }
-        if let Some(Preview { mut gif, mut canvas, kept, lengths, .. }) = self.preview.take() {
+        if let Some(Preview { mut gif, mut canvas, kept, lengths, paint, painted, range, .. }) =
+            self.preview.take()
+        {
             // The camera of the whole run, now that it has been seen.
             let camera = self.view.camera(f64::from(canvas.width()) / f64::from(canvas.height()));
+            // The colour scale: the grid's own for its density, the kept values' otherwise
+            // (from zero for a speed).
+            let range = match (&self.grid_range, &paint) {
+                (Some((shown, r)), Paint::Field(name)) if name == shown => *r,
+                _ if range.0 > range.1 => (0.0, 1.0),
+                (_, Paint::Field(name)) if name == SPEED => (0.0, range.1),
+                _ => range,
+            };
+            let caption = paint.caption(range);
+            self.view.paint(paint, range);
             let mut snapshot = Snapshot::default();
-            let mut at = 0;
+            let mut values = Vec::new();
+            let (mut at, mut at_painted) = (0, 0);
             for n in lengths {
                 snapshot.x.clear();
                 snapshot.x.extend(kept[at..at + n].iter().map(|&v| f64::from(v)));
                 at += n;
+                values.clear();
+                if !self.grid && !painted.is_empty() {
+                    let points = n / 3;
+                    values.extend(painted[at_painted..at_painted + points].iter().map(|&v| f64::from(v)));
+                    at_painted += points;
+                }
                 canvas.clear();
-                self.view.draw(&mut canvas, &camera, &snapshot)?;
+                self.view.draw(&mut canvas, &camera, &snapshot, &values)?;
                 gif.push(&canvas).map_err(|e| e.to_string())?;
             }
             let png = self.dir.join("preview.png");
             canvas.save_png(&png).map_err(|e| e.to_string())?;
             let path = gif.finish().map_err(|e| e.to_string())?;
-            files.push(path.display().to_string());
-            files.push(png.display().to_string());
+            let coloured = caption.map(|c| format!(" (coloured by {c})")).unwrap_or_default();
+            files.push(format!("{}{coloured}", path.display()));
+            files.push(format!("{}{coloured}", png.display()));
         }
         Ok(files)
     }
 }
 
 impl Output {
-    /// The writer of a run; `preview` the preview's largest size and the run's number of
-    /// frames; `continuing` holds the times of the frame files an earlier part of the run wrote
+    /// The writer of a run; `preview` the preview's largest size, the run's number of frames
+    /// and what the preview colours by; `continuing` holds the times of the frame files an earlier part of the run wrote
     /// (resumed runs continue the numbering and append to `frames.csv`).
     pub(crate) fn new(
         dir: &Path,
         format: OutputFormat,
         stride: usize,
-        preview: Option<((u32, u32), usize)>,
+        preview: Option<((u32, u32), usize, Paint)>,
         (geometry, dof): (&Geometry, usize),
         continuing: Option<&[f64]>,
         viewer: Option<ViewerSpec<'_>>,
@@ -222,6 +279,8 @@ impl Output {
             csv: None,
             preview: None,
             viewer: None,
+            grid,
+            grid_range: None,
         };
         let point_dim = viewer.as_ref().map_or(3, |spec| spec.context.point_dim);
         if let Some(spec) = viewer {
@@ -252,15 +311,20 @@ impl Output {
                 .map_err(|e| format!("{}: {e}", path.display()))?;
             writer.csv = Some(csv);
         }
-        if let Some((size, frames)) = preview {
+        if let Some((size, frames, paint)) = preview {
             // A grid is shown at its own proportions; everything else at the size asked for.
             let (width, height) = preview_size(size, writer.view.aspect());
             let path = dir.join("preview.gif");
             let gif = GifWriter::create(&path, width, height, 4, true).map_err(|e| e.to_string())?;
-            // What a kept frame holds: a grid's density per cell, or the coordinates.
+            // What a kept frame holds: a grid's painted value per cell, or the coordinates and
+            // the painted value per point.
             let values = match geometry {
-                Geometry::Grid { dims, .. } => dims.iter().product(),
-                _ => dof,
+                Geometry::Grid { dims, range, .. } => {
+                    writer.grid_range = Some(("density", *range));
+                    dims.iter().product()
+                }
+                _ if paint == Paint::Plain => dof,
+                _ => dof + dof / 3,
             };
             let every = preview_every(frames, values);
             writer.preview = Some(Preview {
@@ -272,6 +336,10 @@ impl Output {
                     frames.div_ceil(every).min(PREVIEW_BYTES / 4 / values.max(1)).max(1) * values,
                 ),
                 lengths: Vec::new(),
+                paint,
+                painted: Vec::new(),
+                range: (f64::INFINITY, f64::NEG_INFINITY),
+                scratch: Vec::new(),
             });
         }
         let (sender, receiver) = std::sync::mpsc::sync_channel::<(usize, Snapshot)>(4);

@@ -4,7 +4,7 @@
 use crate::output::{Output, ViewerSpec};
 use crate::scene::{self, SceneFile};
 use crate::tolerance;
-use crate::view::{Geometry, OutputFormat, Snapshot};
+use crate::view::{Geometry, OutputFormat, Paint, Snapshot};
 use anim_core::scene::{DynScene, Frame};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
@@ -71,6 +71,11 @@ pub struct RunArgs {
     /// the grid's proportions within it.
     #[arg(long, value_name = "WxH", default_value = "640x480", value_parser = crate::output::parse_preview_size)]
     pub preview_size: (u32, u32),
+    /// What the preview colours the points (or a grid's cells) by: `speed`, a field of the
+    /// scene's frames (`material`, `strain`, `velocity`, `density`, ...) or `none`. Default:
+    /// `material` where a scene has several, a grid's density, otherwise the bodies' colours.
+    #[arg(long, value_name = "FIELD")]
+    pub color_by: Option<String>,
     /// No progress bar or summary on the terminal.
     #[arg(long)]
     pub quiet: bool,
@@ -194,6 +199,9 @@ struct RunCheckpoint {
     /// previews were 3/4 as high as wide.
     #[serde(default)]
     preview_height: Option<u32>,
+    /// What the preview colours by (`--color-by`); absent: the scene's default.
+    #[serde(default)]
+    color_by: Option<String>,
     checkpoint_every: Option<usize>,
     /// Frames completed.
     frame: usize,
@@ -273,6 +281,8 @@ struct Session {
     stride: usize,
     /// The preview's size in pixels, or none.
     preview_size: Option<(u32, u32)>,
+    /// `--color-by`, checked against the scene's frames when the run starts.
+    color_by: Option<String>,
     viewer: bool,
     checkpoint_every: Option<usize>,
     quiet: bool,
@@ -393,6 +403,7 @@ fn fresh(args: &RunArgs) -> Result<Session, String> {
         stride: args.stride,
         viewer: !args.no_viewer,
         preview_size: (!args.no_preview).then_some(args.preview_size),
+        color_by: args.color_by.clone(),
         checkpoint_every: args.checkpoint_every,
         quiet: args.quiet,
         runner,
@@ -446,6 +457,7 @@ fn resumed(args: &ResumeArgs) -> Result<Session, String> {
         format: ckpt.format,
         stride: ckpt.stride,
         preview_size: ckpt.preview_width.map(|w| (w, ckpt.preview_height.unwrap_or((w * 3 / 4).max(1)))),
+        color_by: ckpt.color_by,
         viewer: ckpt.viewer,
         checkpoint_every: ckpt.checkpoint_every,
         quiet: args.quiet,
@@ -475,6 +487,7 @@ impl Session {
             stride: self.stride,
             preview_width: self.preview_size.map(|s| s.0),
             preview_height: self.preview_size.map(|s| s.1),
+            color_by: self.color_by.clone(),
             viewer: self.viewer,
             checkpoint_every: self.checkpoint_every,
             frame,
@@ -499,17 +512,21 @@ fn execute(mut s: Session) -> Result<(), String> {
             println!("note: {note}");
         }
     }
+    let mut first = Frame::default();
+    let dof = {
+        let mut snap = Snapshot::default();
+        snap.fill(s.runner.as_ref(), &mut first, false, None);
+        snap.x.len()
+    };
+    let context = s.runner.context();
+    // Checked before anything is written.
+    let paint = Paint::choose(s.color_by.as_deref(), &context, &first)?;
     std::fs::create_dir_all(&out)
         .map_err(|e| format!("{}: cannot create output folder: {e}", out.display()))?;
     let run = s.file.run;
-    let preview = s.preview_size.map(|size| (size, run.frames));
     let continuing = s.resumed.then_some(s.written_times.as_slice());
-    let dof = {
-        let mut snap = Snapshot::default();
-        snap.fill(s.runner.as_ref(), &mut Frame::default(), false, None);
-        snap.x.len()
-    };
-    let context = s.viewer.then(|| s.runner.context());
+    let preview = s.preview_size.map(|size| (size, run.frames, paint));
+    let context = s.viewer.then_some(context);
     let viewer =
         context.as_ref().map(|context| ViewerSpec { title: &s.file.name, context, resume: s.resumed });
     let mut output = Output::new(&out, s.format, s.stride, preview, (&s.geometry, dof), continuing, viewer)?;

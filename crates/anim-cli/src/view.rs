@@ -119,6 +119,8 @@ pub enum Geometry {
         tetrahedra: Vec<[usize; 4]>,
         /// Line segments (springs), drawn when there is no surface.
         edges: Vec<[usize; 2]>,
+        /// Points the scene holds in place (pins, clamps, attachments), marked dark.
+        pins: Vec<usize>,
         /// Particle disc radius in world units (0: none drawn).
         radius: f64,
         /// Height of a ground plane `y = h`, if any.
@@ -147,6 +149,12 @@ pub enum Geometry {
         spacing: f64,
         /// Density shown as the ends of the colour scale (fixed for the run).
         range: (f64, f64),
+        /// The grid's lower corner.
+        origin: [f64; 3],
+        /// Colliders in the grid (a sphere the smoke rises around), drawn over the field.
+        obstacles: Vec<Prop>,
+        /// Obstacles of triangles (the user's closed surfaces), drawn over the field.
+        meshes: Vec<MeshProp>,
     },
 }
 
@@ -162,6 +170,14 @@ impl Geometry {
                 dim: image.dim,
                 spacing: image.spacing,
                 range: image.range,
+                origin: image.origin,
+                obstacles: context
+                    .props
+                    .iter()
+                    .filter(|p| matches!(p, Prop::Sphere { .. } | Prop::Cuboid { .. } | Prop::Capsule { .. }))
+                    .copied()
+                    .collect(),
+                meshes: context.mesh_props.clone(),
             };
         }
         let bounds = context.bounds.unwrap_or(([-1.0; 3], [1.0; 3]));
@@ -187,6 +203,7 @@ impl Geometry {
             triangles: context.triangles.clone(),
             tetrahedra: context.tetrahedra.clone(),
             edges: context.lines.clone(),
+            pins: context.pins.clone(),
             radius: context.point_radius,
             ground,
             obstacles,
@@ -243,10 +260,18 @@ pub struct View {
     positions: Vec<[f64; 3]>,
     velocities: Vec<[f64; 3]>,
     vertices: Vec<usize>,
+    /// The pins' positions in the frame drawn, scratch.
+    pinned: Vec<[f64; 3]>,
     /// The bounding box of every finite point seen so far ([`View::see`]).
     seen: Option<([f64; 3], [f64; 3])>,
     /// The region the last [`View::camera`] framed (the ground is drawn under it).
     framed: ([f64; 3], [f64; 3]),
+    /// What the points or cells are coloured by, and the ends of its colour scale.
+    paint: Paint,
+    range: (f64, f64),
+    /// Colours per point and per segment, scratch.
+    colors: Vec<[u8; 3]>,
+    segment_colors: Vec<[u8; 3]>,
 }
 
 fn triples(flat: &[f64], out: &mut Vec<[f64; 3]>) {
@@ -272,9 +297,22 @@ impl View {
             positions: Vec::new(),
             velocities: Vec::new(),
             vertices: Vec::new(),
+            pinned: Vec::new(),
             seen: None,
             framed: ([-1.0; 3], [1.0; 3]),
+            paint: Paint::Plain,
+            range: (0.0, 1.0),
+            colors: Vec::new(),
+            segment_colors: Vec::new(),
         }
+    }
+
+    /// Colours the points (or a grid's cells) by `paint` over `range` in the pictures drawn
+    /// from now on: [`View::draw`] then takes the painted values per point, or a grid's
+    /// snapshot holds them in place of its density.
+    pub fn paint(&mut self, paint: Paint, range: (f64, f64)) {
+        self.paint = paint;
+        self.range = range;
     }
 
     /// Takes in the points of a snapshot of a particle scene: the camera frames every finite
@@ -373,12 +411,12 @@ impl View {
                 };
                 io(frames.write(s.t, &grid)).map(|_| ())
             }
-            Geometry::Grid { dims, dim, spacing, .. } => {
+            Geometry::Grid { dims, dim, spacing, origin, .. } => {
                 let h = *spacing;
                 let image = if *dim == 2 {
-                    ImageData::from_cells_2d([dims[0], dims[1]], [0.0; 2], [h; 2])
+                    ImageData::from_cells_2d([dims[0], dims[1]], [origin[0], origin[1]], [h; 2])
                 } else {
-                    ImageData::from_cells_3d(*dims, [0.0; 3], [h; 3])
+                    ImageData::from_cells_3d(*dims, *origin, [h; 3])
                 };
                 let image = image
                     .cell_field(DataArray::scalars("density", &s.x))
@@ -404,14 +442,23 @@ impl View {
                     Camera::fitting(lo, hi, VIEW_DIRECTION, UP, aspect)
                 }
             }
-            Geometry::Grid { dims, spacing, .. } => {
-                Camera::xy_plane([0.0, 0.0], [dims[0] as f64 * spacing, dims[1] as f64 * spacing], aspect)
-            }
+            Geometry::Grid { dims, spacing, origin, .. } => Camera::xy_plane(
+                [origin[0], origin[1]],
+                [origin[0] + dims[0] as f64 * spacing, origin[1] + dims[1] as f64 * spacing],
+                aspect,
+            ),
         }
     }
 
-    /// Draws the snapshot.
-    pub fn draw(&mut self, canvas: &mut Canvas, camera: &Camera, s: &Snapshot) -> Result<(), String> {
+    /// Draws the snapshot; `painted` holds the painted field's value per point of a particle
+    /// scene ([`View::paint`], [`Paint::values`]; empty for the bodies' own colours).
+    pub fn draw(
+        &mut self,
+        canvas: &mut Canvas,
+        camera: &Camera,
+        s: &Snapshot,
+        painted: &[f64],
+    ) -> Result<(), String> {
         match &self.geometry {
             Geometry::Planar { extent, sun } => {
                 let p = planar(&s.x);
@@ -440,7 +487,9 @@ impl View {
                 }
                 io(canvas.draw_particles(camera, &[p], 0.03 * scale, Colors::Uniform([60, 110, 200])))
             }
-            Geometry::Particles { triangles, edges, radius, ground, obstacles, meshes, planar, .. } => {
+            Geometry::Particles {
+                triangles, edges, pins, radius, ground, obstacles, meshes, planar, ..
+            } => {
                 triples(&s.x, &mut self.positions);
                 for prop in obstacles {
                     draw_obstacle(canvas, camera, prop)?;
@@ -448,10 +497,10 @@ impl View {
                 for mesh in meshes {
                     io(canvas.draw_mesh(camera, &mesh.positions, &mesh.triangles, &OBSTACLE_STYLE))?;
                 }
+                let (lo, hi) = self.framed;
                 if let Some(y) = ground.filter(|_| !planar) {
                     // A floor under the framed region (not beyond it: corners behind the
                     // camera would clip the whole quad).
-                    let (lo, hi) = self.framed;
                     let quad = [[lo[0], y, lo[2]], [hi[0], y, lo[2]], [hi[0], y, hi[2]], [lo[0], y, hi[2]]];
                     let style = MeshStyle {
                         color: [200, 200, 195],
@@ -460,285 +509,104 @@ impl View {
                     };
                     io(canvas.draw_mesh(camera, &quad, &[[0, 1, 2], [0, 2, 3]], &style))?;
                 }
+                let by_field = !painted.is_empty() && painted.len() == self.positions.len();
+                if by_field {
+                    self.paint.colors(painted, self.range, &mut self.colors);
+                }
+                let size = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
                 if !triangles.is_empty() {
-                    io(canvas.draw_mesh(camera, &self.positions, triangles, &MeshStyle::default()))
-                } else {
-                    io(canvas.draw_lines(
-                        camera,
-                        &self.positions,
-                        edges,
-                        1.0,
-                        Colors::Uniform([70, 70, 90]),
-                    ))?;
-                    if *radius > 0.0 {
-                        io(canvas.draw_particles(
+                    if by_field {
+                        io(canvas.draw_mesh_colored(
                             camera,
                             &self.positions,
-                            *radius,
-                            Colors::Uniform([200, 90, 60]),
+                            triangles,
+                            &self.colors,
+                            Shading::Smooth,
                         ))?;
+                    } else {
+                        io(canvas.draw_mesh(camera, &self.positions, triangles, &MeshStyle::default()))?;
                     }
-                    Ok(())
+                } else {
+                    let colors = if by_field {
+                        self.segment_colors.clear();
+                        self.segment_colors.extend(edges.iter().map(|e| self.colors[e[0]]));
+                        Colors::PerItem(&self.segment_colors)
+                    } else {
+                        Colors::Uniform([70, 70, 90])
+                    };
+                    let width = line_width(edges.len(), canvas.height());
+                    io(canvas.draw_lines(camera, &self.positions, edges, width, colors))?;
+                    if *radius > 0.0 {
+                        let colors = if by_field {
+                            Colors::PerItem(&self.colors)
+                        } else {
+                            Colors::Uniform([200, 90, 60])
+                        };
+                        io(canvas.draw_particles(camera, &self.positions, *radius, colors))?;
+                    }
                 }
+                // Pins: dark beads a little larger than the particles, over the body.
+                self.pinned.clear();
+                self.pinned.extend(pins.iter().filter_map(|&i| self.positions.get(i).copied()));
+                if !self.pinned.is_empty() {
+                    let bead = (1.6 * radius).max(0.011 * size);
+                    io(canvas.draw_particles(camera, &self.pinned, bead, Colors::Uniform(PIN)))?;
+                }
+                Ok(())
             }
-            Geometry::Grid { dims, dim, range, .. } => {
+            Geometry::Grid { dims, dim, range, obstacles, meshes, .. } => {
                 let [nx, ny, nz] = *dims;
                 if s.x.len() != nx * ny * nz {
-                    return Err(format!("{} density values for a {nx} x {ny} x {nz} grid", s.x.len()));
+                    return Err(format!("{} values for a {nx} x {ny} x {nz} grid", s.x.len()));
                 }
+                let range = if self.paint == Paint::Plain { *range } else { self.range };
                 if *dim == 2 {
-                    return io(canvas.draw_scalar_field(&s.x, nx, ny, Some(*range)));
-                }
-                // Maximum along z: what looking through the smoke along the view axis shows.
-                self.projection.clear();
-                self.projection.extend_from_slice(&s.x[..nx * ny]);
-                for layer in s.x.chunks_exact(nx * ny).skip(1) {
-                    for (p, &d) in self.projection.iter_mut().zip(layer) {
-                        *p = p.max(d);
+                    io(canvas.draw_scalar_field(&s.x, nx, ny, Some(range)))?;
+                } else {
+                    // Maximum along z: what looking through the smoke along the view axis shows.
+                    self.projection.clear();
+                    self.projection.extend_from_slice(&s.x[..nx * ny]);
+                    for layer in s.x.chunks_exact(nx * ny).skip(1) {
+                        for (p, &d) in self.projection.iter_mut().zip(layer) {
+                            *p = p.max(d);
+                        }
                     }
+                    io(canvas.draw_scalar_field(&self.projection, nx, ny, Some(range)))?;
                 }
-                io(canvas.draw_scalar_field(&self.projection, nx, ny, Some(*range)))
+                // The obstacles the fluid flows around, seen along the same axis.
+                for prop in obstacles {
+                    draw_obstacle(canvas, camera, prop)?;
+                }
+                for mesh in meshes {
+                    io(canvas.draw_mesh(camera, &mesh.positions, &mesh.triangles, &OBSTACLE_STYLE))?;
+                }
+                Ok(())
             }
         }
     }
 }
 
-/// The colour of obstacles: a light grey, apart from the bodies' blue and orange.
-const OBSTACLE: [u8; 3] = [190, 190, 180];
+/// The colour of pins: near black, apart from every body's colour.
+const PIN: [u8; 3] = [35, 35, 45];
 
-/// How solid obstacles are drawn: the obstacle colour on both sides, flat shaded.
-const OBSTACLE_STYLE: MeshStyle = MeshStyle { color: OBSTACLE, back_color: OBSTACLE, shading: Shading::Flat };
-
-/// Draws an obstacle prop: a sphere as a shaded ball, a box as its six faces, a capsule as its
-/// tube and two balls, a tank as its twelve edges.
-fn draw_obstacle(canvas: &mut Canvas, camera: &Camera, prop: &Prop) -> Result<(), String> {
-    let solid = OBSTACLE_STYLE;
-    match *prop {
-        Prop::Sphere { center, radius } => {
-            io(canvas.draw_particles(camera, &[center], radius, Colors::Uniform(OBSTACLE)))
-        }
-        Prop::Cuboid { lo, hi } => io(canvas.draw_mesh(camera, &box_corners(lo, hi), &BOX_FACES, &solid)),
-        Prop::Tank { lo, hi } => io(canvas.draw_lines(
-            camera,
-            &box_corners(lo, hi),
-            &BOX_EDGES,
-            1.5,
-            Colors::Uniform([120, 120, 130]),
-        )),
-        Prop::Capsule { a, b, radius } => {
-            let (a, b) = (anim_core::glam::DVec3::from_array(a), anim_core::glam::DVec3::from_array(b));
-            let axis = b - a;
-            if axis.length() > 0.0 {
-                let u = axis.normalize().any_orthonormal_vector();
-                let v = axis.normalize().cross(u);
-                const SIDES: usize = 24;
-                let mut ring = Vec::with_capacity(2 * SIDES);
-                for end in [a, b] {
-                    for k in 0..SIDES {
-                        let t = std::f64::consts::TAU * k as f64 / SIDES as f64;
-                        ring.push((end + radius * (t.cos() * u + t.sin() * v)).to_array());
-                    }
-                }
-                let tube: Vec<[usize; 3]> = (0..SIDES)
-                    .flat_map(|k| {
-                        let n = (k + 1) % SIDES;
-                        [[k, n, SIDES + k], [n, SIDES + n, SIDES + k]]
-                    })
-                    .collect();
-                io(canvas.draw_mesh(camera, &ring, &tube, &solid))?;
-            }
-            io(canvas.draw_particles(
-                camera,
-                &[a.to_array(), b.to_array()],
-                radius,
-                Colors::Uniform(OBSTACLE),
-            ))
-        }
-        _ => Ok(()),
+/// The width in pixels of `segments` line segments on a picture `height` pixels high: a few
+/// links (a robot's, a pendulum chain's) drawn as bars, a rope's hundred as a cord, a
+/// network of thousands of springs as threads.
+fn line_width(segments: usize, height: u32) -> f64 {
+    let h = f64::from(height);
+    if segments <= 40 {
+        (h / 70.0).max(2.0)
+    } else if segments <= 400 {
+        (h / 140.0).max(1.5)
+    } else {
+        (h / 400.0).max(1.0)
     }
 }
 
-/// The corners of the box `[lo, hi]`, corner `i` taking `hi` on the axes of the bits of `i`.
-fn box_corners(lo: [f64; 3], hi: [f64; 3]) -> [[f64; 3]; 8] {
-    std::array::from_fn(|i| std::array::from_fn(|a| if i >> a & 1 == 1 { hi[a] } else { lo[a] }))
-}
-
-/// The twelve triangles of a box's faces over [`box_corners`], counter-clockwise from outside.
-const BOX_FACES: [[usize; 3]; 12] = [
-    [0, 2, 1],
-    [1, 2, 3],
-    [4, 5, 6],
-    [5, 7, 6],
-    [0, 1, 4],
-    [1, 5, 4],
-    [2, 6, 3],
-    [3, 6, 7],
-    [0, 4, 2],
-    [2, 4, 6],
-    [1, 3, 5],
-    [3, 7, 5],
-];
-
-/// The twelve edges of a box over [`box_corners`].
-const BOX_EDGES: [[usize; 2]; 12] =
-    [[0, 1], [2, 3], [4, 5], [6, 7], [0, 2], [1, 3], [4, 6], [5, 7], [0, 4], [1, 5], [2, 6], [3, 7]];
-
+mod paint;
+mod props;
 #[cfg(test)]
-mod tests {
-    use super::*;
+mod tests;
 
-    /// Pixels other than the white background.
-    fn painted(canvas: &Canvas) -> Vec<(u32, u32)> {
-        let w = canvas.width();
-        (0..canvas.pixels().len() as u32)
-            .map(|i| (i % w, i / w))
-            .filter(|&(x, y)| canvas.pixel(x, y) != [255, 255, 255])
-            .collect()
-    }
-
-    /// A box and a capsule through the middle of the view cover the centre pixel with a grey
-    /// of the obstacle colour's hue; a tank around the view is drawn as edges and leaves its
-    /// middle empty; a ground or attractor is not an obstacle.
-    #[test]
-    fn obstacles_are_drawn_solid_and_tanks_as_edges() {
-        let camera = Camera::framing([-1.0; 3], [1.0; 3], VIEW_DIRECTION, UP);
-        let grey =
-            |p: [u8; 3]| p != [255, 255, 255] && p[0].abs_diff(p[1]) <= 12 && p[1].abs_diff(p[2]) <= 12;
-        for prop in [
-            Prop::Cuboid { lo: [-0.3; 3], hi: [0.3; 3] },
-            Prop::Capsule { a: [-0.8, 0.0, 0.0], b: [0.8, 0.0, 0.0], radius: 0.1 },
-        ] {
-            let mut canvas = Canvas::new(120, 120, [255, 255, 255]);
-            draw_obstacle(&mut canvas, &camera, &prop).unwrap();
-            assert!(grey(canvas.pixel(60, 60)), "{prop:?}: {:?}", canvas.pixel(60, 60));
-        }
-        let mut canvas = Canvas::new(120, 120, [255, 255, 255]);
-        draw_obstacle(&mut canvas, &camera, &Prop::Tank { lo: [-1.0; 3], hi: [1.0; 3] }).unwrap();
-        assert_eq!(canvas.pixel(60, 60), [255, 255, 255]);
-        assert!(painted(&canvas).len() > 200, "{} pixels of edges", painted(&canvas).len());
-        let mut context = Context::default();
-        context.point_dim = 3;
-        context.props = vec![
-            Prop::Ground { height: 0.0 },
-            Prop::Cuboid { lo: [0.0; 3], hi: [1.0; 3] },
-            Prop::Tank { lo: [0.0; 3], hi: [2.0; 3] },
-        ];
-        let geometry = Geometry::from_context(&context);
-        let Geometry::Particles { ground, obstacles, .. } = geometry else { panic!("particles") };
-        assert_eq!((ground, obstacles.len()), (Some(0.0), 2));
-    }
-
-    /// The painted pixels' bounding box, `(x0, y0, x1, y1)`, `y` down; something must be.
-    fn extent(canvas: &Canvas) -> (u32, u32, u32, u32) {
-        assert!(!painted(canvas).is_empty(), "nothing drawn");
-        painted(canvas).iter().fold((u32::MAX, u32::MAX, 0, 0), |(a, b, c, d), &(x, y)| {
-            (a.min(x), b.min(y), c.max(x), d.max(y))
-        })
-    }
-
-    /// A particle context whose region is the unit cube about the origin.
-    fn particles(planar: bool) -> View {
-        let mut context = Context::default();
-        context.point_dim = 3;
-        context.point_radius = 0.05;
-        context.planar = planar;
-        context.bounds = Some(([-1.0; 3], [1.0; 3]));
-        View::new(Geometry::from_context(&context))
-    }
-
-    /// The camera frames every point the run reached, not only the context's region: a body
-    /// that leaves that region (the snowball flying off) stays in the picture, drawn inside the
-    /// canvas; with the camera of the region alone it would be off the picture.
-    #[test]
-    fn the_camera_frames_the_whole_run() {
-        let far = Snapshot { x: vec![6.0, 0.0, 0.0], ..Snapshot::default() };
-        let mut view = particles(false);
-        let hint = view.camera(4.0 / 3.0);
-        let mut canvas = Canvas::new(160, 120, [255, 255, 255]);
-        view.draw(&mut canvas, &hint, &far).unwrap();
-        assert!(painted(&canvas).is_empty(), "the far point is outside the region's picture");
-        view.see(&Snapshot { x: vec![0.0; 3], ..Snapshot::default() });
-        view.see(&far);
-        view.see(&Snapshot { x: vec![f64::NAN, 1e300, 0.0], ..Snapshot::default() });
-        let camera = view.camera(4.0 / 3.0);
-        view.draw(&mut canvas, &camera, &far).unwrap();
-        assert!(painted(&canvas).len() > 4, "the far point is not drawn");
-        let (x0, y0, x1, y1) = extent(&canvas);
-        assert!(x0 > 0 && y0 > 0 && x1 < 159 && y1 < 119, "{:?}", extent(&canvas));
-    }
-
-    /// A 3-D scene stands y up in the picture: a point above another (greater y) is drawn
-    /// higher; the ground `y = 0` is drawn below the points above it.
-    #[test]
-    fn a_3d_scene_is_drawn_y_up() {
-        let mut context = Context::default();
-        context.point_dim = 3;
-        context.point_radius = 0.1;
-        context.bounds = Some(([-1.0, 0.0, -1.0], [1.0, 2.0, 1.0]));
-        let mut view = View::new(Geometry::from_context(&context));
-        let camera = view.camera(1.0);
-        let row = |view: &mut View, y: f64| {
-            let mut canvas = Canvas::new(100, 100, [255, 255, 255]);
-            view.draw(&mut canvas, &camera, &Snapshot { x: vec![0.0, y, 0.0], ..Snapshot::default() })
-                .unwrap();
-            let (_, y0, _, y1) = extent(&canvas);
-            (y0 + y1) / 2
-        };
-        let (low, high) = (row(&mut view, 0.5), row(&mut view, 1.5));
-        assert!(high + 10 < low, "y = 1.5 drawn at row {high}, y = 0.5 at row {low}");
-        context.props = vec![Prop::Ground { height: 0.0 }];
-        let mut view = View::new(Geometry::from_context(&context));
-        let camera = view.camera(1.0);
-        let mut canvas = Canvas::new(100, 100, [255, 255, 255]);
-        view.draw(&mut canvas, &camera, &Snapshot::default()).unwrap();
-        let (_, top, _, bottom) = extent(&canvas);
-        assert!(bottom > low && top > high, "the ground spans rows {top} to {bottom}");
-    }
-
-    /// A 2-D scene is drawn face on: x to the right, y up, orthographic (a point's place does
-    /// not depend on its depth, which a 2-D scene does not have anyway).
-    #[test]
-    fn a_2d_scene_is_drawn_in_its_plane() {
-        let mut view = particles(true);
-        let camera = view.camera(1.0);
-        let at = |view: &mut View, p: [f64; 3]| {
-            let mut canvas = Canvas::new(100, 100, [255, 255, 255]);
-            view.draw(&mut canvas, &camera, &Snapshot { x: p.to_vec(), ..Snapshot::default() }).unwrap();
-            let (x0, y0, x1, y1) = extent(&canvas);
-            ((x0 + x1) / 2, (y0 + y1) / 2)
-        };
-        let (x, y) = at(&mut view, [0.0; 3]);
-        assert!(x.abs_diff(50) <= 1 && y.abs_diff(50) <= 1, "{x} {y}");
-        let (x, y) = at(&mut view, [0.8, 0.8, 0.0]);
-        assert!(x > 85 && y < 15, "{x} {y}");
-        assert_eq!(at(&mut view, [0.8, 0.8, 0.7]), (x, y), "orthographic");
-    }
-
-    /// A mesh obstacle of the context (a tetrahedron around the view's centre) is drawn solid
-    /// in the obstacle grey where it covers the picture, and nowhere else.
-    #[test]
-    fn mesh_obstacles_are_drawn_solid() {
-        let mut context = Context::default();
-        context.point_dim = 3;
-        context.bounds = Some(([-1.0; 3], [1.0; 3]));
-        let s = 0.5;
-        context.mesh_props = vec![MeshProp {
-            positions: vec![[s, s, s], [s, -s, -s], [-s, s, -s], [-s, -s, s]],
-            triangles: vec![[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]],
-        }];
-        let camera = Camera::framing([-1.0; 3], [1.0; 3], VIEW_DIRECTION, UP);
-        let mut view = View::new(Geometry::from_context(&context));
-        let mut canvas = Canvas::new(120, 120, [255, 255, 255]);
-        view.draw(&mut canvas, &camera, &Snapshot::default()).unwrap();
-        let centre = canvas.pixel(60, 60);
-        assert!(centre != [255, 255, 255] && centre[0].abs_diff(centre[2]) <= 12, "{centre:?}");
-        // The tetrahedron's bounding box (about a third of the view) bounds what is painted.
-        let painted = painted(&canvas);
-        assert!(
-            painted.len() > 300
-                && painted.iter().all(|&(x, y)| (20..100).contains(&x) && (20..100).contains(&y)),
-            "{}",
-            painted.len()
-        );
-    }
-}
+pub use paint::{MATERIAL, Paint, SPEED};
+use props::{OBSTACLE_STYLE, draw_obstacle};

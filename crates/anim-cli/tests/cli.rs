@@ -34,6 +34,13 @@ fn bad_flags_and_names_are_refused_with_the_value_named() {
             "wide: expected WIDTHxHEIGHT in pixels, such as 640x480",
         ),
         (&["run", "kepler", "--checkpoint-every", "0"], "--checkpoint-every must be at least 1"),
+        (
+            &["run", "mpm", "--color-by", "pressure"],
+            "--color-by pressure: the scene's frames have no field `pressure`; it can be coloured by speed, \
+             velocity, material, strain, none",
+        ),
+        (&["run", "kepler", "--color-by", "speed"], "--color-by speed: the scene's frames have no field"),
+        (&["run", "smoke-box-2d", "--color-by", "none"], "it can be coloured by density, speed"),
         (&["run", "warp-drive"], "warp-drive: no such scene file, and no built-in scene of that name"),
         (&["resume", "no-such-checkpoint.anim"], "no-such-checkpoint.anim"),
         (&["run", "lid-driven-cavity", "--resolution", "1"], "field `scene.resolution`: anim-fluid: grid"),

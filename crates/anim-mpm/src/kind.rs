@@ -7,7 +7,7 @@
 //! | `mpm` | `three-materials`: jelly, snow and water blocks falling together, 2D, 128^2 cells | 120 frames of 40 x 0.5 ms |
 //! | `dam-break-2d-mpm` | `dam-break-2d`: Martin & Moyce's dam break, 64^2 cells, with the surge front against the experiment | 35 frames of 64 x 0.156 ms |
 //! | `dam-break` | `dam-break-3d`: a water column collapsing in a tank, 48^3 cells | 100 frames of 16 x 1 ms |
-//! | `snowball` | `snowball`: a snowball hitting a wall and breaking up, 64^3 cells | 100 frames of 16 x 0.5 ms |
+//! | `snowball` | `snowball`: a snowball hitting a wall: it flattens, rebounds and falls to the floor, 64^3 cells | 100 frames of 16 x 0.5 ms |
 //!
 //! **Bodies.** Instead of a `preset`, a scene file may bring its own matter: `[[scene.bodies]]`
 //! tables ([`BodySpec`]), each a box, a sphere or a closed OBJ surface filled with particles,
@@ -208,7 +208,7 @@ fn presets() -> Vec<Preset> {
         ),
         preset(
             "snowball",
-            "MLS-MPM in 3D: a snowball hitting a wall and breaking up",
+            "MLS-MPM in 3D: a snowball flattening against a wall, rebounding and falling to the floor",
             RunDefaults::new(0.0005, 100, 16),
             serde_json::json!({ "preset": "snowball" }),
             16,

@@ -604,7 +604,8 @@ impl SurgeFront {
 }
 
 /// A snowball (radius 0.1, 6 m/s) thrown against a wall (separating contact, Coulomb friction
-/// 0.5): it flattens, partly sticks by friction and slides down.
+/// 0.5): it flattens against the wall (from 0.2 m to 0.1 m thick along x), rebounds at about
+/// 0.5 m/s, falls to the floor and slides back along it.
 ///
 /// # Errors
 /// [`MpmError`] for a resolution below 8.

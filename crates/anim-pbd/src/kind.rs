@@ -46,6 +46,7 @@
 //! The model works z up (gravity along `-z`, the scene file's coordinates); its view turns all
 //! of it y up, the frame of every view ([`anim_core::scene::turn_z_up`]).
 
+use crate::constraint::ConstraintFunction;
 use crate::scenes;
 use crate::sim::{Method, PbdSimulation};
 use anim_core::integrate::State;
@@ -291,8 +292,23 @@ impl View for PbdSimulation {
         context.triangles = triangles;
         context.lines = edges;
         context.tetrahedra = model.tets().to_vec();
-        context.pins =
-            model.inverse_masses().iter().enumerate().filter(|&(_, &w)| w == 0.0).map(|(i, _)| i).collect();
+        // Pinned particles (no inverse mass) and particles held to a point or a moving body with
+        // no slack (the flag's pole side).
+        let held = model.constraints().iter().filter_map(|c| match c.function {
+            ConstraintFunction::Attachment { particle, distance, .. } if distance == 0.0 => Some(particle),
+            _ => None,
+        });
+        let mut pins: Vec<usize> = model
+            .inverse_masses()
+            .iter()
+            .enumerate()
+            .filter(|&(_, &w)| w == 0.0)
+            .map(|(i, _)| i)
+            .chain(held)
+            .collect();
+        pins.sort_unstable();
+        pins.dedup();
+        context.pins = pins;
         context.point_radius = 0.2 * mean;
         context.props.extend(ground.map(|height| Prop::Ground { height }));
         context.props.extend(spheres);

@@ -284,6 +284,31 @@ pub fn colorize(values: &[f64], range: Option<(f64, f64)>, nan_color: [u8; 3]) -
     values.iter().map(|&v| if v.is_finite() { viridis((v - lo) / span) } else { nan_color }).collect()
 }
 
+/// Ten colours told apart at a glance (Tableau 10, the default categorical palette of
+/// matplotlib and Vega), for categories such as material ids.
+pub const CATEGORIES: [[u8; 3]; 10] = [
+    [0x4e, 0x79, 0xa7],
+    [0xf2, 0x8e, 0x2b],
+    [0x59, 0xa1, 0x4f],
+    [0xe1, 0x57, 0x59],
+    [0x76, 0xb7, 0xb2],
+    [0xed, 0xc9, 0x48],
+    [0xb0, 0x7a, 0xa1],
+    [0xff, 0x9d, 0xa7],
+    [0x9c, 0x75, 0x5f],
+    [0xba, 0xb0, 0xac],
+];
+
+/// The colour of category `id` (an integer value, such as a material id): [`CATEGORIES`] in
+/// turn, repeating after ten; `nan_color` for a value that is not a finite whole number >= 0.
+pub fn category(id: f64, nan_color: [u8; 3]) -> [u8; 3] {
+    if id.is_finite() && id >= 0.0 && id.fract() == 0.0 {
+        CATEGORIES[(id % 10.0) as usize]
+    } else {
+        nan_color
+    }
+}
+
 /// The smallest and largest finite value, `(0, 1)` when there is none.
 pub fn finite_range(values: &[f64]) -> (f64, f64) {
     let mut lo = f64::INFINITY;
@@ -326,5 +351,15 @@ mod tests {
         assert_eq!(c[1], [255, 0, 255]);
         assert_eq!(c[2], VIRIDIS[255]);
         assert_eq!(c[3], viridis(0.5));
+    }
+
+    #[test]
+    fn categories_repeat_after_ten_and_refuse_fractions() {
+        assert_eq!(category(0.0, [0; 3]), [0x4e, 0x79, 0xa7]);
+        assert_eq!(category(12.0, [0; 3]), CATEGORIES[2]);
+        assert_ne!(category(0.0, [0; 3]), category(1.0, [0; 3]));
+        for bad in [0.5, -1.0, f64::NAN, f64::INFINITY] {
+            assert_eq!(category(bad, [1, 2, 3]), [1, 2, 3], "{bad}");
+        }
     }
 }

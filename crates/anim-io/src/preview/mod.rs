@@ -178,6 +178,33 @@ impl Canvas {
         triangles: &[[usize; 3]],
         style: &MeshStyle,
     ) -> Result<(), IoError> {
+        self.mesh(camera, positions, triangles, style, None)
+    }
+
+    /// Draws a triangle mesh with a colour per vertex (a field through a colour map), blended
+    /// across each triangle and lit as [`Canvas::draw_mesh`] lights `shading`; both faces take
+    /// the vertices' colours. A colour list of another length than `positions` is an error.
+    pub fn draw_mesh_colored<T: Real>(
+        &mut self,
+        camera: &Camera,
+        positions: &[[T; 3]],
+        triangles: &[[usize; 3]],
+        colors: &[[u8; 3]],
+        shading: Shading,
+    ) -> Result<(), IoError> {
+        Colors::PerItem(colors).check(positions.len(), "mesh vertices")?;
+        let style = MeshStyle { shading, ..MeshStyle::default() };
+        self.mesh(camera, positions, triangles, &style, Some(colors))
+    }
+
+    fn mesh<T: Real>(
+        &mut self,
+        camera: &Camera,
+        positions: &[[T; 3]],
+        triangles: &[[usize; 3]],
+        style: &MeshStyle,
+        vertex_colors: Option<&[[u8; 3]]>,
+    ) -> Result<(), IoError> {
         let n = positions.len();
         if let Some(e) = triangles.iter().position(|t| t.iter().any(|&i| i >= n)) {
             return Err(index_error("triangle", e, n));
@@ -240,8 +267,18 @@ impl Canvas {
                     if key >= self.depth[i] {
                         continue;
                     }
+                    let base = match vertex_colors {
+                        Some(vc) => [0, 1, 2].map(|k| {
+                            let mix = w0 * f64::from(vc[t[0]][k])
+                                + w1 * f64::from(vc[t[1]][k])
+                                + w2 * f64::from(vc[t[2]][k]);
+                            mix.round().clamp(0.0, 255.0) as u8
+                        }),
+                        None => base,
+                    };
                     let col = match style.shading {
-                        Shading::Flat => flat,
+                        Shading::Flat if vertex_colors.is_none() => flat,
+                        Shading::Flat => shade(base, toward(face_n).dot(light)),
                         Shading::Smooth => {
                             let nv = (w0 * normals[t[0]] + w1 * normals[t[1]] + w2 * normals[t[2]])
                                 .try_normalize()
@@ -496,6 +533,26 @@ mod tests {
         assert_eq!(c.pixel(0, 19), colormap::VIRIDIS[0]);
         assert_eq!(c.pixel(19, 0), colormap::VIRIDIS[255]);
         assert!(c.draw_scalar_field(&[0.0; 3], 2, 2, None).is_err());
+    }
+
+    /// A square red on its left vertices and blue on its right, lit head on: the left edge is
+    /// red, the right blue, the middle a blend of both; a colour list of the wrong length is an
+    /// error naming the counts.
+    #[test]
+    fn vertex_colours_blend_across_the_triangles() {
+        let square = [[-1.5, -1.5, 0.0], [1.5, -1.5, 0.0], [1.5, 1.5, 0.0], [-1.5, 1.5, 0.0]];
+        let colors = [[250, 0, 0], [0, 0, 250], [0, 0, 250], [250, 0, 0]];
+        let mut c = Canvas::new(40, 40, [0; 3]);
+        c.draw_mesh_colored(&front_camera(), &square, &[[0, 1, 2], [0, 2, 3]], &colors, Shading::Flat)
+            .unwrap();
+        let (left, mid, right) = (c.pixel(6, 20), c.pixel(20, 20), c.pixel(33, 20));
+        assert!(left[0] > 150 && left[2] < 40, "{left:?}");
+        assert!(right[2] > 150 && right[0] < 40, "{right:?}");
+        assert!(mid[0] > 60 && mid[2] > 60 && mid[0].abs_diff(mid[2]) < 30, "{mid:?}");
+        let e = c
+            .draw_mesh_colored(&front_camera(), &square, &[[0, 1, 2]], &colors[..3], Shading::Smooth)
+            .unwrap_err();
+        assert!(e.to_string().contains("3 colours for 4 mesh vertices"), "{e}");
     }
 
     #[test]

@@ -149,10 +149,13 @@ fn the_context_draws_the_model_its_pins_and_its_static_colliders() {
     assert_eq!(c.props, vec![Prop::Ground { height: 0.0 }]);
     assert!(c.pins.is_empty());
     assert_eq!(c, sim.context(&state));
-    // The flag: attached to the moving pole, not pinned; the ground only.
-    let flag = build_params(&preset("flag").quick_params.expect("quick"));
-    let c = flag.context();
-    assert!(c.pins.is_empty());
+    // The flag: its pole-side column (x = 0, 16 of 24 x 16 particles) is held to the moving
+    // pole, so marked as pins; the ground only.
+    let (sim, state) = scenes::flag(Some(24)).expect("scene").into_simulation().expect("sim");
+    let c = sim.context(&state);
+    let on_pole: Vec<usize> = (0..state.x.len() / 3).filter(|&i| state.x[3 * i] == 0.0).collect();
+    assert_eq!(on_pole.len(), 16);
+    assert_eq!(c.pins, on_pole);
     assert_eq!(c.props, vec![Prop::Ground { height: 0.0 }]);
 }
 
