@@ -69,6 +69,8 @@ struct Preview {
     range: (f64, f64),
     /// Scratch for one frame's painted values.
     scratch: Vec<f64>,
+    /// The moving props of each kept frame (none for most scenes).
+    props: Vec<Vec<anim_core::scene::Prop>>,
 }
 
 impl Preview {
@@ -90,6 +92,7 @@ impl Preview {
             self.paint.values(&s.fields, &s.v, &mut self.scratch);
             self.painted.extend(self.scratch.iter().map(|&v| v as f32));
         }
+        self.props.push(s.props.clone());
         for &v in self.scratch.iter().filter(|v| v.is_finite()) {
             self.range = (self.range.0.min(v), self.range.1.max(v));
         }
@@ -175,7 +178,12 @@ impl Writer {
                         .iter()
                         .map(|f| ViewerField::points(f.name, f.components, &f.values))
                         .collect();
-                    viewer.frame(index, s.t, &s.x, s.point_dim, &fields)
+                    let props = if s.props.is_empty() {
+                        serde_json::Value::Null
+                    } else {
+                        serde_json::to_value(&s.props).map_err(|e| format!("viewer frame {index}: {e}"))?
+                    };
+                    viewer.frame_with_props(index, s.t, &s.x, s.point_dim, &fields, &props)
                 }
             };
             result.map_err(|e| e.to_string())?;
@@ -213,7 +221,7 @@ impl Writer {
             csv.flush().map_err(|e| e.to_string())?;
             files.push(self.dir.join("frames.csv").display().to_string());
         }
-        if let Some(Preview { mut gif, mut canvas, kept, lengths, paint, painted, range, .. }) =
+        if let Some(Preview { mut gif, mut canvas, kept, lengths, paint, painted, range, props, .. }) =
             self.preview.take()
         {
             // The camera of the whole run, now that it has been seen.
@@ -231,7 +239,8 @@ impl Writer {
             let mut snapshot = Snapshot::default();
             let mut values = Vec::new();
             let (mut at, mut at_painted) = (0, 0);
-            for n in lengths {
+            for (n, props) in lengths.into_iter().zip(props) {
+                snapshot.props = props;
                 snapshot.x.clear();
                 snapshot.x.extend(kept[at..at + n].iter().map(|&v| f64::from(v)));
                 at += n;
@@ -340,6 +349,7 @@ impl Output {
                 painted: Vec::new(),
                 range: (f64::INFINITY, f64::NEG_INFINITY),
                 scratch: Vec::new(),
+                props: Vec::new(),
             });
         }
         let (sender, receiver) = std::sync::mpsc::sync_channel::<(usize, Snapshot)>(4);

@@ -63,6 +63,8 @@ pub struct Snapshot {
     pub point_dim: usize,
     /// Every named field of the frame (not a grid's), for the browser viewer.
     pub fields: Vec<anim_core::scene::Field>,
+    /// The props that move with the scene, where they are at this frame ([`Frame::props`]).
+    pub props: Vec<Prop>,
 }
 
 impl Snapshot {
@@ -93,6 +95,7 @@ impl Snapshot {
         if let Some(v) = velocity {
             self.v.extend_from_slice(&v.values);
         }
+        self.props.clone_from(&frame.props);
         self.energy = energy;
         self.error = scene.reference_error();
     }
@@ -321,13 +324,23 @@ impl View {
         if !matches!(self.geometry, Geometry::Particles { .. }) {
             return;
         }
-        for p in s.x.chunks_exact(3) {
+        let mut take = |p: [f64; 3]| {
             if p.iter().all(|c| c.is_finite()) {
-                let (lo, hi) = self.seen.get_or_insert(([p[0], p[1], p[2]], [p[0], p[1], p[2]]));
+                let (lo, hi) = self.seen.get_or_insert((p, p));
                 for k in 0..3 {
                     lo[k] = lo[k].min(p[k]);
                     hi[k] = hi[k].max(p[k]);
                 }
+            }
+        };
+        for p in s.x.chunks_exact(3) {
+            take([p[0], p[1], p[2]]);
+        }
+        // The moving props are part of the picture too.
+        for prop in &s.props {
+            if let Some((lo, hi)) = extent(prop) {
+                take(lo);
+                take(hi);
             }
         }
     }
@@ -347,19 +360,9 @@ impl View {
                 hi[k] = hi[k].max(p[k] + r);
             }
         };
-        for prop in obstacles {
-            match *prop {
-                Prop::Sphere { center, radius } => take(center, radius),
-                Prop::Capsule { a, b, radius } => {
-                    take(a, radius);
-                    take(b, radius);
-                }
-                Prop::Cuboid { lo: corner, hi: other } | Prop::Tank { lo: corner, hi: other } => {
-                    take(corner, 0.0);
-                    take(other, 0.0);
-                }
-                _ => {}
-            }
+        for (corner, other) in obstacles.iter().filter_map(extent) {
+            take(corner, 0.0);
+            take(other, 0.0);
         }
         for p in meshes.iter().flat_map(|m| &m.positions) {
             take(*p, 0.0);
@@ -491,7 +494,7 @@ impl View {
                 triangles, edges, pins, radius, ground, obstacles, meshes, planar, ..
             } => {
                 triples(&s.x, &mut self.positions);
-                for prop in obstacles {
+                for prop in obstacles.iter().chain(&s.props) {
                     draw_obstacle(canvas, camera, prop)?;
                 }
                 for mesh in meshes {
@@ -609,4 +612,4 @@ mod props;
 mod tests;
 
 pub use paint::{MATERIAL, Paint, SPEED};
-use props::{OBSTACLE_STYLE, draw_obstacle};
+use props::{OBSTACLE_STYLE, draw_obstacle, extent};

@@ -14,7 +14,7 @@ fn anim(args: &[&str]) -> (bool, String) {
 fn bad_flags_and_names_are_refused_with_the_value_named() {
     let dir = std::env::temp_dir().join(format!("anim-cli-flags-{}", std::process::id()));
     let out = dir.to_str().unwrap();
-    let cases: [(&[&str], &str); 17] = [
+    let cases: [(&[&str], &str); 20] = [
         (&["run", "kepler", "--frames", "0"], "--frames must be at least 1"),
         (&["run", "kepler", "--dt", "0"], "--dt must be a positive finite number, got 0"),
         (&["run", "kepler", "--dt", "-1e-3"], "got -0.001"),

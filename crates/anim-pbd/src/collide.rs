@@ -164,13 +164,43 @@ pub struct KinematicBody {
     pub pose: Pose,
     /// Motion from that pose.
     pub motion: BodyMotion,
+    /// What the body looks like in pictures, in its own frame (the flag's pole): drawn where
+    /// the body is at each frame, never collided with (give the body a [`Collider`] for that).
+    #[serde(default)]
+    pub look: Option<Shape>,
 }
 
 impl KinematicBody {
-    /// A body at `pose` following `motion`.
+    /// A body at `pose` following `motion`, with no look.
     #[must_use]
     pub fn new(pose: Pose, motion: BodyMotion) -> Self {
-        Self { pose, motion }
+        Self { pose, motion, look: None }
+    }
+
+    /// The body drawn as `shape` (in its own frame) wherever it moves; see
+    /// [`KinematicBody::look`].
+    #[must_use]
+    pub fn with_look(mut self, shape: Shape) -> Self {
+        self.look = Some(shape);
+        self
+    }
+
+    /// The body's look placed at its pose at time `t`, in the world frame: a sphere or capsule
+    /// moved and turned with the body, a box moved (drawn axis-aligned: a box look is kept only
+    /// by a body that does not turn). `None` without a look, for a plane, or for a box on a
+    /// turned body.
+    #[must_use]
+    pub fn look_at(&self, t: f64) -> Option<Shape> {
+        let pose = self.pose_at(t);
+        let at = |p: [f64; 3]| pose.apply(DVec3::from_array(p)).to_array();
+        match self.look? {
+            Shape::Sphere { center, radius } => Some(Shape::Sphere { center: at(center), radius }),
+            Shape::Capsule { a, b, radius } => Some(Shape::Capsule { a: at(a), b: at(b), radius }),
+            Shape::Box { center, half_extents } if pose.rotation.angle_between(DQuat::IDENTITY) < 1e-12 => {
+                Some(Shape::Box { center: at(center), half_extents })
+            }
+            Shape::Box { .. } | Shape::Plane { .. } => None,
+        }
     }
 
     /// Pose at time `t`.

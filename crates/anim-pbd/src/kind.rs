@@ -295,7 +295,7 @@ impl View for PbdSimulation {
         // Pinned particles (no inverse mass) and particles held to a point or a moving body with
         // no slack (the flag's pole side).
         let held = model.constraints().iter().filter_map(|c| match c.function {
-            ConstraintFunction::Attachment { particle, distance, .. } if distance == 0.0 => Some(particle),
+            ConstraintFunction::Attachment { particle, distance: 0.0, .. } => Some(particle),
             _ => None,
         });
         let mut pins: Vec<usize> = model
@@ -331,6 +331,15 @@ impl View for PbdSimulation {
         out.time = state.t;
         out.points.clone_from(&state.x);
         out.field_mut("velocity", 3).extend_from_slice(&state.v);
+        // The moving bodies drawn where they are (the flag's pole).
+        out.props.clear();
+        out.props.extend(
+            self.model()
+                .bodies()
+                .iter()
+                .filter_map(|b| b.look_at(state.t))
+                .filter_map(|s| Prop::of_shape(&s)),
+        );
         out.turn_z_up(3, &["velocity"]);
     }
 }

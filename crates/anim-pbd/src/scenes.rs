@@ -32,7 +32,7 @@ use crate::build::{
     Bending, BuildError, Chain, Cloth, EARTH_GRAVITY, InputError, MeshMass, MeshParams, PbdBuilder,
     TetMeshParams,
 };
-use crate::collide::{BodyMotion, Collider, KinematicBody, Pose};
+use crate::collide::{BodyMotion, Collider, KinematicBody, Pose, Shape};
 use crate::constraint::{AttachTarget, ConstraintParams};
 use crate::model::{PbdModel, Wind};
 use crate::sim::{Method, PbdError, PbdParams, PbdSimulation, SolverKind};
@@ -170,6 +170,9 @@ pub fn cloth_drape(n: Option<usize>) -> Result<PbdScene, BuildError> {
     })
 }
 
+/// The radius of the flag's pole (m).
+pub const POLE_RADIUS: f64 = 0.025;
+
 /// A 1.2 m x 0.8 m flag of `n x (2n/3)` particles (default 24), 0.15 kg/m^2, hanging from a pole
 /// that sways 5 cm at 0.5 Hz: its pole-side column is attached (rigidly) to points of the pole,
 /// a kinematic body. Gusty wind of 6 m/s blows along +x with a sideways component; dihedral
@@ -183,10 +186,19 @@ pub fn flag(n: Option<usize>) -> Result<PbdScene, BuildError> {
     let (width, height) = (1.2, 0.8);
     let mut b = PbdBuilder::new();
     b.gravity(EARTH_GRAVITY);
-    let pole = b.body(KinematicBody::new(
-        Pose::from_translation([0.0, 0.0, 1.2]),
-        BodyMotion::Oscillate { amplitude: [0.0, 0.05, 0.0], frequency: 0.5 },
-    ));
+    // The pole, drawn from the ground to 5 cm above the flag: a 2.5 cm capsule whose surface
+    // the attached edge (x = 0) touches.
+    let pole = b.body(
+        KinematicBody::new(
+            Pose::from_translation([0.0, 0.0, 1.2]),
+            BodyMotion::Oscillate { amplitude: [0.0, 0.05, 0.0], frequency: 0.5 },
+        )
+        .with_look(Shape::Capsule {
+            a: [-POLE_RADIUS, 0.0, -1.2],
+            b: [-POLE_RADIUS, 0.0, 0.85],
+            radius: POLE_RADIUS,
+        }),
+    );
     let mass = 0.15 * width * height / (nx * nz) as f64;
     let cloth = b.cloth(&Cloth {
         nx,

@@ -96,7 +96,7 @@ impl Paint {
         match self {
             Paint::Plain => None,
             Paint::Field(name) if self.is_categorical() => Some(format!("{name} (one colour per id)")),
-            Paint::Field(name) => Some(format!("{name}, {:.3e} to {:.3e} (viridis)", range.0, range.1)),
+            Paint::Field(name) => Some(format!("{name}, {} to {} (viridis)", short(range.0), short(range.1))),
         }
     }
 
@@ -115,6 +115,20 @@ impl Paint {
                     .map(|&x| if x.is_finite() { colormap::viridis((x - range.0) / span) } else { BAD }),
             );
         }
+    }
+}
+
+/// A number in three significant digits: `0`, `4.18`, `0.0123`, `1.23e-5`, `2.50e6`.
+fn short(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = 2 - x.abs().log10().floor() as i32;
+    if (-3..=4).contains(&(2 - digits)) {
+        let text = format!("{:.*}", digits.max(0) as usize, x);
+        if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_string() } else { text }
+    } else {
+        format!("{x:.2e}")
     }
 }
 
@@ -191,6 +205,16 @@ mod tests {
         Paint::Field(MATERIAL.into()).colors(&[0.0, 3.0, 0.5], (0.0, 3.0), &mut colors);
         assert_eq!(colors, [colormap::CATEGORIES[0], colormap::CATEGORIES[3], [255, 0, 255]]);
         Paint::Field(SPEED.into()).colors(&[1.0, 5.0, f64::NAN], (1.0, 5.0), &mut colors);
+        assert_eq!(
+            Paint::Field(SPEED.into()).caption((0.0, 4.1771)).as_deref(),
+            Some("speed, 0 to 4.18 (viridis)")
+        );
+        assert_eq!(
+            Paint::Field(MATERIAL.into()).caption((0.0, 2.0)).as_deref(),
+            Some("material (one colour per id)")
+        );
+        let shorts: Vec<String> = [0.0123456, 1.23456e-5, 2.5e6, 123456.0, -0.5].map(short).to_vec();
+        assert_eq!(shorts, ["0.0123", "1.23e-5", "2.50e6", "1.23e5", "-0.5"]);
         assert_eq!(colors, [colormap::viridis(0.0), colormap::viridis(1.0), [255, 0, 255]]);
     }
 }

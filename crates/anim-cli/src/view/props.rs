@@ -60,6 +60,20 @@ pub(super) fn draw_obstacle(canvas: &mut Canvas, camera: &Camera, prop: &Prop) -
     }
 }
 
+/// The corners of the box a solid prop or a tank takes, `(lo, hi)`; `None` for the ground,
+/// an attractor or an anchor.
+pub(super) fn extent(prop: &Prop) -> Option<([f64; 3], [f64; 3])> {
+    match *prop {
+        Prop::Sphere { center, radius } => Some((center.map(|c| c - radius), center.map(|c| c + radius))),
+        Prop::Capsule { a, b, radius } => Some((
+            std::array::from_fn(|k| a[k].min(b[k]) - radius),
+            std::array::from_fn(|k| a[k].max(b[k]) + radius),
+        )),
+        Prop::Cuboid { lo, hi } | Prop::Tank { lo, hi } => Some((lo, hi)),
+        _ => None,
+    }
+}
+
 /// The corners of the box `[lo, hi]`, corner `i` taking `hi` on the axes of the bits of `i`.
 fn box_corners(lo: [f64; 3], hi: [f64; 3]) -> [[f64; 3]; 8] {
     std::array::from_fn(|i| std::array::from_fn(|a| if i >> a & 1 == 1 { hi[a] } else { lo[a] }))

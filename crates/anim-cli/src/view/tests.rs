@@ -222,3 +222,25 @@ fn a_grids_obstacles_are_drawn_over_its_field() {
     assert!(centre[0].abs_diff(centre[2]) <= 12 && centre[0] > 100, "the sphere: {centre:?}");
     assert_eq!(canvas.pixel(4, 4), anim_io::preview::colormap::viridis(0.5), "the field");
 }
+
+/// A prop that moves with the scene (the flag's pole) is drawn where the frame puts it, and the
+/// camera frames it: a sphere prop of one frame covers its place in grey, and is gone from the
+/// next frame that does not hold it.
+#[test]
+fn moving_props_are_drawn_where_each_frame_puts_them() {
+    let mut view = particles(true);
+    let camera = Camera::xy_plane([-1.0, -1.0], [1.0, 1.0], 1.0);
+    let ball = Prop::Sphere { center: [0.5, 0.5, 0.0], radius: 0.2 };
+    let with = Snapshot { x: vec![-0.5, -0.5, 0.0], props: vec![ball], ..Snapshot::default() };
+    let mut canvas = Canvas::new(100, 100, [255, 255, 255]);
+    view.draw(&mut canvas, &camera, &with, &[]).unwrap();
+    let there = canvas.pixel(75, 25);
+    assert!(there != [255, 255, 255] && there[0].abs_diff(there[2]) <= 12, "{there:?}");
+    canvas.clear();
+    view.draw(&mut canvas, &camera, &Snapshot { props: Vec::new(), ..with.clone() }, &[]).unwrap();
+    assert_eq!(canvas.pixel(75, 25), [255, 255, 255]);
+    // Seen, a far prop widens the picture.
+    let far = Prop::Sphere { center: [9.0, 0.0, 0.0], radius: 0.5 };
+    view.see(&Snapshot { x: vec![0.0; 3], props: vec![far], ..Snapshot::default() });
+    assert!(view.region().1[0] >= 9.5, "{:?}", view.region());
+}

@@ -18,6 +18,12 @@
 //! assert_eq!(frame.points, [1.0, 3.0, -2.0]);
 //! assert_eq!(frame.field("velocity").map(|f| f.values.clone()), Some(vec![0.0, -9.81, -0.0]));
 //!
+//! // A pole moving with the scene, 2 m tall z up, stands 2 m tall y up.
+//! let mut frame = Frame::default();
+//! frame.props.push(Prop::Capsule { a: [0.0; 3], b: [0.0, 0.0, 2.0], radius: 0.02 });
+//! frame.turn_z_up(3, &[]);
+//! assert_eq!(frame.props, [Prop::Capsule { a: [0.0, 0.0, -0.0], b: [0.0, 2.0, -0.0], radius: 0.02 }]);
+//!
 //! let mut context = Context::default();
 //! context.props.push(Prop::Ground { height: 0.5 }); // the plane z = 0.5, then y = 0.5
 //! context.turn_z_up();
@@ -87,7 +93,8 @@ impl Frame {
     /// Turns a frame written in a z-up frame into the y-up frame ([`turn_z_up`]), in place
     /// (nothing is allocated): the points when there are 3 coordinates per point
     /// (`point_dim`, [`Context::point_dim`]), and the per-point or per-cell vector fields
-    /// named in `vectors` (`"velocity"`) that the frame has. Scalar fields need no turn.
+    /// named in `vectors` (`"velocity"`) that the frame has, and the moving props
+    /// ([`Prop::turned_z_up`]). Scalar fields need no turn.
     ///
     /// # Panics
     /// A field named in `vectors` that does not have 3 components (a caller's mistake).
@@ -102,6 +109,9 @@ impl Frame {
                 field.name, field.components
             );
             turn_all(&mut field.values);
+        }
+        for prop in &mut self.props {
+            *prop = prop.turned_z_up();
         }
     }
 }
@@ -197,12 +207,14 @@ mod tests {
                 Field { name: "normal", components: 3, values: vec![0.0, 1.0, 0.0, 0.0, 0.0, 1.0] },
                 Field { name: "mass", components: 1, values: vec![2.0, 3.0] },
             ],
+            props: vec![Prop::Sphere { center: [0.0, 1.0, 2.0], radius: 0.5 }],
         };
         let buffers = (frame.points.as_ptr(), frame.fields[0].values.as_ptr());
         frame.turn_z_up(3, &["velocity", "normal", "absent"]);
         assert_eq!(frame.points, [1.0, 3.0, -2.0, -4.0, -6.0, -5.0]);
         assert_eq!(frame.fields[0].values, [0.0, -1.0, -0.0, 1.0, 0.0, -1.0]);
         assert_eq!(frame.fields[1].values, [0.0, 0.0, -1.0, 0.0, 1.0, -0.0]);
+        assert_eq!(frame.props, [Prop::Sphere { center: [0.0, 2.0, -1.0], radius: 0.5 }]);
         assert_eq!(frame.fields[2].values, [2.0, 3.0]);
         assert_eq!((frame.points.as_ptr(), frame.fields[0].values.as_ptr()), buffers);
         // Two coordinates per point (a system drawn in the plane): the points are not triples.

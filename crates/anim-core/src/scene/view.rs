@@ -221,6 +221,10 @@ pub struct Frame {
     pub points: Vec<f64>,
     /// Named fields, in a fixed order per scene (velocity first, where there is one).
     pub fields: Vec<Field>,
+    /// Props that move with the scene, where they are at this frame's time (a kinematic body
+    /// drawn with the shape it is given, such as the flag's swaying pole); the fixed props are
+    /// the context's ([`Context::props`]). Empty for most scenes.
+    pub props: Vec<Prop>,
 }
 
 impl Frame {

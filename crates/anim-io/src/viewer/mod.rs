@@ -10,7 +10,7 @@
 //! | --- | --- |
 //! | `viewer.html` | the page, three.js and the viewer's code; written once when the run starts |
 //! | `viewer/context.js` | `ANIM.context(JSON)`: what the frames are drawn with (the scene's static context, as given) |
-//! | `viewer/f00000.js` ... | `ANIM.frame(k, header, data)`: one frame; `data` is base64 of little-endian parts, each padded to 4 bytes, named in `header.parts` as `[name, components, "f32"]` (points, then per-point fields) or `[name, 1, "u8", lo, hi]` (a cell field quantised over `[lo, hi]`) |
+//! | `viewer/f00000.js` ... | `ANIM.frame(k, header, data)`: one frame; `data` is base64 of little-endian parts, each padded to 4 bytes, named in `header.parts` as `[name, components, "f32"]` (points, then per-point fields) or `[name, 1, "u8", lo, hi]` (a cell field quantised over `[lo, hi]`); `header.props`, where present, the props that move with the scene |
 //! | `viewer/index.js` | `ANIM.index({"frames": [[t, file], ...]})`: the frames present, rewritten (atomically) after every frame, so a run that stops early leaves a page that shows what it wrote |
 //!
 //! Frames are loaded as classic scripts rather than fetched: browsers refuse `fetch` of files
@@ -141,6 +141,25 @@ impl Viewer {
         point_dim: usize,
         fields: &[ViewerField<'_>],
     ) -> Result<(), IoError> {
+        self.frame_with_props(index, time, points, point_dim, fields, &serde_json::Value::Null)
+    }
+
+    /// [`Viewer::frame`] with the props that move with the scene at this frame: a JSON array
+    /// of props as the context lists its fixed ones (`{"Capsule": {"a": [...], "b": [...],
+    /// "radius": r}}`, `Sphere`, `Cuboid`), drawn where they are at each frame (the flag's
+    /// swaying pole). Anything but a non-empty array adds nothing.
+    ///
+    /// # Errors
+    /// As [`Viewer::frame`].
+    pub fn frame_with_props(
+        &mut self,
+        index: usize,
+        time: f64,
+        points: &[f64],
+        point_dim: usize,
+        fields: &[ViewerField<'_>],
+        props: &serde_json::Value,
+    ) -> Result<(), IoError> {
         let file = frame_file(index);
         let what = || format!("viewer frame {index}");
         if !points.is_empty() && !(1..=3).contains(&point_dim) {
@@ -201,7 +220,14 @@ impl Viewer {
         }
         self.text.clear();
         let time = if time.is_finite() { time } else { 0.0 };
-        let _ = write!(self.text, "ANIM.frame({index},{{\"t\":{time:e},\"n\":{n},\"parts\":[{parts}]}},\"");
+        let moving = match props {
+            serde_json::Value::Array(list) if !list.is_empty() => format!(",\"props\":{props}"),
+            _ => String::new(),
+        };
+        let _ = write!(
+            self.text,
+            "ANIM.frame({index},{{\"t\":{time:e},\"n\":{n},\"parts\":[{parts}]{moving}}},\""
+        );
         base64::engine::general_purpose::STANDARD.encode_string(&self.bytes, &mut self.text);
         self.text.push_str("\");\n");
         let path = self.data.join(&file);

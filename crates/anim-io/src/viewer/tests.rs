@@ -55,6 +55,13 @@ fn a_frame_holds_its_points_and_fields_in_the_stated_layout() {
         read_call(&dir.join("viewer/index.js"), "index"),
         serde_json::json!({ "frames": [[0.125, "f00007.js"]] })
     );
+    assert!(header.get("props").is_none(), "no moving props: none written");
+    // A prop that moves with the scene is in its frame's header, as given.
+    let pole =
+        serde_json::json!([{ "Capsule": { "a": [0.0, 0.0, 0.1], "b": [0.0, 2.0, 0.1], "radius": 0.02 } }]);
+    viewer.frame_with_props(8, 0.25, &x, 2, &fields, &pole).unwrap();
+    let (_, header, _) = read_frame(&dir.join("viewer/f00008.js"));
+    assert_eq!(header["props"], pole);
     let page = viewer.finish().unwrap();
     assert_eq!(page, dir.join("viewer.html"));
     std::fs::remove_dir_all(&dir).unwrap();

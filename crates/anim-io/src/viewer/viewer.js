@@ -20,8 +20,9 @@ function viridis(s, out, at) {
   const x = Math.min(Math.max(s, 0), 1) * (VIRIDIS.length - 1), i = Math.min(Math.floor(x), VIRIDIS.length - 2), f = x - i;
   for (let c = 0; c < 3; c++) out[at + c] = (VIRIDIS[i][c] * (1 - f) + VIRIDIS[i + 1][c] * f) / 255;
 }
-const PALETTE = [[0.26, 0.52, 0.84], [0.89, 0.45, 0.17], [0.3, 0.69, 0.29], [0.84, 0.25, 0.3],
-  [0.58, 0.4, 0.74], [0.55, 0.34, 0.29], [0.9, 0.47, 0.76], [0.5, 0.5, 0.5]];
+// The previews' categorical palette (Tableau 10).
+const PALETTE = [[0x4e, 0x79, 0xa7], [0xf2, 0x8e, 0x2b], [0x59, 0xa1, 0x4f], [0xe1, 0x57, 0x59], [0x76, 0xb7, 0xb2],
+  [0xed, 0xc9, 0x48], [0xb0, 0x7a, 0xa1], [0xff, 0x9d, 0xa7], [0x9c, 0x75, 0x5f], [0xba, 0xb0, 0xac]].map((c) => c.map((x) => x / 255));
 const BODY = [0.85, 0.45, 0.25];
 
 // ---------------------------------------------------------------- the scene
@@ -63,7 +64,9 @@ function runBounds() {
     const x = f.parts.points.values;
     for (let k = 0; k < x.length; k += 3) box.expandByPoint(p.set(x[k], x[k + 1], x[k + 2]));
   }
-  for (const prop of props) {
+  const moving = [];
+  for (let i = 0; i < list.length; i++) { const f = frameOf(i); if (f) moving.push(...f.props); }
+  for (const prop of props.concat(moving)) {
     const [kind, v] = Object.entries(prop)[0];
     if (kind === "Sphere") { box.expandByPoint(p.fromArray(v.center).addScalar(v.radius)); box.expandByPoint(p.fromArray(v.center).addScalar(-v.radius)); }
     if (kind === "Cuboid" || kind === "Tank") { box.expandByPoint(p.fromArray(v.lo)); box.expandByPoint(p.fromArray(v.hi)); }
@@ -124,6 +127,41 @@ function frameCamera() {
 }
 
 // ---------------------------------------------------------------- the context
+// A solid prop (sphere, capsule, box) as a mesh; null for any other prop.
+function solid(kind, v) {
+  if (kind === "Sphere") {
+    const m = new THREE.Mesh(new THREE.SphereGeometry(v.radius, 48, 24), grey);
+    m.position.fromArray(v.center);
+    return m;
+  }
+  if (kind === "Capsule") {
+    const a = new THREE.Vector3().fromArray(v.a), b = new THREE.Vector3().fromArray(v.b);
+    const m = new THREE.Mesh(new THREE.CapsuleGeometry(v.radius, a.distanceTo(b), 8, 24), grey);
+    m.position.copy(a).add(b).multiplyScalar(0.5);
+    m.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), b.clone().sub(a).normalize());
+    return m;
+  }
+  if (kind === "Cuboid") {
+    const lo = new THREE.Vector3().fromArray(v.lo), hi = new THREE.Vector3().fromArray(v.hi);
+    const s = hi.clone().sub(lo).max(new THREE.Vector3(1e-4, 1e-4, 1e-4).multiplyScalar(extent));
+    const m = new THREE.Mesh(new THREE.BoxGeometry(s.x, s.y, s.z), grey);
+    m.position.copy(lo).add(hi).multiplyScalar(0.5);
+    return m;
+  }
+  return null;
+}
+// The props that move with the scene, redrawn at each frame shown.
+const movingProps = new THREE.Group();
+scene.add(movingProps);
+function showMoving(f) {
+  for (const m of movingProps.children) m.geometry.dispose();
+  movingProps.clear();
+  for (const prop of f.props || []) {
+    const [kind, v] = Object.entries(prop)[0];
+    const m = solid(kind, v);
+    if (m) movingProps.add(m);
+  }
+}
 const grey = new THREE.MeshStandardMaterial({ color: 0x9a9aa2, roughness: 0.8 });
 const wall = new THREE.MeshStandardMaterial({ color: 0x6a8caf, transparent: true, opacity: 0.12, side: THREE.DoubleSide, depthWrite: false });
 const edge = new THREE.LineBasicMaterial({ color: 0x4a6a8a });
@@ -144,22 +182,8 @@ function addContext(box) {
     } else if (kind === "Ground") {
       const g = new THREE.BufferGeometry().setFromPoints([new THREE.Vector3(box.min.x - size.x, v.height, 0), new THREE.Vector3(box.max.x + size.x, v.height, 0)]);
       scene.add(new THREE.Line(g, edge));
-    } else if (kind === "Sphere") {
-      const m = new THREE.Mesh(new THREE.SphereGeometry(v.radius, 48, 24), grey);
-      m.position.fromArray(v.center);
-      scene.add(m);
-    } else if (kind === "Capsule") {
-      const a = new THREE.Vector3().fromArray(v.a), b = new THREE.Vector3().fromArray(v.b);
-      const m = new THREE.Mesh(new THREE.CapsuleGeometry(v.radius, a.distanceTo(b), 8, 24), grey);
-      m.position.copy(a).add(b).multiplyScalar(0.5);
-      m.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), b.clone().sub(a).normalize());
-      scene.add(m);
-    } else if (kind === "Cuboid") {
-      const lo = new THREE.Vector3().fromArray(v.lo), hi = new THREE.Vector3().fromArray(v.hi);
-      const s = hi.clone().sub(lo).max(new THREE.Vector3(1e-4, 1e-4, 1e-4).multiplyScalar(extent));
-      const m = new THREE.Mesh(new THREE.BoxGeometry(s.x, s.y, s.z), grey);
-      m.position.copy(lo).add(hi).multiplyScalar(0.5);
-      scene.add(m);
+    } else if (kind === "Sphere" || kind === "Capsule" || kind === "Cuboid") {
+      scene.add(solid(kind, v));
     } else if (kind === "Tank") {
       const [lo, hi] = [v.lo, v.hi];
       if (flat || hi[2] - lo[2] <= 0) {
@@ -334,6 +358,7 @@ function show(i) {
   const f = frameOf(current);
   $("slider").value = String(current);
   if (!f) { status(`frame ${current} is still loading`); return; }
+  showMoving(f);
   const o = options[Number($("color").value) || 0];
   $("time").textContent = `t = ${f.t.toFixed(3)} s  (${current + 1}/${list.length})`;
   if (image) {
