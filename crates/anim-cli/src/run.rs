@@ -819,20 +819,27 @@ pub fn interrupted() -> bool {
 /// then the folder is completed as after the last frame (the frame series and its `.pvd`, the
 /// preview of the frames so far, `metrics.json` with `"status": "interrupted"`, and a
 /// checkpoint to resume from when `--checkpoint-every` was given), and [`run`] returns an error
-/// saying so. A second Ctrl-C quits at once (exit status 130).
+/// saying so. A second Ctrl-C quits at once (exit status 130); a signal within
+/// [`SAME_INTERRUPT`] of the first is the same interrupt delivered twice (`timeout -s INT` sends
+/// it to the process and to its process group), not a second Ctrl-C.
 ///
 /// # Errors
 /// The handler could not be installed (one was installed before).
 pub fn stop_on_interrupt() -> Result<(), String> {
+    static FIRST: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
     ctrlc::set_handler(|| {
+        let first = *FIRST.get_or_init(Instant::now);
         if INTERRUPTS.fetch_add(1, Ordering::Relaxed) == 0 {
             eprintln!("\ninterrupted: finishing the current frame and the output folder (Ctrl-C again to quit at once)");
-        } else {
+        } else if first.elapsed() >= SAME_INTERRUPT {
             std::process::exit(130);
         }
     })
     .map_err(|e| format!("cannot handle Ctrl-C: {e}"))
 }
+
+/// How soon after the first an interrupt signal counts as the same one.
+pub const SAME_INTERRUPT: Duration = Duration::from_millis(300);
 
 /// Runs the scene `args` names and writes its output.
 ///

@@ -189,6 +189,47 @@ fn an_interrupted_run_finishes_its_folder_and_resumes() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// `timeout -s INT 3 anim run mpm` delivers SIGINT twice at once (to the process, then to its
+/// process group), and a loaded machine may handle the two apart: that is one interrupt, not the
+/// second Ctrl-C that quits at once. Two signals 20 ms apart finish the folder: metrics with
+/// status "interrupted", a `.pvd` whose every listed file exists, exit status 130.
+#[cfg(unix)]
+#[test]
+fn an_interrupt_delivered_twice_at_once_still_finishes_the_folder() {
+    let dir = std::env::temp_dir().join(format!("anim-cli-twice-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_anim"))
+        .args(["run", "mpm", "--quiet", "--no-viewer"])
+        .arg("--out")
+        .arg(&dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the anim binary runs");
+    let pvd_dir = dir.join("frames");
+    let start = std::time::Instant::now();
+    while std::fs::read_dir(&pvd_dir).map_or(0, |d| d.count()) < 2 {
+        assert!(start.elapsed().as_secs() < 120, "no frames written");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    for _ in 0..2 {
+        let kill = std::process::Command::new("kill").args(["-INT", &child.id().to_string()]).status();
+        assert!(kill.is_ok_and(|s| s.success()));
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().expect("the run ends");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted after frame"), "{stderr}");
+    let metrics: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("metrics.json")).expect("metrics.json"))
+            .unwrap();
+    assert_eq!(metrics["status"], "interrupted");
+    let pvd = std::fs::read_to_string(pvd_dir.join("frames.pvd")).expect("frames.pvd");
+    let listed: Vec<&str> = pvd.split("file=\"").skip(1).filter_map(|s| s.split('"').next()).collect();
+    assert!(!listed.is_empty() && listed.iter().all(|f| pvd_dir.join(f).is_file()), "{listed:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// The frame files `viewer/index.js` lists, after checking each is present.
 fn viewer_frames(dir: &Path) -> Vec<String> {
     let text = std::fs::read_to_string(dir.join("viewer/index.js")).unwrap();

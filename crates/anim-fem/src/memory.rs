@@ -2,8 +2,8 @@
 //! built, so the `fem` kind refuses a preset resolution, a mesh file or an OBJ `cell` the
 //! machine cannot hold (anim-core's [`MemoryNeed`]) instead of aborting halfway through.
 //!
-//! The parts, per item (sizes of the buffers of [`crate::model`], [`crate::assembly`],
-//! [`crate::newton`] and [`crate::sim`]):
+//! The parts, per item (sizes of the buffers of `model`, `assembly`,
+//! `newton` and `sim`):
 //!
 //! | part | bytes | what |
 //! | --- | --- | --- |

@@ -2,7 +2,7 @@
 //! or the particles exist, so the `flip` kind refuses a resolution the machine cannot hold
 //! (anim-core's [`MemoryNeed`]) instead of aborting halfway through the build.
 //!
-//! The parts, per item (sizes of the buffers of [`crate::sim`], the MAC grid, the particles
+//! The parts, per item (sizes of the buffers of `sim`, the MAC grid, the particles
 //! and anim-fluid's pressure solver):
 //!
 //! | part | bytes (2D, 3D) | what |

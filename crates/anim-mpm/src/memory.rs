@@ -2,7 +2,7 @@
 //! grid or the particles exist, so the `mpm` kind refuses a size the machine cannot hold
 //! (anim-core's [`MemoryNeed`]) instead of aborting halfway through the build.
 //!
-//! The parts, per item (sizes of the buffers of [`crate::particles`] and the sparse grid):
+//! The parts, per item (sizes of the buffers of the particle arrays and the sparse grid):
 //!
 //! | part | bytes (2D, 3D) | what |
 //! | --- | --- | --- |

@@ -2,7 +2,7 @@
 //! anything is built, so the `pbd` kind refuses a size the machine cannot hold (anim-core's
 //! [`MemoryNeed`]) instead of aborting halfway through the build.
 //!
-//! The parts, per item (sizes of the types of [`crate::model`], [`crate::constraint`] and the
+//! The parts, per item (sizes of the types of `model`, `constraint` and the
 //! solver's scratch):
 //!
 //! | part | bytes | what |

@@ -2,7 +2,7 @@
 //! before anything is built, so the `springs` kind refuses a size the machine cannot hold
 //! (anim-core's [`MemoryNeed`]) instead of aborting halfway through the build.
 //!
-//! The parts, per item (sizes from the types of [`crate::network`] and anim-core's integrators):
+//! The parts, per item (sizes from the types of `network` and anim-core's integrators):
 //!
 //! | part | bytes | what |
 //! | --- | --- | --- |

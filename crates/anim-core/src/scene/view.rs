@@ -147,7 +147,7 @@ impl Prop {
 pub enum Up {
     /// `+y` up, gravity along `-y`: the frame of every [`Frame`] and [`Context`].
     Y,
-    /// `+z` up, gravity along `-z`: turned y up by [`turn_z_up`].
+    /// `+z` up, gravity along `-z`: turned y up by [`turn_z_up`](super::turn_z_up).
     Z,
 }
 
@@ -164,7 +164,7 @@ impl Up {
 
 /// The height along `up` of the first plane among `shapes` whose normal points straight up
 /// along it (`+y` or `+z`, any length): the ground a preview draws, in the frame of `shapes`.
-/// The plane `z = h` of a z-up solver is the ground `y = h` once turned ([`turn_z_up`]).
+/// The plane `z = h` of a z-up solver is the ground `y = h` once turned ([`turn_z_up`](super::turn_z_up)).
 pub fn ground_height<'a>(shapes: impl IntoIterator<Item = &'a Shape>, up: Up) -> Option<f64> {
     let a = up.axis();
     shapes.into_iter().find_map(|s| match *s {
