@@ -54,6 +54,7 @@ use std::f64::consts::PI;
 use crate::geometry::closest_point_on_triangle;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 mod distance;
 #[cfg(test)]
@@ -285,12 +286,12 @@ impl ClosedSurface {
         let rows = lattice::Rows::new(self, origin[1], origin[2], spacing, [counts[1], counts[2]]);
         let mut inside = vec![false; counts.iter().product()];
         let xs: Vec<f64> = (0..counts[0]).map(|i| origin[0] + i as f64 * spacing).collect();
-        for k in 0..counts[2] {
-            for j in 0..counts[1] {
-                let start = (k * counts[1] + j) * counts[0];
-                rows.classify(self, j, k, &xs, &mut inside[start..start + counts[0]]);
+        // Rows are independent: z-slices in parallel, the same answers on any thread count.
+        inside.par_chunks_mut(counts[0] * counts[1]).enumerate().for_each(|(k, slice)| {
+            for (j, row) in slice.chunks_mut(counts[0]).enumerate() {
+                rows.classify(self, j, k, &xs, row);
             }
-        }
+        });
         Ok(inside)
     }
 

@@ -71,35 +71,80 @@ impl Rows {
     }
 
     /// Classifies the points `(x, y_j, z_k)` of row `(j, k)`, `xs` ascending.
+    ///
+    /// Along the row the winding number changes only at crossings. A triangle the row grazes
+    /// (along an edge, through a vertex: [`Crossing::Ambiguous`]) changes it by an amount the
+    /// row cannot count, so the x-range of every such triangle is a *cluster* where points are
+    /// classified by the solid-angle sum one by one, and the winding number just past a cluster
+    /// is taken from one solid-angle sum between it and the next event. Elsewhere the count of
+    /// crossings behind a point gives its winding number, so a row that grazes the surface
+    /// costs a few solid-angle sums instead of one per point.
     pub(super) fn classify(&self, s: &ClosedSurface, j: usize, k: usize, xs: &[f64], out: &mut [bool]) {
         let (y, z) = (self.y0 + j as f64 * self.h, self.z0 + k as f64 * self.h);
         let mut crossings: Vec<(f64, f64)> = Vec::new();
+        let mut clusters: Vec<(f64, f64)> = Vec::new();
         for &t in &self.buckets[k * self.ny + j] {
-            match self.crossing(s, s.triangles[t as usize], y, z) {
+            let tri = s.triangles[t as usize];
+            match self.crossing(s, tri, y, z) {
                 Crossing::None => {}
                 Crossing::At(x, sign) => crossings.push((x, sign)),
                 Crossing::Ambiguous => {
-                    for (o, &x) in out.iter_mut().zip(xs) {
-                        *o = s.contains([x, y, z]);
-                    }
-                    return;
+                    let xs = tri.map(|i| s.positions[i].x);
+                    let (lo, hi) = (xs[0].min(xs[1]).min(xs[2]), xs[0].max(xs[1]).max(xs[2]));
+                    clusters.push((lo - self.eps, hi + self.eps));
                 }
             }
         }
         crossings.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-        // Winding number of a point = orientation x (sum of the signs of the crossings ahead).
-        let mut ahead: f64 = crossings.iter().map(|c| c.1).sum();
-        let mut next = 0;
-        for (o, &x) in out.iter_mut().zip(xs) {
-            while next < crossings.len() && crossings[next].0 < x - self.eps {
-                ahead -= crossings[next].1;
-                next += 1;
+        // Overlapping clusters merge; a crossing inside one is the cluster's to account for.
+        clusters.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        let mut merged: Vec<(f64, f64)> = Vec::with_capacity(clusters.len());
+        for (lo, hi) in clusters {
+            match merged.last_mut() {
+                Some(last) if lo <= last.1 => last.1 = last.1.max(hi),
+                _ => merged.push((lo, hi)),
             }
-            *o = if next < crossings.len() && crossings[next].0 <= x + self.eps {
-                s.contains([x, y, z])
-            } else {
-                s.orientation * ahead > 0.5
-            };
+        }
+        crossings.retain(|c| !merged.iter().any(|m| c.0 >= m.0 && c.0 <= m.1));
+        // Winding number (orientation applied) behind each point, 0 before every event.
+        let mut winding = 0.0;
+        let (mut next, mut cluster) = (0, 0);
+        for (o, &x) in out.iter_mut().zip(xs) {
+            loop {
+                let crossing = crossings.get(next).map(|c| c.0);
+                let passed = merged.get(cluster).filter(|m| m.1 < x);
+                match (crossing, passed) {
+                    // The nearer event first: a crossing behind the point before the cluster.
+                    (Some(c), Some(m)) if c < m.0 && c < x - self.eps => {
+                        winding -= s.orientation * crossings[next].1;
+                        next += 1;
+                    }
+                    (_, Some(&(_, end))) => {
+                        // Past a cluster: the winding number between it and the next event.
+                        while crossings.get(next).is_some_and(|c| c.0 < end) {
+                            next += 1;
+                        }
+                        let after = crossings.get(next).map(|c| c.0);
+                        let ahead = merged.get(cluster + 1).map(|m| m.0);
+                        winding = match (after, ahead) {
+                            (None, None) => 0.0,
+                            (a, b) => {
+                                let bound = a.unwrap_or(f64::INFINITY).min(b.unwrap_or(f64::INFINITY));
+                                s.winding_number([0.5 * (end + bound), y, z]).round()
+                            }
+                        };
+                        cluster += 1;
+                    }
+                    (Some(c), None) if c < x - self.eps => {
+                        winding -= s.orientation * crossings[next].1;
+                        next += 1;
+                    }
+                    _ => break,
+                }
+            }
+            let in_cluster = merged.get(cluster).is_some_and(|m| x >= m.0);
+            let near_crossing = crossings.get(next).is_some_and(|c| c.0 <= x + self.eps);
+            *o = if in_cluster || near_crossing { s.contains([x, y, z]) } else { winding > 0.5 };
         }
     }
 
