@@ -584,6 +584,18 @@ const PALETTE: [RGBColor; 10] = [
     RGBColor(23, 190, 207),
 ];
 
+/// The power of ten at or below `x` (positive): a time axis spans whole decades (a hair
+/// wider, so that both ends are ticks), so it always has labelled ticks (a span inside one
+/// decade would have none).
+fn decade_below(x: f64) -> f64 {
+    10f64.powf(x.log10().floor())
+}
+
+/// The power of ten at or above `x` (positive).
+fn decade_above(x: f64) -> f64 {
+    10f64.powf(x.log10().ceil())
+}
+
 /// Log-log plot of error against wall time, one line per method.
 pub fn plot(r: &StudyResult, path: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let pts =
@@ -605,7 +617,10 @@ pub fn plot(r: &StudyResult, path: &Path) -> Result<(), Box<dyn std::error::Erro
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d((tmin / 1.5..tmax * 1.5).log_scale(), (emin / 3.0..emax * 3.0).log_scale())?;
+        .build_cartesian_2d(
+            (0.999 * decade_below(tmin / 1.5)..1.001 * decade_above(tmax * 1.5)).log_scale(),
+            (emin / 3.0..emax * 3.0).log_scale(),
+        )?;
     chart
         .configure_mesh()
         .x_desc("wall time per run [s]")

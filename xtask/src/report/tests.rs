@@ -338,3 +338,34 @@ fn cheapest_json_lists_every_tolerance_with_the_measured_pick() {
     assert_eq!(table.families[0].picks[3].method.as_deref(), Some("slow-accurate"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Times that all lie inside one decade (17 to 64 ms) still get labelled ticks on the time
+/// axis: it spans the decades around them (1e-2 and 1e-1 labelled).
+#[test]
+fn a_time_axis_inside_one_decade_is_labelled() {
+    let r = StudyResult {
+        series: vec![Series {
+            label: "field".into(),
+            points: vec![
+                Point { param: 0.2, seconds: 0.0174, error: 0.011 },
+                Point { param: 0.1, seconds: 0.028, error: 0.003 },
+                Point { param: 0.05, seconds: 0.064, error: 0.0011 },
+            ],
+        }],
+        ..tiny()
+    };
+    let dir = std::env::temp_dir().join(format!("anim-report-decade-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("decade.svg");
+    plot(&r, &path).unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    // The time axis's labels are centred under their ticks (the error axis's are not).
+    let centred: Vec<&str> = svg
+        .split("<text")
+        .filter(|t| t.contains("text-anchor=\"middle\""))
+        .filter_map(|t| t.split('>').nth(1))
+        .map(|t| t.split('<').next().unwrap_or("").trim())
+        .collect();
+    assert!(centred.contains(&"1e-2") && centred.contains(&"1e-1"), "time ticks: {centred:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}
