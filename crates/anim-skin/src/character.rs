@@ -141,6 +141,18 @@ impl Character {
 }
 
 impl CharacterData {
+    /// Sets DQS's rigidity tolerance of every mesh ([`Skinned::set_rigid_tolerance`]; default
+    /// [`crate::skinning::RIGID_TOLERANCE`]).
+    ///
+    /// # Errors
+    /// [`SkinError::BadTolerance`] unless `0 <= tolerance < 1`; nothing is changed then.
+    pub fn set_rigid_tolerance(&mut self, tolerance: f64) -> Result<(), SkinError> {
+        for s in &mut self.skinned {
+            s.set_rigid_tolerance(tolerance)?;
+        }
+        Ok(())
+    }
+
     /// Posed positions of all meshes, concatenated, written into `out` (cleared first).
     pub fn positions(&self, out: &mut Vec<[f64; 3]>) {
         out.clear();

@@ -44,7 +44,9 @@
 //! LBS loses 33.3 % of the volume of the cylinder while DQS keeps it within 0.04 %.
 //! DQS blends unit dual quaternions: a rigid motion per vertex, no collapse, similar cost, but it
 //! needs rigid joints (scaled joint transforms are rejected with
-//! [`SkinError::NonRigidJoint`]) and bulges slightly at bends. Use DQS for characters with
+//! [`SkinError::NonRigidJoint`]; transforms rigid within a tolerance, default
+//! [`skinning::RIGID_TOLERANCE`], settable with [`CharacterData::set_rigid_tolerance`], are
+//! re-orthonormalised, which absorbs exporters' f32 noise) and bulges slightly at bends. Use DQS for characters with
 //! twisting joints (forearms, necks), LBS when joints scale or for compatibility with engines
 //! that author for LBS. Both agree to `1e-12` on rigid single-influence vertices.
 //!
@@ -152,10 +154,12 @@ pub enum SkinError {
         /// The skin joint.
         joint: usize,
     },
-    /// DQS was asked to blend a joint transform with scale, shear or reflection.
+    /// DQS was asked to blend a joint transform with scale, shear or reflection beyond its
+    /// rigidity tolerance.
     #[error(
-        "skin joint {joint}: skinning matrix is not rigid (max |R^T R - I| = {deviation:.3e}, det = {determinant:.6}); \
-         dual-quaternion skinning needs rigid joints, use linear blend skinning for scaled joints"
+        "skin joint {joint}: skinning matrix is not rigid (max |R^T R - I| = {deviation:.3e}, det = {determinant:.6}, \
+         tolerance {tolerance:.1e}); dual-quaternion skinning needs rigid joints, use linear blend skinning \
+         for scaled joints"
     )]
     NonRigidJoint {
         /// The skin joint.
@@ -164,5 +168,13 @@ pub enum SkinError {
         deviation: f64,
         /// Determinant of the 3x3 block.
         determinant: f64,
+        /// The tolerance it exceeded ([`Skinned::rigid_tolerance`]).
+        tolerance: f64,
+    },
+    /// A DQS rigidity tolerance outside `[0, 1)`.
+    #[error("rigid_tolerance {tolerance}: must be at least 0 and below 1")]
+    BadTolerance {
+        /// The tolerance given.
+        tolerance: f64,
     },
 }

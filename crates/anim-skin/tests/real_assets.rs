@@ -1,0 +1,90 @@
+//! Real exported characters (`testdata/fox/`, `testdata/SimpleSkin.gltf`, see
+//! `testdata/README.md`): DQS on exporter noise, DQS against LBS on f32 data, and the loader's
+//! report.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use anim_core::glam::{DMat4, DQuat, DVec3};
+use anim_skin::{SkinError, Skinned, SkinnedMesh, SkinningMethod, scenes, skin};
+use std::path::PathBuf;
+
+fn testdata(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("testdata").join(name)
+}
+
+/// Times from the clip's start to its end in `n` steps.
+fn times(end: f64, n: usize) -> impl Iterator<Item = f64> {
+    (0..=n).map(move |i| end * i as f64 / n as f64)
+}
+
+/// The Fox's inverse bind matrices are stored in f32, so its skinning matrices are rigid only
+/// to f32 rounding (largest `|R^T R - I|` entry 3.7e-7, in the Run clip): DQS poses it at rest
+/// and through every clip; with the tolerance set below that deviation (`1e-7`) a pose is
+/// refused, naming the joint and the deviation.
+#[test]
+fn dqs_poses_the_fox_at_rest_and_through_every_clip() {
+    let scene = scenes::from_gltf(testdata("fox/Fox.gltf")).unwrap();
+    let character = &scene.character;
+    assert_eq!(character.clips.len(), 3);
+    let mut data = character.data();
+    character.pose(&mut data, None, 0.0, SkinningMethod::Dqs).unwrap();
+    for c in 0..character.clips.len() {
+        for t in times(character.clips[c].end(), 60) {
+            character
+                .pose(&mut data, Some(c), t, SkinningMethod::Dqs)
+                .unwrap_or_else(|e| panic!("clip {c} t {t}: {e}"));
+        }
+    }
+    data.set_rigid_tolerance(1e-7).unwrap();
+    let refused = (0..character.clips.len())
+        .flat_map(|c| times(character.clips[c].end(), 60).map(move |t| (c, t)))
+        .find_map(|(c, t)| character.pose(&mut data, Some(c), t, SkinningMethod::Dqs).err());
+    let Some(SkinError::NonRigidJoint { deviation, tolerance, .. }) = refused else { panic!("{refused:?}") };
+    assert!(deviation > 1e-7 && deviation < 1e-6 && tolerance == 1e-7, "{deviation:e}");
+    assert!(data.set_rigid_tolerance(-1.0).is_err() && data.set_rigid_tolerance(f64::NAN).is_err());
+}
+
+/// One vertex per joint, each on its joint alone, at distance about 1 from the origin.
+fn single_influence_mesh(joints: usize) -> SkinnedMesh {
+    let pos: Vec<[f64; 3]> = (0..joints).map(|j| [0.3, 1.0, -0.2 * j as f64]).collect();
+    let js: Vec<u16> = (0..joints).map(|j| u16::try_from(j).unwrap()).collect();
+    SkinnedMesh::new(&pos, None, 1, &js, &vec![1.0; joints], vec![], joints).unwrap()
+}
+
+/// A joint scaled uniformly by `1.0000104` (exporter noise) is re-orthonormalised: DQS gives
+/// what it gives for the same rotation and translation without the scale. A joint scaled by
+/// `1.1` is still refused, naming the joint and the deviation `1.1^2 - 1 = 0.21`.
+#[test]
+fn dqs_absorbs_scale_noise_and_refuses_real_scale() {
+    let mesh = single_influence_mesh(3);
+    let rotation = |j: usize| DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 0.5).normalize(), 0.7 + j as f64);
+    let translation = |j: usize| DVec3::new(j as f64, -1.0, 0.5);
+    let rigid: Vec<DMat4> =
+        (0..3).map(|j| DMat4::from_rotation_translation(rotation(j), translation(j))).collect();
+    let noisy: Vec<DMat4> = (0..3)
+        .map(|j| {
+            let s = if j == 1 { 1.0000104 } else { 1.0 };
+            DMat4::from_scale_rotation_translation(DVec3::splat(s), rotation(j), translation(j))
+        })
+        .collect();
+    let (mut a, mut b) = (Skinned::new(&mesh), Skinned::new(&mesh));
+    skin(&mesh, &rigid, SkinningMethod::Dqs, &mut a).unwrap();
+    skin(&mesh, &noisy, SkinningMethod::Dqs, &mut b).unwrap();
+    for v in 0..3 {
+        let d = DVec3::from_array(a.position(v)) - DVec3::from_array(b.position(v));
+        assert!(d.length() < 1e-14, "vertex {v}: {d}");
+    }
+    let scaled: Vec<DMat4> = (0..3)
+        .map(|j| {
+            let s = if j == 2 { 1.1 } else { 1.0 };
+            DMat4::from_scale_rotation_translation(DVec3::splat(s), rotation(j), translation(j))
+        })
+        .collect();
+    let e = skin(&mesh, &scaled, SkinningMethod::Dqs, &mut b).unwrap_err();
+    let SkinError::NonRigidJoint { joint, deviation, .. } = e else { panic!("{e}") };
+    assert_eq!(joint, 2);
+    assert!((deviation - 0.21).abs() < 1e-12, "{deviation}");
+    assert!(e.to_string().contains("skin joint 2") && e.to_string().contains("2.100e-1"), "{e}");
+    assert!(b.set_rigid_tolerance(0.3).is_ok());
+    skin(&mesh, &scaled, SkinningMethod::Dqs, &mut b).unwrap();
+}
