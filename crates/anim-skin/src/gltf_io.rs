@@ -11,7 +11,9 @@
 //!
 //! What is refused with a [`LoadError`]: morph targets on a skinned primitive, sparse accessors,
 //! non-triangle primitives, any extension in `extensionsRequired`, and extensions that change
-//! geometry even when only used (Draco, meshopt, mesh quantization, GPU instancing). What is
+//! geometry even when only used (Draco, meshopt, mesh quantization, GPU instancing); a required
+//! extension is named before anything else is checked, and invalid glTF names its first few
+//! problems and counts the rest, so an error stays one line. What is
 //! skipped with a warning in [`Loaded::warnings`]: meshes on nodes without a skin, morph target
 //! weight channels, other used extensions (materials and the like do not change the pose).
 //!
@@ -92,6 +94,11 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
         gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| err("document", e.to_string()))?;
     {
         let json = unchecked.document.as_json();
+        // Required extensions first: the glTF crate's validation reports every element an
+        // unsupported extension (Draco, meshopt) leaves incomplete, hundreds of lines for one cause.
+        if let Some(ext) = json.extensions_required.first() {
+            return Err(err("extensionsRequired", format!("extension {ext} is required but not supported")));
+        }
         let accessors = json.accessors.len();
         for (m, mesh) in json.meshes.iter().enumerate() {
             for (p, prim) in mesh.primitives.iter().enumerate() {
@@ -130,15 +137,12 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
         }
     }
     let blob = unchecked.blob;
-    let document = gltf::Document::from_json(unchecked.document.into_json())
-        .map_err(|e| err("document", e.to_string()))?;
+    let document =
+        gltf::Document::from_json(unchecked.document.into_json()).map_err(|e| err("document", short(&e)))?;
     let gltf = gltf::Gltf { document, blob };
     let doc = &gltf.document;
     let mut warnings = Vec::new();
 
-    if let Some(ext) = doc.extensions_required().next() {
-        return Err(err("extensionsRequired", format!("extension {ext} is required but not supported")));
-    }
     for ext in doc.extensions_used() {
         if GEOMETRY_EXTENSIONS.contains(&ext) {
             return Err(err(
@@ -419,6 +423,21 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
         Character::new(skeleton, skins, meshes, clips).map_err(|e| err("skins", e.to_string()))?;
     Ok(Loaded { character, warnings, node_joint })
 }
+
+/// A glTF crate error, its validation list cut to the first [`SHOWN_ERRORS`] entries and a count.
+fn short(e: &gltf::Error) -> String {
+    match e {
+        gltf::Error::Validation(list) if list.len() > SHOWN_ERRORS => {
+            let shown: Vec<String> =
+                list[..SHOWN_ERRORS].iter().map(|(path, e)| format!("{path}: {e}")).collect();
+            format!("invalid glTF: {} (and {} more)", shown.join(", "), list.len() - SHOWN_ERRORS)
+        }
+        _ => e.to_string(),
+    }
+}
+
+/// Validation errors named in a [`LoadError`]; the rest are counted.
+const SHOWN_ERRORS: usize = 3;
 
 fn vec3(v: [f32; 3]) -> DVec4 {
     DVec4::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]), 0.0)
