@@ -51,10 +51,10 @@
 //! that author for LBS. On single-influence vertices both agree to rounding (`1e-12`) when
 //! the skinning matrices are rigid; on f32 data they are rigid only to f32 rounding, and DQS
 //! (which re-orthonormalises) and LBS (which applies the matrix as stored) differ by up to
-//! `|S - I| |p|` (`S` the matrix's stretch, `p` the rest position): 1.2e-7 of the character's
-//! size on the Fox over its three clips, 4.8e-16 on SimpleSkin, whose inverse bind matrices
-//! are exact in f32 (`tests/real_assets.rs`); up to about half the rigidity tolerance on data
-//! at its edge.
+//! `|S - I| |p|` (`S` the matrix's stretch, `p` the rest position): on the Fox over its three
+//! clips, 1.2e-7 relative to the largest vertex distance from the origin; on SimpleSkin, whose
+//! inverse bind matrices are exact in f32, 4.8e-16 (`tests/real_assets.rs`); on data at the
+//! edge of the rigidity tolerance, up to about half the tolerance.
 //!
 //! ## Precision
 //!
