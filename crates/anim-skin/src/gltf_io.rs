@@ -16,6 +16,9 @@
 //! problems and counts the rest, so an error stays one line. What is
 //! skipped with a warning in [`Loaded::warnings`]: meshes on nodes without a skin, morph target
 //! weight channels, other used extensions (materials and the like do not change the pose).
+//! What is changed, with a note there and a count in [`Loaded::renormalised`]: weights that do
+//! not sum to 1 within [`WEIGHT_SUM_TOLERANCE`] are renormalised (as [`SkinnedMesh::new`] does
+//! for any mesh), not refused.
 //!
 //! Buffers are resolved here rather than by `gltf::import` so the `image` decoders are not
 //! compiled in: a GLB's binary chunk, `data:` URIs in base64, or files relative to the glTF file.
@@ -46,10 +49,47 @@ pub struct LoadError {
 pub struct Loaded {
     /// Skeleton (one joint per glTF node), skins, skinned meshes, clips.
     pub character: Character,
-    /// Parts of the file that were skipped (never ones that change a skinned pose).
+    /// Notes on reading the file: parts that were skipped (never ones that change a skinned
+    /// pose) and vertices whose weights were renormalised (one note per primitive, as in
+    /// [`Loaded::renormalised`]).
     pub warnings: Vec<String>,
     /// Skeleton joint of each glTF node index.
     pub node_joint: Vec<usize>,
+    /// The meshes with vertices whose weights did not sum to 1 (within
+    /// [`WEIGHT_SUM_TOLERANCE`]) and were renormalised.
+    pub renormalised: Vec<Renormalised>,
+}
+
+/// Vertices of one mesh whose weights were renormalised on loading.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Renormalised {
+    /// Index into [`Character::meshes`].
+    pub mesh: usize,
+    /// Vertices whose weights did not sum to 1.
+    pub vertices: usize,
+    /// Vertices of the mesh.
+    pub of: usize,
+    /// Largest `|sum of weights - 1|` among them.
+    pub max_deviation: f64,
+}
+
+/// A vertex's weights (as read, in f64) sum to 1 if within this: above the rounding of a sum of
+/// 8 f32 weights (`8 * 2^-24 = 4.8e-7`) and far below any authored difference.
+pub const WEIGHT_SUM_TOLERANCE: f64 = 1e-6;
+
+/// How many vertices of `k` weights each do not sum to 1 within [`WEIGHT_SUM_TOLERANCE`], and
+/// the largest deviation among them.
+fn weight_sums_off(weights: &[f64], k: usize) -> (usize, f64) {
+    let mut off = 0;
+    let mut worst = 0.0f64;
+    for w in weights.chunks_exact(k) {
+        let d = (w.iter().sum::<f64>() - 1.0).abs();
+        if d > WEIGHT_SUM_TOLERANCE {
+            off += 1;
+            worst = worst.max(d);
+        }
+    }
+    (off, worst)
 }
 
 /// Extensions that change geometry or accessors: refused even if only "used".
@@ -278,6 +318,7 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
 
     // Skinned meshes.
     let mut meshes = Vec::new();
+    let mut renormalised = Vec::new();
     for node in &nodes {
         let Some(mesh) = node.mesh() else { continue };
         let Some(skin) = node.skin() else {
@@ -363,8 +404,20 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
             {
                 return Err(err(&el, format!("{n} positions but {} normals", nr.len())));
             }
+            let (off, worst) = weight_sums_off(&weights, k);
             let m = SkinnedMesh::new(&pos, nrm.as_deref(), k, &joints, &weights, tris, n_joints)
                 .map_err(|e| err(&el, e.to_string()))?;
+            if off > 0 {
+                warnings.push(format!(
+                    "{el}: weights of {off} of {n} vertices do not sum to 1 (off by up to {worst:.1e}): renormalised"
+                ));
+                renormalised.push(Renormalised {
+                    mesh: meshes.len(),
+                    vertices: off,
+                    of: n,
+                    max_deviation: worst,
+                });
+            }
             meshes.push(CharacterMesh {
                 name: format!(
                     "{}#{}",
@@ -421,7 +474,7 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
 
     let character =
         Character::new(skeleton, skins, meshes, clips).map_err(|e| err("skins", e.to_string()))?;
-    Ok(Loaded { character, warnings, node_joint })
+    Ok(Loaded { character, warnings, node_joint, renormalised })
 }
 
 /// A glTF crate error, its validation list cut to the first [`SHOWN_ERRORS`] entries and a count.

@@ -90,7 +90,7 @@ pub mod skinning;
 
 pub use character::{Character, CharacterData, CharacterMesh};
 pub use clip::{Channel, Clip, Interpolation, Property};
-pub use gltf_io::{LoadError, Loaded};
+pub use gltf_io::{LoadError, Loaded, Renormalised};
 pub use kind::KIND;
 pub use mesh::{MAX_INFLUENCES, SkinnedMesh, signed_volume};
 pub use skeleton::{Joint, Pose, Skeleton, Skin, Trs};

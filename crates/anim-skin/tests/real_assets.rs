@@ -6,6 +6,8 @@
 
 use anim_core::glam::{DMat3, DMat4, DQuat, DVec3};
 use anim_core::linalg::svd::{polar, svd3};
+use anim_core::scene::View;
+use anim_skin::kind::{SkinPlayback, SkinningChoice};
 use anim_skin::{SkinError, Skinned, SkinnedMesh, SkinningMethod, scenes, skin};
 use std::path::PathBuf;
 
@@ -144,4 +146,83 @@ fn dqs_and_lbs_agree_on_single_influence_vertices_of_f32_exports() {
         eprintln!("{file}: {single} single-influence vertex poses, DQS-LBS relative {worst:.2e}");
         assert!(worst <= documented, "{file}: {worst:e} above the documented {documented:e}");
     }
+}
+
+/// A glTF file of three vertices (one triangle) on two joints, external buffer, float weights
+/// `weights` (4 per vertex, joints 0 and 1 then unused slots), written into a fresh folder.
+fn three_vertex_file(name: &str, weights: [[f32; 4]; 3]) -> PathBuf {
+    let mut bin: Vec<u8> = Vec::new();
+    for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+        p.iter().for_each(|c| bin.extend(c.to_le_bytes()));
+    }
+    for _ in 0..3 {
+        bin.extend([0u8, 1, 0, 0]);
+    }
+    for w in weights {
+        w.iter().for_each(|c| bin.extend(c.to_le_bytes()));
+    }
+    let gltf = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "buffers": [{"uri": format!("{name}.bin"), "byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 36},
+            {"buffer": 0, "byteOffset": 36, "byteLength": 12},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 48}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+             "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0]},
+            {"bufferView": 1, "componentType": 5121, "count": 3, "type": "VEC4"},
+            {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC4"}
+        ],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2}}]}],
+        "nodes": [{"children": [1]}, {"translation": [0.0, 1.0, 0.0]}, {"mesh": 0, "skin": 0}],
+        "skins": [{"joints": [0, 1]}],
+        "scenes": [{"nodes": [0, 2]}]
+    });
+    let dir = std::env::temp_dir().join(format!("anim-skin-assets-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join(format!("{name}.bin")), bin).unwrap();
+    let path = dir.join(format!("{name}.gltf"));
+    std::fs::write(&path, gltf.to_string()).unwrap();
+    path
+}
+
+/// Weights that do not sum to 1 are renormalised and counted: the loader's report says how
+/// many vertices and by how much, and the `skinning` scene lists the note among its context's
+/// notes (which the `anim` command prints). Weights summing to 1 within f32 rounding are not
+/// counted.
+#[test]
+fn weights_not_summing_to_one_are_renormalised_and_reported() {
+    // Vertex 0 sums to 1 up to f32 rounding (0.7 and 0.3 as f32), vertex 1 to 0.9,
+    // vertex 2 to 1.25.
+    let path = three_vertex_file(
+        "renormalised",
+        [[0.7, 0.3, 0.0, 0.0], [0.6, 0.3, 0.0, 0.0], [1.0, 0.25, 0.0, 0.0]],
+    );
+    let loaded = anim_skin::gltf_io::load(&path).unwrap();
+    assert_eq!(loaded.renormalised.len(), 1);
+    let r = loaded.renormalised[0];
+    assert_eq!((r.mesh, r.vertices, r.of), (0, 2, 3));
+    assert!((r.max_deviation - 0.25).abs() < 1e-12, "{r:?}");
+    let mesh = &loaded.character.meshes[0].mesh;
+    // The renormalised weights: 0.6 / 0.9 and 1 / 1.25 (f32 inputs, so to f32 precision).
+    assert!((mesh.weights()[4] - 2.0 / 3.0).abs() < 1e-7 && (mesh.weights()[8] - 0.8).abs() < 1e-7);
+    let note =
+        "mesh 0 primitive 0: weights of 2 of 3 vertices do not sum to 1 (off by up to 2.5e-1): renormalised";
+    assert_eq!(loaded.warnings, vec![note.to_string()]);
+
+    let scene = scenes::from_gltf(&path).unwrap();
+    let (playback, state) = SkinPlayback::new(scene, SkinningChoice::Lbs).unwrap();
+    assert!(playback.context(&state).notes.iter().any(|n| n == note));
+
+    // Weights that sum to 1: no note.
+    let clean =
+        three_vertex_file("clean", [[0.7, 0.3, 0.0, 0.0], [0.5, 0.5, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]]);
+    let loaded = anim_skin::gltf_io::load(&clean).unwrap();
+    assert!(loaded.renormalised.is_empty() && loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    // The Fox's weights (f32, 1728 vertices) sum to 1 within f32 rounding (largest deviation
+    // 6.0e-8, measured independently with numpy).
+    let fox = anim_skin::gltf_io::load(testdata("fox/Fox.gltf")).unwrap();
+    assert!(fox.renormalised.is_empty(), "{:?}", fox.renormalised);
 }
