@@ -6,7 +6,8 @@
 //! inverse bind matrices, identity when absent), every triangle primitive of every skinned mesh
 //! node (`POSITION`, `NORMAL`, indices, `JOINTS_0/WEIGHTS_0` and `JOINTS_1/WEIGHTS_1` for up to 8
 //! influences; joints as unsigned byte or short, weights as float or normalised unsigned
-//! byte/short), and every animation's translation, rotation and scale channels with STEP,
+//! byte/short; one [`CharacterMesh`] per skinned node and primitive, which records them in its
+//! [`GltfSource`]), and every animation's translation, rotation and scale channels with STEP,
 //! LINEAR and CUBICSPLINE samplers.
 //!
 //! What is refused with a [`LoadError`]: morph targets on a skinned primitive, sparse accessors,
@@ -23,7 +24,7 @@
 //! Buffers are resolved here rather than by `gltf::import` so the `image` decoders are not
 //! compiled in: a GLB's binary chunk, `data:` URIs in base64, or files relative to the glTF file.
 
-use crate::character::{Character, CharacterMesh};
+use crate::character::{Character, CharacterMesh, GltfSource};
 use crate::clip::{Channel, Clip, Interpolation, Property};
 use crate::mesh::SkinnedMesh;
 use crate::skeleton::{Joint, Skeleton, Skin, Trs};
@@ -426,6 +427,7 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
                 ),
                 skin: skin.index(),
                 mesh: m,
+                source: Some(GltfSource { node: node.index(), mesh: mesh.index(), primitive: prim.index() }),
             });
         }
     }

@@ -20,7 +20,10 @@
 //! - [`skin`]: LBS and DQS, normals with positions, parallel over vertex chunks with rayon and
 //!   bitwise identical for any thread count, no allocation per pose.
 //! - [`gltf_io::load`]: `.gltf` (external or data-URI buffers) and `.glb` files into a
-//!   [`Character`] (skeleton, skins, meshes, clips) plus warnings for what was ignored.
+//!   [`Character`] (skeleton, skins, meshes, clips) plus notes on what was ignored or
+//!   renormalised; each mesh keeps the glTF node, mesh and primitive it came from
+//!   ([`GltfSource`]) and poses into its own buffers ([`CharacterData::mesh_positions`];
+//!   [`CharacterData::positions`] joins all meshes).
 //! - [`scenes`]: the twisted cylinder (LBS's candy-wrapper collapse next to DQS) and
 //!   [`scenes::from_gltf`], both posable at any time into positions and triangles.
 //!
@@ -88,7 +91,7 @@ pub mod scenes;
 pub mod skeleton;
 pub mod skinning;
 
-pub use character::{Character, CharacterData, CharacterMesh};
+pub use character::{Character, CharacterData, CharacterMesh, GltfSource};
 pub use clip::{Channel, Clip, Interpolation, Property};
 pub use gltf_io::{LoadError, Loaded, Renormalised};
 pub use kind::KIND;

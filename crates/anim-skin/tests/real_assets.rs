@@ -8,7 +8,7 @@ use anim_core::glam::{DMat3, DMat4, DQuat, DVec3};
 use anim_core::linalg::svd::{polar, svd3};
 use anim_core::scene::View;
 use anim_skin::kind::{SkinPlayback, SkinningChoice};
-use anim_skin::{SkinError, Skinned, SkinnedMesh, SkinningMethod, scenes, skin};
+use anim_skin::{GltfSource, SkinError, Skinned, SkinnedMesh, SkinningMethod, scenes, skin};
 use std::path::PathBuf;
 
 fn testdata(name: &str) -> PathBuf {
@@ -225,4 +225,46 @@ fn weights_not_summing_to_one_are_renormalised_and_reported() {
     // 6.0e-8, measured independently with numpy).
     let fox = anim_skin::gltf_io::load(testdata("fox/Fox.gltf")).unwrap();
     assert!(fox.renormalised.is_empty(), "{:?}", fox.renormalised);
+}
+
+/// Each skinned mesh records its glTF node, mesh and primitive, and poses on its own: a glTF
+/// mesh on two skinned nodes gives two meshes with the node of each, each mesh's positions are
+/// its slice of the joined positions.
+#[test]
+fn skinned_meshes_keep_their_gltf_source_and_positions() {
+    let fox: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(testdata("fox/Fox.gltf")).unwrap()).unwrap();
+    let mesh_node = fox["nodes"].as_array().unwrap().iter().position(|n| n.get("mesh").is_some()).unwrap();
+    let loaded = anim_skin::gltf_io::load(testdata("fox/Fox.gltf")).unwrap();
+    let sources: Vec<_> = loaded.character.meshes.iter().map(|m| m.source).collect();
+    assert_eq!(sources, vec![Some(GltfSource { node: mesh_node, mesh: 0, primitive: 0 })]);
+
+    // skin_embedded.gltf with its skinned mesh (node 6) used by a second skinned node, 7.
+    let text = std::fs::read_to_string(testdata("skin_embedded.gltf")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["nodes"].as_array_mut().unwrap().push(serde_json::json!({"mesh": 0, "skin": 0}));
+    v["scenes"][0]["nodes"].as_array_mut().unwrap().push(serde_json::json!(7));
+    let dir = std::env::temp_dir().join(format!("anim-skin-twice-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("twice.gltf");
+    std::fs::write(&path, v.to_string()).unwrap();
+    let scene = scenes::from_gltf(&path).unwrap();
+    let character = &scene.character;
+    let sources: Vec<_> = character.meshes.iter().map(|m| m.source.unwrap()).collect();
+    assert_eq!(
+        sources,
+        vec![GltfSource { node: 6, mesh: 0, primitive: 0 }, GltfSource { node: 7, mesh: 0, primitive: 0 }]
+    );
+    let mut data = scene.data();
+    scene.pose(&mut data, 1.5, SkinningMethod::Lbs).unwrap();
+    let (mut all, mut first, mut second) = (Vec::new(), Vec::new(), Vec::new());
+    data.positions(&mut all);
+    data.mesh_positions(0, &mut first);
+    data.mesh_positions(1, &mut second);
+    let n = character.meshes[0].mesh.len();
+    assert_eq!(all.len(), 2 * n);
+    assert_eq!((&all[..n], &all[n..]), (first.as_slice(), second.as_slice()));
+    // Both nodes carry the same mesh and skin, and the mesh node's transform is ignored: the
+    // same posed vertices.
+    assert_eq!(first, second);
 }
