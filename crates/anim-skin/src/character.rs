@@ -17,6 +17,20 @@ pub struct CharacterMesh {
     pub skin: usize,
     /// The mesh.
     pub mesh: SkinnedMesh,
+    /// Where it came from in a glTF file (`None` for meshes built in code).
+    pub source: Option<GltfSource>,
+}
+
+/// The glTF elements a [`CharacterMesh`] was read from: one per skinned node and primitive (a
+/// glTF mesh used by two skinned nodes gives two meshes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct GltfSource {
+    /// Index of the node in the file's `nodes`.
+    pub node: usize,
+    /// Index of the mesh in `meshes`.
+    pub mesh: usize,
+    /// Index of the primitive in the mesh's `primitives`.
+    pub primitive: usize,
 }
 
 /// Skeleton, skins, meshes and clips. Never modified by posing.
@@ -141,7 +155,43 @@ impl Character {
 }
 
 impl CharacterData {
-    /// Posed positions of all meshes, concatenated, written into `out` (cleared first).
+    /// Sets DQS's rigidity tolerance of every mesh ([`Skinned::set_rigid_tolerance`]; default
+    /// [`crate::skinning::RIGID_TOLERANCE`]).
+    ///
+    /// # Errors
+    /// [`SkinError::BadTolerance`] unless `0 <= tolerance < 1`; nothing is changed then.
+    pub fn set_rigid_tolerance(&mut self, tolerance: f64) -> Result<(), SkinError> {
+        for s in &mut self.skinned {
+            s.set_rigid_tolerance(tolerance)?;
+        }
+        Ok(())
+    }
+
+    /// Posed positions of mesh `mesh` alone ([`Character::meshes`] order), written into `out`
+    /// (cleared first).
+    ///
+    /// # Panics
+    /// If `mesh` is out of range (API misuse).
+    #[track_caller]
+    pub fn mesh_positions(&self, mesh: usize, out: &mut Vec<[f64; 3]>) {
+        let s = &self.skinned[mesh];
+        out.clear();
+        out.extend((0..s.x.len()).map(|v| s.position(v)));
+    }
+
+    /// Posed normals of mesh `mesh` alone, written into `out` (cleared first).
+    ///
+    /// # Panics
+    /// If `mesh` is out of range (API misuse).
+    #[track_caller]
+    pub fn mesh_normals(&self, mesh: usize, out: &mut Vec<[f64; 3]>) {
+        let s = &self.skinned[mesh];
+        out.clear();
+        out.extend((0..s.x.len()).map(|v| s.normal(v)));
+    }
+
+    /// Posed positions of all meshes, concatenated, written into `out` (cleared first);
+    /// [`CharacterData::mesh_positions`] gives one mesh's.
     pub fn positions(&self, out: &mut Vec<[f64; 3]>) {
         out.clear();
         for s in &self.skinned {

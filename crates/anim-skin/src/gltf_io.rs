@@ -6,19 +6,25 @@
 //! inverse bind matrices, identity when absent), every triangle primitive of every skinned mesh
 //! node (`POSITION`, `NORMAL`, indices, `JOINTS_0/WEIGHTS_0` and `JOINTS_1/WEIGHTS_1` for up to 8
 //! influences; joints as unsigned byte or short, weights as float or normalised unsigned
-//! byte/short), and every animation's translation, rotation and scale channels with STEP,
+//! byte/short; one [`CharacterMesh`] per skinned node and primitive, which records them in its
+//! [`GltfSource`]), and every animation's translation, rotation and scale channels with STEP,
 //! LINEAR and CUBICSPLINE samplers.
 //!
 //! What is refused with a [`LoadError`]: morph targets on a skinned primitive, sparse accessors,
 //! non-triangle primitives, any extension in `extensionsRequired`, and extensions that change
-//! geometry even when only used (Draco, meshopt, mesh quantization, GPU instancing). What is
+//! geometry even when only used (Draco, meshopt, mesh quantization, GPU instancing); a required
+//! extension is named before anything else is checked, and invalid glTF names its first few
+//! problems and counts the rest, so an error stays one line. What is
 //! skipped with a warning in [`Loaded::warnings`]: meshes on nodes without a skin, morph target
 //! weight channels, other used extensions (materials and the like do not change the pose).
+//! What is changed, with a note there and a count in [`Loaded::renormalised`]: weights that do
+//! not sum to 1 within [`WEIGHT_SUM_TOLERANCE`] are renormalised (as [`SkinnedMesh::new`] does
+//! for any mesh), not refused.
 //!
 //! Buffers are resolved here rather than by `gltf::import` so the `image` decoders are not
 //! compiled in: a GLB's binary chunk, `data:` URIs in base64, or files relative to the glTF file.
 
-use crate::character::{Character, CharacterMesh};
+use crate::character::{Character, CharacterMesh, GltfSource};
 use crate::clip::{Channel, Clip, Interpolation, Property};
 use crate::mesh::SkinnedMesh;
 use crate::skeleton::{Joint, Skeleton, Skin, Trs};
@@ -44,10 +50,47 @@ pub struct LoadError {
 pub struct Loaded {
     /// Skeleton (one joint per glTF node), skins, skinned meshes, clips.
     pub character: Character,
-    /// Parts of the file that were skipped (never ones that change a skinned pose).
+    /// Notes on reading the file: parts that were skipped (never ones that change a skinned
+    /// pose) and vertices whose weights were renormalised (one note per primitive, as in
+    /// [`Loaded::renormalised`]).
     pub warnings: Vec<String>,
     /// Skeleton joint of each glTF node index.
     pub node_joint: Vec<usize>,
+    /// The meshes with vertices whose weights did not sum to 1 (within
+    /// [`WEIGHT_SUM_TOLERANCE`]) and were renormalised.
+    pub renormalised: Vec<Renormalised>,
+}
+
+/// Vertices of one mesh whose weights were renormalised on loading.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Renormalised {
+    /// Index into [`Character::meshes`].
+    pub mesh: usize,
+    /// Vertices whose weights did not sum to 1.
+    pub vertices: usize,
+    /// Vertices of the mesh.
+    pub of: usize,
+    /// Largest `|sum of weights - 1|` among them.
+    pub max_deviation: f64,
+}
+
+/// A vertex's weights (as read, in f64) sum to 1 if within this: above the rounding of a sum of
+/// 8 f32 weights (`8 * 2^-24 = 4.8e-7`) and far below any authored difference.
+pub const WEIGHT_SUM_TOLERANCE: f64 = 1e-6;
+
+/// How many vertices of `k` weights each do not sum to 1 within [`WEIGHT_SUM_TOLERANCE`], and
+/// the largest deviation among them.
+fn weight_sums_off(weights: &[f64], k: usize) -> (usize, f64) {
+    let mut off = 0;
+    let mut worst = 0.0f64;
+    for w in weights.chunks_exact(k) {
+        let d = (w.iter().sum::<f64>() - 1.0).abs();
+        if d > WEIGHT_SUM_TOLERANCE {
+            off += 1;
+            worst = worst.max(d);
+        }
+    }
+    (off, worst)
 }
 
 /// Extensions that change geometry or accessors: refused even if only "used".
@@ -92,6 +135,11 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
         gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| err("document", e.to_string()))?;
     {
         let json = unchecked.document.as_json();
+        // Required extensions first: the glTF crate's validation reports every element an
+        // unsupported extension (Draco, meshopt) leaves incomplete, hundreds of lines for one cause.
+        if let Some(ext) = json.extensions_required.first() {
+            return Err(err("extensionsRequired", format!("extension {ext} is required but not supported")));
+        }
         let accessors = json.accessors.len();
         for (m, mesh) in json.meshes.iter().enumerate() {
             for (p, prim) in mesh.primitives.iter().enumerate() {
@@ -130,15 +178,12 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
         }
     }
     let blob = unchecked.blob;
-    let document = gltf::Document::from_json(unchecked.document.into_json())
-        .map_err(|e| err("document", e.to_string()))?;
+    let document =
+        gltf::Document::from_json(unchecked.document.into_json()).map_err(|e| err("document", short(&e)))?;
     let gltf = gltf::Gltf { document, blob };
     let doc = &gltf.document;
     let mut warnings = Vec::new();
 
-    if let Some(ext) = doc.extensions_required().next() {
-        return Err(err("extensionsRequired", format!("extension {ext} is required but not supported")));
-    }
     for ext in doc.extensions_used() {
         if GEOMETRY_EXTENSIONS.contains(&ext) {
             return Err(err(
@@ -274,6 +319,7 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
 
     // Skinned meshes.
     let mut meshes = Vec::new();
+    let mut renormalised = Vec::new();
     for node in &nodes {
         let Some(mesh) = node.mesh() else { continue };
         let Some(skin) = node.skin() else {
@@ -359,8 +405,20 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
             {
                 return Err(err(&el, format!("{n} positions but {} normals", nr.len())));
             }
+            let (off, worst) = weight_sums_off(&weights, k);
             let m = SkinnedMesh::new(&pos, nrm.as_deref(), k, &joints, &weights, tris, n_joints)
                 .map_err(|e| err(&el, e.to_string()))?;
+            if off > 0 {
+                warnings.push(format!(
+                    "{el}: weights of {off} of {n} vertices do not sum to 1 (off by up to {worst:.1e}): renormalised"
+                ));
+                renormalised.push(Renormalised {
+                    mesh: meshes.len(),
+                    vertices: off,
+                    of: n,
+                    max_deviation: worst,
+                });
+            }
             meshes.push(CharacterMesh {
                 name: format!(
                     "{}#{}",
@@ -369,6 +427,7 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
                 ),
                 skin: skin.index(),
                 mesh: m,
+                source: Some(GltfSource { node: node.index(), mesh: mesh.index(), primitive: prim.index() }),
             });
         }
     }
@@ -417,8 +476,23 @@ pub fn load_slice(bytes: &[u8], path: &Path) -> Result<Loaded, LoadError> {
 
     let character =
         Character::new(skeleton, skins, meshes, clips).map_err(|e| err("skins", e.to_string()))?;
-    Ok(Loaded { character, warnings, node_joint })
+    Ok(Loaded { character, warnings, node_joint, renormalised })
 }
+
+/// A glTF crate error, its validation list cut to the first [`SHOWN_ERRORS`] entries and a count.
+fn short(e: &gltf::Error) -> String {
+    match e {
+        gltf::Error::Validation(list) if list.len() > SHOWN_ERRORS => {
+            let shown: Vec<String> =
+                list[..SHOWN_ERRORS].iter().map(|(path, e)| format!("{path}: {e}")).collect();
+            format!("invalid glTF: {} (and {} more)", shown.join(", "), list.len() - SHOWN_ERRORS)
+        }
+        _ => e.to_string(),
+    }
+}
+
+/// Validation errors named in a [`LoadError`]; the rest are counted.
+const SHOWN_ERRORS: usize = 3;
 
 fn vec3(v: [f32; 3]) -> DVec4 {
     DVec4::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]), 0.0)

@@ -20,7 +20,10 @@
 //! - [`skin`]: LBS and DQS, normals with positions, parallel over vertex chunks with rayon and
 //!   bitwise identical for any thread count, no allocation per pose.
 //! - [`gltf_io::load`]: `.gltf` (external or data-URI buffers) and `.glb` files into a
-//!   [`Character`] (skeleton, skins, meshes, clips) plus warnings for what was ignored.
+//!   [`Character`] (skeleton, skins, meshes, clips) plus notes on what was ignored or
+//!   renormalised; each mesh keeps the glTF node, mesh and primitive it came from
+//!   ([`GltfSource`]) and poses into its own buffers ([`CharacterData::mesh_positions`];
+//!   [`CharacterData::positions`] joins all meshes).
 //! - [`scenes`]: the twisted cylinder (LBS's candy-wrapper collapse next to DQS) and
 //!   [`scenes::from_gltf`], both posable at any time into positions and triangles.
 //!
@@ -44,9 +47,17 @@
 //! LBS loses 33.3 % of the volume of the cylinder while DQS keeps it within 0.04 %.
 //! DQS blends unit dual quaternions: a rigid motion per vertex, no collapse, similar cost, but it
 //! needs rigid joints (scaled joint transforms are rejected with
-//! [`SkinError::NonRigidJoint`]) and bulges slightly at bends. Use DQS for characters with
+//! [`SkinError::NonRigidJoint`]; transforms rigid within a tolerance, default
+//! [`skinning::RIGID_TOLERANCE`], settable with [`CharacterData::set_rigid_tolerance`], are
+//! re-orthonormalised, which absorbs exporters' f32 noise) and bulges slightly at bends. Use DQS for characters with
 //! twisting joints (forearms, necks), LBS when joints scale or for compatibility with engines
-//! that author for LBS. Both agree to `1e-12` on rigid single-influence vertices.
+//! that author for LBS. On single-influence vertices both agree to rounding (`1e-12`) when
+//! the skinning matrices are rigid; on f32 data they are rigid only to f32 rounding, and DQS
+//! (which re-orthonormalises) and LBS (which applies the matrix as stored) differ by up to
+//! `|S - I| |p|` (`S` the matrix's stretch, `p` the rest position): on the Fox over its three
+//! clips, 1.2e-7 relative to the largest vertex distance from the origin; on SimpleSkin, whose
+//! inverse bind matrices are exact in f32, 4.8e-16 (`tests/real_assets.rs`); on data at the
+//! edge of the rigidity tolerance, up to about half the tolerance.
 //!
 //! ## Precision
 //!
@@ -80,9 +91,9 @@ pub mod scenes;
 pub mod skeleton;
 pub mod skinning;
 
-pub use character::{Character, CharacterData, CharacterMesh};
+pub use character::{Character, CharacterData, CharacterMesh, GltfSource};
 pub use clip::{Channel, Clip, Interpolation, Property};
-pub use gltf_io::{LoadError, Loaded};
+pub use gltf_io::{LoadError, Loaded, Renormalised};
 pub use kind::KIND;
 pub use mesh::{MAX_INFLUENCES, SkinnedMesh, signed_volume};
 pub use skeleton::{Joint, Pose, Skeleton, Skin, Trs};
@@ -152,10 +163,12 @@ pub enum SkinError {
         /// The skin joint.
         joint: usize,
     },
-    /// DQS was asked to blend a joint transform with scale, shear or reflection.
+    /// DQS was asked to blend a joint transform with scale, shear or reflection beyond its
+    /// rigidity tolerance.
     #[error(
-        "skin joint {joint}: skinning matrix is not rigid (max |R^T R - I| = {deviation:.3e}, det = {determinant:.6}); \
-         dual-quaternion skinning needs rigid joints, use linear blend skinning for scaled joints"
+        "skin joint {joint}: skinning matrix is not rigid (max |R^T R - I| = {deviation:.3e}, det = {determinant:.6}, \
+         tolerance {tolerance:.1e}); dual-quaternion skinning needs rigid joints, use linear blend skinning \
+         for scaled joints"
     )]
     NonRigidJoint {
         /// The skin joint.
@@ -164,5 +177,13 @@ pub enum SkinError {
         deviation: f64,
         /// Determinant of the 3x3 block.
         determinant: f64,
+        /// The tolerance it exceeded ([`Skinned::rigid_tolerance`]).
+        tolerance: f64,
+    },
+    /// A DQS rigidity tolerance outside `[0, 1)`.
+    #[error("rigid_tolerance {tolerance}: must be at least 0 and below 1")]
+    BadTolerance {
+        /// The tolerance given.
+        tolerance: f64,
     },
 }

@@ -144,7 +144,7 @@ pub fn twisted_cylinder(resolution: Option<usize>) -> Result<SkinScene, SkinErro
     let character = Character::new(
         skeleton,
         vec![skin],
-        vec![CharacterMesh { name: "cylinder".into(), skin: 0, mesh }],
+        vec![CharacterMesh { name: "cylinder".into(), skin: 0, mesh, source: None }],
         vec![clip],
     )?;
     Ok(SkinScene {

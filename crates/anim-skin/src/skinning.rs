@@ -13,8 +13,14 @@
 //!   (antipodal quaternions describe the same rotation, and blending them unaligned cancels),
 //!   then normalises by `|b_0|` and applies the rigid motion. Normals are rotated by the blended
 //!   rotation. DQS needs rigid joint transforms: a skinning matrix whose 3x3 block is not a
-//!   rotation within [`RIGID_TOLERANCE`] (scale, shear, reflection) is rejected with
-//!   [`SkinError::NonRigidJoint`]; use LBS for scaled joints.
+//!   rotation within a tolerance (scale, shear, reflection) is rejected with
+//!   [`SkinError::NonRigidJoint`]; use LBS for scaled joints. The tolerance bounds the largest
+//!   entry of `|R^T R - I|` of the 3x3 block `R` ([`RIGID_TOLERANCE`] by default, set per mesh
+//!   with [`Skinned::set_rigid_tolerance`]); a block within it is replaced by its nearest
+//!   rotation (the polar decomposition's rotation factor) before conversion, so exporter noise
+//!   (a joint scale of `1.00001`, inverse bind matrices stored in f32) is absorbed rather than
+//!   refused. LBS uses the matrices as they are, so on such data the two differ at single-influence
+//!   vertices by about the deviation times the vertex's distance from the joint.
 //!
 //! Both run in parallel over fixed chunks of [`CHUNK`] vertices; each vertex is computed by the
 //! same sequence of operations whatever the chunk's thread, so results are bitwise identical for
@@ -57,6 +63,7 @@
 use crate::SkinError;
 use crate::mesh::{MAX_INFLUENCES, SkinnedMesh};
 use anim_core::glam::{DMat3, DMat4, DQuat};
+use anim_core::linalg::svd::polar;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use wide::f64x2;
@@ -70,8 +77,20 @@ use outputs::Outputs;
 /// Vertices per parallel task.
 pub const CHUNK: usize = 2048;
 
-/// Largest `max |R^T R - I|` entry (and smallest determinant slack) accepted as rigid by DQS.
-pub const RIGID_TOLERANCE: f64 = 1e-5;
+/// Default largest entry of `|R^T R - I|` (and of the bottom row's deviation from `(0, 0, 0, 1)`)
+/// accepted as rigid by DQS; `R` is then re-orthonormalised. A uniform scale `s` gives
+/// `|s^2 - 1|`, so `1e-4` admits scales within about `5e-5` of 1 and refuses real scaling.
+pub const RIGID_TOLERANCE: f64 = 1e-4;
+
+/// DQS's rigidity tolerance of one [`Skinned`] (default [`RIGID_TOLERANCE`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct RigidTolerance(f64);
+
+impl Default for RigidTolerance {
+    fn default() -> Self {
+        Self(RIGID_TOLERANCE)
+    }
+}
 
 /// Which skinning algorithm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -122,6 +141,8 @@ pub struct Skinned {
     /// once per pose for all joint pairs; empty for skins of more than [`SIGN_TABLE_JOINTS`]
     /// joints.
     pairs: Vec<u16>,
+    /// DQS's rigidity tolerance.
+    rigid_tolerance: RigidTolerance,
 }
 
 /// Largest skin (in joints) for which the AVX2 DQS kernel keeps a joint-pair sign table
@@ -148,6 +169,7 @@ impl Skinned {
             } else {
                 Vec::new()
             },
+            rigid_tolerance: RigidTolerance::default(),
         }
         .resized(n)
     }
@@ -157,6 +179,26 @@ impl Skinned {
             v.resize(n, 0.0);
         }
         self
+    }
+
+    /// DQS's rigidity tolerance: the largest entry of `|R^T R - I|` of a skinning matrix's 3x3
+    /// block `R` that DQS accepts (re-orthonormalising `R`) rather than refuses with
+    /// [`SkinError::NonRigidJoint`].
+    #[must_use]
+    pub fn rigid_tolerance(&self) -> f64 {
+        self.rigid_tolerance.0
+    }
+
+    /// Sets DQS's rigidity tolerance (default [`RIGID_TOLERANCE`]).
+    ///
+    /// # Errors
+    /// [`SkinError::BadTolerance`] unless `0 <= tolerance < 1`.
+    pub fn set_rigid_tolerance(&mut self, tolerance: f64) -> Result<(), SkinError> {
+        if !(0.0..1.0).contains(&tolerance) {
+            return Err(SkinError::BadTolerance { tolerance });
+        }
+        self.rigid_tolerance = RigidTolerance(tolerance);
+        Ok(())
     }
 
     /// Posed position of vertex `v`.
@@ -248,7 +290,7 @@ fn skin_with(
     }
     if method == SkinningMethod::Dqs {
         for (j, m) in matrices.iter().enumerate() {
-            let d = to_dual_quat(j, m)?;
+            let d = to_dual_quat(j, m, out.rigid_tolerance.0)?;
             out.dqs[j] = [[d[0], d[1]], [d[2], d[3]], [d[4], d[5]], [d[6], d[7]]].map(f64x2::new);
         }
     }
@@ -266,7 +308,7 @@ fn skin_with(
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = simd;
-    let Skinned { x, y, z, nx, ny, nz, mats, dqs, signed, pairs } = out;
+    let Skinned { x, y, z, nx, ny, nz, mats, dqs, signed, pairs, rigid_tolerance: _ } = out;
     #[cfg(target_arch = "x86_64")]
     let tables = avx2::Tables { mats: bytemuck::cast_slice(mats), signed, pairs, joints: nj };
     #[cfg(not(target_arch = "x86_64"))]
@@ -535,17 +577,19 @@ fn fill_sign_table(out: &mut Skinned) {
     }
 }
 
-/// The unit dual quaternion of a rigid skinning matrix.
-fn to_dual_quat(joint: usize, m: &DMat4) -> Result<[f64; 8], SkinError> {
+/// The unit dual quaternion of a skinning matrix rigid within `tolerance`: its 3x3 block is
+/// replaced by the nearest rotation (polar decomposition) first.
+fn to_dual_quat(joint: usize, m: &DMat4, tolerance: f64) -> Result<[f64; 8], SkinError> {
     let r = DMat3::from_mat4(*m);
     let e = r.transpose() * r - DMat3::IDENTITY;
     let deviation = e.to_cols_array().iter().fold(0.0f64, |a, b| a.max(b.abs()));
     let det = r.determinant();
     let bottom = m.row(3) - anim_core::glam::DVec4::W;
-    if !(deviation <= RIGID_TOLERANCE) || !(det > 0.0) || bottom.abs().max_element() > RIGID_TOLERANCE {
-        return Err(SkinError::NonRigidJoint { joint, deviation, determinant: det });
+    if !(deviation <= tolerance) || !(det > 0.0) || !(bottom.abs().max_element() <= tolerance) {
+        return Err(SkinError::NonRigidJoint { joint, deviation, determinant: det, tolerance });
     }
-    let q = DQuat::from_mat3(&r).normalize();
+    let (rotation, _) = polar(r);
+    let q = DQuat::from_mat3(&rotation).normalize();
     let t = m.w_axis.truncate();
     // d = 1/2 (t, 0) q
     let qv = anim_core::glam::DVec3::new(q.x, q.y, q.z);

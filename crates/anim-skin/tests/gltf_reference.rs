@@ -30,7 +30,19 @@ fn posed_vertices_match_numpy_reference() {
     assert_eq!(files.len(), 3);
     for (file, poses) in files {
         let scene = scenes::from_gltf(testdata(file)).unwrap();
-        assert!(scene.warnings.is_empty(), "{file}: {:?}", scene.warnings);
+        // Nothing skipped; the quantised weights of the two integer-weight files do not sum to
+        // 1 at 72 of 204 vertices (counted independently with numpy from the stored u16 values:
+        // up to 1.5e-5 off), and are renormalised with a note.
+        let renormalised = match file.as_str() {
+            "skin_embedded.gltf" => vec![],
+            "skin.glb" => vec![
+                "mesh 0 primitive 0: weights of 72 of 204 vertices do not sum to 1 (off by up to 3.9e-3): renormalised",
+            ],
+            _ => vec![
+                "mesh 0 primitive 0: weights of 72 of 204 vertices do not sum to 1 (off by up to 1.5e-5): renormalised",
+            ],
+        };
+        assert_eq!(scene.warnings, renormalised, "{file}");
         assert_eq!(scene.character.meshes[0].mesh.influences(), 8);
         let mut data = scene.data();
         let (mut p, mut n) = (Vec::new(), Vec::new());
@@ -186,4 +198,50 @@ fn an_animation_channel_targeting_a_missing_node_is_an_error() {
     let e = anim_skin::gltf_io::load(&p).unwrap_err();
     assert_eq!(e.element, "animation 0 channel 0");
     assert!(e.cause.contains("node 999 does not exist"), "{e}");
+}
+
+/// A Draco-compressed file: the primitive's attributes live in the extension's buffer view and
+/// its accessors have none. The loader refuses it in one short sentence naming the extension
+/// and the file, not with the glTF crate's list of every incomplete accessor.
+#[test]
+fn an_unsupported_required_extension_is_one_short_error() {
+    let accessors: Vec<serde_json::Value> = (0..40)
+        .map(|i| {
+            serde_json::json!({"componentType": 5126, "count": 3, "type": if i % 2 == 0 { "VEC3" } else { "VEC4" }})
+        })
+        .collect();
+    let meshes: Vec<serde_json::Value> = (0..10)
+        .map(|m| {
+            serde_json::json!({"primitives": [{
+                "attributes": {"POSITION": 4 * m, "NORMAL": 4 * m + 2, "WEIGHTS_0": 4 * m + 1, "JOINTS_0": 4 * m + 3},
+                "extensions": {"KHR_draco_mesh_compression": {"bufferView": 7, "attributes": {"POSITION": 0}}}
+            }]})
+        })
+        .collect();
+    let file = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_draco_mesh_compression"],
+        "extensionsRequired": ["KHR_draco_mesh_compression"],
+        "accessors": accessors,
+        "meshes": meshes,
+        "nodes": [{"mesh": 0, "skin": 0}, {}],
+        "skins": [{"joints": [1]}],
+        "buffers": [{"byteLength": 4}],
+        "bufferViews": [{"buffer": 0, "byteLength": 4}]
+    });
+    let p = write_temp("draco_required.gltf", &file.to_string());
+    let e = anim_skin::gltf_io::load(&p).unwrap_err();
+    let text = e.to_string();
+    assert!(text.len() < 300, "{} characters: {text}", text.len());
+    assert!(text.contains("KHR_draco_mesh_compression") && text.contains("draco_required.gltf"), "{text}");
+    assert_eq!(e.element, "extensionsRequired");
+
+    // Without the extension the same accessors are invalid glTF: the first few problems are
+    // named and the rest counted.
+    let mut plain = file;
+    plain.as_object_mut().unwrap().remove("extensionsRequired");
+    plain.as_object_mut().unwrap().remove("extensionsUsed");
+    let p = write_temp("no_buffer_views.gltf", &plain.to_string());
+    let text = anim_skin::gltf_io::load(&p).unwrap_err().to_string();
+    assert!(text.len() < 300 && text.contains("accessors[0].bufferView") && text.contains("(and "), "{text}");
 }
