@@ -7,7 +7,9 @@
 //! `prismatic`, `fixed`, and `floating` ([`JointType::Free`]); `planar` is rejected. What is
 //! ignored without failing: `<visual>`, `<collision>`, `<material>`, `<mimic>` (the mimicking
 //! joint stays an independent joint, as in Pinocchio's default), `<dynamics>`,
-//! `<safety_controller>`, `<transmission>`, `<gazebo>` and anything else.
+//! `<safety_controller>`, `<transmission>`, `<gazebo>` and anything else, and, as urdfdom does,
+//! the `<axis>` of fixed and floating joints (it may be `0 0 0` there; on a revolute, continuous
+//! or prismatic joint a zero or non-finite axis is an error).
 //!
 //! The tree is built as Pinocchio's URDF parser builds it, so that `q` vectors, joint indices
 //! and frames can be exchanged:
@@ -393,7 +395,10 @@ fn parse_with_name(xml: &str, file: &str, options: &UrdfOptions) -> Result<Model
             }
         }
         let origin = cx.origin(node)?;
-        let axis = match child(node, "axis") {
+        // urdfdom reads `<axis>` only for joints that have one: on fixed and floating joints it
+        // is ignored, whatever it says (several published robots give fixed joints `0 0 0`).
+        let has_axis = !matches!(type_name, "fixed" | "floating");
+        let axis = match child(node, "axis").filter(|_| has_axis) {
             None => Axis::X,
             Some(a) => {
                 let text = a.attribute("xyz").unwrap_or("1 0 0");
