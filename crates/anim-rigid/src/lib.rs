@@ -23,7 +23,12 @@
 //!   joints store a unit quaternion `(x, y, z, w)` in `q` and an angular velocity in `v`, so
 //!   `nq ≠ nv`; [`config::integrate`] and [`config::difference`] move on that manifold.
 //!
-//! Algorithms are free functions `algorithm(&model, &mut data, inputs)`:
+//! Algorithms are free functions `algorithm(&model, &mut data, inputs)`. Those of the crate root
+//! are the unchecked hot path: a slice of the wrong length panics, a NaN flows into the result.
+//! [`checked`] has the same functions returning a [`checked::InputError`] for a wrong length, a
+//! non-finite entry (naming the joint), a zero quaternion, an index past the end or a `Data` of
+//! another model; use it where the input comes from outside.
+//!
 //!
 //! | function | computes | equation |
 //! | --- | --- | --- |
@@ -151,6 +156,7 @@
 
 #[cfg(feature = "cases")]
 pub mod cases;
+pub mod checked;
 pub mod config;
 pub mod data;
 pub mod dense;
@@ -169,6 +175,7 @@ pub mod sim;
 pub mod spatial;
 pub mod urdf;
 
+pub use checked::InputError;
 pub use data::Data;
 pub use dense::SquareMatrix;
 pub use dynamics::{
