@@ -76,6 +76,14 @@ pub enum InputError {
         /// The joint.
         joint: String,
     },
+    /// A `(cos θ, sin θ)` pair of Pinocchio's layout that is zero ([`crate::pinocchio`]).
+    #[error("q_pin[{index}..{}]: the (cos, sin) of joint '{joint}' is zero", index + 2)]
+    ZeroCosSin {
+        /// Its first entry in Pinocchio's `q`.
+        index: usize,
+        /// The joint.
+        joint: String,
+    },
     /// `data` was not made for `model`.
     #[error("this Data was not made for this Model (Data::new(&model))")]
     DataMismatch,

@@ -21,7 +21,10 @@
 //!   algorithm allocates.
 //! - The configuration `q` (length `nq`) and velocity `v` (length `nv`): spherical and free
 //!   joints store a unit quaternion `(x, y, z, w)` in `q` and an angular velocity in `v`, so
-//!   `nq ≠ nv`; [`config::integrate`] and [`config::difference`] move on that manifold.
+//!   `nq ≠ nv`; [`config::integrate`] and [`config::difference`] move on that manifold. A
+//!   revolute joint without limits (URDF `continuous`) stores its angle, where Pinocchio stores
+//!   `(cos θ, sin θ)`: [`pinocchio::to_pinocchio`] and [`pinocchio::from_pinocchio`] convert `q`
+//!   (`v` is the same in both).
 //!
 //! Algorithms are free functions `algorithm(&model, &mut data, inputs)`. Those of the crate root
 //! are the unchecked hot path: a slice of the wrong length panics, a NaN flows into the result.
@@ -168,6 +171,7 @@ pub mod kinematics;
 pub mod matrix6x;
 pub mod model;
 pub mod paden_kahan;
+pub mod pinocchio;
 pub mod poe;
 pub mod robot;
 pub mod scenes;

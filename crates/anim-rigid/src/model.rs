@@ -32,8 +32,11 @@
 //! | spherical | 4 | 3 | unit quaternion `(x, y, z, w)` | angular velocity in the joint (child) frame |
 //! | free | 7 | 6 | translation `(x, y, z)`, unit quaternion `(x, y, z, w)` | twist `(v, ω)` in the joint (child) frame |
 //!
-//! The quaternion order `(x, y, z, w)` and the local-frame velocity are Pinocchio's, so `q` and
-//! `v` vectors can be exchanged with it. Moving on this manifold is [`crate::config::integrate`]
+//! The quaternion order `(x, y, z, w)` and the local-frame velocity are Pinocchio's, so `v`
+//! vectors (and accelerations, torques, Jacobian columns) can be exchanged with it. `q` vectors
+//! can too, except that Pinocchio stores a revolute joint without position limits (URDF
+//! `continuous`) as `(cos θ, sin θ)` where this table has the angle; [`crate::pinocchio`]
+//! converts between the two layouts. Moving on this manifold is [`crate::config::integrate`]
 //! and [`crate::config::difference`].
 
 use anim_core::glam::{DMat3, DQuat, DVec3};

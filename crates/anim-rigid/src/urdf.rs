@@ -3,7 +3,8 @@
 //! What is read: every `<link>` (its `<inertial>`: `origin`, `mass`, `inertia`) and every
 //! `<joint>` (`type`, `parent`, `child`, `origin` `xyz`/`rpy`, `axis`, `limit`). Joint types:
 //! `revolute` and `continuous` become [`JointType::Revolute`] (continuous without position
-//! limits; Pinocchio represents it by `(cos θ, sin θ)`, here it is the angle itself),
+//! limits; Pinocchio represents it by `(cos θ, sin θ)`, here it is the angle itself, see
+//! [`crate::pinocchio`]),
 //! `prismatic`, `fixed`, and `floating` ([`JointType::Free`]); `planar` is rejected. What is
 //! ignored without failing: `<visual>`, `<collision>`, `<material>`, `<mimic>` (the mimicking
 //! joint stays an independent joint, as in Pinocchio's default), `<dynamics>`,
@@ -11,8 +12,9 @@
 //! the `<axis>` of fixed and floating joints (it may be `0 0 0` there; on a revolute, continuous
 //! or prismatic joint a zero or non-finite axis is an error).
 //!
-//! The tree is built as Pinocchio's URDF parser builds it, so that `q` vectors, joint indices
-//! and frames can be exchanged:
+//! The tree is built as Pinocchio's URDF parser builds it, so that joint indices, frames and
+//! `v` vectors can be exchanged, and `q` vectors through [`crate::pinocchio::to_pinocchio`] and
+//! [`crate::pinocchio::from_pinocchio`] (continuous joints differ):
 //!
 //! - the root link (the one link that is no joint's child) is fixed to the universe, or carried
 //!   by a free joint named `root_joint` ([`UrdfOptions::floating_base`]);
