@@ -12,7 +12,7 @@
 //! ## Model, Data, configuration (Pinocchio's split)
 //!
 //! - [`Model`]: joints in topological order (parent index below the child's; joint `0` is the
-//!   universe), each with a [`JointType`] (revolute, prismatic, fixed, spherical, free), an axis,
+//!   universe), each with a [`JointType`] (revolute, prismatic, fixed, spherical, free, planar), an axis,
 //!   limits and a placement [`Se3`](anim_core::lie::Se3) in its parent's frame; the [`Inertia`]
 //!   of the body each joint carries; named [`Frame`]s (joints, links, merged fixed joints, tool
 //!   points); gravity. Built by [`ModelBuilder`] or [`load_urdf`]; never changed by an algorithm.
@@ -21,7 +21,7 @@
 //!   algorithm allocates.
 //! - The configuration `q` (length `nq`) and velocity `v` (length `nv`): spherical and free
 //!   joints store a unit quaternion `(x, y, z, w)` in `q` and an angular velocity in `v`, so
-//!   `nq ≠ nv`; [`config::integrate`] and [`config::difference`] move on that manifold. A
+//!   `nq ≠ nv`; a planar joint stores `(x, y, θ)` and moves on SE(2); [`config::integrate`] and [`config::difference`] move on that manifold. A
 //!   revolute joint without limits (URDF `continuous`) stores its angle, where Pinocchio stores
 //!   `(cos θ, sin θ)`: [`pinocchio::to_pinocchio`] and [`pinocchio::from_pinocchio`] convert `q`
 //!   (`v` is the same in both).
@@ -111,8 +111,8 @@
 //! ## What is not here
 //!
 //! Skinning, collision and contact are other modules or issues; external forces on bodies are
-//! not an input of the dynamics yet. URDF `planar` joints, `mimic` couplings and meshes are not
-//! modelled (see [`urdf`]).
+//! not an input of the dynamics yet. URDF `mimic` couplings and meshes are not modelled (see
+//! [`urdf`]).
 //!
 //! ## Example
 //!

@@ -29,6 +29,7 @@
 //! | revolute | 1 | 1 | angle (rad) | angular rate about the axis |
 //! | prismatic | 1 | 1 | displacement (m) | rate along the axis |
 //! | fixed | 0 | 0 | | |
+//! | planar | 3 | 3 | `(x, y, θ)`: translation along the plane's `e₁`, `e₂` ([`Axis::plane_basis`]) and angle about its normal | `(vx, vy, ω)` in the joint (child) frame |
 //! | spherical | 4 | 3 | unit quaternion `(x, y, z, w)` | angular velocity in the joint (child) frame |
 //! | free | 7 | 6 | translation `(x, y, z)`, unit quaternion `(x, y, z, w)` | twist `(v, ω)` in the joint (child) frame |
 //!
@@ -103,6 +104,31 @@ impl Axis {
         }
     }
 
+    /// Two unit vectors `(e₁, e₂)` spanning the plane normal to this axis, with `e₁ × e₂` the
+    /// axis: `(y, z)` for `+x`, `(z, x)` for `+y`, `(x, y)` for `+z` (Pinocchio's planar joint),
+    /// and for any other `n`, `e₁ = n × c / |n × c|` with `c` the coordinate axis least aligned
+    /// with `n` (the first of them on a tie), `e₂ = n × e₁`.
+    #[must_use]
+    pub fn plane_basis(&self) -> (DVec3, DVec3) {
+        match *self {
+            Axis::X => (DVec3::Y, DVec3::Z),
+            Axis::Y => (DVec3::Z, DVec3::X),
+            Axis::Z => (DVec3::X, DVec3::Y),
+            Axis::Unaligned(n) => {
+                let a = n.abs();
+                let c = if a.x <= a.y && a.x <= a.z {
+                    DVec3::X
+                } else if a.y <= a.z {
+                    DVec3::Y
+                } else {
+                    DVec3::Z
+                };
+                let e1 = n.cross(c).normalize();
+                (e1, n.cross(e1))
+            }
+        }
+    }
+
     /// The rotation by `angle` about this axis.
     #[inline]
     #[must_use]
@@ -140,6 +166,11 @@ pub enum JointType {
     Spherical,
     /// A free (floating) joint: any rigid motion, `q = (x, y, z, qx, qy, qz, qw)`.
     Free,
+    /// A planar joint (URDF `planar`): translations in the plane normal to the axis and the
+    /// rotation about it, `q = (x, y, θ)` with the translation `x e₁ + y e₂`
+    /// ([`Axis::plane_basis`]), `v = (vx, vy, ω)` in the joint (child) frame. Pinocchio's
+    /// `JointModelPlanar` (normal `+z`) stores `(x, y, cos θ, sin θ)`; see [`crate::pinocchio`].
+    Planar(Axis),
 }
 
 impl JointType {
@@ -152,6 +183,7 @@ impl JointType {
             JointType::Fixed => 0,
             JointType::Spherical => 4,
             JointType::Free => 7,
+            JointType::Planar(_) => 3,
         }
     }
 
@@ -162,12 +194,12 @@ impl JointType {
         match self {
             JointType::Revolute(_) | JointType::Prismatic(_) => 1,
             JointType::Fixed => 0,
-            JointType::Spherical => 3,
+            JointType::Spherical | JointType::Planar(_) => 3,
             JointType::Free => 6,
         }
     }
 
-    /// A short name: `revolute`, `prismatic`, `fixed`, `spherical` or `free`.
+    /// A short name: `revolute`, `prismatic`, `fixed`, `spherical`, `free` or `planar`.
     #[must_use]
     pub const fn name(&self) -> &'static str {
         match self {
@@ -176,6 +208,7 @@ impl JointType {
             JointType::Fixed => "fixed",
             JointType::Spherical => "spherical",
             JointType::Free => "free",
+            JointType::Planar(_) => "planar",
         }
     }
 
@@ -191,6 +224,10 @@ impl JointType {
             JointType::Fixed => Se3::IDENTITY,
             JointType::Spherical => Se3::from_rotation(quat_to_matrix(q[0], q[1], q[2], q[3])),
             JointType::Free => Se3::new(quat_to_matrix(q[3], q[4], q[5], q[6]), DVec3::new(q[0], q[1], q[2])),
+            JointType::Planar(axis) => {
+                let (e1, e2) = axis.plane_basis();
+                Se3::new(axis.rotation(q[2]), e1 * q[0] + e2 * q[1])
+            }
         }
     }
 
@@ -199,7 +236,8 @@ impl JointType {
     /// velocity is `S v_joint`; dynamics uses `S` for projections (`τ = Sᵀ f`).
     ///
     /// Revolute: `(0, a)`; prismatic: `(a, 0)`; spherical: `(0, e_k)`; free: the `k`-th unit
-    /// twist (`(e_k, 0)` for `k < 3`, `(0, e_{k-3})` otherwise).
+    /// twist (`(e_k, 0)` for `k < 3`, `(0, e_{k-3})` otherwise); planar: `(e₁, 0)`, `(e₂, 0)`,
+    /// `(0, n)`.
     ///
     /// # Panics
     /// When `k >= nv`.
@@ -219,6 +257,14 @@ impl JointType {
                 } else {
                     Twist::new(DVec3::ZERO, e(k - 3))
                 }
+            }
+            JointType::Planar(axis) => {
+                let (e1, e2) = axis.plane_basis();
+                [
+                    Twist::new(e1, DVec3::ZERO),
+                    Twist::new(e2, DVec3::ZERO),
+                    Twist::new(DVec3::ZERO, axis.vector()),
+                ][k]
             }
         }
     }
@@ -654,10 +700,13 @@ impl Model {
     }
 
     /// Whether every joint's configuration is a vector space (revolute, prismatic and fixed
-    /// joints only), so that `nq == nv` and `q` moves by plain addition.
+    /// joints only), so that `nq == nv` and `q` moves by plain addition (a planar joint has
+    /// `nq == nv` but its `v` is in the moving frame).
     #[must_use]
     pub fn is_euclidean(&self) -> bool {
-        self.joints.iter().all(|j| j.nq() == j.nv())
+        self.joints
+            .iter()
+            .all(|j| matches!(j.kind, JointType::Revolute(_) | JointType::Prismatic(_) | JointType::Fixed))
     }
 }
 
@@ -797,6 +846,10 @@ impl ModelBuilder {
                 m.upper.extend([f64::INFINITY; 3]);
                 m.lower.extend([-1.0; 4]);
                 m.upper.extend([1.0; 4]);
+            }
+            JointType::Planar(_) => {
+                m.lower.extend([f64::NEG_INFINITY; 3]);
+                m.upper.extend([f64::INFINITY; 3]);
             }
         }
         m.nq += kind.nq();

@@ -5,7 +5,9 @@
 //! `revolute` and `continuous` become [`JointType::Revolute`] (continuous without position
 //! limits; Pinocchio represents it by `(cos θ, sin θ)`, here it is the angle itself, see
 //! [`crate::pinocchio`]),
-//! `prismatic`, `fixed`, and `floating` ([`JointType::Free`]); `planar` is rejected. What is
+//! `prismatic`, `fixed`, `floating` ([`JointType::Free`]) and `planar` ([`JointType::Planar`],
+//! its `axis` the plane's normal, its `<limit>` ignored; Pinocchio ignores that axis and uses `+z`,
+//! so the two agree on planar joints whose axis is `0 0 1`). What is
 //! ignored without failing: `<visual>`, `<collision>`, `<material>`, `<mimic>` (the mimicking
 //! joint stays an independent joint, as in Pinocchio's default), `<dynamics>`,
 //! `<safety_controller>`, `<transmission>`, `<gazebo>` and anything else, and, as urdfdom does,
@@ -126,8 +128,10 @@ pub enum UrdfCause {
     /// A joint axis of zero length or with non-finite entries.
     #[error("axis xyz=\"{0}\" has zero length or is not finite")]
     BadAxis(String),
-    /// A `type` this loader does not support (`planar`) or does not know.
-    #[error("joint type '{0}' is not supported (revolute, continuous, prismatic, fixed and floating are)")]
+    /// A `type` this loader does not know.
+    #[error(
+        "joint type '{0}' is not supported (revolute, continuous, prismatic, fixed, floating and planar are)"
+    )]
     UnsupportedJointType(String),
     /// Two links with the same name.
     #[error("link '{0}' is defined twice")]
@@ -444,6 +448,7 @@ fn parse_with_name(xml: &str, file: &str, options: &UrdfOptions) -> Result<Model
             "prismatic" => (JointType::Prismatic(axis), read_limits(true)?),
             "fixed" => (JointType::Fixed, JointLimits::UNBOUNDED),
             "floating" => (JointType::Free, JointLimits::UNBOUNDED),
+            "planar" => (JointType::Planar(axis), JointLimits::UNBOUNDED),
             other => return Err(cx.err(node, UrdfCause::UnsupportedJointType(other.into()))),
         };
         joints.push(UJoint { name, node, kind, parent, child: child_link, origin, limits });

@@ -195,8 +195,8 @@ fn bad_axes_and_numbers() {
 
 #[test]
 fn unsupported_and_malformed() {
-    let e = err(&robot(r#"  <joint name="j" type="planar"><parent link="a"/><child link="b"/></joint>"#));
-    assert_eq!(*e.cause, UrdfCause::UnsupportedJointType("planar".into()));
+    let e = err(&robot(r#"  <joint name="j" type="screw"><parent link="a"/><child link="b"/></joint>"#));
+    assert_eq!(*e.cause, UrdfCause::UnsupportedJointType("screw".into()));
     let e = err(&robot(r#"  <joint name="j" type="revolute"><parent link="a"/><child link="b"/></joint>"#));
     assert_eq!(*e.cause, UrdfCause::MissingElement("limit"));
     let e = err("<robot name=\"r\"><link name=\"a\"></robot>");
