@@ -107,6 +107,17 @@ pub fn integrate_into(model: &Model, q: &[f64], v: &[f64], dt: f64, out: &mut [f
                 out[iq..iq + 3].copy_from_slice(&t.to_array());
                 write_quat(&mut out[iq + 3..iq + 7], r);
             }
+            JointType::Planar(_) => {
+                // SE(2) exponential of the local twist (vx, vy, ω) dt.
+                let phi = v[iv + 2] * dt;
+                let (a, b) = se2_v(phi);
+                let (lx, ly) = (v[iv] * dt, v[iv + 1] * dt);
+                let (dx, dy) = (a * lx - b * ly, b * lx + a * ly);
+                let (s, c) = q[iq + 2].sin_cos();
+                out[iq] = q[iq] + c * dx - s * dy;
+                out[iq + 1] = q[iq + 1] + s * dx + c * dy;
+                out[iq + 2] = q[iq + 2] + phi;
+            }
         }
     }
 }
@@ -147,6 +158,18 @@ pub fn difference_into(model: &Model, q0: &[f64], q1: &[f64], out: &mut [f64]) {
                 let m1 = j.kind.transform(&q1[iq..iq + 7]);
                 let xi: Twist = (m0.inverse() * m1).log();
                 out[iv..iv + 6].copy_from_slice(&xi.to_array());
+            }
+            JointType::Planar(_) => {
+                // SE(2) logarithm of the relative motion, ω = θ₁ - θ₀ unwrapped.
+                let phi = q1[iq + 2] - q0[iq + 2];
+                let (s, c) = q0[iq + 2].sin_cos();
+                let (px, py) = (q1[iq] - q0[iq], q1[iq + 1] - q0[iq + 1]);
+                let (lx, ly) = (c * px + s * py, -s * px + c * py);
+                let (a, b) = se2_v(phi);
+                let d = a * a + b * b;
+                out[iv] = (a * lx + b * ly) / d;
+                out[iv + 1] = (-b * lx + a * ly) / d;
+                out[iv + 2] = phi;
             }
         }
     }
@@ -215,7 +238,8 @@ pub fn within_limits(model: &Model, q: &[f64], tol: f64) -> bool {
 
 /// A random configuration drawn with `uniform`, a source of independent samples in `[0, 1)`:
 /// uniform within the limits of bounded joints, in `[-π, π]` for unbounded revolute joints, in
-/// `[-1, 1]` (m) for unbounded prismatic joints and free-joint translations, and uniform over
+/// `[-1, 1]` (m) for unbounded prismatic joints and free and planar translations, in `[-π, π]`
+/// for planar angles, and uniform over
 /// rotations (Shoemake's method) for quaternions.
 #[must_use]
 pub fn random_configuration(model: &Model, uniform: &mut impl FnMut() -> f64) -> Vec<f64> {
@@ -252,9 +276,26 @@ pub fn random_configuration(model: &Model, uniform: &mut impl FnMut() -> f64) ->
                 }
                 write_quat(&mut q[iq + 3..iq + 7], rand_quat(uniform));
             }
+            JointType::Planar(_) => {
+                q[iq] = 2.0 * uniform() - 1.0;
+                q[iq + 1] = 2.0 * uniform() - 1.0;
+                q[iq + 2] = std::f64::consts::PI * (2.0 * uniform() - 1.0);
+            }
         }
     }
     q
+}
+
+/// `(sin φ / φ, (1 - cos φ) / φ)`: the SE(2) exponential moves the local translation `(x, y)`
+/// to `(a x - b y, b x + a y)`. Series below `1e-4`.
+fn se2_v(phi: f64) -> (f64, f64) {
+    if phi.abs() < 1e-4 {
+        let p2 = phi * phi;
+        (1.0 - p2 / 6.0, phi / 2.0 - phi * p2 / 24.0)
+    } else {
+        let (s, c) = phi.sin_cos();
+        (s / phi, (1.0 - c) / phi)
+    }
 }
 
 /// The joint motion of the free joint `q = (t, quaternion)` as an [`Se3`].

@@ -62,7 +62,7 @@ pub(crate) fn world_columns(kind: &JointType, world_m_i: &Se3, out: &mut [Twist]
         }
         JointType::Prismatic(axis) => out[0] = Twist::new(*r * axis.vector(), anim_core::glam::DVec3::ZERO),
         JointType::Fixed => {}
-        JointType::Spherical | JointType::Free => {
+        JointType::Spherical | JointType::Free | JointType::Planar(_) => {
             for (k, o) in out.iter_mut().enumerate() {
                 *o = world_m_i.adjoint(kind.motion_subspace_column(k));
             }

@@ -38,7 +38,7 @@ pub(crate) fn joint_placement(placement: &Se3, kind: &JointType, q: &[f64]) -> S
         }
         JointType::Prismatic(axis) => Se3::new(*r, placement.translation + *r * (axis.vector() * q[0])),
         JointType::Fixed => *placement,
-        JointType::Spherical | JointType::Free => *placement * kind.transform(q),
+        JointType::Spherical | JointType::Free | JointType::Planar(_) => *placement * kind.transform(q),
     }
 }
 

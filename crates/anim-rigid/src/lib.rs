@@ -12,7 +12,7 @@
 //! ## Model, Data, configuration (Pinocchio's split)
 //!
 //! - [`Model`]: joints in topological order (parent index below the child's; joint `0` is the
-//!   universe), each with a [`JointType`] (revolute, prismatic, fixed, spherical, free), an axis,
+//!   universe), each with a [`JointType`] (revolute, prismatic, fixed, spherical, free, planar), an axis,
 //!   limits and a placement [`Se3`](anim_core::lie::Se3) in its parent's frame; the [`Inertia`]
 //!   of the body each joint carries; named [`Frame`]s (joints, links, merged fixed joints, tool
 //!   points); gravity. Built by [`ModelBuilder`] or [`load_urdf`]; never changed by an algorithm.
@@ -21,9 +21,17 @@
 //!   algorithm allocates.
 //! - The configuration `q` (length `nq`) and velocity `v` (length `nv`): spherical and free
 //!   joints store a unit quaternion `(x, y, z, w)` in `q` and an angular velocity in `v`, so
-//!   `nq ≠ nv`; [`config::integrate`] and [`config::difference`] move on that manifold.
+//!   `nq ≠ nv`; a planar joint stores `(x, y, θ)` and moves on SE(2); [`config::integrate`] and [`config::difference`] move on that manifold. A
+//!   revolute joint without limits (URDF `continuous`) stores its angle, where Pinocchio stores
+//!   `(cos θ, sin θ)`: [`pinocchio::to_pinocchio`] and [`pinocchio::from_pinocchio`] convert `q`
+//!   (`v` is the same in both).
 //!
-//! Algorithms are free functions `algorithm(&model, &mut data, inputs)`:
+//! Algorithms are free functions `algorithm(&model, &mut data, inputs)`. Those of the crate root
+//! are the unchecked hot path: a slice of the wrong length panics, a NaN flows into the result.
+//! [`checked`] has the same functions returning a [`checked::InputError`] for a wrong length, a
+//! non-finite entry (naming the joint), a zero quaternion, an index past the end or a `Data` of
+//! another model; use it where the input comes from outside.
+//!
 //!
 //! | function | computes | equation |
 //! | --- | --- | --- |
@@ -103,8 +111,8 @@
 //! ## What is not here
 //!
 //! Skinning, collision and contact are other modules or issues; external forces on bodies are
-//! not an input of the dynamics yet. URDF `planar` joints, `mimic` couplings and meshes are not
-//! modelled (see [`urdf`]).
+//! not an input of the dynamics yet. URDF `mimic` couplings and meshes are not modelled (see
+//! [`urdf`]).
 //!
 //! ## Example
 //!
@@ -151,6 +159,7 @@
 
 #[cfg(feature = "cases")]
 pub mod cases;
+pub mod checked;
 pub mod config;
 pub mod data;
 pub mod dense;
@@ -162,6 +171,7 @@ pub mod kinematics;
 pub mod matrix6x;
 pub mod model;
 pub mod paden_kahan;
+pub mod pinocchio;
 pub mod poe;
 pub mod robot;
 pub mod scenes;
@@ -169,6 +179,7 @@ pub mod sim;
 pub mod spatial;
 pub mod urdf;
 
+pub use checked::InputError;
 pub use data::Data;
 pub use dense::SquareMatrix;
 pub use dynamics::{

@@ -3,14 +3,20 @@
 //! What is read: every `<link>` (its `<inertial>`: `origin`, `mass`, `inertia`) and every
 //! `<joint>` (`type`, `parent`, `child`, `origin` `xyz`/`rpy`, `axis`, `limit`). Joint types:
 //! `revolute` and `continuous` become [`JointType::Revolute`] (continuous without position
-//! limits; Pinocchio represents it by `(cos θ, sin θ)`, here it is the angle itself),
-//! `prismatic`, `fixed`, and `floating` ([`JointType::Free`]); `planar` is rejected. What is
+//! limits; Pinocchio represents it by `(cos θ, sin θ)`, here it is the angle itself, see
+//! [`crate::pinocchio`]),
+//! `prismatic`, `fixed`, `floating` ([`JointType::Free`]) and `planar` ([`JointType::Planar`],
+//! its `axis` the plane's normal, its `<limit>` ignored; Pinocchio ignores that axis and uses `+z`,
+//! so the two agree on planar joints whose axis is `0 0 1`). What is
 //! ignored without failing: `<visual>`, `<collision>`, `<material>`, `<mimic>` (the mimicking
 //! joint stays an independent joint, as in Pinocchio's default), `<dynamics>`,
-//! `<safety_controller>`, `<transmission>`, `<gazebo>` and anything else.
+//! `<safety_controller>`, `<transmission>`, `<gazebo>` and anything else, and, as urdfdom does,
+//! the `<axis>` of fixed and floating joints (it may be `0 0 0` there; on a revolute, continuous
+//! or prismatic joint a zero or non-finite axis is an error).
 //!
-//! The tree is built as Pinocchio's URDF parser builds it, so that `q` vectors, joint indices
-//! and frames can be exchanged:
+//! The tree is built as Pinocchio's URDF parser builds it, so that joint indices, frames and
+//! `v` vectors can be exchanged, and `q` vectors through [`crate::pinocchio::to_pinocchio`] and
+//! [`crate::pinocchio::from_pinocchio`] (continuous joints differ):
 //!
 //! - the root link (the one link that is no joint's child) is fixed to the universe, or carried
 //!   by a free joint named `root_joint` ([`UrdfOptions::floating_base`]);
@@ -122,8 +128,10 @@ pub enum UrdfCause {
     /// A joint axis of zero length or with non-finite entries.
     #[error("axis xyz=\"{0}\" has zero length or is not finite")]
     BadAxis(String),
-    /// A `type` this loader does not support (`planar`) or does not know.
-    #[error("joint type '{0}' is not supported (revolute, continuous, prismatic, fixed and floating are)")]
+    /// A `type` this loader does not know.
+    #[error(
+        "joint type '{0}' is not supported (revolute, continuous, prismatic, fixed, floating and planar are)"
+    )]
     UnsupportedJointType(String),
     /// Two links with the same name.
     #[error("link '{0}' is defined twice")]
@@ -393,7 +401,10 @@ fn parse_with_name(xml: &str, file: &str, options: &UrdfOptions) -> Result<Model
             }
         }
         let origin = cx.origin(node)?;
-        let axis = match child(node, "axis") {
+        // urdfdom reads `<axis>` only for joints that have one: on fixed and floating joints it
+        // is ignored, whatever it says (several published robots give fixed joints `0 0 0`).
+        let has_axis = !matches!(type_name, "fixed" | "floating");
+        let axis = match child(node, "axis").filter(|_| has_axis) {
             None => Axis::X,
             Some(a) => {
                 let text = a.attribute("xyz").unwrap_or("1 0 0");
@@ -437,6 +448,7 @@ fn parse_with_name(xml: &str, file: &str, options: &UrdfOptions) -> Result<Model
             "prismatic" => (JointType::Prismatic(axis), read_limits(true)?),
             "fixed" => (JointType::Fixed, JointLimits::UNBOUNDED),
             "floating" => (JointType::Free, JointLimits::UNBOUNDED),
+            "planar" => (JointType::Planar(axis), JointLimits::UNBOUNDED),
             other => return Err(cx.err(node, UrdfCause::UnsupportedJointType(other.into()))),
         };
         joints.push(UJoint { name, node, kind, parent, child: child_link, origin, limits });

@@ -139,6 +139,27 @@ fn cycles_and_roots() {
 }
 
 #[test]
+fn the_axis_of_a_fixed_joint_is_ignored() {
+    // As urdfdom (and so Pinocchio) does: Talos, TIAGo, iCub and others write `0 0 0` there.
+    let fixed = robot(
+        "  <joint name=\"j\" type=\"fixed\"><parent link=\"a\"/><child link=\"b\"/>\n    <axis xyz=\"0 0 0\"/></joint>",
+    );
+    let m = parse_urdf(&fixed, &UrdfOptions::default()).unwrap();
+    assert_eq!((m.nq(), m.nv(), m.njoints()), (0, 0, 1));
+    assert!(m.frame_id_of_kind("j", FrameKind::FixedJoint).is_some());
+    let unmerged = parse_urdf(&fixed, &UrdfOptions::default().merge_fixed_joints(false)).unwrap();
+    assert_eq!(unmerged.joint(1).kind, JointType::Fixed);
+    // A revolute joint with the same axis is still refused, naming the file and line.
+    let revolute = robot(
+        "  <joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/>\n    <axis xyz=\"0 0 0\"/><limit lower=\"-1\" upper=\"1\"/></joint>",
+    );
+    let e = err(&revolute);
+    assert_eq!(*e.cause, UrdfCause::BadAxis("0 0 0".into()));
+    assert_eq!((e.file.as_str(), e.line, e.element.as_str()), ("<string>", 6, "axis"));
+    assert!(e.to_string().starts_with("<string>:6: <axis>:"), "{e}");
+}
+
+#[test]
 fn bad_axes_and_numbers() {
     let joint = |axis: &str| {
         robot(&format!(
@@ -174,8 +195,8 @@ fn bad_axes_and_numbers() {
 
 #[test]
 fn unsupported_and_malformed() {
-    let e = err(&robot(r#"  <joint name="j" type="planar"><parent link="a"/><child link="b"/></joint>"#));
-    assert_eq!(*e.cause, UrdfCause::UnsupportedJointType("planar".into()));
+    let e = err(&robot(r#"  <joint name="j" type="screw"><parent link="a"/><child link="b"/></joint>"#));
+    assert_eq!(*e.cause, UrdfCause::UnsupportedJointType("screw".into()));
     let e = err(&robot(r#"  <joint name="j" type="revolute"><parent link="a"/><child link="b"/></joint>"#));
     assert_eq!(*e.cause, UrdfCause::MissingElement("limit"));
     let e = err("<robot name=\"r\"><link name=\"a\"></robot>");

@@ -92,6 +92,10 @@ fn project(kind: &JointType, k: usize, f: &Force) -> f64 {
         JointType::Prismatic(axis) => axis_dot(axis, f.linear),
         JointType::Fixed => 0.0,
         JointType::Spherical => f.angular[k],
+        JointType::Planar(_) => {
+            let s = kind.motion_subspace_column(k);
+            s.v.dot(f.linear) + s.w.dot(f.angular)
+        }
         JointType::Free => {
             if k < 3 {
                 f.linear[k]

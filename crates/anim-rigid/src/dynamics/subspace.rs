@@ -30,6 +30,10 @@ pub(crate) fn joint_motion(kind: &JointType, qd: &[f64]) -> Motion {
         JointType::Fixed => Motion::ZERO,
         JointType::Spherical => Motion::new(DVec3::ZERO, DVec3::new(qd[0], qd[1], qd[2])),
         JointType::Free => Motion::new(DVec3::new(qd[0], qd[1], qd[2]), DVec3::new(qd[3], qd[4], qd[5])),
+        JointType::Planar(axis) => {
+            let (e1, e2) = axis.plane_basis();
+            Motion::new(e1 * qd[0] + e2 * qd[1], axis.vector() * qd[2])
+        }
     }
 }
 
@@ -44,6 +48,12 @@ pub(crate) fn joint_project(kind: &JointType, f: &Force, out: &mut [f64]) {
         JointType::Free => {
             out[..3].copy_from_slice(&f.linear.to_array());
             out[3..].copy_from_slice(&f.angular.to_array());
+        }
+        JointType::Planar(axis) => {
+            let (e1, e2) = axis.plane_basis();
+            out[0] = e1.dot(f.linear);
+            out[1] = e2.dot(f.linear);
+            out[2] = axis_dot(axis, f.angular);
         }
     }
 }
