@@ -143,22 +143,14 @@ fn damaged_or_foreign_checkpoints_are_clear_errors() {
 fn an_interrupted_run_finishes_its_folder_and_resumes() {
     let dir = std::env::temp_dir().join(format!("anim-cli-interrupt-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let child = std::process::Command::new(env!("CARGO_BIN_EXE_anim"))
-        .args(["run", "cloth", "--frames", "1000000", "--checkpoint-every", "1000000", "--quiet"])
-        .arg("--out")
-        .arg(&dir)
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("the anim binary runs");
     // Wait for a few frames, then interrupt.
+    let child = spawn_until_frames(
+        &["run", "cloth", "--frames", "1000000", "--checkpoint-every", "1000000"],
+        &dir,
+        3,
+    );
     let pvd_dir = dir.join("frames");
-    let start = std::time::Instant::now();
-    while std::fs::read_dir(&pvd_dir).map_or(0, |d| d.count()) < 3 {
-        assert!(start.elapsed().as_secs() < 120, "no frames written");
-        std::thread::sleep(std::time::Duration::from_millis(50));
-    }
-    let kill = std::process::Command::new("kill").args(["-INT", &child.id().to_string()]).status();
-    assert!(kill.is_ok_and(|s| s.success()));
+    interrupt(&child);
     let out = child.wait_with_output().expect("the run ends");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{stderr}");
@@ -198,22 +190,10 @@ fn an_interrupted_run_finishes_its_folder_and_resumes() {
 fn an_interrupt_delivered_twice_at_once_still_finishes_the_folder() {
     let dir = std::env::temp_dir().join(format!("anim-cli-twice-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let child = std::process::Command::new(env!("CARGO_BIN_EXE_anim"))
-        .args(["run", "mpm", "--quiet", "--no-viewer"])
-        .arg("--out")
-        .arg(&dir)
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("the anim binary runs");
+    let child = spawn_until_frames(&["run", "mpm", "--no-viewer"], &dir, 2);
     let pvd_dir = dir.join("frames");
-    let start = std::time::Instant::now();
-    while std::fs::read_dir(&pvd_dir).map_or(0, |d| d.count()) < 2 {
-        assert!(start.elapsed().as_secs() < 120, "no frames written");
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
     for _ in 0..2 {
-        let kill = std::process::Command::new("kill").args(["-INT", &child.id().to_string()]).status();
-        assert!(kill.is_ok_and(|s| s.success()));
+        interrupt(&child);
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
     let out = child.wait_with_output().expect("the run ends");
@@ -228,6 +208,32 @@ fn an_interrupt_delivered_twice_at_once_still_finishes_the_folder() {
     let listed: Vec<&str> = pvd.split("file=\"").skip(1).filter_map(|s| s.split('"').next()).collect();
     assert!(!listed.is_empty() && listed.iter().all(|f| pvd_dir.join(f).is_file()), "{listed:?}");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `anim ARGS --quiet --out DIR`, started and left running once `DIR/frames` holds `frames`
+/// files (two minutes at most).
+#[cfg(unix)]
+fn spawn_until_frames(args: &[&str], dir: &Path, frames: usize) -> std::process::Child {
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_anim"))
+        .args(args)
+        .args(["--quiet", "--out"])
+        .arg(dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the anim binary runs");
+    let start = std::time::Instant::now();
+    while std::fs::read_dir(dir.join("frames")).map_or(0, |d| d.count()) < frames {
+        assert!(start.elapsed().as_secs() < 120, "no frames written");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child
+}
+
+/// Sends SIGINT to `child`.
+#[cfg(unix)]
+fn interrupt(child: &std::process::Child) {
+    let kill = std::process::Command::new("kill").args(["-INT", &child.id().to_string()]).status();
+    assert!(kill.is_ok_and(|s| s.success()));
 }
 
 /// The frame files `viewer/index.js` lists, after checking each is present.

@@ -30,7 +30,7 @@ fn the_estimate_is_within_a_factor_of_two_of_what_a_build_and_a_step_hold() {
             let (be, cholesky) = (TimeIntegrator::BackwardEuler, LinearSolverChoice::Cholesky);
             let need = memory::preset_need(preset, Some(n), order, be, cholesky).expect("known");
             // What writing frames holds is left out: the measurement draws a frame, writes none.
-            let estimate = need.bytes() - need.bytes_of("written points") - need.bytes_of("written cells");
+            let estimate = need.bytes_without_writing();
             let held = build_and_step_peak(&ALLOC, &KIND, &params, dt).expect("builds and steps") as f64;
             let ratio = estimate / held;
             println!(

@@ -28,7 +28,7 @@ fn the_estimate_is_within_a_factor_of_two_of_what_a_build_and_a_step_hold() {
             let params = serde_json::json!({ "preset": preset, "resolution": n });
             let need = memory::scene_need(preset, Some(n), None, None).expect("known");
             // What writing frames holds is left out: the measurement draws a frame, writes none.
-            let estimate = need.bytes() - need.bytes_of("written points") - need.bytes_of("written cells");
+            let estimate = need.bytes_without_writing();
             let held = build_and_step_peak(&ALLOC, &KIND, &params, dt).expect("builds and steps") as f64;
             let ratio = estimate / held;
             println!("{preset} {n}: estimate {estimate:.4e} B, held {held:.4e} B, ratio {ratio:.3}");

@@ -123,6 +123,14 @@ impl MemoryNeed {
         self.parts.iter().filter(|p| p.noun == noun).map(|p| p.count * p.each).sum()
     }
 
+    /// The bytes apart from what a run holds to write frames (the parts `written points` and
+    /// `written cells`): what a build, a step and a drawn frame hold, which the crates' estimate
+    /// tests measure.
+    #[must_use]
+    pub fn bytes_without_writing(&self) -> f64 {
+        self.bytes() - self.bytes_of("written points") - self.bytes_of("written cells")
+    }
+
     /// Adds every part of `other`.
     pub fn extend(&mut self, other: MemoryNeed) {
         self.parts.extend(other.parts);
@@ -410,6 +418,7 @@ mod tests {
         let view = MemoryNeed::new().with(10.0, "particles", 100.0).with_frame_points(10.0);
         assert_eq!(view.bytes_of("written points"), 10.0 * WRITTEN_POINT_BYTES);
         assert_eq!(view.bytes() - view.bytes_of("written points"), 10.0 * (100.0 + FRAME_POINT_BYTES));
+        assert_eq!(view.bytes_without_writing(), 10.0 * (100.0 + FRAME_POINT_BYTES));
         assert_eq!(view.bytes_of("cells"), 0.0);
         // Empty parts are left out; no parts at all print no parentheses.
         let empty = MemoryNeed::new().with(0.0, "cells", 8.0);
