@@ -162,8 +162,7 @@ pub fn preset_step_allocations(
     alloc: &CountingAllocator,
     kind: &crate::scene::SceneKind,
 ) -> Result<Vec<PresetAllocations>, String> {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().map_err(|e| e.to_string())?;
-    pool.install(|| {
+    crate::par::with_threads(2, || {
         let mut out = Vec::new();
         for preset in (kind.presets)() {
             let name = preset.name;
@@ -175,7 +174,7 @@ pub fn preset_step_allocations(
             out.push(PresetAllocations { preset: name, blocks });
         }
         Ok(out)
-    })
+    })?
 }
 
 /// The allocations of `scene`'s next steps by `dt`: blocks of four steps, up to three, stopping

@@ -186,7 +186,7 @@ fn has_non_finite(values: &[f64]) -> bool {
 #[inline]
 #[must_use]
 pub fn first_non_finite(values: &[f64]) -> Option<usize> {
-    use rayon::prelude::*;
+    use crate::par::prelude::*;
     let bad = if values.len() >= PARALLEL_LEN {
         values.par_chunks(CHUNK).any(has_non_finite)
     } else {

@@ -43,6 +43,7 @@ pub mod input;
 pub mod integrate;
 pub mod lie;
 pub mod linalg;
+pub mod par;
 pub mod scalar;
 pub mod scene;
 pub mod solver;

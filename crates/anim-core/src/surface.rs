@@ -54,7 +54,7 @@ use std::f64::consts::PI;
 use crate::geometry::closest_point_on_triangle;
 
 use glam::DVec3;
-use rayon::prelude::*;
+use crate::par::prelude::*;
 
 mod distance;
 #[cfg(test)]

@@ -147,6 +147,17 @@ fn build(value: &serde_json::Value, context: &BuildContext<'_>) -> Result<Box<dy
                 format!("unknown preset `{name}` (one of {})", scenes::NAMES.join(", ")),
             ));
         }
+        #[cfg(not(feature = "gltf"))]
+        (None, Some(file)) => {
+            return Err(BuildError::invalid(
+                "file",
+                format!(
+                    "{}: reading glTF files needs anim-skin's `gltf` feature, which this build lacks",
+                    context.resolve(file).display()
+                ),
+            ));
+        }
+        #[cfg(feature = "gltf")]
         (None, Some(file)) => {
             let path = context.resolve(file);
             let scene = scenes::from_gltf(&path).map_err(|e| BuildError::invalid("file", e.to_string()))?;

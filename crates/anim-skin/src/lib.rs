@@ -83,6 +83,7 @@
 pub mod cases;
 pub mod character;
 pub mod clip;
+#[cfg(feature = "gltf")]
 pub mod gltf_io;
 pub mod kind;
 pub mod mesh;
@@ -93,6 +94,7 @@ pub mod skinning;
 
 pub use character::{Character, CharacterData, CharacterMesh, GltfSource};
 pub use clip::{Channel, Clip, Interpolation, Property};
+#[cfg(feature = "gltf")]
 pub use gltf_io::{LoadError, Loaded, Renormalised};
 pub use kind::KIND;
 pub use mesh::{MAX_INFLUENCES, SkinnedMesh, signed_volume};

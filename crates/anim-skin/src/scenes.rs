@@ -3,7 +3,7 @@
 //! | scene | what |
 //! | --- | --- |
 //! | [`twisted_cylinder`] | a closed cylinder on two joints, the second twisting by 180 degrees about the axis over 2 s: LBS collapses the middle to the axis (the candy wrapper), DQS keeps its volume |
-//! | [`from_gltf`] | any skinned glTF 2.0 file, its first animation |
+//! | `from_gltf` | any skinned glTF 2.0 file, its first animation (feature `gltf`) |
 //!
 //! A [`SkinScene`] is posed at time `t` with either method into positions and normals
 //! ([`SkinScene::pose`], then [`CharacterData::positions`]); [`Character::triangles`] gives the
@@ -12,11 +12,13 @@
 use crate::SkinError;
 use crate::character::{Character, CharacterData, CharacterMesh};
 use crate::clip::{Channel, Clip, Interpolation, Property};
+#[cfg(feature = "gltf")]
 use crate::gltf_io::{self, LoadError};
 use crate::mesh::{SkinnedMesh, signed_volume};
 use crate::skeleton::{Joint, Skeleton, Skin, Trs};
 use crate::skinning::SkinningMethod;
 use anim_core::glam::{DMat4, DQuat, DVec3, DVec4};
+#[cfg(feature = "gltf")]
 use std::path::Path;
 
 /// A character with the clip to play and how long to play it.
@@ -160,11 +162,12 @@ pub fn twisted_cylinder(resolution: Option<usize>) -> Result<SkinScene, SkinErro
     })
 }
 
-/// A scene from a skinned glTF 2.0 file (`.gltf` or `.glb`), playing its first animation (the
+/// A scene from a skinned glTF 2.0 file (`.gltf` or `.glb`) (feature `gltf`), playing its first animation (the
 /// rest pose if it has none) with LBS, which handles scaled joints.
 ///
 /// # Errors
 /// What [`gltf_io::load`] returns.
+#[cfg(feature = "gltf")]
 pub fn from_gltf(path: impl AsRef<Path>) -> Result<SkinScene, LoadError> {
     let path = path.as_ref();
     scene_of(gltf_io::load(path)?, path)
@@ -175,10 +178,12 @@ pub fn from_gltf(path: impl AsRef<Path>) -> Result<SkinScene, LoadError> {
 ///
 /// # Errors
 /// As [`from_gltf`].
+#[cfg(feature = "gltf")]
 pub fn from_gltf_slice(bytes: &[u8], path: &Path) -> Result<SkinScene, LoadError> {
     scene_of(gltf_io::load_slice(bytes, path)?, path)
 }
 
+#[cfg(feature = "gltf")]
 fn scene_of(loaded: gltf_io::Loaded, path: &Path) -> Result<SkinScene, LoadError> {
     let character = loaded.character;
     let clip = (!character.clips.is_empty()).then_some(0);

@@ -64,7 +64,7 @@ use crate::SkinError;
 use crate::mesh::{MAX_INFLUENCES, SkinnedMesh};
 use anim_core::glam::{DMat3, DMat4, DQuat};
 use anim_core::linalg::svd::polar;
-use rayon::prelude::*;
+use anim_core::par::prelude::*;
 use serde::{Deserialize, Serialize};
 use wide::f64x2;
 

@@ -139,6 +139,7 @@ fn frames_are_the_methods_side_by_side_with_velocities_by_difference() {
 }
 
 #[test]
+#[cfg(feature = "gltf")]
 fn a_gltf_file_is_read_relative_to_the_scene_folder_with_dqs_by_default() {
     let dir = testdata();
     let scene = build_in(&serde_json::json!({ "file": "skin.glb" }), Some(&dir)).unwrap();
@@ -154,6 +155,7 @@ fn a_gltf_file_is_read_relative_to_the_scene_folder_with_dqs_by_default() {
 /// A file whose meshes have no skin has nothing to pose: it is refused naming the file, not run
 /// as an empty scene.
 #[test]
+#[cfg(feature = "gltf")]
 fn a_file_without_a_skinned_mesh_is_refused() {
     let text = std::fs::read_to_string(testdata().join("skin_embedded.gltf")).unwrap();
     let mut gltf: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -177,6 +179,7 @@ fn a_file_without_a_skinned_mesh_is_refused() {
 /// A file without an animation is shown in its rest pose: every step leaves the vertices where
 /// they were, at zero velocity.
 #[test]
+#[cfg(feature = "gltf")]
 fn a_file_without_an_animation_holds_its_rest_pose() {
     let text = std::fs::read_to_string(testdata().join("skin_embedded.gltf")).unwrap();
     let mut gltf: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -199,6 +202,7 @@ fn a_file_without_an_animation_holds_its_rest_pose() {
 /// The embedded asset scales joint 4 on its way to t = 2 s, which DQS refuses: the failing step
 /// names it and leaves the scene (LBS half included) as it was.
 #[test]
+#[cfg(feature = "gltf")]
 fn a_pose_that_fails_leaves_the_scene_as_it_was() {
     let params = serde_json::json!({ "file": "skin_embedded.gltf", "method": "both" });
     let mut scene = build_in(&params, Some(&testdata())).unwrap();
@@ -222,6 +226,14 @@ fn a_pose_that_fails_leaves_the_scene_as_it_was() {
     assert_eq!(err, "anim-skin: time step must be positive and finite, got 0");
     assert!(scene.step(f64::NAN).is_err());
     assert_eq!(scene.save(), before);
+}
+
+#[test]
+#[cfg(not(feature = "gltf"))]
+fn without_the_gltf_feature_a_file_is_refused_naming_the_feature() {
+    let err = build_in(&serde_json::json!({ "file": "skin.glb" }), Some(&testdata())).err().unwrap();
+    assert!(err.contains("skin.glb"), "{err}");
+    assert!(err.contains("anim-skin's `gltf` feature"), "{err}");
 }
 
 #[test]

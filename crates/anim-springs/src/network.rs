@@ -82,7 +82,7 @@ pub use model::{MAX_PARTICLES, MAX_SPRINGS, Particle, Spring, SpringKind, Spring
 use anim_core::glam::{DMat3, DVec3};
 use anim_core::integrate::SecondOrderSystem;
 use anim_core::linalg::CsrMatrix;
-use rayon::prelude::*;
+use anim_core::par::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::sync::OnceLock;
 use std::sync::atomic::AtomicUsize;
@@ -426,9 +426,14 @@ impl SpringNetwork {
         if m == 0 {
             return None;
         }
+        #[cfg(feature = "parallel")]
         let best = if m > PARALLEL_THRESHOLD {
             (0..m).into_par_iter().with_min_len(CHUNK).map(ratio).reduce(|| ratio(0), better)
         } else {
+            (0..m).map(ratio).fold(ratio(0), better)
+        };
+        #[cfg(not(feature = "parallel"))]
+        let best = {
             (0..m).map(ratio).fold(ratio(0), better)
         };
         Some(best)

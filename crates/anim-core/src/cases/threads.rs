@@ -23,11 +23,7 @@ pub fn across_threads(
 ) -> Vec<Check> {
     let mut finals = Vec::new();
     for threads in THREADS {
-        let result = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .map_err(|e| e.to_string())
-            .and_then(|pool| pool.install(&run));
+        let result = crate::par::with_threads(threads, &run).and_then(|r| r);
         finals.push((threads, result));
     }
     let reference = match &finals[0].1 {

@@ -475,7 +475,7 @@ where
     F: Fn(usize, &mut [f64]) + Sync + Send,
 {
     if a.len() >= PARALLEL_DOFS {
-        use rayon::prelude::*;
+        use crate::par::prelude::*;
         a.par_chunks_mut(CHUNK).enumerate().for_each(|(c, ac)| f(c * CHUNK, ac));
     } else {
         f(0, a);
@@ -491,7 +491,7 @@ where
 {
     assert_eq!(a.len(), b.len(), "for_chunks2: length mismatch");
     if a.len() >= PARALLEL_DOFS {
-        use rayon::prelude::*;
+        use crate::par::prelude::*;
         a.par_chunks_mut(CHUNK)
             .zip(b.par_chunks_mut(CHUNK))
             .enumerate()

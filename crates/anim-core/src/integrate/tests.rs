@@ -112,6 +112,7 @@ fn linearized_beta_blend_is_the_closed_form_formula() {
 }
 
 #[test]
+#[cfg(feature = "faer")]
 fn beta_zero_is_symplectic_euler_and_beta_one_is_backward_euler() {
     let run = |kind: IntegratorKind| {
         let mut sys = KeplerOrbit::ellipse(0.3);
@@ -154,6 +155,7 @@ fn backward_euler_solves_its_nonlinear_equation() {
 }
 
 #[test]
+#[cfg(feature = "faer")]
 fn every_linear_solver_gives_the_same_implicit_step() {
     let mut results = Vec::new();
     for linear in LinearSolverKind::ALL {
@@ -169,6 +171,26 @@ fn every_linear_solver_gives_the_same_implicit_step() {
         let diff = state.x.iter().zip(&reference.x).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         assert!(diff < 1e-8, "{linear:?} differs from Cholesky by {diff}");
     }
+}
+
+#[test]
+#[cfg(not(feature = "faer"))]
+fn without_faer_the_direct_solver_reports_it_is_unavailable() {
+    use crate::integrate::IntegrateError;
+    use crate::linalg::SolveError;
+    assert!(!LinearSolverKind::Cholesky.is_available());
+    assert!(LinearSolverKind::ALL.iter().filter(|k| **k != LinearSolverKind::Cholesky).all(|k| k.is_available()));
+    let mut sys = LinearChain::new(6, 1.0, 100.0, 0.1, 9.81);
+    let mut state = sys.rest_state();
+    let mut integ =
+        IntegratorKind::BackwardEuler.build_with(sys.dof(), NewtonParams::default(), LinearSolverKind::Cholesky);
+    let err = integ.step(&mut sys, &mut state, 0.02).unwrap_err();
+    let text = err.to_string();
+    assert!(text.contains("anim-core was built without its `faer` feature"), "{text}");
+    assert!(
+        matches!(err, IntegrateError::LinearSolve { source: SolveError::Unavailable { feature: "faer", .. }, .. }),
+        "{err:?}"
+    );
 }
 
 #[test]
@@ -375,6 +397,7 @@ fn damped_oscillator_converges_with_implicit_methods() {
 }
 
 #[test]
+#[cfg(feature = "faer")]
 fn chain_settles_to_its_analytic_equilibrium_under_backward_euler() {
     // Backward Euler dissipates: a damped chain run long enough rests at the static solution.
     let mut sys = LinearChain::new(10, 0.2, 400.0, 0.1, 9.81).with_damping(2.0);

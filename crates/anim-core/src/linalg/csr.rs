@@ -29,8 +29,9 @@
 //! columns, [`CsrMatrix::to_faer_row`] / [`CsrMatrix::from_faer_row`] to and from its compressed
 //! sparse rows.
 
+#[cfg(feature = "faer")]
 use faer::sparse::{SparseColMat, SparseRowMat, SymbolicSparseColMat, SymbolicSparseRowMat};
-use rayon::prelude::*;
+use crate::par::prelude::*;
 
 use super::LinearOperator;
 
@@ -424,7 +425,11 @@ impl CsrMatrix {
         }
         out
     }
+}
 
+/// Conversions to and from faer's sparse matrices (feature `faer`).
+#[cfg(feature = "faer")]
+impl CsrMatrix {
     /// Converts to faer's compressed sparse columns (same entries, explicit zeros included).
     #[must_use]
     pub fn to_faer(&self) -> SparseColMat<usize, f64> {
@@ -497,6 +502,7 @@ impl LinearOperator for CsrMatrix {
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[cfg(feature = "faer")]
     use faer::{Accum, Mat, Par};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
@@ -700,6 +706,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(feature = "faer")]
     fn faer_round_trip_and_product() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         for &(nr, nc, count) in &[(11, 7, 40), (30, 30, 200), (5, 5, 0)] {

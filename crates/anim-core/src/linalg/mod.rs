@@ -17,14 +17,18 @@
 
 pub mod cg;
 pub mod csr;
+#[cfg(feature = "faer")]
 pub mod direct;
+#[cfg(feature = "faer")]
 pub mod schur;
 pub mod stationary;
 pub mod svd;
 
 pub use cg::{Cg, Preconditioner};
 pub use csr::{CsrError, CsrMatrix};
+#[cfg(feature = "faer")]
 pub use direct::{Factorization, Ldlt, Llt, SparseCholesky, SparseDirect, SparseLdlt};
+#[cfg(feature = "faer")]
 pub use schur::{Eliminate, schur_complement, solve_block, solve_block_diagonal_a};
 pub use stationary::{GaussSeidel, Jacobi, gauss_seidel_sweep, jacobi_sweep};
 pub use svd::{Svd3, polar, polar_f32, svd3, svd3_f32, svd3_real};
@@ -143,6 +147,14 @@ pub enum SolveError {
         /// Iteration at which it was detected.
         iteration: usize,
     },
+    /// The solver was compiled out: this build of anim-core lacks the feature it needs.
+    #[error("{solver} is not available: anim-core was built without its `{feature}` feature")]
+    Unavailable {
+        /// Name of the solver.
+        solver: &'static str,
+        /// The feature that provides it.
+        feature: &'static str,
+    },
     /// A factorisation failed (faer's error, as text).
     #[error("factorisation failed: {0}")]
     Factorization(String),
@@ -189,7 +201,7 @@ pub enum LinearSolverKind {
     Jacobi,
     /// Gauss-Seidel sweeps on the assembled matrix.
     GaussSeidel,
-    /// Sparse Cholesky (faer) on the assembled matrix.
+    /// Sparse Cholesky (faer) on the assembled matrix; needs the `faer` feature.
     Cholesky,
 }
 
@@ -228,8 +240,38 @@ impl LinearSolverKind {
             }
             LinearSolverKind::Jacobi => Box::new(Jacobi::new(params)),
             LinearSolverKind::GaussSeidel => Box::new(GaussSeidel::new(params)),
+            #[cfg(feature = "faer")]
             LinearSolverKind::Cholesky => Box::new(SparseCholesky::new()),
+            #[cfg(not(feature = "faer"))]
+            LinearSolverKind::Cholesky => Box::new(Unavailable { solver: "cholesky", feature: "faer" }),
         }
+    }
+
+    /// Whether this build of anim-core can solve with this kind (`cholesky` needs the `faer`
+    /// feature).
+    #[must_use]
+    pub fn is_available(self) -> bool {
+        cfg!(feature = "faer") || self != LinearSolverKind::Cholesky
+    }
+}
+
+/// A solver compiled out of this build: every solve is [`SolveError::Unavailable`].
+#[cfg(not(feature = "faer"))]
+struct Unavailable {
+    solver: &'static str,
+    feature: &'static str,
+}
+
+#[cfg(not(feature = "faer"))]
+impl LinearSolver for Unavailable {
+    fn name(&self) -> &'static str {
+        self.solver
+    }
+    fn needs_matrix(&self) -> bool {
+        true
+    }
+    fn solve(&mut self, _a: SystemMatrix<'_>, _b: &[f64], _x: &mut [f64]) -> Result<SolveInfo, SolveError> {
+        Err(SolveError::Unavailable { solver: self.solver, feature: self.feature })
     }
 }
 

@@ -33,7 +33,7 @@
 //! last sweep. Both need [`SystemMatrix::Csr`]; a matrix-free operator gives
 //! [`SolveError::NeedsMatrix`].
 
-use rayon::prelude::*;
+use crate::par::prelude::*;
 
 use super::csr::{PARALLEL_ROW_THRESHOLD, ROW_CHUNK};
 use super::{CsrMatrix, IterativeParams, LinearSolver, SolveError, SolveInfo, SystemMatrix, norm};

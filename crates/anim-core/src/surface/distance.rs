@@ -5,7 +5,7 @@ use std::fmt;
 use std::sync::Arc;
 
 use glam::{DMat3, DVec3};
-use rayon::prelude::*;
+use crate::par::prelude::*;
 
 use super::{ClosedSurface, SurfaceError};
 use crate::geometry::closest_point_on_triangle;

@@ -36,7 +36,7 @@ use crate::constraint::ConstraintFunction;
 use crate::model::PbdModel;
 use crate::project::{Buffered, Compiled, Ctx, Direct, Kernel, colour, compile, project, project_contact};
 use anim_core::glam::DVec3;
-use rayon::prelude::*;
+use anim_core::par::prelude::*;
 use std::ops::Range;
 
 /// A colour is swept in parallel (two phases) only with at least this many constraints per
@@ -129,7 +129,7 @@ pub(super) fn solve_constraints(model: &PbdModel, params: &PbdParams, d: &mut Da
         mesh_colliders: &model.mesh_colliders,
         bad: &d.bad,
     };
-    let parallel = rayon::current_num_threads() > 1;
+    let parallel = anim_core::par::current_num_threads() > 1;
     for _ in 0..params.iterations {
         match params.solver {
             SolverKind::GaussSeidel => {
@@ -203,13 +203,13 @@ fn coloured_gauss_seidel(
     for (g, r) in groups.iter().enumerate() {
         let cs = &compiled[r.clone()];
         let ls = &mut lambda[r.clone()];
-        let threads = rayon::current_num_threads();
+        let threads = anim_core::par::current_num_threads();
         if parallel && cs.len() >= COLOUR_PARALLEL_MIN * threads && !group_has_volume[g] {
             // Two phases: corrections from the colour's start positions, then
             // applied over disjoint particle ranges.
             let pos: &[DVec3] = p;
             let colour_corr = &mut corr[r.clone()];
-            let chunk = cs.len().div_ceil(2 * rayon::current_num_threads()).max(CHUNK);
+            let chunk = cs.len().div_ceil(2 * anim_core::par::current_num_threads()).max(CHUNK);
             cs.par_chunks(chunk)
                 .zip(ls.par_chunks_mut(chunk))
                 .zip(colour_corr.par_chunks_mut(chunk))
@@ -220,7 +220,7 @@ fn coloured_gauss_seidel(
                     }
                 });
             let t = &touched[g];
-            let leaf = t.len().div_ceil(2 * rayon::current_num_threads()).max(4 * CHUNK);
+            let leaf = t.len().div_ceil(2 * anim_core::par::current_num_threads()).max(4 * CHUNK);
             apply_sorted(p, 0, t, corr, leaf);
         } else {
             let mut acc = Direct(&mut *p);
@@ -298,7 +298,7 @@ fn apply_sorted(pos: &mut [DVec3], base: usize, list: &[(u32, u32, u32)], corr: 
     let mid = list.len() / 2;
     let split = list[mid].0 as usize;
     let (lo, hi) = pos.split_at_mut(split - base);
-    rayon::join(
+    anim_core::par::join(
         || apply_sorted(lo, base, &list[..mid], corr, leaf),
         || apply_sorted(hi, split, &list[mid..], corr, leaf),
     );

@@ -20,7 +20,7 @@ use super::scratch::Data;
 use crate::collide::coefficients;
 use crate::model::PbdModel;
 use anim_core::glam::{DMat3, DVec3};
-use rayon::prelude::*;
+use anim_core::par::prelude::*;
 
 /// Line (6) with `k = k_damping`.
 pub(super) fn damp_velocities(model: &PbdModel, x: &[DVec3], v: &mut [DVec3], k: f64) {
@@ -67,7 +67,7 @@ pub(super) fn damp_velocities(model: &PbdModel, x: &[DVec3], v: &mut [DVec3], k:
 /// Lines (12)-(15) for a substep of length `h`: `v <- (p - x) / h`, `x <- p`.
 pub(super) fn update_velocities(model: &PbdModel, d: &mut Data, h: f64) {
     let n = model.num_particles();
-    let parallel = rayon::current_num_threads() > 1;
+    let parallel = anim_core::par::current_num_threads() > 1;
     let inv_h = 1.0 / h;
     if parallel && n >= PARALLEL_MIN {
         d.x.par_chunks_mut(CHUNK)

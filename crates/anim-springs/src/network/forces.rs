@@ -22,7 +22,7 @@ use crate::geom::{MIN_LENGTH, outer};
 use anim_core::glam::{DMat3, DVec3};
 use anim_core::integrate::{MechanicalSystem, SecondOrderSystem};
 use anim_core::linalg::CsrMatrix;
-use rayon::prelude::*;
+use anim_core::par::prelude::*;
 use std::sync::atomic::Ordering;
 
 impl SpringModel {
@@ -389,7 +389,7 @@ fn for_block_rows(
     }
     let mid = lo + (hi - lo) / 2;
     let (left, right) = values.split_at_mut(bounds[mid] - bounds[lo]);
-    rayon::join(
+    anim_core::par::join(
         || for_block_rows(left, bounds, lo, mid, parallel, f),
         || for_block_rows(right, bounds, mid, hi, parallel, f),
     );

@@ -1,0 +1,152 @@
+//! Data parallelism that can be switched off: rayon's parallel iterators with the `parallel`
+//! feature (on by default), a sequential stand-in with the same method names without it.
+//!
+//! Solver crates write their loops once, against [`prelude`]:
+//!
+//! ```
+//! use anim_core::par::prelude::*;
+//!
+//! let mut y = vec![0.0; 10_000];
+//! y.par_chunks_mut(1024).enumerate().for_each(|(c, chunk)| {
+//!     for (i, v) in chunk.iter_mut().enumerate() {
+//!         *v = (c * 1024 + i) as f64;
+//!     }
+//! });
+//! assert_eq!(y[4321], 4321.0);
+//! ```
+//!
+//! With the feature the loop runs on rayon's global pool; without it, `par_chunks_mut` is
+//! `chunks_mut` and the loop runs on the calling thread. Every parallel loop of the workspace
+//! gives results that do not depend on the thread count, so the two builds agree bit for bit.
+//!
+//! What the stand-in covers: `par_iter`, `par_iter_mut`, `par_chunks`, `par_chunks_mut`,
+//! `into_par_iter` on ranges, `with_min_len` (ignored), [`join`] and [`current_num_threads`]
+//! (`1`). Rayon's `reduce(identity, op)` has no sequential twin of the same name: write
+//! `fold(identity(), op)` on a sequential iterator, or branch on [`PARALLEL`].
+
+/// Whether this build runs parallel loops on rayon's pool (the `parallel` feature).
+pub const PARALLEL: bool = cfg!(feature = "parallel");
+
+/// The parallel-iterator traits: rayon's, or the sequential stand-ins.
+pub mod prelude {
+    #[cfg(feature = "parallel")]
+    pub use rayon::prelude::*;
+
+    #[cfg(not(feature = "parallel"))]
+    pub use super::seq::{IntoParallelIterator, ParallelSlice, ParallelSliceMut, WithMinLen};
+}
+
+/// Runs two closures, in parallel with the `parallel` feature, one after the other without it.
+#[inline]
+pub fn join<A, B, RA, RB>(a: A, b: B) -> (RA, RB)
+where
+    A: FnOnce() -> RA + Send,
+    B: FnOnce() -> RB + Send,
+    RA: Send,
+    RB: Send,
+{
+    #[cfg(feature = "parallel")]
+    {
+        rayon::join(a, b)
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        (a(), b())
+    }
+}
+
+/// The number of threads parallel loops run on: rayon's current pool, or `1`.
+#[inline]
+#[must_use]
+pub fn current_num_threads() -> usize {
+    #[cfg(feature = "parallel")]
+    {
+        rayon::current_num_threads()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        1
+    }
+}
+
+/// Runs `f` on a pool of `threads` threads (its parallel loops use that many) with the
+/// `parallel` feature; without it, runs `f` on the calling thread.
+///
+/// # Errors
+/// The pool could not be built (the operating system refused the threads).
+pub fn with_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> Result<R, String> {
+    #[cfg(feature = "parallel")]
+    {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
+        Ok(pool.install(f))
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        let _ = threads;
+        Ok(f())
+    }
+}
+
+/// The sequential stand-ins, used when the `parallel` feature is off.
+#[cfg(not(feature = "parallel"))]
+mod seq {
+    /// `par_iter` and `par_chunks` on slices, as plain iterators.
+    pub trait ParallelSlice<T> {
+        /// `iter()`.
+        fn par_iter(&self) -> std::slice::Iter<'_, T>;
+        /// `chunks(n)`.
+        fn par_chunks(&self, n: usize) -> std::slice::Chunks<'_, T>;
+    }
+
+    impl<T> ParallelSlice<T> for [T] {
+        #[inline]
+        fn par_iter(&self) -> std::slice::Iter<'_, T> {
+            self.iter()
+        }
+        #[inline]
+        fn par_chunks(&self, n: usize) -> std::slice::Chunks<'_, T> {
+            self.chunks(n)
+        }
+    }
+
+    /// `par_iter_mut` and `par_chunks_mut` on slices, as plain iterators.
+    pub trait ParallelSliceMut<T> {
+        /// `iter_mut()`.
+        fn par_iter_mut(&mut self) -> std::slice::IterMut<'_, T>;
+        /// `chunks_mut(n)`.
+        fn par_chunks_mut(&mut self, n: usize) -> std::slice::ChunksMut<'_, T>;
+    }
+
+    impl<T> ParallelSliceMut<T> for [T] {
+        #[inline]
+        fn par_iter_mut(&mut self) -> std::slice::IterMut<'_, T> {
+            self.iter_mut()
+        }
+        #[inline]
+        fn par_chunks_mut(&mut self, n: usize) -> std::slice::ChunksMut<'_, T> {
+            self.chunks_mut(n)
+        }
+    }
+
+    /// `into_par_iter` on anything iterable, as `into_iter`.
+    pub trait IntoParallelIterator: IntoIterator + Sized {
+        /// `into_iter()`.
+        #[inline]
+        fn into_par_iter(self) -> Self::IntoIter {
+            self.into_iter()
+        }
+    }
+
+    impl<I: IntoIterator> IntoParallelIterator for I {}
+
+    /// rayon's splitting hint, ignored by a sequential iterator.
+    pub trait WithMinLen: Iterator + Sized {
+        /// Returns the iterator unchanged.
+        #[inline]
+        fn with_min_len(self, _min: usize) -> Self {
+            self
+        }
+    }
+
+    impl<I: Iterator> WithMinLen for I {}
+}
