@@ -53,8 +53,8 @@ use std::f64::consts::PI;
 
 use crate::geometry::closest_point_on_triangle;
 
-use glam::DVec3;
 use crate::par::prelude::*;
+use glam::DVec3;
 
 mod distance;
 #[cfg(test)]

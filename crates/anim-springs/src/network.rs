@@ -433,9 +433,7 @@ impl SpringNetwork {
             (0..m).map(ratio).fold(ratio(0), better)
         };
         #[cfg(not(feature = "parallel"))]
-        let best = {
-            (0..m).map(ratio).fold(ratio(0), better)
-        };
+        let best = { (0..m).map(ratio).fold(ratio(0), better) };
         Some(best)
     }
 }

@@ -1,24 +1,4 @@
-//! # anim
-//!
-//! Every crate of the anim workspace behind one dependency, and the one list of them
-//! ([`CRATES`]) that the `anim` command line, `cargo xtask` and the Python bindings walk.
-//! Nothing here knows what a crate simulates: each crate describes its own scenes as
-//! [`anim_core::scene::SceneKind`]s (its scene-file parameters, its presets, its builder), every
-//! scene is driven through [`anim_core::scene::DynScene`], and with the `cases` feature each
-//! crate registers its own conformance checks, hard cases, soak runs and studies
-//! (`anim_core::cases`).
-//!
-//! Adding a solver crate: write the crate with its `KIND` and its `cases` module, then add one
-//! line to [`CRATES`] (and the dependency to this crate's manifest).
-//!
-//! ```
-//! // Every built-in scene by name, built from its preset's parameters and stepped once.
-//! let (kind, preset) = anim::preset("kepler").expect("a preset");
-//! let mut scene = (kind.build)(&preset.params, &Default::default())?;
-//! scene.step(preset.run.dt)?;
-//! assert!(scene.time() > 0.0);
-//! # Ok::<(), Box<dyn std::error::Error>>(())
-//! ```
+#![doc = include_str!("../README.md")]
 
 pub use anim_core as core;
 pub use anim_fem as fem;

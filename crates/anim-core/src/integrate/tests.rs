@@ -179,16 +179,24 @@ fn without_faer_the_direct_solver_reports_it_is_unavailable() {
     use crate::integrate::IntegrateError;
     use crate::linalg::SolveError;
     assert!(!LinearSolverKind::Cholesky.is_available());
-    assert!(LinearSolverKind::ALL.iter().filter(|k| **k != LinearSolverKind::Cholesky).all(|k| k.is_available()));
+    assert!(
+        LinearSolverKind::ALL.iter().filter(|k| **k != LinearSolverKind::Cholesky).all(|k| k.is_available())
+    );
     let mut sys = LinearChain::new(6, 1.0, 100.0, 0.1, 9.81);
     let mut state = sys.rest_state();
-    let mut integ =
-        IntegratorKind::BackwardEuler.build_with(sys.dof(), NewtonParams::default(), LinearSolverKind::Cholesky);
+    let mut integ = IntegratorKind::BackwardEuler.build_with(
+        sys.dof(),
+        NewtonParams::default(),
+        LinearSolverKind::Cholesky,
+    );
     let err = integ.step(&mut sys, &mut state, 0.02).unwrap_err();
     let text = err.to_string();
     assert!(text.contains("anim-core was built without its `faer` feature"), "{text}");
     assert!(
-        matches!(err, IntegrateError::LinearSolve { source: SolveError::Unavailable { feature: "faer", .. }, .. }),
+        matches!(
+            err,
+            IntegrateError::LinearSolve { source: SolveError::Unavailable { feature: "faer", .. }, .. }
+        ),
         "{err:?}"
     );
 }

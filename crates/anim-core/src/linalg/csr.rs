@@ -29,9 +29,9 @@
 //! columns, [`CsrMatrix::to_faer_row`] / [`CsrMatrix::from_faer_row`] to and from its compressed
 //! sparse rows.
 
+use crate::par::prelude::*;
 #[cfg(feature = "faer")]
 use faer::sparse::{SparseColMat, SparseRowMat, SymbolicSparseColMat, SymbolicSparseRowMat};
-use crate::par::prelude::*;
 
 use super::LinearOperator;
 

@@ -4,8 +4,8 @@
 use std::fmt;
 use std::sync::Arc;
 
-use glam::{DMat3, DVec3};
 use crate::par::prelude::*;
+use glam::{DMat3, DVec3};
 
 use super::{ClosedSurface, SurfaceError};
 use crate::geometry::closest_point_on_triangle;
