@@ -25,6 +25,12 @@ pub mod tet10;
 pub use error::FemError;
 pub use kind::KIND;
 
+/// anim-core, the math and contracts this crate builds on: its `glam`, integrators and scene
+/// traits, without a dependency of your own.
+pub use anim_core;
+/// The trait whose `step` advances this crate's simulations.
+pub use anim_core::solver::Solver;
+
 #[cfg(test)]
 mod contact_shape_tests;
 #[cfg(test)]

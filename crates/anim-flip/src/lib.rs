@@ -28,3 +28,9 @@ pub use sim::{FlipParams, FlipSimulation, Sampling, StepInfo, StepTimes};
 pub use surface::{Contour, Mesh, ParticleSurface, SurfaceParams};
 pub use tank::TankMotion;
 pub use transfer::Transfer;
+
+/// anim-core, the math and contracts this crate builds on: its `glam`, integrators and scene
+/// traits, without a dependency of your own.
+pub use anim_core;
+/// The trait whose `step` advances this crate's simulations.
+pub use anim_core::solver::Solver;

@@ -17,6 +17,12 @@ pub use models::{
 };
 pub use tangent::Tangent;
 
+/// anim-core, the math and contracts this crate builds on: its `glam`, integrators and scene
+/// traits, without a dependency of your own.
+pub use anim_core;
+/// The trait whose `step` advances this crate's simulations.
+pub use anim_core::solver::Solver;
+
 use anim_core::scalar::Real;
 use nalgebra::{RealField, SMatrix};
 

@@ -37,6 +37,12 @@ pub use material::{Elastic, ElasticModel, Fluid, Material, Sand, Snow};
 pub use particles::Particles;
 pub use sim::{MpmParams, MpmSimulation, OutOfDomain, StepStats, Totals, Transfer, max_resolution};
 
+/// anim-core, the math and contracts this crate builds on: its `glam`, integrators and scene
+/// traits, without a dependency of your own.
+pub use anim_core;
+/// The trait whose `step` advances this crate's simulations.
+pub use anim_core::solver::Solver;
+
 /// A `D`-vector of the particle precision.
 pub type Vector<const D: usize> = nalgebra::SVector<f32, D>;
 /// A `D x D` matrix of the particle precision.

@@ -23,5 +23,11 @@ pub use kind::KIND;
 pub use model::{ContactBody, Particle, PbdModel, SparseGradient, VolumeMesh, Wind};
 pub use sim::{Method, PbdError, PbdParams, PbdSimulation, SolverKind, StepInfo};
 
+/// anim-core, the math and contracts this crate builds on: its `glam`, integrators and scene
+/// traits, without a dependency of your own.
+pub use anim_core;
+/// The trait whose `step` advances this crate's simulations.
+pub use anim_core::solver::Solver;
+
 #[cfg(test)]
 mod tests;

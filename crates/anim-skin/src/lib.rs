@@ -22,6 +22,12 @@ pub use mesh::{MAX_INFLUENCES, SkinnedMesh, signed_volume};
 pub use skeleton::{Joint, Pose, Skeleton, Skin, Trs};
 pub use skinning::{Skinned, SkinningMethod, skin};
 
+/// anim-core, the math and contracts this crate builds on: its `glam`, integrators and scene
+/// traits, without a dependency of your own.
+pub use anim_core;
+/// The trait whose `step` advances this crate's simulations.
+pub use anim_core::solver::Solver;
+
 /// Invalid skeletons, skins, meshes, channels, and joint transforms DQS cannot blend.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]

@@ -26,5 +26,11 @@ pub use network::{
 };
 pub use sim::{DEFAULT_MAX_STRETCH, SpringError, SpringSimulation};
 
+/// anim-core, the math and contracts this crate builds on: its `glam`, integrators and scene
+/// traits, without a dependency of your own.
+pub use anim_core;
+/// The trait whose `step` advances this crate's simulations.
+pub use anim_core::solver::Solver;
+
 #[cfg(test)]
 mod tests;
