@@ -59,7 +59,7 @@ use anim_core::scene::study::Candidate;
 pub use anim_core::scene::study::{FORMAT, Family, Machine, Point, Series, Table, parse_table};
 
 /// The report's table, embedded at build time.
-pub const TABLE: &str = include_str!("../../../docs/report/cheapest.json");
+pub const TABLE: &str = include_str!("../cheapest.json");
 
 /// What `--tolerance` did to a scene.
 #[derive(Debug, Clone, PartialEq)]
