@@ -11,6 +11,7 @@
 //! Panda swing across thread counts (`determinism`) and a soak run of the pendulum chain
 //! (`soak`).
 
+pub mod collection;
 mod determinism;
 mod dynamics;
 mod ik;
@@ -106,6 +107,11 @@ pub fn register(r: &mut Registry) {
         run: ik::panda_success_rate,
     });
     dynamics::register(r);
+    r.conformance.push(ConformanceCase {
+        crate_name: CRATE,
+        name: "example-robot-data collection vs Pinocchio (65 robots, fixed and floating base): FK, Jacobians, RNEA, CRBA, ABA",
+        run: Box::new(collection::pinocchio_collection),
+    });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "determinism: Panda swing on 1, 2, 4 threads",
