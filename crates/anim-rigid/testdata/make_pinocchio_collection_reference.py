@@ -17,24 +17,36 @@ robot's samples do not depend on which other robots are present:
   free flyer: translation in [-1, 1]^3 and a uniformly random unit quaternion (x, y, z, w);
 - v in [-2, 2], a in [-3, 3], tau in [-10, 10] (every robot, no scaling by size).
 
-Per sample, in this order, little-endian float64 (Pinocchio's layout and conventions):
+Fixed base, per sample, in this order, little-endian float64 (Pinocchio's layout and conventions):
 
     q (nq), v (nv), a (nv), tau (nv),
-    oMi: for joints 1..njoints-1, the rotation row-major (9) then the translation (3),
-         from `pin.computeJointJacobians` (which runs forward kinematics),
-    J:   `data.J` after `pin.computeJointJacobians`, 6 x nv stored column by column (linear
-         then angular part of each column, world frame),
+    oMi:  for joints 1..njoints-1, the rotation row by row (9) then the translation (3), after
+          `pin.computeJointJacobians` (which runs forward kinematics),
     rnea: `pin.rnea(q, v, a)`, gravity (0, 0, -9.81) included (nv),
     crba: the upper triangle of `pin.crba(q)`, row by row (nv (nv + 1) / 2),
     aba:  `pin.aba(q, v, tau)` (nv).
 
+`data.J` after `computeJointJacobians` (the world Jacobian, 6 x nv) is not stored: its columns
+are `Ad(oMi) S` of the stored `oMi` and of each joint's motion subspace `S` (in the header), and
+the script checks that this reproduces `data.J` to 1e-13 before writing.
+
+Floating base: sample k has the joint configuration of fixed-base sample k on a random base
+placement, so its `oMi` are the root placement times the fixed-base `oMi` and the joint block of
+`H` is the fixed-base `H` (both checked to 1e-13). Per sample it stores what those do not give:
+
+    q (nq), v (nv), a (nv), tau (nv), oMi of root_joint (12), rnea (nv),
+    the first 6 rows of the upper triangle of `pin.crba(q)` (row r from column r on), aba (nv).
+
 Output (`--out DIR`, default `pinocchio_collection/` beside this script): `index.json`, one line
-per robot and base with the model header (joint names, Pinocchio joint types, parents, idx_q,
-idx_v, nq, nv) and the data file's name, or the message with which Pinocchio refused the URDF;
-and `<path without .urdf>.<base>.f64.gz` per loaded model (gzip level 9, no file name, time stamp
+per robot and base with the model header (per joint: name, Pinocchio joint type, parent, idx_q,
+idx_v, width in q and in v, motion subspace `S` column by column; nq, nv, njoints, seed) and the
+data file's name, or one line per URDF Pinocchio refuses, with its message; and `<path without .urdf>.<base>.f64.gz` per loaded model (gzip level 9, no file name, time stamp
 0). Running the script twice gives identical bytes. `--only PREFIX` keeps the paths starting with
 PREFIX (e.g. `--only alex_description` for the models whose licence keeps them out of the
-repository).
+repository: `--robots <site-packages>/cmeel.prefix/share/example-robot-data/robots --only
+alex_description --out DIR`, then set `ANIM_ROBOT_COLLECTION` to that robots directory and
+`ANIM_ROBOT_COLLECTION_REFERENCE` to DIR for `cargo test -p anim-rigid --features cases --test
+pinocchio_collection`).
 """
 
 import argparse
