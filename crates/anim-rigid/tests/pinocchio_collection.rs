@@ -72,6 +72,22 @@ fn every_robot_of_the_collection_matches_pinocchio() {
         failures.join("\n")
     );
     let compared = results.iter().filter(|r| matches!(r.outcome, Outcome::Compared { .. })).count();
+    // H is singular only where whole subtrees have neither mass nor inertia (romeo's hands): there
+    // forward dynamics is undefined, and Pinocchio's ABA returns no finite answer.
+    let mut singular = Vec::new();
+    for r in &results {
+        if let Outcome::Compared { errors, samples, .. } = r.outcome {
+            if errors.singular > 0 {
+                assert_eq!((errors.singular, errors.singular_reference_finite), (samples, 0), "{}", r.urdf);
+                singular.push(r.urdf.as_str());
+            }
+        }
+    }
+    singular.dedup();
+    assert_eq!(
+        singular,
+        ["romeo_description/urdf/romeo.urdf", "romeo_description/urdf/romeo_laas_small.urdf"]
+    );
     // 66 URDFs, one refused by Pinocchio, each of the others on two bases.
     assert_eq!(compared, 2 * 65);
     let refused: Vec<_> =
