@@ -76,11 +76,11 @@ fn every_robot_of_the_collection_matches_pinocchio() {
     // forward dynamics is undefined, and Pinocchio's ABA returns no finite answer.
     let mut singular = Vec::new();
     for r in &results {
-        if let Outcome::Compared { errors, samples, .. } = r.outcome {
-            if errors.singular > 0 {
-                assert_eq!((errors.singular, errors.singular_reference_finite), (samples, 0), "{}", r.urdf);
-                singular.push(r.urdf.as_str());
-            }
+        if let Outcome::Compared { errors, samples, .. } = r.outcome
+            && errors.singular > 0
+        {
+            assert_eq!((errors.singular, errors.singular_reference_finite), (samples, 0), "{}", r.urdf);
+            singular.push(r.urdf.as_str());
         }
     }
     singular.dedup();
