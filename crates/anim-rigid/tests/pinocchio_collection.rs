@@ -24,7 +24,7 @@ fn report(results: &[ModelResult]) -> Vec<String> {
             Outcome::Compared { samples, errors, nv } => {
                 let v = errors.values();
                 eprintln!(
-                    "{:<62} {base:<8} nv {nv:>3} x{samples}: fk {:.1e} J {:.1e} rnea {:.1e} crba {:.1e} aba {:.1e} ({:.2} nv eps cond, cond {:.1e}, {} singular H, finite ABA on {})",
+                    "{:<62} {base:<8} nv {nv:>3} x{samples}: fk {:.1e} J {:.1e} rnea {:.1e} crba {:.1e} aba {:.1e} ({:.1e} nv eps cond, cond {:.1e}, {} singular H, finite ABA on {})",
                     r.urdf,
                     v[0],
                     v[1],

@@ -41,7 +41,7 @@
 //! system, `|δx| / |x| <= c nv ε κ` (Higham, *Accuracy and Stability of Numerical Algorithms*,
 //! 2002, ch. 7 and 10); [`ABA_C`] `= 2` because both libraries round, each within one such bound,
 //! and the two use different recursions (world-frame here, local-frame in Pinocchio). The
-//! bound is loose for ill-conditioned robots (iCub, `κ` up to 4e12, stays below 1e-3 of it) and
+//! bound is loose for ill-conditioned robots (iCub, `κ` up to 4e12, stays within 3e-3 of it) and
 //! reaches 0.9 of it on the 3-joint finger_edu (`κ` = 23, error 7.6e-15). Samples where `H` is
 //! numerically singular (`nv ε κ(H) >= 1`: romeo's hands, whose finger links have neither mass
 //! nor inertia) have no forward dynamics; Pinocchio's ABA returns NaN there and they are
