@@ -7,10 +7,13 @@
 //! solutions reproducing their targets. Hard cases of inverse kinematics (`ik`): IK at
 //! singularities, unreachable targets, workspace-boundary targets, and the numerical IK success
 //! rate on the Panda. Dynamics (`dynamics`): RNEA, CRBA, ABA against Pinocchio, cross-checks,
-//! steppers, the T-handle, their hard cases and the work-precision study. Determinism of the
+//! steppers, the T-handle, their hard cases and the work-precision study. The example-robot-data
+//! collection (`collection`): FK, world Jacobians, RNEA, CRBA and ABA of every robot on a fixed
+//! and a floating base against Pinocchio. Determinism of the
 //! Panda swing across thread counts (`determinism`) and a soak run of the pendulum chain
 //! (`soak`).
 
+pub mod collection;
 mod determinism;
 mod dynamics;
 mod ik;
@@ -106,6 +109,11 @@ pub fn register(r: &mut Registry) {
         run: ik::panda_success_rate,
     });
     dynamics::register(r);
+    r.conformance.push(ConformanceCase {
+        crate_name: CRATE,
+        name: "example-robot-data collection vs Pinocchio (66 URDFs, fixed and floating base): FK, Jacobians, RNEA, CRBA, ABA",
+        run: Box::new(collection::pinocchio_collection),
+    });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "determinism: Panda swing on 1, 2, 4 threads",
