@@ -9,6 +9,7 @@
 //! | suites | the same command, running only `xtask/tests/suites.rs`: the quick conformance and stability suites through the `xtask` binary of this build |
 //! | doc tests | `cargo test --workspace --doc` |
 //! | docs | `cargo doc --workspace --no-deps` with warnings denied |
+//! | crates alone | each library crate as a user who picks it alone gets it: clippy on anim-core, anim-rigid, anim-pbd, anim-skin and anim-springs with `--no-default-features`; anim-core's tests without its default features (no faer, no rayon); `cargo package --workspace --no-verify` (every crate's manifest, README and files complete); `xtask consumer` (a project outside the workspace on anim-pbd and anim-rigid, newest compatible dependency versions) |
 //!
 //! The runner has no dependencies, so it starts at once, and the suites run in the test build
 //! (one build of the workspace, the features of every member unified) instead of a build of
@@ -49,6 +50,21 @@ fn cargo(args: &[&str], env: &[(&str, &str)]) -> bool {
     ok
 }
 
+/// Runs a program built by the tests step (the `xtask` binary).
+fn run(program: &std::path::Path, args: &[&str]) -> bool {
+    eprintln!("\n== {} {}", program.display(), args.join(" "));
+    let start = Instant::now();
+    let ok = match Command::new(program).args(args).status() {
+        Ok(status) => status.success(),
+        Err(e) => {
+            eprintln!("could not run {}: {e}", program.display());
+            false
+        }
+    };
+    eprintln!("== {} in {:.0} s", if ok { "ok" } else { "FAILED" }, start.elapsed().as_secs_f64());
+    ok
+}
+
 fn main() -> ExitCode {
     if let Some(arg) = std::env::args().nth(1) {
         eprintln!("error: `cargo ci` takes no arguments, got '{arg}'");
@@ -57,7 +73,27 @@ fn main() -> ExitCode {
     let start = Instant::now();
     let tests = [&TEST[..], &["--", "--skip", QUICK_CASES_TEST, "--skip", SUITES_TEST]].concat();
     let suites = [&TEST[..], &["--", "--exact", SUITES_TEST]].concat();
-    let steps: [(&str, &dyn Fn() -> bool); 6] = [
+    let target = std::env::var("CARGO_TARGET_DIR").unwrap_or_else(|_| "target".into());
+    let xtask = std::path::Path::new(&target).join("debug").join("xtask");
+    let alone = [
+        "clippy",
+        "-p",
+        "anim-core",
+        "-p",
+        "anim-rigid",
+        "-p",
+        "anim-pbd",
+        "-p",
+        "anim-skin",
+        "-p",
+        "anim-springs",
+        "--no-default-features",
+        "--all-targets",
+        "--",
+        "-D",
+        "warnings",
+    ];
+    let steps: [(&str, &dyn Fn() -> bool); 7] = [
         ("format", &|| cargo(&["fmt", "--all", "--", "--check"], &[])),
         ("clippy", &|| cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"], &[])),
         // The examples are type-checked and linted by clippy above; linking each of them here
@@ -66,6 +102,14 @@ fn main() -> ExitCode {
         ("suites", &|| cargo(&suites, &[])),
         ("doc tests", &|| cargo(&["test", "--workspace", "--doc"], &[])),
         ("docs", &|| cargo(&["doc", "--workspace", "--no-deps"], &[("RUSTDOCFLAGS", "-D warnings")])),
+        ("crates alone", &|| {
+            // Each part runs even when one before it failed, so one run shows every problem.
+            let lint = cargo(&alone, &[]);
+            let core = cargo(&["test", "-p", "anim-core", "--no-default-features", "--lib", "--tests"], &[]);
+            let package = cargo(&["package", "--workspace", "--no-verify", "--allow-dirty"], &[]);
+            let consumer = run(&xtask, &["consumer"]);
+            lint && core && package && consumer
+        }),
     ];
     let mut failed = Vec::new();
     for (name, step) in steps {
