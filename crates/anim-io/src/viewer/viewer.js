@@ -20,6 +20,14 @@ function viridis(s, out, at) {
   const x = Math.min(Math.max(s, 0), 1) * (VIRIDIS.length - 1), i = Math.min(Math.floor(x), VIRIDIS.length - 2), f = x - i;
   for (let c = 0; c < 3; c++) out[at + c] = (VIRIDIS[i][c] * (1 - f) + VIRIDIS[i + 1][c] * f) / 255;
 }
+// The colours above are sRGB, as the previews draw them; three.js treats vertex colours as linear
+// and converts its output to sRGB, so vertex colours are written through this.
+function linear(out, at) {
+  for (let c = at; c < at + 3; c++) {
+    const v = out[c];
+    out[c] = v <= 0.04045 ? v / 12.92 : Math.pow((v + 0.055) / 1.055, 2.4);
+  }
+}
 // The previews' categorical palette (Tableau 10).
 const PALETTE = [[0x4e, 0x79, 0xa7], [0xf2, 0x8e, 0x2b], [0x59, 0xa1, 0x4f], [0xe1, 0x57, 0x59], [0x76, 0xb7, 0xb2],
   [0xed, 0xc9, 0x48], [0xb0, 0x7a, 0xa1], [0xff, 0x9d, 0xa7], [0x9c, 0x75, 0x5f], [0xba, 0xb0, 0xac]].map((c) => c.map((x) => x / 255));
@@ -245,6 +253,7 @@ function buildBodies(first) {
     if (g.dim === 2) {
       const data = new Uint8Array(4 * g.dims[0] * g.dims[1]);
       const tex = new THREE.DataTexture(data, g.dims[0], g.dims[1], THREE.RGBAFormat);
+      tex.colorSpace = THREE.SRGBColorSpace; // the bytes are sRGB viridis, as in the previews
       tex.magFilter = THREE.LinearFilter;
       const m = new THREE.Mesh(new THREE.PlaneGeometry(g.dims[0] * g.spacing, g.dims[1] * g.spacing), new THREE.MeshBasicMaterial({ map: tex }));
       m.position.set(g.origin[0] + (g.dims[0] * g.spacing) / 2, g.origin[1] + (g.dims[1] * g.spacing) / 2, g.origin[2]);
@@ -329,7 +338,7 @@ function scalar(v, k, comps) {
 function paint(f, o, out) {
   const n = out.length / 3;
   if (!o || !o.name || !f.parts[o.name]) {
-    for (let i = 0; i < n; i++) out.set(BODY, 3 * i);
+    for (let i = 0; i < n; i++) { out.set(BODY, 3 * i); linear(out, 3 * i); }
     return;
   }
   const v = f.parts[o.name].values, [lo, hi] = o.range;
@@ -337,6 +346,7 @@ function paint(f, o, out) {
     const s = scalar(v, i * o.comps, o.comps);
     if (o.categorical) out.set(PALETTE[Math.abs(Math.round(s)) % PALETTE.length], 3 * i);
     else viridis((s - lo) / (hi - lo), out, 3 * i);
+    linear(out, 3 * i);
   }
 }
 function legend(o) {
@@ -420,6 +430,7 @@ function showImage(part, o) {
       if (s < 0.05) continue;
       pos.setXYZ(m, g.origin[0] + (x + 0.5) * g.spacing, g.origin[1] + (y + 0.5) * g.spacing, g.origin[2] + (z + 0.5) * g.spacing);
       viridis(s, col.array, 3 * m);
+      linear(col.array, 3 * m);
       m++;
     }
     image.points.geometry.setDrawRange(0, m);
