@@ -183,9 +183,9 @@ pub use checked::InputError;
 pub use data::Data;
 pub use dense::SquareMatrix;
 pub use dynamics::{
-    DynamicsError, aba, center_of_mass, crba, crba_local, crba_world, factor_mass_matrix,
-    forward_dynamics_cholesky, gravity_torques, kinetic_energy, nonlinear_effects, potential_energy, rnea,
-    solve_mass_matrix, spatial_momentum,
+    DynamicsError, aba, aba_local, aba_world, center_of_mass, crba, crba_local, crba_world,
+    factor_mass_matrix, forward_dynamics_cholesky, gravity_torques, kinetic_energy, nonlinear_effects,
+    potential_energy, rnea, solve_mass_matrix, spatial_momentum,
 };
 pub use ik::{AnalyticIk, AnalyticIkKind, IkError, IkParams, IkReport, IkSolution, NumericalIk};
 pub use jacobian::{

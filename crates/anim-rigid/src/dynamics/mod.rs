@@ -99,6 +99,8 @@
 //! bodies and contact are not modelled here.
 
 mod aba;
+mod aba_local;
+mod aba_world;
 mod check;
 mod cholesky;
 mod crba;
@@ -107,6 +109,8 @@ mod rnea;
 mod subspace;
 
 pub use aba::aba;
+pub use aba_local::aba_local;
+pub use aba_world::aba_world;
 pub use cholesky::{DynamicsError, factor_mass_matrix, forward_dynamics_cholesky, solve_mass_matrix};
 pub use crba::{LOCAL_DEPTH, crba, crba_local, crba_world};
 pub use energy::{center_of_mass, kinetic_energy, potential_energy, spatial_momentum};
