@@ -6,8 +6,10 @@ use crate::data::Data;
 use crate::model::Model;
 
 /// Forward dynamics `v̇ = FD(q, v, τ)` by the articulated-body algorithm, gravity included;
-/// written into `data.ddq` and returned. This is [`aba_local`](super::aba_local), and writes
-/// the same [`Data`] fields.
+/// written into `data.ddq` and returned. This is [`aba_world`](super::aba_world), and writes
+/// the same [`Data`] fields: the faster form on the robots measured (see the module
+/// documentation of [`crate::dynamics`]). [`aba_local`](super::aba_local) is the accurate one
+/// for bodies far from the world origin or ill-conditioned trees.
 ///
 /// A joint whose articulated inertia `D = Sᵀ Iᴬ S` is singular (a massless leaf body) gives
 /// non-finite accelerations; the simulation layer reports them at the step that made them.
@@ -16,7 +18,7 @@ use crate::model::Model;
 /// When `q`, `v`, `tau` or `data` does not match `model`.
 #[track_caller]
 pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], tau: &[f64]) -> &'d [f64] {
-    super::aba_local(model, data, q, v, tau)
+    super::aba_world(model, data, q, v, tau)
 }
 
 /// The inverse of the leading `n x n` block of `d` (symmetric positive definite in ABA) by

@@ -10,7 +10,6 @@
 //! about a point on its joint axis, and the lever arms stay the length of one link.
 
 use anim_core::glam::DVec3;
-use anim_core::lie::Se3;
 
 use crate::data::Data;
 use crate::dynamics::aba::invert_spd;
@@ -57,13 +56,13 @@ fn project_axis(kind: &JointType, f: &Force) -> f64 {
 /// bodies' distance from the world origin (see the module documentation of
 /// [`crate::dynamics`]).
 ///
-/// Also writes `data.joint_placements`, `data.world_placements`, the body velocities
+/// Also writes `data.joint_placements`, the body velocities
 /// `data.body_velocities` and accelerations minus gravity `data.body_accelerations` (each in its
 /// joint frame, as [`rnea`](crate::rnea) writes them), and the articulated inertias and bias
 /// forces of every subtree (`data.articulated_inertias`, `data.articulated_forces`) **in the
 /// joint's own frame**, after the joint's degrees of freedom are eliminated. Unlike
-/// [`aba_world`](super::aba_world) it does not write `data.jacobian`, `data.velocities` or
-/// `data.world_accelerations`.
+/// [`aba_world`](super::aba_world) it does not write `data.world_placements`, `data.jacobian`,
+/// `data.velocities` or `data.world_accelerations`.
 ///
 /// A joint whose articulated inertia `D = Sᵀ Iᴬ S` is singular (a massless leaf body) gives
 /// non-finite accelerations.
@@ -77,17 +76,15 @@ pub fn aba_local<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], ta
     check_v(model, "tau", tau);
     let joints = model.joints();
     let n = joints.len();
-    data.world_placements[0] = Se3::IDENTITY;
     data.body_velocities[0] = Motion::ZERO;
 
-    // Pass 1, root to leaves: placements, velocities, velocity-product accelerations, rigid
+    // Pass 1, root to leaves: joint placements, velocities, velocity-product accelerations, rigid
     // inertias and bias forces, all in the body's joint frame.
     for i in 1..n {
         let joint = &joints[i];
         let (iq, iv) = (joint.idx_q, joint.idx_v);
         let m = joint_placement(&joint.placement, &joint.kind, &q[iq..iq + joint.nq()]);
         data.joint_placements[i] = m;
-        data.world_placements[i] = data.world_placements[joint.parent] * m;
         let vj = joint_motion(&joint.kind, &v[iv..iv + joint.nv()]);
         let vel = data.body_velocities[joint.parent].inverse_transform(&m) + vj;
         data.body_velocities[i] = vel;
