@@ -126,10 +126,10 @@ pub fn aba_local<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], ta
                 let mut uu = [0.0; 6];
                 uu.copy_from_slice(&tau[iv..iv + 6]);
                 let p = pa.to_array();
-                for a in 0..6 {
-                    uu[a] -= p[a];
-                    data.aba_uu[iv + a] = uu[a];
+                for (x, pk) in uu.iter_mut().zip(p) {
+                    *x -= pk;
                 }
+                data.aba_uu[iv..iv + 6].copy_from_slice(&uu);
                 data.aba_dinv[iv..iv + 6].copy_from_slice(&invert_spd(&d, 6));
                 ia = ArticulatedInertia::ZERO;
                 pa += Force::from_array(uu);
