@@ -1,6 +1,6 @@
 //! Criterion benches of anim-rigid on the Franka Panda (fingers locked, 7 DoF): forward
 //! kinematics, frame placements, joint Jacobians, one frame Jacobian, the analytic and numerical
-//! IK; and the dynamics (RNEA, CRBA, ABA, the Cholesky forward dynamics, one simulation step) on
+//! IK; and the dynamics (RNEA, CRBA, ABA in both forms, the Cholesky forward dynamics, one simulation step) on
 //! the Panda and the 32-joint chain of `crates/anim-rigid/testdata/chain32.urdf`, over 1024
 //! pre-generated random inputs. `cargo xtask bench --peers` compares FK, Jacobians, RNEA, CRBA
 //! and ABA with Pinocchio's C++.
@@ -9,9 +9,9 @@ use anim_core::solver::Solver;
 use anim_rigid::config::random_configuration;
 use anim_rigid::sim::{RigidIntegrator, RigidSimulation, SimParams};
 use anim_rigid::{
-    AnalyticIk, Data, IkParams, Jacobian, Model, NumericalIk, ReferenceFrame, UrdfOptions, aba,
-    compute_joint_jacobians, crba, crba_local, crba_world, forward_dynamics_cholesky, forward_kinematics,
-    frame_jacobian, frames_forward_kinematics, load_urdf, rnea,
+    AnalyticIk, Data, IkParams, Jacobian, Model, NumericalIk, ReferenceFrame, UrdfOptions, aba, aba_local,
+    aba_world, compute_joint_jacobians, crba, crba_local, crba_world, forward_dynamics_cholesky,
+    forward_kinematics, frame_jacobian, frames_forward_kinematics, load_urdf, rnea,
 };
 use criterion::{Criterion, criterion_group, criterion_main};
 use rand::{Rng, SeedableRng};
@@ -166,6 +166,20 @@ fn dynamics(c: &mut Criterion) {
                 i = (i + 1) & 1023;
                 let (q, v, _, tau) = &inputs[i];
                 black_box(aba(&model, &mut data, black_box(q), black_box(v), black_box(tau))[last])
+            })
+        });
+        g.bench_function("aba_local", |b| {
+            b.iter(|| {
+                i = (i + 1) & 1023;
+                let (q, v, _, tau) = &inputs[i];
+                black_box(aba_local(&model, &mut data, black_box(q), black_box(v), black_box(tau))[last])
+            })
+        });
+        g.bench_function("aba_world", |b| {
+            b.iter(|| {
+                i = (i + 1) & 1023;
+                let (q, v, _, tau) = &inputs[i];
+                black_box(aba_world(&model, &mut data, black_box(q), black_box(v), black_box(tau))[last])
             })
         });
         g.bench_function("forward_dynamics_cholesky", |b| {

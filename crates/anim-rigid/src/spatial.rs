@@ -103,22 +103,17 @@ fn outer(a: DVec3, b: DVec3) -> DMat3 {
     DMat3::from_cols(a * b.x, a * b.y, a * b.z)
 }
 
-/// `â b̂` for the cross-product matrices of `a` and `b` (`= b aᵀ - (a·b) I`).
+/// `â b̂` for the cross-product matrices of `a` and `b` (`= b aᵀ - (a·b) I`), with each diagonal
+/// entry summed from the two other coordinates (`-(a_y b_y + a_z b_z)`, ...) rather than as
+/// `b_x a_x - a·b`, which cancels when `a` lies near a coordinate axis (a centre of mass on a
+/// joint axis).
 #[inline(always)]
 fn hat_hat(a: DVec3, b: DVec3) -> DMat3 {
-    let d = a.dot(b);
-    let m = outer(b, a);
-    DMat3::from_cols(m.x_axis - DVec3::X * d, m.y_axis - DVec3::Y * d, m.z_axis - DVec3::Z * d)
-}
-
-/// `M â` for a 3x3 matrix `M` (column `j` of `â` is `a × e_j`).
-#[inline(always)]
-fn mul_hat(m: &DMat3, a: DVec3) -> DMat3 {
-    // â = [[0, -a_z, a_y], [a_z, 0, -a_x], [-a_y, a_x, 0]]; columns of M â:
+    let (xx, yy, zz) = (a.x * b.x, a.y * b.y, a.z * b.z);
     DMat3::from_cols(
-        m.y_axis * a.z - m.z_axis * a.y,
-        m.z_axis * a.x - m.x_axis * a.z,
-        m.x_axis * a.y - m.y_axis * a.x,
+        DVec3::new(-(yy + zz), b.y * a.x, b.z * a.x),
+        DVec3::new(b.x * a.y, -(xx + zz), b.z * a.y),
+        DVec3::new(b.x * a.z, b.y * a.z, -(xx + yy)),
     )
 }
 
@@ -477,11 +472,12 @@ impl SpatialInertia {
         let c = g.transform_point(inertia.com);
         let [s00, s01, s02, s11, s12, s22] = rotate_symmetric(&g.rotation, &inertia.rotational);
         let h = c * m;
-        let d = h.dot(c);
+        // m (|c|² I - c cᵀ), each diagonal entry from the two other coordinates (no cancellation).
+        let (xx, yy, zz) = (h.x * c.x, h.y * c.y, h.z * c.z);
         let rotational = DMat3::from_cols(
-            DVec3::new(s00 + d - h.x * c.x, s01 - h.y * c.x, s02 - h.z * c.x),
-            DVec3::new(s01 - h.x * c.y, s11 + d - h.y * c.y, s12 - h.z * c.y),
-            DVec3::new(s02 - h.x * c.z, s12 - h.y * c.z, s22 + d - h.z * c.z),
+            DVec3::new(s00 + (yy + zz), s01 - h.y * c.x, s02 - h.z * c.x),
+            DVec3::new(s01 - h.x * c.y, s11 + (xx + zz), s12 - h.z * c.y),
+            DVec3::new(s02 - h.x * c.z, s12 - h.y * c.z, s22 + (xx + yy)),
         );
         SpatialInertia { mass: m, first_moment: h, rotational }
     }
@@ -656,21 +652,22 @@ impl ArticulatedInertia {
 
     /// This inertia, given in frame `B`, expressed in frame `A` with `g = ᴬM_B = (R, t)`:
     /// `Ad_g⁻ᵀ I Ad_g⁻¹`. After rotating every block by `R`,
-    /// `A' = A`, `B' = B - A t̂`, `C' = C + t̂ B - Bᵀ t̂ - t̂ A t̂`.
+    /// `A' = A`, `B' = B - A t̂`, `C' = C + (t̂ B)ᵀ + t̂ B'` (`= C + t̂ B - Bᵀ t̂ - t̂ A t̂`), in
+    /// that order of operations (Pinocchio's `SE3actOn`), each `t̂ M` a column of cross products.
+    #[inline]
     #[must_use]
     pub fn transform(&self, g: &Se3) -> ArticulatedInertia {
         let r = g.rotation;
         let rt = r.transpose();
+        let t = g.translation;
         let a = r * self.a * rt;
         let b = r * self.b * rt;
-        let c = r * self.c * rt;
-        let t = g.translation;
-        let a_t = mul_hat(&a, t); // A t̂
-        let tb = mul_hat(&b.transpose(), t).transpose() * -1.0; // t̂ B = -(Bᵀ t̂)ᵀ
-        let b_new = b - a_t;
-        // C' = C + t̂B + (t̂B)ᵀ - t̂ A t̂, and -t̂ A t̂ = (A t̂)ᵀ t̂ ... computed as t̂ (A t̂) with a sign.
-        let t_a_t = mul_hat(&a_t.transpose(), t).transpose() * -1.0; // t̂ (A t̂) = -((A t̂)ᵀ t̂)ᵀ
-        ArticulatedInertia { a, b: b_new, c: c + tb + tb.transpose() - t_a_t }
+        let mut c = r * self.c * rt;
+        let hat = |m: &DMat3| DMat3::from_cols(t.cross(m.x_axis), t.cross(m.y_axis), t.cross(m.z_axis));
+        c += hat(&b).transpose();
+        let b_new = (hat(&a) + b.transpose()).transpose();
+        c += hat(&b_new);
+        ArticulatedInertia { a, b: b_new, c }
     }
 
     /// The 6x6 matrix (row-major, linear first).

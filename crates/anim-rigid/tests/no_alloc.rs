@@ -1,5 +1,5 @@
 //! The architecture invariant "no solver allocates inside `step`" and "no algorithm allocates":
-//! after a first call, RNEA, the bias and gravity terms, both forms of CRBA, ABA, the Cholesky
+//! after a first call, RNEA, the bias and gravity terms, both forms of CRBA, both forms of ABA, the Cholesky
 //! forward dynamics, the energies and momentum, and a simulation step with every stepper (torques,
 //! damping and limits on) perform no heap allocation. Counted by a wrapping global allocator, so
 //! this file is its own test binary.
@@ -15,8 +15,8 @@ use anim_rigid::config::neutral;
 use anim_rigid::scenes;
 use anim_rigid::sim::{RigidIntegrator, RigidSimulation, SimParams};
 use anim_rigid::{
-    Data, aba, crba, crba_local, crba_world, forward_dynamics_cholesky, gravity_torques, kinetic_energy,
-    nonlinear_effects, potential_energy, rnea, spatial_momentum,
+    Data, aba, aba_local, aba_world, crba, crba_local, crba_world, forward_dynamics_cholesky,
+    gravity_torques, kinetic_energy, nonlinear_effects, potential_energy, rnea, spatial_momentum,
 };
 
 #[global_allocator]
@@ -57,6 +57,8 @@ fn algorithms_and_steps_do_not_allocate() {
             let _ = crba_local(&model, &mut data, &q);
             let _ = crba_world(&model, &mut data, &q);
             let _ = aba(&model, &mut data, &q, &v, &a);
+            let _ = aba_local(&model, &mut data, &q, &v, &a);
+            let _ = aba_world(&model, &mut data, &q, &v, &a);
             let _ = forward_dynamics_cholesky(&model, &mut data, &q, &v, &a).unwrap();
             let _ = kinetic_energy(&model, &mut data, &q, &v) + potential_energy(&model, &mut data, &q);
             let _ = spatial_momentum(&model, &mut data, &q, &v);

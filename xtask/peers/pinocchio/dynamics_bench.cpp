@@ -9,6 +9,8 @@
 //
 // usage: dynamics_bench MODEL_FILE CALLS_PER_BATCH
 // MODEL_FILE lines: "joint PARENT TYPE AX AY AZ R00..R22 TX TY TZ LOWER UPPER MASS CX CY CZ I00..I22"
+// TYPE: RX RY RZ RU (revolute), PX PY PZ PU (prismatic), RUBX RUBY RUBZ RUBU (revolute without
+// limits, q = (cos, sin)), FF (free flyer, q = (x, y, z, qx, qy, qz, qw)).
 // prints one JSON object per line: {"kernel": ..., "ns_per_call": ..., "checksum": ...}
 
 #include <pinocchio/algorithm/aba.hpp>
@@ -17,6 +19,7 @@
 #include <pinocchio/multibody.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -79,6 +82,9 @@ int main(int argc, char** argv) {
     const Eigen::VectorXd lower = Eigen::VectorXd::Constant(1, lo), upper = Eigen::VectorXd::Constant(1, hi);
     pinocchio::JointIndex id = 0;
     const auto add = [&](const auto& joint) { id = model.addJoint(parent, joint, placement, name, e, e, lower, upper); };
+    // (cos, sin) of a revolute joint without limits: two configuration bounds.
+    const Eigen::VectorXd lo2 = Eigen::VectorXd::Constant(2, -1.0), hi2 = Eigen::VectorXd::Constant(2, 1.0);
+    const auto add_unbounded = [&](const auto& joint) { id = model.addJoint(parent, joint, placement, name, e, e, lo2, hi2); };
     if (type == "RX") add(pinocchio::JointModelRX());
     else if (type == "RY") add(pinocchio::JointModelRY());
     else if (type == "RZ") add(pinocchio::JointModelRZ());
@@ -87,6 +93,16 @@ int main(int argc, char** argv) {
     else if (type == "PY") add(pinocchio::JointModelPY());
     else if (type == "PZ") add(pinocchio::JointModelPZ());
     else if (type == "PU") add(pinocchio::JointModelPrismaticUnaligned(axis));
+    else if (type == "RUBX") add_unbounded(pinocchio::JointModelRUBX());
+    else if (type == "RUBY") add_unbounded(pinocchio::JointModelRUBY());
+    else if (type == "RUBZ") add_unbounded(pinocchio::JointModelRUBZ());
+    else if (type == "RUBU") add_unbounded(pinocchio::JointModelRevoluteUnboundedUnaligned(axis));
+    else if (type == "FF") {
+      // Bounds of the translation; the quaternion is drawn apart.
+      const Eigen::VectorXd e6 = Eigen::VectorXd::Constant(6, 1e3);
+      const Eigen::VectorXd lo7 = Eigen::VectorXd::Constant(7, -1.0), hi7 = Eigen::VectorXd::Constant(7, 1.0);
+      id = model.addJoint(parent, pinocchio::JointModelFreeFlyer(), placement, name, e6, e6, lo7, hi7);
+    }
     else {
       std::fprintf(stderr, "unsupported joint type %s\n", type.c_str());
       return 2;
@@ -103,8 +119,21 @@ int main(int argc, char** argv) {
   std::vector<Eigen::VectorXd> qs, vs, as, taus;
   for (int k = 0; k < n; ++k) {
     Eigen::VectorXd q(model.nq), v(model.nv), acc(model.nv), tau(model.nv);
-    for (int i = 0; i < model.nq; ++i)
-      q[i] = model.lowerPositionLimit[i] + (model.upperPositionLimit[i] - model.lowerPositionLimit[i]) * u(rng);
+    for (pinocchio::JointIndex j = 1; j < (pinocchio::JointIndex)model.njoints; ++j) {
+      const int iq = model.joints[j].idx_q();
+      const std::string kind = model.joints[j].shortname();
+      if (kind == "JointModelFreeFlyer") {
+        for (int i = 0; i < 3; ++i) q[iq + i] = 2.0 * u(rng) - 1.0;
+        Eigen::Vector4d quat(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
+        q.segment<4>(iq + 3) = quat.normalized();
+      } else if (kind.rfind("JointModelRUB", 0) == 0 || kind == "JointModelRevoluteUnboundedUnaligned") {
+        const double theta = 2.0 * M_PI * u(rng) - M_PI;
+        q[iq] = std::cos(theta);
+        q[iq + 1] = std::sin(theta);
+      } else {
+        q[iq] = model.lowerPositionLimit[iq] + (model.upperPositionLimit[iq] - model.lowerPositionLimit[iq]) * u(rng);
+      }
+    }
     for (int i = 0; i < model.nv; ++i) {
       v[i] = 4.0 * u(rng) - 2.0;
       acc[i] = 6.0 * u(rng) - 3.0;

@@ -1,8 +1,11 @@
 //! `cargo xtask bench --peers`, anim-rigid part: forward kinematics and joint Jacobians on the
-//! Franka Panda (fingers locked, 7 DoF) and the UR5, and RNEA, CRBA and ABA on the Panda, the UR5
-//! and the 32-joint chain of `crates/anim-rigid/testdata/chain32.urdf`, ns per call, against
-//! Pinocchio's C++ library from the `pin` wheel (header-only, `g++ -O3 -march=native`), measured
-//! side by side.
+//! Franka Panda (fingers locked, 7 DoF) and the UR5, and RNEA, CRBA and ABA on the Panda, the UR5,
+//! the 32-joint chain of `crates/anim-rigid/testdata/chain32.urdf` and, from the gzip'd
+//! example-robot-data URDFs under `testdata/robots`, iCub (32 DoF), TIAGo without hand (12 DoF)
+//! and the human model (36 DoF) on fixed bases, ns per call, against Pinocchio's C++ library from
+//! the `pin` wheel (header-only, `g++ -O3 -march=native`), measured side by side. ABA is timed in
+//! both of our forms too (`aba_local`, `aba_world`, each against Pinocchio's same convention),
+//! with the per-round ratio of our two forms.
 //!
 //! The C++ programs (`xtask/peers/pinocchio/kinematics_bench.cpp`, `dynamics_bench.cpp`) build
 //! their Pinocchio model from a text file written here from anim-rigid's model of the same URDF,
@@ -19,8 +22,8 @@ use std::process::Command;
 use std::time::Instant;
 
 use anim_rigid::{
-    Axis, Data, JointType, Model, UrdfOptions, aba, compute_joint_jacobians, crba, forward_kinematics,
-    load_urdf, rnea,
+    Axis, Data, JointType, Model, UrdfOptions, aba, aba_local, aba_world, compute_joint_jacobians, crba,
+    forward_kinematics, load_urdf, parse_urdf, rnea,
 };
 
 /// The timing programs, relative to the xtask crate, and their binaries under `target/xtask`.
@@ -29,7 +32,7 @@ const DYNAMICS: (&str, &str) = ("peers/pinocchio/dynamics_bench.cpp", "pinocchio
 const CALLS_PER_BATCH: usize = 20_000;
 const BATCHES: usize = 15;
 const CONFIGS: usize = 1024;
-const ROUNDS: usize = 3;
+const ROUNDS: usize = 5;
 
 /// The `cmeel.prefix` holding Pinocchio's and Eigen's headers, if present.
 fn find_prefix() -> Option<PathBuf> {
@@ -110,12 +113,32 @@ fn build(prefix: &Path, (source, name): (&str, &str)) -> Result<PathBuf, String>
     Ok(bin)
 }
 
+/// Loads a URDF, gzip'd when its name ends in `.gz`.
+fn load(path: &Path, options: &UrdfOptions) -> Result<Model, String> {
+    if path.extension().is_some_and(|e| e == "gz") {
+        use std::io::Read;
+        let mut xml = String::new();
+        std::fs::File::open(path)
+            .and_then(|f| flate2::read::GzDecoder::new(f).read_to_string(&mut xml))
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        parse_urdf(&xml, options).map_err(|e| format!("{}: {e}", path.display()))
+    } else {
+        load_urdf(path, options).map_err(|e| e.to_string())
+    }
+}
+
 /// The model as the timing programs read it: one line per joint, with the body's inertia
 /// (mass, centre of mass, rotational inertia about it, row-major) after the limits.
 fn model_file(model: &Model, path: &Path) -> Result<(), String> {
     let mut s = String::new();
     for (i, j) in model.joints().iter().enumerate().skip(1) {
+        let unbounded = anim_rigid::pinocchio::is_unbounded_revolute(j);
         let (code, axis) = match j.kind {
+            JointType::Revolute(Axis::X) if unbounded => ("RUBX", Axis::X.vector()),
+            JointType::Revolute(Axis::Y) if unbounded => ("RUBY", Axis::Y.vector()),
+            JointType::Revolute(Axis::Z) if unbounded => ("RUBZ", Axis::Z.vector()),
+            JointType::Revolute(a) if unbounded => ("RUBU", a.vector()),
+            JointType::Free => ("FF", Axis::X.vector()),
             JointType::Revolute(Axis::X) => ("RX", Axis::X.vector()),
             JointType::Revolute(Axis::Y) => ("RY", Axis::Y.vector()),
             JointType::Revolute(Axis::Z) => ("RZ", Axis::Z.vector()),
@@ -132,7 +155,9 @@ fn model_file(model: &Model, path: &Path) -> Result<(), String> {
         for x in r {
             s.push_str(&format!(" {x:e}"));
         }
-        s.push_str(&format!(" {:e} {:e} {:e} {:e} {:e}", t.x, t.y, t.z, j.limits.lower, j.limits.upper));
+        // The C++ reader takes no `inf`: no limit is written as ±1e300.
+        let (lower, upper) = (j.limits.lower.max(-1e300), j.limits.upper.min(1e300));
+        s.push_str(&format!(" {:e} {:e} {:e} {lower:e} {upper:e}", t.x, t.y, t.z));
         let inertia = &model.inertias()[i];
         s.push_str(&format!(
             " {:e} {:e} {:e} {:e}",
@@ -215,10 +240,13 @@ type Row = (String, &'static str, f64, f64, String);
 pub fn run() -> bool {
     let testdata = Path::new(env!("CARGO_MANIFEST_DIR")).join("../crates/anim-rigid/testdata");
     // (name, URDF, locked joints, time kinematics, time dynamics)
-    let robots: [(&str, &str, &[&str], bool, bool); 3] = [
+    let robots: [(&str, &str, &[&str], bool, bool); 6] = [
         ("panda", "panda.urdf", &["panda_finger_joint1", "panda_finger_joint2"], true, true),
         ("ur5", "ur5_robot.urdf", &[], true, true),
         ("chain32", "chain32.urdf", &[], false, true),
+        ("icub", "robots/icub_description/robots/icub.urdf.gz", &[], false, true),
+        ("tiago_no_hand", "robots/tiago_description/robots/tiago_no_hand.urdf.gz", &[], false, true),
+        ("human", "robots/human_description/robots/human.urdf.gz", &[], false, true),
     ];
     println!(
         "\npeer benchmark: anim-rigid vs Pinocchio (C++, header-only, g++ -O3 -march=native), ns per call: median of {BATCHES} batches of {CALLS_PER_BATCH} calls over {CONFIGS} random inputs, best of {ROUNDS} alternating rounds"
@@ -237,7 +265,7 @@ pub fn run() -> bool {
         for j in locked {
             options = options.lock_joint(j, 0.0);
         }
-        let model = match load_urdf(testdata.join(urdf), &options) {
+        let model = match load(&testdata.join(urdf), &options) {
             Ok(m) => m,
             Err(e) => {
                 eprintln!("{e}");
@@ -251,7 +279,9 @@ pub fn run() -> bool {
         }
         // Three alternating rounds, the fastest of each side: the machine is shared, and the
         // minimum over rounds is the least disturbed measurement.
-        let mut ours = [f64::INFINITY; 5];
+        let mut ours = [f64::INFINITY; 7];
+        // Per round: our aba_local / aba_world, measured back to back.
+        let mut local_over_world = Vec::new();
         let mut theirs: std::collections::BTreeMap<String, f64> = std::collections::BTreeMap::new();
         for _ in 0..ROUNDS {
             if kinematics {
@@ -268,6 +298,11 @@ pub fn run() -> bool {
                 ours[2] = ours[2].min(time_ours(&model, |m, d, s| rnea(m, d, &s.q, &s.v, &s.a)[m.nv() - 1]));
                 ours[3] = ours[3].min(time_ours(&model, |m, d, s| crba(m, d, &s.q)[(0, m.nv() - 1)]));
                 ours[4] = ours[4].min(time_ours(&model, |m, d, s| aba(m, d, &s.q, &s.v, &s.tau)[m.nv() - 1]));
+                let local = time_ours(&model, |m, d, s| aba_local(m, d, &s.q, &s.v, &s.tau)[m.nv() - 1]);
+                let world = time_ours(&model, |m, d, s| aba_world(m, d, &s.q, &s.v, &s.tau)[m.nv() - 1]);
+                ours[5] = ours[5].min(local);
+                ours[6] = ours[6].min(world);
+                local_over_world.push(local / world);
             }
             if peer_model.is_err() {
                 continue;
@@ -309,6 +344,17 @@ pub fn run() -> bool {
                 let (local, world) = (get(&format!("{kernel}_local")), get(&format!("{kernel}_world")));
                 let detail = format!("LOCAL {local:.1} ns, WORLD {world:.1} ns");
                 rows.push((name.to_string(), kernel, ours[k], local.min(world), detail));
+            }
+            for (k, kernel, convention) in [(5, "aba_local", "aba_local"), (6, "aba_world", "aba_world")] {
+                rows.push((name.to_string(), kernel, ours[k], get(convention), "same convention".into()));
+            }
+            local_over_world.sort_by(f64::total_cmp);
+            if let (Some(lo), Some(hi)) = (local_over_world.first(), local_over_world.last()) {
+                println!(
+                    "{name}: ours aba_local / aba_world per round: median {:.3}, range {lo:.3}-{hi:.3} ({} rounds)",
+                    local_over_world[local_over_world.len() / 2],
+                    local_over_world.len()
+                );
             }
         }
     }

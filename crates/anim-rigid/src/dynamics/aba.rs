@@ -1,24 +1,15 @@
-//! The articulated-body algorithm: forward dynamics in `O(n)` (Featherstone table 7.1), in the
-//! world frame. See [`crate::dynamics`] for the equations.
-
-use anim_core::glam::DVec3;
-use anim_core::lie::{Se3, Twist};
+//! The articulated-body algorithm: forward dynamics in `O(n)` (Featherstone table 7.1). [`aba`]
+//! is the default form; the two forms are [`aba_local`](super::aba_local) (joint frames) and
+//! [`aba_world`](super::aba_world) (world frame). See [`crate::dynamics`] for the equations.
 
 use crate::data::Data;
-use crate::dynamics::check::{check_q, check_v};
-use crate::jacobian::world_columns;
-use crate::kinematics::joint_placement;
 use crate::model::Model;
-use crate::spatial::{ArticulatedInertia, Force, Motion, SpatialInertia};
 
 /// Forward dynamics `v̇ = FD(q, v, τ)` by the articulated-body algorithm, gravity included;
-/// written into `data.ddq` and returned.
-///
-/// Also writes `data.joint_placements`, `data.world_placements`, the world Jacobian
-/// `data.jacobian`, the world body velocities `data.velocities`, the articulated inertias and
-/// bias forces of every subtree (`data.articulated_inertias`, `data.articulated_forces`, world
-/// frame, after the joint's own degrees of freedom are eliminated) and the body accelerations
-/// minus gravity (`data.world_accelerations`).
+/// written into `data.ddq` and returned. This is [`aba_world`](super::aba_world), and writes
+/// the same [`Data`] fields: the faster form on the robots measured (see the module
+/// documentation of [`crate::dynamics`]). [`aba_local`](super::aba_local) is the accurate one
+/// for bodies far from the world origin or ill-conditioned trees.
 ///
 /// A joint whose articulated inertia `D = Sᵀ Iᴬ S` is singular (a massless leaf body) gives
 /// non-finite accelerations; the simulation layer reports them at the step that made them.
@@ -27,137 +18,12 @@ use crate::spatial::{ArticulatedInertia, Force, Motion, SpatialInertia};
 /// When `q`, `v`, `tau` or `data` does not match `model`.
 #[track_caller]
 pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], tau: &[f64]) -> &'d [f64] {
-    check_q(model, data, q);
-    check_v(model, "v", v);
-    check_v(model, "tau", tau);
-    let joints = model.joints();
-    let inertias = model.inertias();
-    let n = joints.len();
-    data.world_placements[0] = Se3::IDENTITY;
-    data.velocities[0] = Twist::ZERO;
-
-    // Pass 1, root to leaves: placements, Jacobian columns, velocities, rigid inertias, biases.
-    {
-        let cols = data.jacobian.columns_mut();
-        for i in 1..n {
-            let joint = &joints[i];
-            let (iv, nv) = (joint.idx_v, joint.nv());
-            let m = joint_placement(&joint.placement, &joint.kind, &q[joint.idx_q..joint.idx_q + joint.nq()]);
-            let world = data.world_placements[joint.parent] * m;
-            data.joint_placements[i] = m;
-            data.world_placements[i] = world;
-            let js = &mut cols[iv..iv + nv];
-            world_columns(&joint.kind, &world, js);
-            let mut vj = Motion::ZERO;
-            for (c, &qd) in js.iter().zip(&v[iv..iv + nv]) {
-                vj += Motion::from(*c) * qd;
-            }
-            let parent_v = Motion::from(data.velocities[joint.parent]);
-            let vel = parent_v + vj;
-            data.velocities[i] = vel.into();
-            data.aba_bias[i] = parent_v.cross(&vj);
-            let y = SpatialInertia::from_inertia_at(&inertias[i], &world);
-            data.articulated_inertias[i] = ArticulatedInertia::from(y);
-            data.articulated_forces[i] = vel.cross_force(&y.mul_motion(&vel));
-        }
-    }
-
-    // Pass 2, leaves to root: eliminate each joint's degrees of freedom, pass the rest up.
-    let cols = data.jacobian.columns();
-    for i in (1..n).rev() {
-        let joint = &joints[i];
-        let (iv, nv) = (joint.idx_v, joint.nv());
-        let mut ia = data.articulated_inertias[i];
-        let mut pa = data.articulated_forces[i];
-        let c = data.aba_bias[i];
-        match nv {
-            0 => {}
-            1 => {
-                let s = Motion::from(cols[iv]);
-                let u = ia.mul_motion(&s);
-                let inv_d = 1.0 / s.dot(&u);
-                let uu = tau[iv] - s.dot(&pa);
-                ia.sub_rank_one(&u, inv_d);
-                pa += ia.mul_motion(&c) + u * (uu * inv_d);
-                data.aba_u[iv] = u;
-                data.aba_dinv[iv][0] = inv_d;
-                data.aba_uu[iv] = uu;
-            }
-            _ => {
-                let mut u = [Force::ZERO; 6];
-                let mut d = [[0.0; 6]; 6];
-                for a in 0..nv {
-                    u[a] = ia.mul_motion(&Motion::from(cols[iv + a]));
-                }
-                for a in 0..nv {
-                    let s = Motion::from(cols[iv + a]);
-                    for b in 0..nv {
-                        d[a][b] = s.dot(&u[b]);
-                    }
-                    data.aba_uu[iv + a] = tau[iv + a] - s.dot(&pa);
-                }
-                let dinv = invert_small(&d, nv);
-                let mut w = [Force::ZERO; 6];
-                for b in 0..nv {
-                    for a in 0..nv {
-                        w[b] += u[a] * dinv[a][b];
-                    }
-                }
-                for b in 0..nv {
-                    ia.sub_outer(&w[b], &u[b]);
-                }
-                let mut push = ia.mul_motion(&c);
-                for b in 0..nv {
-                    push += w[b] * data.aba_uu[iv + b];
-                }
-                pa += push;
-                data.aba_u[iv..iv + nv].copy_from_slice(&u[..nv]);
-                data.aba_dinv[iv..iv + nv].copy_from_slice(&dinv[..nv]);
-            }
-        }
-        data.articulated_inertias[i] = ia;
-        data.articulated_forces[i] = pa;
-        if joint.parent != 0 {
-            data.articulated_inertias[joint.parent] += ia;
-            data.articulated_forces[joint.parent] += pa;
-        }
-    }
-
-    // Pass 3, root to leaves: accelerations.
-    data.world_accelerations[0] = Motion::new(-model.gravity(), DVec3::ZERO);
-    for i in 1..n {
-        let joint = &joints[i];
-        let (iv, nv) = (joint.idx_v, joint.nv());
-        let mut acc = data.world_accelerations[joint.parent] + data.aba_bias[i];
-        match nv {
-            0 => {}
-            1 => {
-                let qdd = data.aba_dinv[iv][0] * (data.aba_uu[iv] - data.aba_u[iv].dot(&acc));
-                data.ddq[iv] = qdd;
-                acc += Motion::from(cols[iv]) * qdd;
-            }
-            _ => {
-                let mut r = [0.0; 6];
-                for b in 0..nv {
-                    r[b] = data.aba_uu[iv + b] - data.aba_u[iv + b].dot(&acc);
-                }
-                let mut delta = Motion::ZERO;
-                for a in 0..nv {
-                    let qdd: f64 = (0..nv).map(|b| data.aba_dinv[iv + a][b] * r[b]).sum();
-                    data.ddq[iv + a] = qdd;
-                    delta += Motion::from(cols[iv + a]) * qdd;
-                }
-                acc += delta;
-            }
-        }
-        data.world_accelerations[i] = acc;
-    }
-    &data.ddq
+    super::aba_world(model, data, q, v, tau)
 }
 
 /// The inverse of the leading `n x n` block of `d` (symmetric positive definite in ABA) by
 /// Gauss-Jordan elimination with partial pivoting; a singular block gives non-finite entries.
-fn invert_small(d: &[[f64; 6]; 6], n: usize) -> [[f64; 6]; 6] {
+pub(crate) fn invert_small(d: &[[f64; 6]; 6], n: usize) -> [[f64; 6]; 6] {
     let mut a = *d;
     let mut inv = [[0.0; 6]; 6];
     for i in 0..n {
@@ -187,6 +53,53 @@ fn invert_small(d: &[[f64; 6]; 6], n: usize) -> [[f64; 6]; 6] {
                     }
                 }
             }
+        }
+    }
+    inv
+}
+
+/// The inverse of the leading `n x n` block of the symmetric positive-definite `d` by its
+/// Cholesky factor `d = L Lᵀ`, `d⁻¹ = L⁻ᵀ L⁻¹` (Pinocchio inverts the joint block `D` of ABA the
+/// same way); the result is symmetric. A block that is not positive definite gives non-finite
+/// entries.
+pub(crate) fn invert_spd(d: &[[f64; 6]; 6], n: usize) -> [[f64; 6]; 6] {
+    let mut l = [[0.0; 6]; 6];
+    for j in 0..n {
+        let mut s = d[j][j];
+        for k in 0..j {
+            s -= l[j][k] * l[j][k];
+        }
+        let ljj = s.sqrt();
+        l[j][j] = ljj;
+        for i in j + 1..n {
+            let mut s = d[i][j];
+            for k in 0..j {
+                s -= l[i][k] * l[j][k];
+            }
+            l[i][j] = s / ljj;
+        }
+    }
+    // M = L⁻¹ (lower triangular) by forward substitution, then d⁻¹ = Mᵀ M.
+    let mut m = [[0.0; 6]; 6];
+    for j in 0..n {
+        m[j][j] = 1.0 / l[j][j];
+        for i in j + 1..n {
+            let mut s = 0.0;
+            for k in j..i {
+                s -= l[i][k] * m[k][j];
+            }
+            m[i][j] = s / l[i][i];
+        }
+    }
+    let mut inv = [[0.0; 6]; 6];
+    for i in 0..n {
+        for j in 0..=i {
+            let mut s = 0.0;
+            for k in i..n {
+                s += m[k][i] * m[k][j];
+            }
+            inv[i][j] = s;
+            inv[j][i] = s;
         }
     }
     inv

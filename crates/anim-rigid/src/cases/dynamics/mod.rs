@@ -5,9 +5,11 @@
 //! orders; the Dzhanibekov flip period against Euler's top; the energy balance with torques,
 //! damping and limits ([`conformance`]). Hard cases: the torque-free spinning body over 1e5 steps
 //! per stepper, a 100-link chain, a 1e-4 mass-ratio chain, joints driven into their limits, a
-//! massless leaf ([`hard_cases`]). Study: work-precision of the steppers on the 32-link pendulum
-//! chain ([`study`]).
+//! massless leaf ([`hard_cases`]). The accuracy of the two forms of ABA on iCub, TIAGo and the
+//! human model against an exact solve, beside Pinocchio's ([`aba_accuracy`]). Study:
+//! work-precision of the steppers on the 32-link pendulum chain ([`study`]).
 
+mod aba_accuracy;
 mod conformance;
 mod hard_cases;
 mod study;
@@ -23,6 +25,11 @@ pub(super) fn register(r: &mut Registry) {
         crate_name: CRATE,
         name: "RNEA, CRBA, C, g, ABA vs Pinocchio (Panda, UR5, chain32, floating Panda)",
         run: Box::new(conformance::pinocchio_dynamics),
+    });
+    r.conformance.push(ConformanceCase {
+        crate_name: CRATE,
+        name: "ABA local and world vs an exact solve, with Pinocchio's (iCub, TIAGo, human)",
+        run: Box::new(aba_accuracy::aba_accuracy),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
