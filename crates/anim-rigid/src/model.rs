@@ -173,21 +173,53 @@ pub struct Joint {
     pub idx_q: usize,
     /// First index of this joint in the velocity `v` (and the Jacobian's columns).
     pub idx_v: usize,
+    /// When set, the joint is *coupled* to another one (URDF `<mimic>` with
+    /// [`crate::urdf::UrdfOptions::couple_mimic_joints`]): it owns no entry of `q` or `v`, and
+    /// [`idx_q`](Self::idx_q), [`idx_v`](Self::idx_v) are its master's, as in Pinocchio.
+    #[serde(default)]
+    pub mimic: Option<Mimic>,
+}
+
+/// How a coupled joint follows its master (Pinocchio's `JointModelMimic`): its position is
+/// `q = multiplier · q_master + offset`, its velocity `multiplier · v_master`, and the force it
+/// transmits adds `multiplier · Sᵀ f` to the master's generalised force (the virtual-work
+/// dual of the same map).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Mimic {
+    /// The joint it follows (a one-degree-of-freedom joint that is not itself coupled, with a
+    /// lower index).
+    pub master: JointIndex,
+    /// Slope of the coupling (finite).
+    pub multiplier: f64,
+    /// Offset of the coupling (rad or m, finite).
+    pub offset: f64,
+    /// The column of [`crate::Data::jacobian`] that holds this joint's own world motion
+    /// (columns `nv..`, one per coupled joint in joint order; Pinocchio's extended columns).
+    pub column: usize,
+}
+
+impl Mimic {
+    /// The position of the coupled joint when its master is at `q_master`.
+    #[inline(always)]
+    #[must_use]
+    pub fn position(&self, q_master: f64) -> f64 {
+        self.multiplier * q_master + self.offset
+    }
 }
 
 impl Joint {
-    /// Number of configuration entries.
+    /// Number of configuration entries it owns (`0` for a coupled joint).
     #[inline]
     #[must_use]
     pub fn nq(&self) -> usize {
-        self.kind.nq()
+        if self.mimic.is_some() { 0 } else { self.kind.nq() }
     }
 
-    /// Number of velocity entries.
+    /// Number of velocity entries it owns (`0` for a coupled joint).
     #[inline]
     #[must_use]
     pub fn nv(&self) -> usize {
-        self.kind.nv()
+        if self.mimic.is_some() { 0 } else { self.kind.nv() }
     }
 }
 
@@ -265,6 +297,16 @@ pub enum ModelError {
         /// Effort limit.
         effort: f64,
     },
+    /// A coupled joint that cannot follow the joint it names.
+    #[error("joint '{joint}' cannot mimic joint '{master}': {reason}")]
+    BadMimic {
+        /// The coupled joint.
+        joint: String,
+        /// The joint it names.
+        master: String,
+        /// Why not.
+        reason: String,
+    },
     /// A gravity vector with a non-finite component.
     #[error("gravity {0:?} is not finite")]
     BadGravity([f64; 3]),
@@ -293,6 +335,8 @@ pub struct Model {
     upper: Vec<f64>,
     #[serde(default = "default_gravity")]
     gravity: DVec3,
+    #[serde(default)]
+    mimic_joints: Vec<JointIndex>,
 }
 
 /// Standard gravity along `-z`, `(0, 0, -9.81)` m/s² (Pinocchio's default).
@@ -328,6 +372,22 @@ impl Model {
     #[must_use]
     pub fn nv(&self) -> usize {
         self.nv
+    }
+
+    /// The coupled joints ([`Joint::mimic`]), in increasing index order; empty unless the model
+    /// was built with coupled mimic joints.
+    #[inline]
+    #[must_use]
+    pub fn mimic_joints(&self) -> &[JointIndex] {
+        &self.mimic_joints
+    }
+
+    /// Number of columns of [`crate::Data::jacobian`]: `nv`, plus one per coupled joint
+    /// (Pinocchio's `nvExtended`).
+    #[inline]
+    #[must_use]
+    pub fn nv_extended(&self) -> usize {
+        self.nv + self.mimic_joints.len()
     }
 
     /// Every joint in topological order; index `0` is the universe.
@@ -525,6 +585,7 @@ impl ModelBuilder {
             limits: JointLimits::UNBOUNDED,
             idx_q: 0,
             idx_v: 0,
+            mimic: None,
         };
         let frame = Frame {
             name: "universe".into(),
@@ -544,6 +605,7 @@ impl ModelBuilder {
                 lower: Vec::new(),
                 upper: Vec::new(),
                 gravity: DEFAULT_GRAVITY,
+                mimic_joints: Vec::new(),
             },
         }
     }
@@ -608,7 +670,16 @@ impl ModelBuilder {
             });
         }
         let index = m.joints.len();
-        m.joints.push(Joint { name: name.into(), kind, parent, placement, limits, idx_q: m.nq, idx_v: m.nv });
+        m.joints.push(Joint {
+            name: name.into(),
+            kind,
+            parent,
+            placement,
+            limits,
+            idx_q: m.nq,
+            idx_v: m.nv,
+            mimic: None,
+        });
         m.inertias.push(Inertia::ZERO);
         m.children.push(Vec::new());
         m.children[parent].push(index);
@@ -641,6 +712,73 @@ impl ModelBuilder {
             parent_joint: index,
             placement: Se3::IDENTITY,
         });
+        Ok(index)
+    }
+
+    /// Adds joint `name` like [`add_joint`](Self::add_joint), coupled to joint `master`: its
+    /// position is `multiplier · q_master + offset` and it owns no entry of `q` or `v`
+    /// ([`Mimic`]; Pinocchio's `JointModelMimic`). Its `limits` are kept on the joint but add
+    /// nothing to [`Model::lower_limits`].
+    ///
+    /// # Errors
+    /// As [`add_joint`](Self::add_joint), and [`ModelError::BadMimic`] when `kind` is not
+    /// revolute or prismatic, `master` does not exist yet, is not a revolute or prismatic joint,
+    /// is itself coupled (Pinocchio refuses chains too), or `multiplier`, `offset` are not
+    /// finite.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_mimic_joint(
+        &mut self,
+        parent: JointIndex,
+        name: &str,
+        kind: JointType,
+        placement: Se3,
+        limits: JointLimits,
+        master: JointIndex,
+        multiplier: f64,
+        offset: f64,
+    ) -> Result<JointIndex, ModelError> {
+        let bad = |master: String, reason: &str| ModelError::BadMimic {
+            joint: name.into(),
+            master,
+            reason: reason.into(),
+        };
+        let Some(m) = self.model.joints.get(master).filter(|_| master != 0) else {
+            return Err(bad(format!("#{master}"), "no such joint before it"));
+        };
+        let one_dof = |k: &JointType| matches!(k, JointType::Revolute(_) | JointType::Prismatic(_));
+        if !one_dof(&kind) {
+            return Err(bad(m.name.clone(), "only revolute and prismatic joints can be coupled"));
+        }
+        if !one_dof(&m.kind) {
+            return Err(bad(m.name.clone(), "the master is not a revolute or prismatic joint"));
+        }
+        if m.mimic.is_some() {
+            return Err(bad(
+                m.name.clone(),
+                "the master is itself coupled (chains of mimic joints are not supported)",
+            ));
+        }
+        if !multiplier.is_finite() || !offset.is_finite() {
+            return Err(bad(
+                m.name.clone(),
+                &format!("multiplier {multiplier} and offset {offset} must be finite"),
+            ));
+        }
+        let (idx_q, idx_v) = (m.idx_q, m.idx_v);
+        // Validate name, placement and limits exactly as an ordinary joint.
+        let (nq, nv) = (self.model.nq, self.model.nv);
+        let (nlower, nupper) = (self.model.lower.len(), self.model.upper.len());
+        let index = self.add_joint(parent, name, kind, placement, limits)?;
+        let model = &mut self.model;
+        model.nq = nq;
+        model.nv = nv;
+        model.lower.truncate(nlower);
+        model.upper.truncate(nupper);
+        let j = &mut model.joints[index];
+        j.idx_q = idx_q;
+        j.idx_v = idx_v;
+        j.mimic = Some(Mimic { master, multiplier, offset, column: 0 });
+        model.mimic_joints.push(index);
         Ok(index)
     }
 
@@ -707,7 +845,15 @@ impl ModelBuilder {
     /// The finished model.
     #[must_use]
     pub fn build(self) -> Model {
-        self.model
+        let mut model = self.model;
+        // Coupled joints' own Jacobian columns follow the `nv` columns of `v`.
+        let nv = model.nv;
+        for (k, &i) in model.mimic_joints.iter().enumerate() {
+            if let Some(m) = model.joints[i].mimic.as_mut() {
+                m.column = nv + k;
+            }
+        }
+        model
     }
 }
 
