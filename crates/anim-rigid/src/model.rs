@@ -54,8 +54,10 @@ pub type FrameIndex = usize;
 const PLACEMENT_TOL: f64 = 1e-9;
 
 mod joint_type;
+mod mimic;
 
 pub use joint_type::{Axis, JointType};
+pub use mimic::Mimic;
 
 /// Position, velocity and effort limits of a one-degree-of-freedom joint. Unbounded entries are
 /// infinite; multi-degree-of-freedom joints carry [`JointLimits::UNBOUNDED`].
@@ -178,33 +180,6 @@ pub struct Joint {
     /// [`idx_q`](Self::idx_q), [`idx_v`](Self::idx_v) are its master's, as in Pinocchio.
     #[serde(default)]
     pub mimic: Option<Mimic>,
-}
-
-/// How a coupled joint follows its master (Pinocchio's `JointModelMimic`): its position is
-/// `q = multiplier · q_master + offset`, its velocity `multiplier · v_master`, and the force it
-/// transmits adds `multiplier · Sᵀ f` to the master's generalised force (the virtual-work
-/// dual of the same map).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Mimic {
-    /// The joint it follows (a one-degree-of-freedom joint that is not itself coupled, with a
-    /// lower index).
-    pub master: JointIndex,
-    /// Slope of the coupling (finite).
-    pub multiplier: f64,
-    /// Offset of the coupling (rad or m, finite).
-    pub offset: f64,
-    /// The column of [`crate::Data::jacobian`] that holds this joint's own world motion
-    /// (columns `nv..`, one per coupled joint in joint order; Pinocchio's extended columns).
-    pub column: usize,
-}
-
-impl Mimic {
-    /// The position of the coupled joint when its master is at `q_master`.
-    #[inline(always)]
-    #[must_use]
-    pub fn position(&self, q_master: f64) -> f64 {
-        self.multiplier * q_master + self.offset
-    }
 }
 
 impl Joint {
@@ -715,73 +690,6 @@ impl ModelBuilder {
         Ok(index)
     }
 
-    /// Adds joint `name` like [`add_joint`](Self::add_joint), coupled to joint `master`: its
-    /// position is `multiplier · q_master + offset` and it owns no entry of `q` or `v`
-    /// ([`Mimic`]; Pinocchio's `JointModelMimic`). Its `limits` are kept on the joint but add
-    /// nothing to [`Model::lower_limits`].
-    ///
-    /// # Errors
-    /// As [`add_joint`](Self::add_joint), and [`ModelError::BadMimic`] when `kind` is not
-    /// revolute or prismatic, `master` does not exist yet, is not a revolute or prismatic joint,
-    /// is itself coupled (Pinocchio refuses chains too), or `multiplier`, `offset` are not
-    /// finite.
-    #[allow(clippy::too_many_arguments)]
-    pub fn add_mimic_joint(
-        &mut self,
-        parent: JointIndex,
-        name: &str,
-        kind: JointType,
-        placement: Se3,
-        limits: JointLimits,
-        master: JointIndex,
-        multiplier: f64,
-        offset: f64,
-    ) -> Result<JointIndex, ModelError> {
-        let bad = |master: String, reason: &str| ModelError::BadMimic {
-            joint: name.into(),
-            master,
-            reason: reason.into(),
-        };
-        let Some(m) = self.model.joints.get(master).filter(|_| master != 0) else {
-            return Err(bad(format!("#{master}"), "no such joint before it"));
-        };
-        let one_dof = |k: &JointType| matches!(k, JointType::Revolute(_) | JointType::Prismatic(_));
-        if !one_dof(&kind) {
-            return Err(bad(m.name.clone(), "only revolute and prismatic joints can be coupled"));
-        }
-        if !one_dof(&m.kind) {
-            return Err(bad(m.name.clone(), "the master is not a revolute or prismatic joint"));
-        }
-        if m.mimic.is_some() {
-            return Err(bad(
-                m.name.clone(),
-                "the master is itself coupled (chains of mimic joints are not supported)",
-            ));
-        }
-        if !multiplier.is_finite() || !offset.is_finite() {
-            return Err(bad(
-                m.name.clone(),
-                &format!("multiplier {multiplier} and offset {offset} must be finite"),
-            ));
-        }
-        let (idx_q, idx_v) = (m.idx_q, m.idx_v);
-        // Validate name, placement and limits exactly as an ordinary joint.
-        let (nq, nv) = (self.model.nq, self.model.nv);
-        let (nlower, nupper) = (self.model.lower.len(), self.model.upper.len());
-        let index = self.add_joint(parent, name, kind, placement, limits)?;
-        let model = &mut self.model;
-        model.nq = nq;
-        model.nv = nv;
-        model.lower.truncate(nlower);
-        model.upper.truncate(nupper);
-        let j = &mut model.joints[index];
-        j.idx_q = idx_q;
-        j.idx_v = idx_v;
-        j.mimic = Some(Mimic { master, multiplier, offset, column: 0 });
-        model.mimic_joints.push(index);
-        Ok(index)
-    }
-
     /// Adds the body `inertia`, given in a frame `B` with `placement = joint_M_B`, to the body
     /// carried by `joint` (Pinocchio's `appendBodyToJoint`).
     ///
@@ -866,83 +774,4 @@ fn check_placement(g: &Se3, what: &'static str, name: &str) -> Result<(), ModelE
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn axis_rotations_match_rodrigues() {
-        for axis in [Axis::X, Axis::Y, Axis::Z, Axis::Unaligned(DVec3::new(1.0, -2.0, 0.5).normalize())] {
-            for angle in [-2.5, -0.3, 0.0, 0.7, 3.1] {
-                let r = axis.rotation(angle);
-                let reference = so3::exp(axis.vector() * angle);
-                let err = (r - reference).to_cols_array().iter().fold(0.0_f64, |a, e| a.max(e.abs()));
-                assert!(err < 1e-15, "{axis:?} {angle}: {err}");
-            }
-        }
-    }
-
-    #[test]
-    fn axis_from_vector_snaps_and_rejects() {
-        assert_eq!(Axis::from_vector(DVec3::new(0.0, 0.0, 2.0)), Some(Axis::Z));
-        assert_eq!(Axis::from_vector(DVec3::ZERO), None);
-        assert_eq!(Axis::from_vector(DVec3::new(f64::NAN, 0.0, 1.0)), None);
-        assert!(matches!(Axis::from_vector(DVec3::new(0.0, -1.0, 0.0)), Some(Axis::Unaligned(_))));
-    }
-
-    #[test]
-    fn merged_inertia_matches_point_masses() {
-        // Two unit point masses at ±x: mass 2, com 0, inertia diag(0, 2, 2).
-        let a = Inertia::new(1.0, DVec3::X, DMat3::ZERO);
-        let b = Inertia::new(1.0, -DVec3::X, DMat3::ZERO);
-        let m = a.merged(&b);
-        assert_eq!(m.mass, 2.0);
-        assert_eq!(m.com, DVec3::ZERO);
-        assert!(
-            (m.rotational - DMat3::from_diagonal(DVec3::new(0.0, 2.0, 2.0))).abs_diff_eq(DMat3::ZERO, 1e-15)
-        );
-        assert_eq!(Inertia::ZERO.merged(&Inertia::ZERO), Inertia::ZERO);
-    }
-
-    #[test]
-    fn builder_rejects_bad_input() {
-        let mut b = ModelBuilder::new("m");
-        assert!(matches!(
-            b.add_joint(3, "j", JointType::Fixed, Se3::IDENTITY, JointLimits::UNBOUNDED),
-            Err(ModelError::UnknownParent { .. })
-        ));
-        let j =
-            b.add_joint(0, "j", JointType::Revolute(Axis::Z), Se3::IDENTITY, JointLimits::UNBOUNDED).unwrap();
-        assert!(matches!(
-            b.add_joint(j, "j", JointType::Fixed, Se3::IDENTITY, JointLimits::UNBOUNDED),
-            Err(ModelError::DuplicateJoint(_))
-        ));
-        assert!(matches!(
-            b.add_joint(
-                j,
-                "k",
-                JointType::Revolute(Axis::X),
-                Se3::IDENTITY,
-                JointLimits::position(1.0, -1.0)
-            ),
-            Err(ModelError::BadLimits { .. })
-        ));
-        let skew = Se3::new(DMat3::from_diagonal(DVec3::new(1.0, 2.0, 1.0)), DVec3::ZERO);
-        assert!(matches!(
-            b.add_joint(j, "k", JointType::Fixed, skew, JointLimits::UNBOUNDED),
-            Err(ModelError::BadPlacement { .. })
-        ));
-        assert!(matches!(
-            b.append_body(j, &Inertia::new(-1.0, DVec3::ZERO, DMat3::ZERO), &Se3::IDENTITY),
-            Err(ModelError::BadInertia { .. })
-        ));
-        let s = b
-            .add_joint(j, "ball", JointType::Spherical, Se3::IDENTITY, JointLimits::position(0.0, 1.0))
-            .unwrap();
-        let m = b.build();
-        assert_eq!(m.joint(s).limits, JointLimits::UNBOUNDED);
-        assert_eq!((m.nq(), m.nv()), (5, 4));
-        assert_eq!(m.support(s), vec![1, 2]);
-        assert!(m.is_ancestor(1, 2) && !m.is_ancestor(2, 1) && m.is_ancestor(0, 2));
-        assert_eq!(m.children(0), &[1]);
-    }
-}
+mod tests;
