@@ -8,8 +8,9 @@
 //! `prismatic`, `fixed`, `floating` ([`JointType::Free`]) and `planar` ([`JointType::Planar`],
 //! its `axis` the plane's normal, its `<limit>` ignored; Pinocchio ignores that axis and uses `+z`,
 //! so the two agree on planar joints whose axis is `0 0 1`). What is
-//! ignored without failing: `<visual>`, `<collision>`, `<material>`, `<mimic>` (the mimicking
-//! joint stays an independent joint, as in Pinocchio's default), `<dynamics>`,
+//! ignored without failing: `<visual>`, `<collision>`, `<material>`, `<mimic>` unless
+//! [`UrdfOptions::couple_mimic_joints`] is set (by default the mimicking joint stays an
+//! independent joint, as in Pinocchio's default), `<dynamics>`,
 //! `<safety_controller>`, `<transmission>`, `<gazebo>` and anything else, and, as urdfdom does,
 //! the `<axis>` of fixed and floating joints (it may be `0 0 0` there; on a revolute, continuous
 //! or prismatic joint a zero or non-finite axis is an error).
@@ -27,6 +28,14 @@
 //!   and the child's inertia is merged into the body of the nearest moving ancestor;
 //! - [`UrdfOptions::locked_joints`] turns named moving joints into fixed ones at a given
 //!   position first (Pinocchio's `buildReducedModel`; e.g. the Panda's finger joints);
+//! - with [`UrdfOptions::couple_mimic_joints`], a revolute, continuous or prismatic joint with
+//!   `<mimic joint="J" multiplier="m" offset="o"/>` (defaults `m = 1`, `o = 0`, as urdfdom)
+//!   follows `J`: `q = m · q_J + o`, no entry of its own in `q` and `v`
+//!   ([`crate::model::Mimic`]), as Pinocchio's `buildModelFromUrdf(..., mimic=True)`. The rules
+//!   are Pinocchio's: `J` must be a moving joint earlier in the depth-first order (romeo and
+//!   talos_full_v2 break this and are refused, by Pinocchio too), not itself a mimic, and a
+//!   continuous joint only follows a continuous one; `<mimic>` on a fixed or floating joint is
+//!   ignored; a locked `J` is refused unless the mimicking joint is locked too;
 //! - every moving joint gets a [`FrameKind::Joint`] frame, every link a [`FrameKind::Body`]
 //!   frame, and joint `0`'s frame is named `universe`.
 //!

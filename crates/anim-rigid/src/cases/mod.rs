@@ -8,13 +8,15 @@
 //! singularities, unreachable targets, workspace-boundary targets, and the numerical IK success
 //! rate on the Panda. Dynamics (`dynamics`): RNEA, CRBA, ABA against Pinocchio, cross-checks,
 //! steppers, the T-handle, their hard cases and the work-precision study. Determinism of the
-//! Panda swing across thread counts (`determinism`) and a soak run of the pendulum chain
+//! Panda swing across thread counts (`determinism`), coupled (mimic) joints against Pinocchio
+//! on the robots that have them (`mimic`) and a soak run of the pendulum chain
 //! (`soak`).
 
 mod determinism;
 mod dynamics;
 mod ik;
 mod kinematics;
+mod mimic;
 mod soak;
 
 use std::path::{Path, PathBuf};
@@ -106,6 +108,11 @@ pub fn register(r: &mut Registry) {
         run: ik::panda_success_rate,
     });
     dynamics::register(r);
+    r.conformance.push(ConformanceCase {
+        crate_name: CRATE,
+        name: "coupled (mimic) joints vs Pinocchio mimic=True (Panda, Baxter, PR2, TIAGo Pro)",
+        run: Box::new(mimic::pinocchio_mimic),
+    });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,
         name: "determinism: Panda swing on 1, 2, 4 threads",
