@@ -37,7 +37,7 @@ impl ModelBuilder {
     /// Adds joint `name` like [`add_joint`](Self::add_joint), coupled to joint `master`: its
     /// position is `multiplier · q_master + offset` and it owns no entry of `q` or `v`
     /// ([`Mimic`]; Pinocchio's `JointModelMimic`). Its `limits` are kept on the joint but add
-    /// nothing to [`Model::lower_limits`].
+    /// nothing to [`Model::lower_limits`](super::Model::lower_limits).
     ///
     /// # Errors
     /// As [`add_joint`](Self::add_joint), and [`ModelError::BadMimic`] when `kind` is not
