@@ -105,6 +105,14 @@ pub enum InputError {
         /// Its columns.
         got: usize,
     },
+    /// The algorithm does not handle this model.
+    #[error("{algorithm} does not handle this model: {reason}")]
+    Unsupported {
+        /// The algorithm.
+        algorithm: &'static str,
+        /// Why not, and what to use instead.
+        reason: &'static str,
+    },
     /// The dynamics failed on valid input (a mass matrix that is not positive definite).
     #[error(transparent)]
     Dynamics(#[from] DynamicsError),
@@ -320,7 +328,9 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d Squa
 /// [`crate::aba`], checked.
 ///
 /// # Errors
-/// A bad `q`, `v` or `tau`, or a `data` made for another model.
+/// A bad `q`, `v` or `tau`, a `data` made for another model, or [`InputError::Unsupported`]
+/// for a model with coupled joints ([`Model::mimic_joints`]; use
+/// [`forward_dynamics_cholesky`]).
 pub fn aba<'d>(
     model: &Model,
     data: &'d mut Data,
@@ -331,6 +341,12 @@ pub fn aba<'d>(
     check_q(model, data, q)?;
     check_tangent(model, "v", v)?;
     check_tangent(model, "tau", tau)?;
+    if !model.mimic_joints().is_empty() {
+        return Err(InputError::Unsupported {
+            algorithm: "aba",
+            reason: "the model has coupled (mimic) joints; forward_dynamics_cholesky handles them",
+        });
+    }
     Ok(crate::aba(model, data, q, v, tau))
 }
 

@@ -255,7 +255,8 @@ pub fn random_configuration(model: &Model, uniform: &mut impl FnMut() -> f64) ->
             b * (tau * u3).cos(),
         )
     };
-    for j in &model.joints()[1..] {
+    // A coupled joint has no entry of its own (it would redraw its master's).
+    for j in model.joints()[1..].iter().filter(|j| j.mimic.is_none()) {
         let iq = j.idx_q;
         match j.kind {
             JointType::Revolute(_) | JointType::Prismatic(_) => {

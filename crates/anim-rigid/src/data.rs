@@ -43,6 +43,8 @@ pub struct Data {
     /// The world (spatial) Jacobian of every joint, `6 x nv`: column `k` is the spatial twist
     /// `Ad(world_M_i) S_k` (linear part first, at the world origin) of the joint `i` owning
     /// velocity entry `k`. A joint's own Jacobian is this matrix restricted to its support.
+    /// With coupled joints it has [`Model::nv_extended`] columns: each coupled joint's own
+    /// motion follows the `nv` columns ([`crate::model::Mimic::column`]).
     pub jacobian: Jacobian,
     /// Time derivative of [`jacobian`](Self::jacobian) along the velocity last given to
     /// [`compute_joint_jacobians_time_variation`](crate::compute_joint_jacobians_time_variation).
@@ -82,7 +84,9 @@ pub struct Data {
     pub world_accelerations: Vec<Motion>,
     /// The parent of each degree of freedom in the tree of degrees of freedom (the previous
     /// degree of freedom of the same joint, or the last one of the nearest moving ancestor;
-    /// [`NO_PARENT`] at a root): the sparsity pattern of `H` and of its factor.
+    /// [`NO_PARENT`] at a root): the sparsity pattern of `H` and of its factor. With coupled
+    /// joints ([`Model::mimic_joints`]) `H` is treated as dense: degree of freedom `k`'s parent
+    /// is `k - 1`.
     pub dof_parents: Vec<usize>,
     /// Mean number of degrees of freedom from each degree of freedom to the root (itself
     /// included): chooses between the two forms of CRBA.
@@ -110,8 +114,8 @@ impl Data {
             joint_placements: vec![Se3::IDENTITY; model.njoints()],
             world_placements: vec![Se3::IDENTITY; model.njoints()],
             frame_placements: vec![Se3::IDENTITY; model.frames().len()],
-            jacobian: Jacobian::zeros(model.nv()),
-            jacobian_dot: Jacobian::zeros(model.nv()),
+            jacobian: Jacobian::zeros(model.nv_extended()),
+            jacobian_dot: Jacobian::zeros(model.nv_extended()),
             velocities: vec![Twist::ZERO; model.njoints()],
             tau: vec![0.0; model.nv()],
             nle: vec![0.0; model.nv()],
@@ -143,8 +147,8 @@ impl Data {
         self.joint_placements.len() == model.njoints()
             && self.world_placements.len() == model.njoints()
             && self.frame_placements.len() == model.frames().len()
-            && self.jacobian.ncols() == model.nv()
-            && self.jacobian_dot.ncols() == model.nv()
+            && self.jacobian.ncols() == model.nv_extended()
+            && self.jacobian_dot.ncols() == model.nv_extended()
             && self.velocities.len() == model.njoints()
             && self.tau.len() == model.nv()
             && self.mass_matrix.n() == model.nv()
@@ -167,6 +171,11 @@ fn mean_depth(parents: &[usize]) -> f64 {
 
 /// The parent of each degree of freedom (see [`Data::dof_parents`]).
 fn dof_parents(model: &Model) -> Vec<usize> {
+    if !model.mimic_joints().is_empty() {
+        // Coupling fills entries of the mass matrix between branches: treat it as dense (a
+        // chain), which the factorisation and the coupled CRBA handle.
+        return (0..model.nv()).map(|k| if k == 0 { NO_PARENT } else { k - 1 }).collect();
+    }
     let mut parents = vec![NO_PARENT; model.nv()];
     for j in &model.joints()[1..] {
         if j.nv() == 0 {

@@ -24,12 +24,21 @@
 //! `J̇_L = Ad(world_M_f)⁻¹ (J̇_W - [V_f, J_W])` and
 //! `J̇_LWA = [[I, -p̂], [0, I]] J̇_W - [[0, ṗ̂], [0, 0]] J_W`. Cost: one extra sweep, about the
 //! cost of the Jacobian itself.
+//!
+//! # Coupled joints
+//!
+//! A coupled joint ([`crate::model::Mimic`]) owns no column of `v`: [`Data::jacobian`] holds its
+//! own world motion times its multiplier in an extra column ([`crate::model::Mimic::column`],
+//! after the `nv` columns; Pinocchio's extended Jacobian, whose mimic columns are scaled the
+//! same way), and the joint and frame Jacobians add it to the master's column when the joint is
+//! in the support:
+//! `J[:, master] = Σ_{j ∈ support, j drives master} multiplier_j · Ad(world_M_j) S_j`.
 
 use anim_core::lie::{Se3, Twist};
 use serde::{Deserialize, Serialize};
 
 use crate::data::Data;
-use crate::kinematics::joint_placement;
+use crate::kinematics::local_placement;
 use crate::model::{FrameIndex, JointIndex, JointType, Model};
 
 pub use crate::matrix6x::Jacobian;
@@ -70,6 +79,15 @@ pub(crate) fn world_columns(kind: &JointType, world_m_i: &Se3, out: &mut [Twist]
     }
 }
 
+/// The extended column of a coupled joint: `multiplier · Ad(world_M_i) S_i` (Pinocchio's
+/// `data.J` column of a `JointModelMimic`).
+#[inline]
+pub(crate) fn mimic_column(kind: &JointType, multiplier: f64, world_m_i: &Se3, out: &mut Twist) {
+    let mut c = [Twist::ZERO];
+    world_columns(kind, world_m_i, &mut c);
+    *out = c[0].scale(multiplier);
+}
+
 #[track_caller]
 fn check_sizes(model: &Model, data: &Data, q: &[f64]) {
     assert_eq!(q.len(), model.nq(), "q has length {}, the model nq = {}", q.len(), model.nq());
@@ -86,11 +104,14 @@ pub fn compute_joint_jacobians(model: &Model, data: &mut Data, q: &[f64]) {
     check_sizes(model, data, q);
     let cols = data.jacobian.columns_mut();
     for (i, joint) in model.joints().iter().enumerate().skip(1) {
-        let local = joint_placement(&joint.placement, &joint.kind, &q[joint.idx_q..joint.idx_q + joint.nq()]);
+        let local = local_placement(joint, q);
         let world = data.world_placements[joint.parent] * local;
         data.joint_placements[i] = local;
         data.world_placements[i] = world;
-        world_columns(&joint.kind, &world, &mut cols[joint.idx_v..joint.idx_v + joint.nv()]);
+        match &joint.mimic {
+            None => world_columns(&joint.kind, &world, &mut cols[joint.idx_v..joint.idx_v + joint.nv()]),
+            Some(m) => mimic_column(&joint.kind, m.multiplier, &world, &mut cols[m.column]),
+        }
     }
 }
 
@@ -105,11 +126,20 @@ pub fn compute_joint_jacobians_time_variation(model: &Model, data: &mut Data, q:
     compute_joint_jacobians(model, data, q);
     data.velocities[0] = Twist::ZERO;
     for (i, joint) in model.joints().iter().enumerate().skip(1) {
-        let range = joint.idx_v..joint.idx_v + joint.nv();
         let mut vel = data.velocities[joint.parent];
-        for k in range.clone() {
-            vel += data.jacobian.column(k).scale(v[k]);
-        }
+        let range = match &joint.mimic {
+            None => {
+                let range = joint.idx_v..joint.idx_v + joint.nv();
+                for k in range.clone() {
+                    vel += data.jacobian.column(k).scale(v[k]);
+                }
+                range
+            }
+            Some(m) => {
+                vel += data.jacobian.column(m.column).scale(v[joint.idx_v]);
+                m.column..m.column + 1
+            }
+        };
         data.velocities[i] = vel;
         for k in range {
             data.jacobian_dot.columns_mut()[k] = vel.bracket(data.jacobian.column(k));
@@ -174,6 +204,23 @@ fn express(
         }
         j = jt.parent;
     }
+    if model.mimic_joints().is_empty() {
+        return;
+    }
+    // Coupled joints in the support add their own column to their master's.
+    let mut j = joint;
+    while j != 0 {
+        let jt = model.joint(j);
+        if let Some(m) = &jt.mimic {
+            let c = src.column(m.column);
+            out.columns[jt.idx_v] += match rf {
+                ReferenceFrame::World => c,
+                ReferenceFrame::Local => placement.adjoint_inv(c),
+                ReferenceFrame::LocalWorldAligned => Twist::new(c.v - p.cross(c.w), c.w),
+            };
+        }
+        j = jt.parent;
+    }
 }
 
 /// The time derivative of [`frame_jacobian`] along the velocity given to
@@ -209,6 +256,25 @@ pub fn frame_jacobian_time_variation(
             let c = data.jacobian.column(k);
             let dc = data.jacobian_dot.column(k);
             out.columns[k] = match rf {
+                ReferenceFrame::World => dc,
+                ReferenceFrame::Local => placement.adjoint_inv(dc - vel.bracket(c)),
+                ReferenceFrame::LocalWorldAligned => {
+                    Twist::new(dc.v - p.cross(dc.w) - p_dot.cross(c.w), dc.w)
+                }
+            };
+        }
+        j = jt.parent;
+    }
+    if model.mimic_joints().is_empty() {
+        return;
+    }
+    let mut j = f.parent_joint;
+    while j != 0 {
+        let jt = model.joint(j);
+        if let Some(m) = &jt.mimic {
+            let c = data.jacobian.column(m.column);
+            let dc = data.jacobian_dot.column(m.column);
+            out.columns[jt.idx_v] += match rf {
                 ReferenceFrame::World => dc,
                 ReferenceFrame::Local => placement.adjoint_inv(dc - vel.bracket(c)),
                 ReferenceFrame::LocalWorldAligned => {

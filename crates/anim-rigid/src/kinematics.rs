@@ -9,7 +9,7 @@ use anim_core::glam::{DMat3, DVec3};
 use anim_core::lie::Se3;
 
 use crate::data::Data;
-use crate::model::{Axis, FrameIndex, JointIndex, JointType, Model};
+use crate::model::{Axis, FrameIndex, Joint, JointIndex, JointType, Model};
 
 /// `placement · X_J(q)`, specialised per joint type (one sine/cosine and two column
 /// combinations for an axis-aligned revolute joint instead of a full 3x3 product).
@@ -42,6 +42,18 @@ pub(crate) fn joint_placement(placement: &Se3, kind: &JointType, q: &[f64]) -> S
     }
 }
 
+/// `parent_M_i(q)` of `joint`: its own entries of `q`, or for a coupled joint
+/// ([`crate::model::Mimic`]) `multiplier · q_master + offset`.
+#[inline(always)]
+pub(crate) fn local_placement(joint: &Joint, q: &[f64]) -> Se3 {
+    match &joint.mimic {
+        None => {
+            joint_placement(&joint.placement, &joint.kind, &q[joint.idx_q..joint.idx_q + joint.kind.nq()])
+        }
+        Some(m) => joint_placement(&joint.placement, &joint.kind, &[m.position(q[joint.idx_q])]),
+    }
+}
+
 #[track_caller]
 fn check_sizes(model: &Model, data: &Data, q: &[f64]) {
     assert_eq!(q.len(), model.nq(), "q has length {}, the model nq = {}", q.len(), model.nq());
@@ -57,7 +69,7 @@ fn check_sizes(model: &Model, data: &Data, q: &[f64]) {
 pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) {
     check_sizes(model, data, q);
     for (i, joint) in model.joints().iter().enumerate().skip(1) {
-        let local = joint_placement(&joint.placement, &joint.kind, &q[joint.idx_q..joint.idx_q + joint.nq()]);
+        let local = local_placement(joint, q);
         let world = data.world_placements[joint.parent] * local;
         data.joint_placements[i] = local;
         data.world_placements[i] = world;
@@ -110,8 +122,7 @@ pub fn joint_world_placement(model: &Model, q: &[f64], joint: JointIndex) -> Se3
     assert_eq!(q.len(), model.nq(), "q has length {}, the model nq = {}", q.len(), model.nq());
     let mut g = Se3::IDENTITY;
     for i in model.support(joint) {
-        let j = model.joint(i);
-        g *= joint_placement(&j.placement, &j.kind, &q[j.idx_q..j.idx_q + j.nq()]);
+        g *= local_placement(model.joint(i), q);
     }
     g
 }

@@ -202,7 +202,7 @@ pub use kinematics::{
 };
 pub use model::{
     Axis, DEFAULT_GRAVITY, Frame, FrameIndex, FrameKind, Inertia, Joint, JointIndex, JointLimits, JointType,
-    Model, ModelBuilder, ModelError,
+    Mimic, Model, ModelBuilder, ModelError,
 };
 pub use poe::PoeChain;
 pub use spatial::{ArticulatedInertia, Force, Motion, SpatialInertia};

@@ -54,8 +54,10 @@ pub type FrameIndex = usize;
 const PLACEMENT_TOL: f64 = 1e-9;
 
 mod joint_type;
+mod mimic;
 
 pub use joint_type::{Axis, JointType};
+pub use mimic::Mimic;
 
 /// Position, velocity and effort limits of a one-degree-of-freedom joint. Unbounded entries are
 /// infinite; multi-degree-of-freedom joints carry [`JointLimits::UNBOUNDED`].
@@ -173,21 +175,26 @@ pub struct Joint {
     pub idx_q: usize,
     /// First index of this joint in the velocity `v` (and the Jacobian's columns).
     pub idx_v: usize,
+    /// When set, the joint is *coupled* to another one (URDF `<mimic>` with
+    /// [`crate::urdf::UrdfOptions::couple_mimic_joints`]): it owns no entry of `q` or `v`, and
+    /// [`idx_q`](Self::idx_q), [`idx_v`](Self::idx_v) are its master's, as in Pinocchio.
+    #[serde(default)]
+    pub mimic: Option<Mimic>,
 }
 
 impl Joint {
-    /// Number of configuration entries.
+    /// Number of configuration entries it owns (`0` for a coupled joint).
     #[inline]
     #[must_use]
     pub fn nq(&self) -> usize {
-        self.kind.nq()
+        if self.mimic.is_some() { 0 } else { self.kind.nq() }
     }
 
-    /// Number of velocity entries.
+    /// Number of velocity entries it owns (`0` for a coupled joint).
     #[inline]
     #[must_use]
     pub fn nv(&self) -> usize {
-        self.kind.nv()
+        if self.mimic.is_some() { 0 } else { self.kind.nv() }
     }
 }
 
@@ -265,6 +272,16 @@ pub enum ModelError {
         /// Effort limit.
         effort: f64,
     },
+    /// A coupled joint that cannot follow the joint it names.
+    #[error("joint '{joint}' cannot mimic joint '{master}': {reason}")]
+    BadMimic {
+        /// The coupled joint.
+        joint: String,
+        /// The joint it names.
+        master: String,
+        /// Why not.
+        reason: String,
+    },
     /// A gravity vector with a non-finite component.
     #[error("gravity {0:?} is not finite")]
     BadGravity([f64; 3]),
@@ -293,6 +310,8 @@ pub struct Model {
     upper: Vec<f64>,
     #[serde(default = "default_gravity")]
     gravity: DVec3,
+    #[serde(default)]
+    mimic_joints: Vec<JointIndex>,
 }
 
 /// Standard gravity along `-z`, `(0, 0, -9.81)` m/s² (Pinocchio's default).
@@ -328,6 +347,22 @@ impl Model {
     #[must_use]
     pub fn nv(&self) -> usize {
         self.nv
+    }
+
+    /// The coupled joints ([`Joint::mimic`]), in increasing index order; empty unless the model
+    /// was built with coupled mimic joints.
+    #[inline]
+    #[must_use]
+    pub fn mimic_joints(&self) -> &[JointIndex] {
+        &self.mimic_joints
+    }
+
+    /// Number of columns of [`crate::Data::jacobian`]: `nv`, plus one per coupled joint
+    /// (Pinocchio's `nvExtended`).
+    #[inline]
+    #[must_use]
+    pub fn nv_extended(&self) -> usize {
+        self.nv + self.mimic_joints.len()
     }
 
     /// Every joint in topological order; index `0` is the universe.
@@ -525,6 +560,7 @@ impl ModelBuilder {
             limits: JointLimits::UNBOUNDED,
             idx_q: 0,
             idx_v: 0,
+            mimic: None,
         };
         let frame = Frame {
             name: "universe".into(),
@@ -544,6 +580,7 @@ impl ModelBuilder {
                 lower: Vec::new(),
                 upper: Vec::new(),
                 gravity: DEFAULT_GRAVITY,
+                mimic_joints: Vec::new(),
             },
         }
     }
@@ -608,7 +645,16 @@ impl ModelBuilder {
             });
         }
         let index = m.joints.len();
-        m.joints.push(Joint { name: name.into(), kind, parent, placement, limits, idx_q: m.nq, idx_v: m.nv });
+        m.joints.push(Joint {
+            name: name.into(),
+            kind,
+            parent,
+            placement,
+            limits,
+            idx_q: m.nq,
+            idx_v: m.nv,
+            mimic: None,
+        });
         m.inertias.push(Inertia::ZERO);
         m.children.push(Vec::new());
         m.children[parent].push(index);
@@ -707,7 +753,15 @@ impl ModelBuilder {
     /// The finished model.
     #[must_use]
     pub fn build(self) -> Model {
-        self.model
+        let mut model = self.model;
+        // Coupled joints' own Jacobian columns follow the `nv` columns of `v`.
+        let nv = model.nv;
+        for (k, &i) in model.mimic_joints.iter().enumerate() {
+            if let Some(m) = model.joints[i].mimic.as_mut() {
+                m.column = nv + k;
+            }
+        }
+        model
     }
 }
 
@@ -720,83 +774,4 @@ fn check_placement(g: &Se3, what: &'static str, name: &str) -> Result<(), ModelE
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn axis_rotations_match_rodrigues() {
-        for axis in [Axis::X, Axis::Y, Axis::Z, Axis::Unaligned(DVec3::new(1.0, -2.0, 0.5).normalize())] {
-            for angle in [-2.5, -0.3, 0.0, 0.7, 3.1] {
-                let r = axis.rotation(angle);
-                let reference = so3::exp(axis.vector() * angle);
-                let err = (r - reference).to_cols_array().iter().fold(0.0_f64, |a, e| a.max(e.abs()));
-                assert!(err < 1e-15, "{axis:?} {angle}: {err}");
-            }
-        }
-    }
-
-    #[test]
-    fn axis_from_vector_snaps_and_rejects() {
-        assert_eq!(Axis::from_vector(DVec3::new(0.0, 0.0, 2.0)), Some(Axis::Z));
-        assert_eq!(Axis::from_vector(DVec3::ZERO), None);
-        assert_eq!(Axis::from_vector(DVec3::new(f64::NAN, 0.0, 1.0)), None);
-        assert!(matches!(Axis::from_vector(DVec3::new(0.0, -1.0, 0.0)), Some(Axis::Unaligned(_))));
-    }
-
-    #[test]
-    fn merged_inertia_matches_point_masses() {
-        // Two unit point masses at ±x: mass 2, com 0, inertia diag(0, 2, 2).
-        let a = Inertia::new(1.0, DVec3::X, DMat3::ZERO);
-        let b = Inertia::new(1.0, -DVec3::X, DMat3::ZERO);
-        let m = a.merged(&b);
-        assert_eq!(m.mass, 2.0);
-        assert_eq!(m.com, DVec3::ZERO);
-        assert!(
-            (m.rotational - DMat3::from_diagonal(DVec3::new(0.0, 2.0, 2.0))).abs_diff_eq(DMat3::ZERO, 1e-15)
-        );
-        assert_eq!(Inertia::ZERO.merged(&Inertia::ZERO), Inertia::ZERO);
-    }
-
-    #[test]
-    fn builder_rejects_bad_input() {
-        let mut b = ModelBuilder::new("m");
-        assert!(matches!(
-            b.add_joint(3, "j", JointType::Fixed, Se3::IDENTITY, JointLimits::UNBOUNDED),
-            Err(ModelError::UnknownParent { .. })
-        ));
-        let j =
-            b.add_joint(0, "j", JointType::Revolute(Axis::Z), Se3::IDENTITY, JointLimits::UNBOUNDED).unwrap();
-        assert!(matches!(
-            b.add_joint(j, "j", JointType::Fixed, Se3::IDENTITY, JointLimits::UNBOUNDED),
-            Err(ModelError::DuplicateJoint(_))
-        ));
-        assert!(matches!(
-            b.add_joint(
-                j,
-                "k",
-                JointType::Revolute(Axis::X),
-                Se3::IDENTITY,
-                JointLimits::position(1.0, -1.0)
-            ),
-            Err(ModelError::BadLimits { .. })
-        ));
-        let skew = Se3::new(DMat3::from_diagonal(DVec3::new(1.0, 2.0, 1.0)), DVec3::ZERO);
-        assert!(matches!(
-            b.add_joint(j, "k", JointType::Fixed, skew, JointLimits::UNBOUNDED),
-            Err(ModelError::BadPlacement { .. })
-        ));
-        assert!(matches!(
-            b.append_body(j, &Inertia::new(-1.0, DVec3::ZERO, DMat3::ZERO), &Se3::IDENTITY),
-            Err(ModelError::BadInertia { .. })
-        ));
-        let s = b
-            .add_joint(j, "ball", JointType::Spherical, Se3::IDENTITY, JointLimits::position(0.0, 1.0))
-            .unwrap();
-        let m = b.build();
-        assert_eq!(m.joint(s).limits, JointLimits::UNBOUNDED);
-        assert_eq!((m.nq(), m.nv()), (5, 4));
-        assert_eq!(m.support(s), vec![1, 2]);
-        assert!(m.is_ancestor(1, 2) && !m.is_ancestor(2, 1) && m.is_ancestor(0, 2));
-        assert_eq!(m.children(0), &[1]);
-    }
-}
+mod tests;

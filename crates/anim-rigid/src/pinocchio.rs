@@ -16,6 +16,9 @@
 //! | planar | `(x, y, θ)` | `(x, y, cos θ, sin θ)` |
 //! | spherical, free | `(x, y, z, w)`, `(x, y, z, qx, qy, qz, qw)` | the same |
 //!
+//! A joint coupled to another ([`crate::model::Mimic`]) has no entry in either layout, and its
+//! `idx_q`, `idx_v` are its master's in both, as in a Pinocchio model built with `mimic=True`.
+//!
 //! [`to_pinocchio`] and [`from_pinocchio`] convert whole vectors; going to Pinocchio and back
 //! returns `θ` wrapped into `(-π, π]`, which places every frame at the same pose.
 
@@ -34,7 +37,9 @@ pub fn is_unbounded_revolute(joint: &Joint) -> bool {
 /// How many more entries `joint` has in Pinocchio's `q` than here: one for an unbounded
 /// revolute or a planar joint (an angle stored as `(cos θ, sin θ)`), else none.
 fn extra(joint: &Joint) -> usize {
-    usize::from(is_unbounded_revolute(joint) || matches!(joint.kind, JointType::Planar(_)))
+    usize::from(
+        joint.mimic.is_none() && (is_unbounded_revolute(joint) || matches!(joint.kind, JointType::Planar(_))),
+    )
 }
 
 /// Pinocchio's `nq` for `model`: [`Model::nq`] plus one per unbounded revolute or planar joint.
@@ -51,6 +56,10 @@ pub fn nq(model: &Model) -> usize {
 #[track_caller]
 pub fn idx_q(model: &Model, joint: JointIndex) -> usize {
     let j = model.joint(joint);
+    if let Some(m) = &j.mimic {
+        // A coupled joint has its master's index, in Pinocchio as here.
+        return idx_q(model, m.master);
+    }
     j.idx_q + model.joints()[1..joint].iter().map(extra).sum::<usize>()
 }
 
@@ -66,7 +75,7 @@ pub fn to_pinocchio_into(model: &Model, q: &[f64], out: &mut [f64]) -> Result<()
         return Err(InputError::Length { name: "out", expected: n, got: out.len(), size: "Pinocchio nq" });
     }
     let mut k = 0;
-    for j in &model.joints()[1..] {
+    for j in model.joints()[1..].iter().filter(|j| j.mimic.is_none()) {
         let src = &q[j.idx_q..j.idx_q + j.nq()];
         if matches!(j.kind, JointType::Planar(_)) {
             let (s, c) = src[2].sin_cos();

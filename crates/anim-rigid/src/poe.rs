@@ -22,6 +22,10 @@
 //! is exactly what `e^{Ŝθ}` is for a one-degree-of-freedom joint; its columns are
 //! `Ad(factors up to and including i) Ad(M_i⁰) S_k^local` and the body analogue.
 //!
+//! A coupled joint ([`crate::model::Mimic`]) at `multiplier · θ_master + offset` is the factor
+//! `e^{Ŝ (multiplier θ_master)}` about its neutral placement (which includes the offset), and
+//! its column, times the multiplier, adds to its master's.
+//!
 //! This is the formulation the analytic inverse kinematics (Paden-Kahan) works in; joint-frame
 //! composition ([`crate::forward_kinematics`]) is the fast path. The tests check that both forms
 //! agree with it to rounding.
@@ -41,6 +45,9 @@ struct PoeJoint {
     kind: JointType,
     idx_q: usize,
     idx_v: usize,
+    /// `1`, or the multiplier of a coupled joint ([`crate::model::Mimic`]): the joint turns by
+    /// `scale · q[idx_q]` from its neutral placement (which includes the coupling's offset).
+    scale: f64,
     /// World placement at the neutral configuration.
     zero: Se3,
     /// `M⁻¹ M_i⁰`.
@@ -55,7 +62,9 @@ impl PoeJoint {
     fn space_factor(&self, q: &[f64]) -> Se3 {
         let qi = &q[self.idx_q..self.idx_q + self.kind.nq()];
         match self.kind {
-            JointType::Revolute(_) | JointType::Prismatic(_) => Se3::exp_screw(self.space[0], qi[0]),
+            JointType::Revolute(_) | JointType::Prismatic(_) => {
+                Se3::exp_screw(self.space[0], self.scale * qi[0])
+            }
             _ => self.zero * self.kind.transform(qi) * self.zero.inverse(),
         }
     }
@@ -63,7 +72,9 @@ impl PoeJoint {
     fn body_factor(&self, q: &[f64]) -> Se3 {
         let qi = &q[self.idx_q..self.idx_q + self.kind.nq()];
         match self.kind {
-            JointType::Revolute(_) | JointType::Prismatic(_) => Se3::exp_screw(self.body[0], qi[0]),
+            JointType::Revolute(_) | JointType::Prismatic(_) => {
+                Se3::exp_screw(self.body[0], self.scale * qi[0])
+            }
             _ => self.zero_in_home * self.kind.transform(qi) * self.zero_in_home.inverse(),
         }
     }
@@ -98,17 +109,19 @@ impl PoeChain {
         let joints = model
             .support(model.frame(frame).parent_joint)
             .into_iter()
-            .filter(|&j| model.joint(j).nv() > 0)
+            .filter(|&j| model.joint(j).kind.nv() > 0)
             .map(|j| {
                 let jt = model.joint(j);
                 let zero = data.world_placements[j];
                 let zero_in_home = home_inv * zero;
-                let local: Vec<Twist> = (0..jt.nv()).map(|k| jt.kind.motion_subspace_column(k)).collect();
+                let local: Vec<Twist> =
+                    (0..jt.kind.nv()).map(|k| jt.kind.motion_subspace_column(k)).collect();
                 PoeJoint {
                     joint: j,
                     kind: jt.kind,
                     idx_q: jt.idx_q,
                     idx_v: jt.idx_v,
+                    scale: jt.mimic.map_or(1.0, |m| m.multiplier),
                     zero,
                     zero_in_home,
                     space: local.iter().map(|s| zero.adjoint(*s)).collect(),
@@ -200,7 +213,8 @@ impl PoeChain {
                 prefix *= j.space_factor(q);
             }
             for (k, s) in j.space.iter().enumerate() {
-                out.columns_mut()[j.idx_v + k] = prefix.adjoint(*s);
+                // `+=`: a coupled joint adds to its master's column.
+                out.columns_mut()[j.idx_v + k] += prefix.adjoint(*s).scale(j.scale);
             }
             if one_dof {
                 prefix *= j.space_factor(q);
@@ -233,7 +247,7 @@ impl PoeChain {
                 suffix = j.body_factor(q) * suffix;
             }
             for (k, b) in j.body.iter().enumerate() {
-                out.columns_mut()[j.idx_v + k] = suffix.adjoint_inv(*b);
+                out.columns_mut()[j.idx_v + k] += suffix.adjoint_inv(*b).scale(j.scale);
             }
             if !one_dof {
                 suffix = j.body_factor(q) * suffix;

@@ -8,8 +8,9 @@
 //! `prismatic`, `fixed`, `floating` ([`JointType::Free`]) and `planar` ([`JointType::Planar`],
 //! its `axis` the plane's normal, its `<limit>` ignored; Pinocchio ignores that axis and uses `+z`,
 //! so the two agree on planar joints whose axis is `0 0 1`). What is
-//! ignored without failing: `<visual>`, `<collision>`, `<material>`, `<mimic>` (the mimicking
-//! joint stays an independent joint, as in Pinocchio's default), `<dynamics>`,
+//! ignored without failing: `<visual>`, `<collision>`, `<material>`, `<mimic>` unless
+//! [`UrdfOptions::couple_mimic_joints`] is set (by default the mimicking joint stays an
+//! independent joint, as in Pinocchio's default), `<dynamics>`,
 //! `<safety_controller>`, `<transmission>`, `<gazebo>` and anything else, and, as urdfdom does,
 //! the `<axis>` of fixed and floating joints (it may be `0 0 0` there; on a revolute, continuous
 //! or prismatic joint a zero or non-finite axis is an error).
@@ -27,6 +28,14 @@
 //!   and the child's inertia is merged into the body of the nearest moving ancestor;
 //! - [`UrdfOptions::locked_joints`] turns named moving joints into fixed ones at a given
 //!   position first (Pinocchio's `buildReducedModel`; e.g. the Panda's finger joints);
+//! - with [`UrdfOptions::couple_mimic_joints`], a revolute, continuous or prismatic joint with
+//!   `<mimic joint="J" multiplier="m" offset="o"/>` (defaults `m = 1`, `o = 0`, as urdfdom)
+//!   follows `J`: `q = m · q_J + o`, no entry of its own in `q` and `v`
+//!   ([`crate::model::Mimic`]), as Pinocchio's `buildModelFromUrdf(..., mimic=True)`. The rules
+//!   are Pinocchio's: `J` must be a moving joint earlier in the depth-first order (romeo and
+//!   talos_full_v2 break this and are refused, by Pinocchio too), not itself a mimic, and a
+//!   continuous joint only follows a continuous one; `<mimic>` on a fixed or floating joint is
+//!   ignored; a locked `J` is refused unless the mimicking joint is locked too;
 //! - every moving joint gets a [`FrameKind::Joint`] frame, every link a [`FrameKind::Body`]
 //!   frame, and joint `0`'s frame is named `universe`.
 //!
@@ -60,11 +69,21 @@ pub struct UrdfOptions {
     /// Moving joints to lock, with the position each is locked at: they are treated as fixed
     /// joints whose origin includes the joint motion at that position. Default: none.
     pub locked_joints: Vec<(String, f64)>,
+    /// Couple the joints that carry a `<mimic joint="J" multiplier="m" offset="o"/>` to `J`:
+    /// `q = m · q_J + o`, with no entry of their own in `q` and `v` ([`crate::model::Mimic`];
+    /// Pinocchio's `buildModelFromUrdf(..., mimic=True)`). Default `false`: `<mimic>` is
+    /// ignored and every such joint is independent (Pinocchio's default).
+    pub couple_mimic_joints: bool,
 }
 
 impl Default for UrdfOptions {
     fn default() -> Self {
-        Self { merge_fixed_joints: true, floating_base: false, locked_joints: Vec::new() }
+        Self {
+            merge_fixed_joints: true,
+            floating_base: false,
+            locked_joints: Vec::new(),
+            couple_mimic_joints: false,
+        }
     }
 }
 
@@ -86,6 +105,13 @@ impl UrdfOptions {
     #[must_use]
     pub fn merge_fixed_joints(mut self, merge: bool) -> Self {
         self.merge_fixed_joints = merge;
+        self
+    }
+
+    /// These options with [`couple_mimic_joints`](Self::couple_mimic_joints) set to `couple`.
+    #[must_use]
+    pub fn couple_mimic_joints(mut self, couple: bool) -> Self {
+        self.couple_mimic_joints = couple;
         self
     }
 
@@ -169,6 +195,14 @@ pub enum UrdfCause {
     /// A joint named in [`UrdfOptions::locked_joints`] does not exist or cannot be locked.
     #[error("cannot lock joint '{0}': no such revolute, continuous or prismatic joint")]
     BadLockedJoint(String),
+    /// A `<mimic>` that cannot be coupled ([`UrdfOptions::couple_mimic_joints`]).
+    #[error("cannot couple to joint '{master}': {reason}")]
+    BadMimic {
+        /// The joint named by `<mimic joint=...>`.
+        master: String,
+        /// Why not.
+        reason: String,
+    },
     /// The model builder refused an element (bad limits, non-rotation placement, bad inertia).
     #[error(transparent)]
     Model(#[from] ModelError),
@@ -223,6 +257,9 @@ struct UJoint<'a> {
     child: &'a str,
     origin: Se3,
     limits: JointLimits,
+    continuous: bool,
+    /// `<mimic>` (read only when coupling): the master's name, multiplier, offset and element.
+    mimic: Option<(&'a str, f64, f64, Node<'a, 'a>)>,
 }
 
 /// A parsed `<link>`.
@@ -451,7 +488,27 @@ fn parse_with_name(xml: &str, file: &str, options: &UrdfOptions) -> Result<Model
             "planar" => (JointType::Planar(axis), JointLimits::UNBOUNDED),
             other => return Err(cx.err(node, UrdfCause::UnsupportedJointType(other.into()))),
         };
-        joints.push(UJoint { name, node, kind, parent, child: child_link, origin, limits });
+        let mimic = match child(node, "mimic").filter(|_| options.couple_mimic_joints) {
+            None => None,
+            Some(m) => Some((
+                cx.attr(m, "joint")?,
+                cx.number(m, "multiplier")?.unwrap_or(1.0),
+                cx.number(m, "offset")?.unwrap_or(0.0),
+                m,
+            )),
+        };
+        let continuous = type_name == "continuous";
+        joints.push(UJoint {
+            name,
+            node,
+            kind,
+            parent,
+            child: child_link,
+            origin,
+            limits,
+            continuous,
+            mimic,
+        });
     }
 
     // Locked joints become fixed joints at their locked position.
@@ -547,9 +604,17 @@ fn parse_with_name(xml: &str, file: &str, options: &UrdfOptions) -> Result<Model
                 .map_err(|e| model_err(child_link.node, e))?;
             push_children(&mut stack, j.child, carrier, placement);
         } else {
-            let index = b
-                .add_joint(carrier, j.name, j.kind, placement, j.limits)
-                .map_err(|e| model_err(j.node, e))?;
+            let index = match j
+                .mimic
+                .filter(|_| matches!(j.kind, JointType::Revolute(_) | JointType::Prismatic(_)))
+            {
+                None => b.add_joint(carrier, j.name, j.kind, placement, j.limits),
+                Some((master, multiplier, offset, node)) => {
+                    let id = mimic_master(&cx, &b, &joints, j, master, node)?;
+                    b.add_mimic_joint(carrier, j.name, j.kind, placement, j.limits, id, multiplier, offset)
+                }
+            }
+            .map_err(|e| model_err(j.node, e))?;
             b.add_frame(j.child, FrameKind::Body, index, Se3::IDENTITY)
                 .map_err(|e| model_err(child_link.node, e))?;
             b.append_body(index, &child_link.inertia, &child_link.inertial_origin)
@@ -578,6 +643,44 @@ fn parse_with_name(xml: &str, file: &str, options: &UrdfOptions) -> Result<Model
         return Err(cx.err(node, UrdfCause::Cycle(cycle)));
     }
     Ok(b.build())
+}
+
+/// The model joint that the coupled URDF joint `j` follows (`<mimic joint="master">` at
+/// `node`), or why it cannot: Pinocchio's rules, which need the master already in the model
+/// (earlier in the depth-first order), moving, of the same configuration size (a continuous
+/// joint only follows a continuous one, in Pinocchio's `(cos, sin)` layout) and not itself
+/// coupled.
+fn mimic_master(
+    cx: &Ctx<'_>,
+    b: &ModelBuilder,
+    joints: &[UJoint<'_>],
+    j: &UJoint<'_>,
+    master: &str,
+    node: Node<'_, '_>,
+) -> Result<JointIndex, UrdfError> {
+    let bad = |reason: &str| {
+        cx.err(
+            node,
+            UrdfCause::BadMimic { master: master.into(), reason: format!("joint '{}': {reason}", j.name) },
+        )
+    };
+    let Some(m) = joints.iter().find(|u| u.name == master) else {
+        return Err(bad("no such joint"));
+    };
+    if !matches!(m.kind, JointType::Revolute(_) | JointType::Prismatic(_)) {
+        return Err(bad("it is not a revolute, continuous or prismatic joint (or it is locked)"));
+    }
+    if m.continuous != j.continuous {
+        return Err(bad(
+            "a continuous joint can only mimic a continuous one (Pinocchio's configuration sizes differ)",
+        ));
+    }
+    if m.mimic.is_some() {
+        return Err(bad("it is itself a mimic joint (chains of mimic joints are not supported)"));
+    }
+    b.model()
+        .joint_id(master)
+        .ok_or_else(|| bad("it comes later in the depth-first joint order (Pinocchio refuses this too)"))
 }
 
 /// The links of the cycle reached by following parent joints from `start`.

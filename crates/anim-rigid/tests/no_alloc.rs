@@ -1,7 +1,8 @@
 //! The architecture invariant "no solver allocates inside `step`" and "no algorithm allocates":
 //! after a first call, RNEA, the bias and gravity terms, both forms of CRBA, both forms of ABA, the Cholesky
 //! forward dynamics, the energies and momentum, and a simulation step with every stepper (torques,
-//! damping and limits on) perform no heap allocation. Counted by a wrapping global allocator, so
+//! damping and limits on) perform no heap allocation; the same, with kinematics and Jacobians,
+//! for a model with coupled (mimic) joints. Counted by a wrapping global allocator, so
 //! this file is its own test binary.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -15,12 +16,18 @@ use anim_rigid::config::neutral;
 use anim_rigid::scenes;
 use anim_rigid::sim::{RigidIntegrator, RigidSimulation, SimParams};
 use anim_rigid::{
-    Data, aba, aba_local, aba_world, crba, crba_local, crba_world, forward_dynamics_cholesky,
-    gravity_torques, kinetic_energy, nonlinear_effects, potential_energy, rnea, spatial_momentum,
+    Data, Jacobian, ReferenceFrame, UrdfOptions, aba, aba_local, aba_world, compute_joint_jacobians,
+    compute_joint_jacobians_time_variation, crba, crba_local, crba_world, forward_dynamics_cholesky,
+    forward_kinematics, frame_jacobian, frame_jacobian_time_variation, gravity_torques, joint_jacobian,
+    kinetic_energy, nonlinear_effects, parse_urdf, potential_energy, rnea, spatial_momentum,
 };
 
 #[global_allocator]
 static ALLOC: CountingAllocator = CountingAllocator::new();
+
+/// The counter sees every thread: the tests of this file take turns, so that one test's setup
+/// (loading a URDF, building a simulation) is not counted in another's steps.
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 /// Allocations in five calls of `f` after a first one. The counter sees every thread of the
 /// process, the test harness's included, which can allocate at any time under load; code that
@@ -44,6 +51,7 @@ fn counted(mut f: impl FnMut()) -> usize {
 
 #[test]
 fn algorithms_and_steps_do_not_allocate() {
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     for model in [common::panda(), common::mixed_massive(), common::chain32()] {
         let mut data = Data::new(&model);
         let q = neutral(&model);
@@ -83,4 +91,49 @@ fn algorithms_and_steps_do_not_allocate() {
         sim.step(&mut state, 1e-3).unwrap();
     });
     assert_eq!(n, 0, "free-body midpoint: {n} allocations in 5 steps");
+}
+
+#[test]
+fn coupled_models_do_not_allocate() {
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    use std::io::Read;
+    let path = common::testdata("robots/pr2_description/urdf/pr2.urdf.gz");
+    let mut text = String::new();
+    flate2::read::GzDecoder::new(std::fs::File::open(path).unwrap()).read_to_string(&mut text).unwrap();
+    let model = parse_urdf(&text, &UrdfOptions::default().couple_mimic_joints(true)).unwrap();
+    assert!(!model.mimic_joints().is_empty());
+    let mut data = Data::new(&model);
+    let q: Vec<f64> = (0..model.nq()).map(|k| 0.1 * (k as f64).sin()).collect();
+    let v: Vec<f64> = (0..model.nv()).map(|k| 0.1 * k as f64).collect();
+    let frame = model.frame_id("r_gripper_r_finger_tip_link").unwrap();
+    let joint = model.frame(frame).parent_joint;
+    let mut out = Jacobian::zeros(model.nv());
+    let n = counted(|| {
+        forward_kinematics(&model, &mut data, &q);
+        compute_joint_jacobians(&model, &mut data, &q);
+        joint_jacobian(&model, &data, joint, ReferenceFrame::World, &mut out);
+        frame_jacobian(&model, &data, frame, ReferenceFrame::Local, &mut out);
+        compute_joint_jacobians_time_variation(&model, &mut data, &q, &v);
+        frame_jacobian_time_variation(&model, &data, frame, ReferenceFrame::LocalWorldAligned, &mut out);
+        let _ = rnea(&model, &mut data, &q, &v, &v);
+        let _ = nonlinear_effects(&model, &mut data, &q, &v);
+        let _ = gravity_torques(&model, &mut data, &q);
+        let _ = crba(&model, &mut data, &q);
+        let _ = forward_dynamics_cholesky(&model, &mut data, &q, &v, &v).unwrap();
+        let _ = kinetic_energy(&model, &mut data, &q, &v) + potential_energy(&model, &mut data, &q);
+        let _ = spatial_momentum(&model, &mut data, &q, &v);
+    });
+    assert_eq!(n, 0, "coupled PR2: {n} allocations in the algorithms");
+    for integrator in RigidIntegrator::ALL {
+        if integrator == RigidIntegrator::FreeBodyMidpoint {
+            continue;
+        }
+        let params = SimParams::default().with_damping(0.1).with_torque(vec![0.5; model.nv()]);
+        let mut sim = RigidSimulation::new(model.clone(), params, integrator).unwrap();
+        let mut state = sim.initial_state(q.clone(), v.clone()).unwrap();
+        let n = counted(|| {
+            sim.step(&mut state, 1e-4).unwrap();
+        });
+        assert_eq!(n, 0, "coupled PR2 / {}: {n} allocations in 5 steps", integrator.label());
+    }
 }

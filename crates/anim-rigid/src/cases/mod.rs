@@ -9,7 +9,8 @@
 //! rate on the Panda. Dynamics (`dynamics`): RNEA, CRBA, ABA against Pinocchio, cross-checks,
 //! steppers, the T-handle, their hard cases and the work-precision study. The example-robot-data
 //! collection (`collection`): FK, world Jacobians, RNEA, CRBA and ABA of every robot on a fixed
-//! and a floating base against Pinocchio. Determinism of the
+//! and a floating base against Pinocchio. Coupled (mimic) joints against Pinocchio on the robots
+//! that have them (`mimic`). Determinism of the
 //! Panda swing across thread counts (`determinism`) and a soak run of the pendulum chain
 //! (`soak`).
 
@@ -18,6 +19,7 @@ mod determinism;
 mod dynamics;
 mod ik;
 mod kinematics;
+mod mimic;
 mod soak;
 
 use std::path::{Path, PathBuf};
@@ -113,6 +115,11 @@ pub fn register(r: &mut Registry) {
         crate_name: CRATE,
         name: "example-robot-data collection vs Pinocchio (66 URDFs, fixed and floating base): FK, Jacobians, RNEA, CRBA, ABA",
         run: Box::new(collection::pinocchio_collection),
+    });
+    r.conformance.push(ConformanceCase {
+        crate_name: CRATE,
+        name: "coupled (mimic) joints vs Pinocchio mimic=True (Panda, Baxter, PR2, TIAGo Pro)",
+        run: Box::new(mimic::pinocchio_mimic),
     });
     r.conformance.push(ConformanceCase {
         crate_name: CRATE,

@@ -15,7 +15,9 @@ use crate::model::Model;
 /// non-finite accelerations; the simulation layer reports them at the step that made them.
 ///
 /// # Panics
-/// When `q`, `v`, `tau` or `data` does not match `model`.
+/// When `q`, `v`, `tau` or `data` does not match `model`, or when the model has coupled joints
+/// ([`Model::mimic_joints`]): the recursion has no coupling between branches (Pinocchio's ABA
+/// refuses such models too); [`crate::forward_dynamics_cholesky`] handles them.
 #[track_caller]
 pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], tau: &[f64]) -> &'d [f64] {
     super::aba_world(model, data, q, v, tau)

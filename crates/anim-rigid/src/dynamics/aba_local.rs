@@ -68,9 +68,14 @@ fn project_axis(kind: &JointType, f: &Force) -> f64 {
 /// non-finite accelerations.
 ///
 /// # Panics
-/// When `q`, `v`, `tau` or `data` does not match `model`.
+/// When `q`, `v`, `tau` or `data` does not match `model`, or when the model has coupled (mimic)
+/// joints: [`crate::forward_dynamics_cholesky`] handles those.
 #[track_caller]
 pub fn aba_local<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], tau: &[f64]) -> &'d [f64] {
+    assert!(
+        model.mimic_joints().is_empty(),
+        "ABA does not handle coupled (mimic) joints; use forward_dynamics_cholesky"
+    );
     check_q(model, data, q);
     check_v(model, "v", v);
     check_v(model, "tau", tau);

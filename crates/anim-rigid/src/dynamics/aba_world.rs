@@ -26,9 +26,14 @@ use crate::spatial::{ArticulatedInertia, Force, Motion, SpatialInertia};
 /// non-finite accelerations; the simulation layer reports them at the step that made them.
 ///
 /// # Panics
-/// When `q`, `v`, `tau` or `data` does not match `model`.
+/// When `q`, `v`, `tau` or `data` does not match `model`, or when the model has coupled (mimic)
+/// joints: [`crate::forward_dynamics_cholesky`] handles those.
 #[track_caller]
 pub fn aba_world<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], tau: &[f64]) -> &'d [f64] {
+    assert!(
+        model.mimic_joints().is_empty(),
+        "ABA does not handle coupled (mimic) joints; use forward_dynamics_cholesky"
+    );
     check_q(model, data, q);
     check_v(model, "v", v);
     check_v(model, "tau", tau);

@@ -20,6 +20,7 @@ use anim_core::lie::Se3;
 use crate::data::{Data, NO_PARENT};
 use crate::dense::SquareMatrix;
 use crate::dynamics::check::check_q;
+use crate::dynamics::crba_mimic::crba_coupled;
 use crate::dynamics::subspace::axis_dot;
 use crate::jacobian::world_columns;
 use crate::kinematics::joint_placement;
@@ -35,9 +36,16 @@ use crate::spatial::{Force, Motion, SpatialInertia};
 ///
 /// # Panics
 /// When `q` or `data` does not match `model`.
+///
+/// A model with coupled joints ([`Model::mimic_joints`]) takes a third form, `H = Gᵀ H_ext G`
+/// (see the coupled-joint section of [`crate::dynamics`]); so do [`crba_local`] and
+/// [`crba_world`] when given one.
 #[track_caller]
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d SquareMatrix {
     check_q(model, data, q);
+    if !model.mimic_joints().is_empty() {
+        return crba_coupled(model, data, q);
+    }
     if data.mean_dof_depth <= LOCAL_DEPTH { crba_local(model, data, q) } else { crba_world(model, data, q) }
 }
 
@@ -115,6 +123,9 @@ fn project(kind: &JointType, k: usize, f: &Force) -> f64 {
 #[track_caller]
 pub fn crba_local<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d SquareMatrix {
     check_q(model, data, q);
+    if !model.mimic_joints().is_empty() {
+        return crba_coupled(model, data, q);
+    }
     let joints = model.joints();
     for i in 1..joints.len() {
         let joint = &joints[i];
@@ -168,6 +179,9 @@ pub fn crba_local<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d Squar
 #[track_caller]
 pub fn crba_world<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d SquareMatrix {
     check_q(model, data, q);
+    if !model.mimic_joints().is_empty() {
+        return crba_coupled(model, data, q);
+    }
     let joints = model.joints();
     let inertias = model.inertias();
     data.world_placements[0] = Se3::IDENTITY;

@@ -14,8 +14,8 @@ use anim_core::glam::DVec3;
 
 use crate::data::Data;
 use crate::dynamics::check::{check_q, check_v};
-use crate::dynamics::subspace::joint_motion;
-use crate::kinematics::{forward_kinematics, joint_placement};
+use crate::dynamics::subspace::joint_motion_of;
+use crate::kinematics::{forward_kinematics, local_placement};
 use crate::model::Model;
 use crate::spatial::{Force, Motion};
 
@@ -31,10 +31,9 @@ pub fn kinetic_energy(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> f
     let mut t = 0.0;
     data.body_velocities[0] = Motion::ZERO;
     for (i, joint) in model.joints().iter().enumerate().skip(1) {
-        let m = joint_placement(&joint.placement, &joint.kind, &q[joint.idx_q..joint.idx_q + joint.nq()]);
+        let m = local_placement(joint, q);
         data.joint_placements[i] = m;
-        let vel = data.body_velocities[joint.parent].inverse_transform(&m)
-            + joint_motion(&joint.kind, &v[joint.idx_v..joint.idx_v + joint.nv()]);
+        let vel = data.body_velocities[joint.parent].inverse_transform(&m) + joint_motion_of(joint, v);
         data.body_velocities[i] = vel;
         t += data.body_inertias[i].kinetic_energy(&vel);
     }

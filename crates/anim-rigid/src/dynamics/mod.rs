@@ -121,6 +121,17 @@
 //! [`forward_dynamics_cholesky`] solves `H v̇ = τ - C` with it: a second, independent forward
 //! dynamics that ABA is tested against.
 //!
+//! # Coupled joints
+//!
+//! A joint coupled to another ([`crate::model::Mimic`], URDF `<mimic>` with
+//! [`crate::urdf::UrdfOptions::couple_mimic_joints`]) moves by `multiplier · v_master`; the
+//! model's `v` has no entry for it. With `G` the map from `v` to the velocities of the same
+//! tree with every joint independent, RNEA adds `multiplier · Sᵀ f` of the coupled joint to the
+//! master's torque (`τ = Gᵀ τ_ext`), CRBA returns `H = Gᵀ H_ext G` (which has entries between
+//! branches, so the factorisation treats it as dense), and the energies follow the coupled
+//! motion. [`aba`] has no such coupling and refuses these models; [`forward_dynamics_cholesky`]
+//! solves `H v̇ = τ - C` for them, as Pinocchio does with its mimic joints.
+//!
 //! # Conventions
 //!
 //! Spatial vectors are linear first (see [`crate::spatial`]); gravity is the model's
@@ -135,6 +146,7 @@ mod aba_world;
 mod check;
 mod cholesky;
 mod crba;
+mod crba_mimic;
 mod energy;
 mod rnea;
 mod subspace;

@@ -6,8 +6,8 @@ use anim_core::glam::DVec3;
 
 use crate::data::Data;
 use crate::dynamics::check::{check_q, check_v};
-use crate::dynamics::subspace::{joint_motion, joint_project};
-use crate::kinematics::joint_placement;
+use crate::dynamics::subspace::{joint_motion_of, joint_project};
+use crate::kinematics::local_placement;
 use crate::model::Model;
 use crate::spatial::Motion;
 
@@ -27,24 +27,23 @@ fn rnea_core<const VEL: bool, const ACC: bool>(
     data.body_accelerations[0] = Motion::new(-gravity, DVec3::ZERO);
     for i in 1..joints.len() {
         let joint = &joints[i];
-        let (iq, iv) = (joint.idx_q, joint.idx_v);
-        let m = joint_placement(&joint.placement, &joint.kind, &q[iq..iq + joint.nq()]);
+        let m = local_placement(joint, q);
         data.joint_placements[i] = m;
         let parent = joint.parent;
         let mut acc = data.body_accelerations[parent].inverse_transform(&m);
         let inertia = data.body_inertias[i];
         let force = if VEL {
-            let vj = joint_motion(&joint.kind, &v[iv..iv + joint.nv()]);
+            let vj = joint_motion_of(joint, v);
             let vel = data.body_velocities[parent].inverse_transform(&m) + vj;
             acc += vel.cross(&vj);
             if ACC {
-                acc += joint_motion(&joint.kind, &a[iv..iv + joint.nv()]);
+                acc += joint_motion_of(joint, a);
             }
             data.body_velocities[i] = vel;
             inertia.mul_motion(&acc) + vel.cross_force(&inertia.mul_motion(&vel))
         } else {
             if ACC {
-                acc += joint_motion(&joint.kind, &a[iv..iv + joint.nv()]);
+                acc += joint_motion_of(joint, a);
             }
             data.body_velocities[i] = Motion::ZERO;
             inertia.mul_motion(&acc)
@@ -55,10 +54,21 @@ fn rnea_core<const VEL: bool, const ACC: bool>(
     for i in (1..joints.len()).rev() {
         let joint = &joints[i];
         let f = data.body_forces[i];
-        joint_project(&joint.kind, &f, &mut data.tau[joint.idx_v..joint.idx_v + joint.nv()]);
+        if joint.mimic.is_none() {
+            joint_project(&joint.kind, &f, &mut data.tau[joint.idx_v..joint.idx_v + joint.nv()]);
+        }
         if joint.parent != 0 {
             let up = f.transform(&data.joint_placements[i]);
             data.body_forces[joint.parent] += up;
+        }
+    }
+    // A coupled joint's force works through its master: τ_master += multiplier · Sᵀ f.
+    for &i in model.mimic_joints() {
+        let joint = &joints[i];
+        if let Some(m) = &joint.mimic {
+            let mut t = [0.0];
+            joint_project(&joint.kind, &data.body_forces[i], &mut t);
+            data.tau[joint.idx_v] += m.multiplier * t[0];
         }
     }
 }

@@ -7,7 +7,7 @@
 
 use anim_core::glam::DVec3;
 
-use crate::model::{Axis, JointType};
+use crate::model::{Axis, Joint, JointType};
 use crate::spatial::{Force, Motion};
 
 /// `a · v` for an axis, reading one component when the axis is a coordinate axis.
@@ -38,6 +38,16 @@ pub(crate) fn joint_motion(kind: &JointType, qd: &[f64]) -> Motion {
 }
 
 /// `Sᵀ f` written into the joint's slice `out`.
+/// `S_i qd_i` of `joint` for the rates `qd` of the whole model (`v` or `v̇`): its own entries,
+/// or for a coupled joint `multiplier · qd_master`.
+#[inline(always)]
+pub(crate) fn joint_motion_of(joint: &Joint, qd: &[f64]) -> Motion {
+    match &joint.mimic {
+        None => joint_motion(&joint.kind, &qd[joint.idx_v..joint.idx_v + joint.kind.nv()]),
+        Some(m) => joint_motion(&joint.kind, &[m.multiplier * qd[joint.idx_v]]),
+    }
+}
+
 #[inline(always)]
 pub(crate) fn joint_project(kind: &JointType, f: &Force, out: &mut [f64]) {
     match kind {

@@ -176,9 +176,12 @@ impl AnalyticIk {
         let chain_joints: Vec<usize> = model
             .support(model.frame(frame).parent_joint)
             .into_iter()
-            .filter(|&j| model.joint(j).nv() > 0)
+            .filter(|&j| model.joint(j).kind.nv() > 0)
             .collect();
-        let revolute = chain_joints.iter().all(|&j| matches!(model.joint(j).kind, JointType::Revolute(_)));
+        // Six independent revolute joints: a coupled one does not count as its own.
+        let revolute = chain_joints.iter().all(|&j| {
+            matches!(model.joint(j).kind, JointType::Revolute(_)) && model.joint(j).mimic.is_none()
+        });
         if chain_joints.len() != 6 || !revolute {
             return Err(IkError::NotSixRevolute {
                 frame: frame_name,

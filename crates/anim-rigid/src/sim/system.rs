@@ -4,7 +4,7 @@
 use anim_core::integrate::SecondOrderSystem;
 
 use crate::data::Data;
-use crate::dynamics::{aba, kinetic_energy, potential_energy, spatial_momentum};
+use crate::dynamics::{aba, forward_dynamics_cholesky, kinetic_energy, potential_energy, spatial_momentum};
 use crate::model::{JointType, Model};
 use crate::sim::error::SimError;
 use crate::sim::params::{Servo, SimParams};
@@ -183,7 +183,10 @@ impl ArticulatedSystem {
     }
 
     /// The acceleration `ABA(q, v, τ)` with the joint forces of [`joint_forces`](Self::joint_forces),
-    /// written into `out`.
+    /// written into `out`. A model with coupled joints ([`Model::mimic_joints`]), which ABA does
+    /// not handle, takes [`forward_dynamics_cholesky`] (`H v̇ = τ - C`) instead; when its mass
+    /// matrix is not positive definite `out` is NaN, which the steppers report as a non-finite
+    /// state.
     ///
     /// # Panics
     /// When a length does not match the model.
@@ -191,7 +194,14 @@ impl ArticulatedSystem {
     pub fn acceleration_into(&mut self, q: &[f64], v: &[f64], out: &mut [f64]) {
         let mut tau = std::mem::take(&mut self.tau);
         self.joint_forces(q, v, &mut tau);
-        out.copy_from_slice(aba(&self.model, &mut self.data, q, v, &tau));
+        if self.model.mimic_joints().is_empty() {
+            out.copy_from_slice(aba(&self.model, &mut self.data, q, v, &tau));
+        } else {
+            match forward_dynamics_cholesky(&self.model, &mut self.data, q, v, &tau) {
+                Ok(ddq) => out.copy_from_slice(ddq),
+                Err(_) => out.fill(f64::NAN),
+            }
+        }
         self.tau = tau;
     }
 
