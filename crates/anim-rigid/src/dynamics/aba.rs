@@ -4,6 +4,7 @@
 
 use crate::data::Data;
 use crate::model::Model;
+use crate::spatial::{ArticulatedInertia, Force, Motion};
 
 /// Forward dynamics `v̇ = FD(q, v, τ)` by the articulated-body algorithm, gravity included;
 /// written into `data.ddq` and returned. This is [`aba_world`](super::aba_world), and writes
@@ -21,6 +22,56 @@ use crate::model::Model;
 #[track_caller]
 pub fn aba<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], tau: &[f64]) -> &'d [f64] {
     super::aba_world(model, data, q, v, tau)
+}
+
+/// The inverse of the leading `n x n` block of a 6 x 6 matrix.
+pub(crate) type Invert = fn(&[[f64; 6]; 6], usize) -> [[f64; 6]; 6];
+
+/// The elimination step of the articulated-body algorithm for a joint of `nv = s.len()` degrees
+/// of freedom (2 to 6), the same in both frames (Featherstone 2008, table 7.1): `U = Iᴬ S`,
+/// `D = Sᵀ U` (inverted by `invert`), `u = τ - Sᵀ pᴬ`; then `Iᴬ -= U D⁻¹ Uᵀ` and
+/// `pᴬ += Iᴬ c + U D⁻¹ u`, what the joint passes to its parent. Writes `U`, `D⁻¹` and `u` into
+/// the joint's rows of `aba_u`, `aba_dinv` and `aba_uu` for the acceleration pass.
+pub(crate) fn eliminate_joint(
+    ia: &mut ArticulatedInertia,
+    pa: &mut Force,
+    c: &Motion,
+    s: &[Motion],
+    tau: &[f64],
+    aba_u: &mut [Force],
+    aba_dinv: &mut [[f64; 6]],
+    aba_uu: &mut [f64],
+    invert: Invert,
+) {
+    let nv = s.len();
+    let mut u = [Force::ZERO; 6];
+    let mut d = [[0.0; 6]; 6];
+    for a in 0..nv {
+        u[a] = ia.mul_motion(&s[a]);
+    }
+    for a in 0..nv {
+        for b in 0..nv {
+            d[a][b] = s[a].dot(&u[b]);
+        }
+        aba_uu[a] = tau[a] - s[a].dot(pa);
+    }
+    let dinv = invert(&d, nv);
+    let mut w = [Force::ZERO; 6];
+    for b in 0..nv {
+        for a in 0..nv {
+            w[b] += u[a] * dinv[a][b];
+        }
+    }
+    for b in 0..nv {
+        ia.sub_outer(&w[b], &u[b]);
+    }
+    let mut push = ia.mul_motion(c);
+    for b in 0..nv {
+        push += w[b] * aba_uu[b];
+    }
+    *pa += push;
+    aba_u[..nv].copy_from_slice(&u[..nv]);
+    aba_dinv[..nv].copy_from_slice(&dinv[..nv]);
 }
 
 /// The inverse of the leading `n x n` block of `d` (symmetric positive definite in ABA) by

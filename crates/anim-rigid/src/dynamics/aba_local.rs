@@ -12,7 +12,7 @@
 use anim_core::glam::DVec3;
 
 use crate::data::Data;
-use crate::dynamics::aba::invert_spd;
+use crate::dynamics::aba::{eliminate_joint, invert_spd};
 use crate::dynamics::check::{check_q, check_v};
 use crate::dynamics::subspace::{axis_dot, joint_motion};
 use crate::kinematics::joint_placement;
@@ -141,35 +141,20 @@ pub fn aba_local<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], ta
             }
             _ => {
                 let mut s = [Motion::ZERO; 6];
-                let mut u = [Force::ZERO; 6];
-                let mut d = [[0.0; 6]; 6];
                 for a in 0..nv {
                     s[a] = Motion::from(joint.kind.motion_subspace_column(a));
-                    u[a] = ia.mul_motion(&s[a]);
                 }
-                for a in 0..nv {
-                    for b in 0..nv {
-                        d[a][b] = s[a].dot(&u[b]);
-                    }
-                    data.aba_uu[iv + a] = tau[iv + a] - s[a].dot(&pa);
-                }
-                let dinv = invert_spd(&d, nv);
-                let mut w = [Force::ZERO; 6];
-                for b in 0..nv {
-                    for a in 0..nv {
-                        w[b] += u[a] * dinv[a][b];
-                    }
-                }
-                for b in 0..nv {
-                    ia.sub_outer(&w[b], &u[b]);
-                }
-                let mut push = ia.mul_motion(&c);
-                for b in 0..nv {
-                    push += w[b] * data.aba_uu[iv + b];
-                }
-                pa += push;
-                data.aba_u[iv..iv + nv].copy_from_slice(&u[..nv]);
-                data.aba_dinv[iv..iv + nv].copy_from_slice(&dinv[..nv]);
+                eliminate_joint(
+                    &mut ia,
+                    &mut pa,
+                    &c,
+                    &s[..nv],
+                    &tau[iv..iv + nv],
+                    &mut data.aba_u[iv..iv + nv],
+                    &mut data.aba_dinv[iv..iv + nv],
+                    &mut data.aba_uu[iv..iv + nv],
+                    invert_spd,
+                );
             }
         }
         data.articulated_inertias[i] = ia;

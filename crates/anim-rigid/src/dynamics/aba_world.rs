@@ -6,12 +6,12 @@ use anim_core::glam::DVec3;
 use anim_core::lie::{Se3, Twist};
 
 use crate::data::Data;
-use crate::dynamics::aba::invert_small;
+use crate::dynamics::aba::{eliminate_joint, invert_small};
 use crate::dynamics::check::{check_q, check_v};
 use crate::jacobian::world_columns;
 use crate::kinematics::joint_placement;
 use crate::model::Model;
-use crate::spatial::{ArticulatedInertia, Force, Motion, SpatialInertia};
+use crate::spatial::{ArticulatedInertia, Motion, SpatialInertia};
 
 /// Forward dynamics `v̇ = FD(q, v, τ)` by the articulated-body algorithm, gravity included;
 /// written into `data.ddq` and returned.
@@ -91,35 +91,21 @@ pub fn aba_world<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], ta
                 data.aba_uu[iv] = uu;
             }
             _ => {
-                let mut u = [Force::ZERO; 6];
-                let mut d = [[0.0; 6]; 6];
+                let mut s = [Motion::ZERO; 6];
                 for a in 0..nv {
-                    u[a] = ia.mul_motion(&Motion::from(cols[iv + a]));
+                    s[a] = Motion::from(cols[iv + a]);
                 }
-                for a in 0..nv {
-                    let s = Motion::from(cols[iv + a]);
-                    for b in 0..nv {
-                        d[a][b] = s.dot(&u[b]);
-                    }
-                    data.aba_uu[iv + a] = tau[iv + a] - s.dot(&pa);
-                }
-                let dinv = invert_small(&d, nv);
-                let mut w = [Force::ZERO; 6];
-                for b in 0..nv {
-                    for a in 0..nv {
-                        w[b] += u[a] * dinv[a][b];
-                    }
-                }
-                for b in 0..nv {
-                    ia.sub_outer(&w[b], &u[b]);
-                }
-                let mut push = ia.mul_motion(&c);
-                for b in 0..nv {
-                    push += w[b] * data.aba_uu[iv + b];
-                }
-                pa += push;
-                data.aba_u[iv..iv + nv].copy_from_slice(&u[..nv]);
-                data.aba_dinv[iv..iv + nv].copy_from_slice(&dinv[..nv]);
+                eliminate_joint(
+                    &mut ia,
+                    &mut pa,
+                    &c,
+                    &s[..nv],
+                    &tau[iv..iv + nv],
+                    &mut data.aba_u[iv..iv + nv],
+                    &mut data.aba_dinv[iv..iv + nv],
+                    &mut data.aba_uu[iv..iv + nv],
+                    invert_small,
+                );
             }
         }
         data.articulated_inertias[i] = ia;
