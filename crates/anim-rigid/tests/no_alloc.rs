@@ -25,9 +25,13 @@ use anim_rigid::{
 #[global_allocator]
 static ALLOC: CountingAllocator = CountingAllocator::new();
 
-/// The counter sees every thread: the tests of this file take turns, so that one test's setup
-/// (loading a URDF, building a simulation) is not counted in another's steps.
-static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+/// The counter sees every thread, the test harness's included (it allocates when it reports a
+/// test's end), so this file has a single test running the two parts one after the other.
+#[test]
+fn nothing_allocates_after_the_first_call() {
+    algorithms_and_steps_do_not_allocate();
+    coupled_models_do_not_allocate();
+}
 
 /// Allocations in five calls of `f` after a first one. The counter sees every thread of the
 /// process, the test harness's included, which can allocate at any time under load; code that
@@ -49,9 +53,7 @@ fn counted(mut f: impl FnMut()) -> usize {
     n
 }
 
-#[test]
 fn algorithms_and_steps_do_not_allocate() {
-    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     for model in [common::panda(), common::mixed_massive(), common::chain32()] {
         let mut data = Data::new(&model);
         let q = neutral(&model);
@@ -93,9 +95,7 @@ fn algorithms_and_steps_do_not_allocate() {
     assert_eq!(n, 0, "free-body midpoint: {n} allocations in 5 steps");
 }
 
-#[test]
 fn coupled_models_do_not_allocate() {
-    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     use std::io::Read;
     let path = common::testdata("robots/pr2_description/urdf/pr2.urdf.gz");
     let mut text = String::new();
