@@ -9,7 +9,8 @@
 //! | suites | the same command, running only `xtask/tests/suites.rs`: the quick conformance and stability suites through the `xtask` binary of this build |
 //! | doc tests | `cargo test --workspace --doc` |
 //! | docs | `cargo doc --workspace --no-deps` with warnings denied |
-//! | crates alone | each library crate as a user who picks it alone gets it: clippy on anim-core, anim-rigid, anim-pbd, anim-skin and anim-springs with `--no-default-features`; anim-core's tests without its default features (no faer, no rayon); `cargo package --workspace --no-verify` (every crate's manifest, README and files complete); `xtask consumer` (a project outside the workspace on anim-pbd and anim-rigid, newest compatible dependency versions) |
+//! | dependency versions | the library crates' unit tests (`cargo test --workspace --lib`, without xtask, this runner and the benches) against the newest versions the dependency ranges allow (`cargo update`); the committed `Cargo.lock` is put back afterwards |
+//! | crates alone | each library crate as a user who picks it alone gets it: clippy on anim-core, anim-rigid, anim-pbd, anim-skin and anim-springs with `--no-default-features`; anim-core's tests without its default features (no faer, no rayon); `xtask packaged` (every publishable crate checked from its `.crate` archive, all targets and features, against the lowest versions our direct requirements allow); `xtask consumer` (a project outside the workspace on anim-pbd and anim-rigid, newest compatible dependency versions) |
 //!
 //! The runner has no dependencies, so it starts at once, and the suites run in the test build
 //! (one build of the workspace, the features of every member unified) instead of a build of
@@ -65,6 +66,31 @@ fn run(program: &std::path::Path, args: &[&str]) -> bool {
     ok
 }
 
+/// The unit tests of every library crate: the workspace without the tools (xtask, this runner)
+/// and the benchmarks, which users never depend on.
+const LIBRARY_TESTS: [&str; 9] =
+    ["test", "--workspace", "--lib", "--exclude", "xtask", "--exclude", "ci", "--exclude", "anim-benches"];
+
+/// Runs the library crates' unit tests under the lock file that `cargo update` writes (the
+/// newest versions the ranges allow), then puts the committed `Cargo.lock` back, whatever
+/// happened.
+fn newest_versions() -> bool {
+    let lock = std::path::Path::new("Cargo.lock");
+    let committed = match std::fs::read(lock) {
+        Ok(bytes) => bytes,
+        Err(e) => {
+            eprintln!("could not read {}: {e}", lock.display());
+            return false;
+        }
+    };
+    let ok = cargo(&["update"], &[]) && cargo(&LIBRARY_TESTS, &[]);
+    if let Err(e) = std::fs::write(lock, &committed) {
+        eprintln!("could not put the committed {} back: {e}", lock.display());
+        return false;
+    }
+    ok
+}
+
 fn main() -> ExitCode {
     if let Some(arg) = std::env::args().nth(1) {
         eprintln!("error: `cargo ci` takes no arguments, got '{arg}'");
@@ -93,7 +119,7 @@ fn main() -> ExitCode {
         "-D",
         "warnings",
     ];
-    let steps: [(&str, &dyn Fn() -> bool); 7] = [
+    let steps: [(&str, &dyn Fn() -> bool); 8] = [
         ("format", &|| cargo(&["fmt", "--all", "--", "--check"], &[])),
         ("clippy", &|| cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"], &[])),
         // The examples are type-checked and linted by clippy above; linking each of them here
@@ -102,13 +128,14 @@ fn main() -> ExitCode {
         ("suites", &|| cargo(&suites, &[])),
         ("doc tests", &|| cargo(&["test", "--workspace", "--doc"], &[])),
         ("docs", &|| cargo(&["doc", "--workspace", "--no-deps"], &[("RUSTDOCFLAGS", "-D warnings")])),
+        ("dependency versions", &newest_versions),
         ("crates alone", &|| {
             // Each part runs even when one before it failed, so one run shows every problem.
             let lint = cargo(&alone, &[]);
             let core = cargo(&["test", "-p", "anim-core", "--no-default-features", "--lib", "--tests"], &[]);
-            let package = cargo(&["package", "--workspace", "--no-verify", "--allow-dirty"], &[]);
+            let packaged = run(&xtask, &["packaged"]);
             let consumer = run(&xtask, &["consumer"]);
-            lint && core && package && consumer
+            lint && core && packaged && consumer
         }),
     ];
     let mut failed = Vec::new();
