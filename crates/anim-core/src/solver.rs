@@ -138,7 +138,8 @@ impl StepClock {
     }
 }
 
-#[cfg(all(test, feature = "serde"))]
+#[cfg(test)]
+#[cfg(feature = "serde")]
 mod tests {
     use super::StepClock;
 
