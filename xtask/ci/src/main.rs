@@ -9,7 +9,7 @@
 //! | suites | the same command, running only `xtask/tests/suites.rs`: the quick conformance and stability suites through the `xtask` binary of this build |
 //! | doc tests | `cargo test --workspace --doc` |
 //! | docs | `cargo doc --workspace --no-deps` with warnings denied |
-//! | crates alone | each library crate as a user who picks it alone gets it: clippy on anim-core, anim-rigid, anim-pbd, anim-skin and anim-springs with `--no-default-features`; anim-core's tests without its default features (no faer, no rayon); `cargo package --workspace --no-verify` (every crate's manifest, README and files complete); `xtask consumer` (a project outside the workspace on anim-pbd and anim-rigid, newest compatible dependency versions) |
+//! | crates alone | each library crate as a user who picks it alone gets it: clippy on anim-core, anim-rigid, anim-pbd, anim-skin and anim-springs with `--no-default-features`; anim-core's tests without its default features (no faer, no rayon); `cargo package --workspace --no-verify` (every crate's manifest, README and files complete); `xtask consumer` (a project outside the workspace on anim-pbd and anim-rigid without their default features, newest compatible dependency versions, no serde crate in its tree) |
 //!
 //! The runner has no dependencies, so it starts at once, and the suites run in the test build
 //! (one build of the workspace, the features of every member unified) instead of a build of
