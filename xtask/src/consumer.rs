@@ -177,7 +177,10 @@ fn serde_free(dir: &Path, target: &Path, extra: &[&str]) -> Result<(), String> {
     serde.sort_unstable();
     serde.dedup();
     if serde.is_empty() {
-        eprintln!("  cargo tree {}: no serde crate", extra.join(" "));
+        eprintln!(
+            "  {}: no serde crate",
+            ["cargo tree"].iter().chain(extra).copied().collect::<Vec<_>>().join(" ")
+        );
         Ok(())
     } else {
         Err(format!(
