@@ -322,6 +322,7 @@ fn assembled_jacobian_matches_matrix_free_and_keeps_its_pattern() {
 
 // ---------------------------------------------------------------- statics, conservation
 
+#[cfg_attr(not(feature = "faer"), ignore = "sparse Cholesky needs the `faer` feature")]
 #[test]
 fn hanging_chain_rests_at_the_analytic_stretch() {
     let chain = HangingChain {
@@ -443,6 +444,7 @@ fn run_in_pool(
     })
 }
 
+#[cfg_attr(not(feature = "faer"), ignore = "sparse Cholesky needs the `faer` feature")]
 #[test]
 fn results_are_bitwise_identical_for_1_2_and_4_threads() {
     for (kind, linear, steps, dt) in [
@@ -847,6 +849,7 @@ fn mesh_from_obj_builds_a_network() {
 
 // ---------------------------------------------------------------- contact, scenes
 
+#[cfg_attr(not(feature = "faer"), ignore = "sparse Cholesky needs the `faer` feature")]
 #[test]
 fn a_particle_rests_on_the_ground_at_the_penalty_depth() {
     let mut b = NetworkBuilder::new();
@@ -883,6 +886,7 @@ fn a_sphere_pushes_particles_out() {
     assert!((e.contact - 0.5 * 100.0 * 0.01).abs() < 1e-12);
 }
 
+#[cfg_attr(not(feature = "faer"), ignore = "sparse Cholesky needs the `faer` feature")]
 #[test]
 fn every_scene_runs_with_its_suggested_integrator() {
     for name in scenes::NAMES {
@@ -909,6 +913,7 @@ fn every_scene_runs_with_its_suggested_integrator() {
     assert!(scenes::hanging_cloth(Some(1)).is_err());
 }
 
+#[cfg_attr(not(feature = "faer"), ignore = "sparse Cholesky needs the `faer` feature")]
 #[test]
 fn jelly_lands_and_stays_above_the_ground() {
     let scene = scenes::jelly_drop(Some(4)).unwrap();

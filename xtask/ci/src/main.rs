@@ -10,7 +10,7 @@
 //! | doc tests | `cargo test --workspace --doc` |
 //! | docs | `cargo doc --workspace --no-deps` with warnings denied |
 //! | dependency versions | the library crates' unit tests (`cargo test --workspace --lib`, without xtask, this runner and the benches) against the newest versions the dependency ranges allow (`cargo update`); the committed `Cargo.lock` is put back afterwards |
-//! | crates alone | each library crate as a user who picks it alone gets it: clippy on anim-core, anim-rigid, anim-pbd, anim-skin and anim-springs with `--no-default-features`; anim-core's tests without its default features (no faer, no rayon); `xtask packaged` (every publishable crate checked from its `.crate` archive, all targets and features, against the lowest versions our direct requirements allow); `xtask consumer` (a project outside the workspace on anim-pbd and anim-rigid without their default features, newest compatible dependency versions, no serde crate in its tree) |
+//! | crates alone | each library crate as a user who picks it alone gets it: clippy on anim-core, anim-rigid, anim-pbd, anim-skin and anim-springs with `--no-default-features`; the same five crates' unit and integration tests without their default features (no faer, no rayon, no serde); `xtask packaged` (every publishable crate checked from its `.crate` archive, all targets and features, against the lowest versions our direct requirements allow); `xtask consumer` (a project outside the workspace on anim-pbd and anim-rigid without their default features, newest compatible dependency versions, no serde crate in its tree) |
 //!
 //! The runner has no dependencies, so it starts at once, and the suites run in the test build
 //! (one build of the workspace, the features of every member unified) instead of a build of
@@ -132,7 +132,8 @@ fn main() -> ExitCode {
         ("crates alone", &|| {
             // Each part runs even when one before it failed, so one run shows every problem.
             let lint = cargo(&alone, &[]);
-            let core = cargo(&["test", "-p", "anim-core", "--no-default-features", "--lib", "--tests"], &[]);
+            let tests = [&["test"], &alone[1..11], &["--lib", "--tests"]].concat();
+            let core = cargo(&tests, &[]);
             let packaged = run(&xtask, &["packaged"]);
             let consumer = run(&xtask, &["consumer"]);
             lint && core && packaged && consumer

@@ -239,14 +239,24 @@ pub trait Integrator<S: ?Sized> {
     /// acceleration), as a self-describing value for checkpoints. Scratch buffers are not part
     /// of it: a fresh integrator given this memory continues bit for bit like the one that
     /// produced it.
+    ///
+    /// Both memory methods have default bodies so that turning on the `serde` feature (which
+    /// any crate in a build may do) never breaks an integrator written without it: such a
+    /// method saves no memory, and restoring one says so.
     #[cfg(feature = "serde")]
-    fn memory(&self) -> serde_json::Value;
+    fn memory(&self) -> serde_json::Value {
+        serde_json::json!({ "method": self.name(), "memory": null })
+    }
     /// Restores what [`Integrator::memory`] of the same method returned.
     ///
     /// # Errors
-    /// [`IntegrateError::Memory`] when `memory` is not a memory of this method.
+    /// [`IntegrateError::Memory`] when `memory` is not a memory of this method, or when the
+    /// method keeps the default [`Integrator::memory`] and saves nothing to restore.
     #[cfg(feature = "serde")]
-    fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), IntegrateError>;
+    fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), IntegrateError> {
+        let _ = memory;
+        Err(IntegrateError::Memory { method: self.name(), cause: "this method saves no memory".into() })
+    }
     /// Theoretical order of accuracy of the method.
     fn order(&self) -> u32;
     /// Whether the method is symplectic (bounded energy error on Hamiltonian systems).

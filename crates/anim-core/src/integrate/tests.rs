@@ -586,3 +586,30 @@ fn a_run_resumed_from_saved_memory_and_state_is_bitwise_identical() {
         IntegratorKind::SymplecticEuler.build::<LinearChain>(36).restore_memory(&euler.memory()).is_err()
     );
 }
+
+/// An integrator written without the `serde` feature in mind (no memory methods) still
+/// compiles when the feature is on, saves an empty memory and refuses to restore one.
+#[cfg(feature = "serde")]
+#[test]
+fn an_integrator_without_memory_methods_saves_none_and_refuses_a_restore() {
+    struct Still;
+    impl<S: SecondOrderSystem + ?Sized> Integrator<S> for Still {
+        fn name(&self) -> &'static str {
+            "still"
+        }
+        fn step(&mut self, _: &mut S, _: &mut State, _: f64) -> Result<StepInfo, IntegrateError> {
+            Ok(StepInfo::default())
+        }
+        fn order(&self) -> u32 {
+            0
+        }
+        fn symplectic(&self) -> bool {
+            false
+        }
+    }
+    let mut still = Still;
+    let memory = <Still as Integrator<HarmonicOscillator>>::memory(&still);
+    assert_eq!(memory, serde_json::json!({ "method": "still", "memory": null }));
+    let err = <Still as Integrator<HarmonicOscillator>>::restore_memory(&mut still, &memory).unwrap_err();
+    assert!(matches!(err, IntegrateError::Memory { method: "still", .. }), "{err}");
+}

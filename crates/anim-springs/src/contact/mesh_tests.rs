@@ -109,6 +109,7 @@ fn mesh_jacobians_match_central_finite_differences() {
 /// sphere's, and a particle held on a vertical line meets a surface lower by `d` along a normal
 /// `n` a height `d / n_z` lower: the particles end apart by at most that, with or without a
 /// thickness, and by more than a micrometre (a face's centre is where the faces lie deepest).
+#[cfg_attr(not(feature = "faer"), ignore = "sparse Cholesky needs the `faer` feature")]
 #[test]
 fn a_particle_rests_on_a_mesh_sphere_where_it_rests_on_the_sphere() {
     let (ball, sagitta) = mesh_ball(4);
@@ -166,6 +167,7 @@ fn a_particle_rests_on_a_mesh_sphere_where_it_rests_on_the_sphere() {
 /// interpolation; the nodes hold it in `f32`): a particle on a mesh box's top face rests at the
 /// penalty depth below `top + thickness`, as on the analytic box, to the `f32` rounding of the
 /// node values (`2^-24` of their size, at most the thickness plus two cells).
+#[cfg_attr(not(feature = "faer"), ignore = "sparse Cholesky needs the `faer` feature")]
 #[test]
 fn a_particle_rests_on_a_mesh_box_where_it_rests_on_the_box() {
     let h = 0.02;
@@ -227,6 +229,7 @@ fn a_bad_mesh_collider_is_named() {
 
 /// A cloth of more particles than the parallel threshold falls onto a mesh sphere: the same bits
 /// on 1, 2 and 4 threads, explicit and implicit.
+#[cfg_attr(not(feature = "faer"), ignore = "sparse Cholesky needs the `faer` feature")]
 #[test]
 fn a_cloth_on_a_mesh_is_bitwise_identical_for_any_thread_count() {
     let (ball, _) = mesh_ball(3);

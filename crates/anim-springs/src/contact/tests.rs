@@ -172,6 +172,7 @@ fn the_force_pushes_out_along_the_nearest_surface_and_vanishes_outside() {
 
 /// A particle on a box's top face settles at the penalty depth, and one dropped onto a capsule's
 /// side comes to rest on top of it, with the definite Jacobian and sparse Cholesky.
+#[cfg_attr(not(feature = "faer"), ignore = "sparse Cholesky needs the `faer` feature")]
 #[test]
 fn particles_rest_on_a_box_and_a_capsule_at_the_penalty_depth() {
     let settle = |shape: Shape, thickness: f64, start: [f64; 3]| {
