@@ -1,0 +1,41 @@
+//! Python bindings of the anim workspace: the native module `anim._anim` behind the Python
+//! package `anim` (`pip install ./crates/anim-py`).
+//!
+//! Each submodule calls one crate's own library code with the crate's own names and parameter
+//! spellings: [`scene`] the scene registry of the `anim` crate and the scene files and
+//! `--tolerance` pick of `anim-cli`; [`pbd`] anim-pbd's builder and simulation; [`rigid`]
+//! anim-rigid's checked entry points, named as in Pinocchio.
+//! Arrays go in as numpy arrays checked at the boundary ([`arrays`]) and come back as new
+//! arrays; steps and batch calls release the GIL.
+
+pub mod arrays;
+pub mod errors;
+pub mod pbd;
+pub mod rigid;
+pub mod scene;
+
+use pyo3::prelude::*;
+
+/// Adds `child` as the submodule `name` of `parent`, importable as `anim.NAME`.
+fn submodule(
+    parent: &Bound<'_, PyModule>,
+    name: &str,
+    fill: impl FnOnce(&Bound<'_, PyModule>) -> PyResult<()>,
+) -> PyResult<()> {
+    let child = PyModule::new(parent.py(), name)?;
+    fill(&child)?;
+    parent.add_submodule(&child)?;
+    Ok(())
+}
+
+/// The native module.
+#[pymodule]
+#[pyo3(name = "_anim")]
+fn anim_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    errors::register(m)?;
+    submodule(m, "scene", scene::register)?;
+    submodule(m, "pbd", pbd::register)?;
+    submodule(m, "rigid", rigid::register)?;
+    Ok(())
+}
