@@ -4,12 +4,16 @@
 //! Each submodule calls one crate's own library code with the crate's own names and parameter
 //! spellings: [`scene`] the scene registry of the `anim` crate and the scene files and
 //! `--tolerance` pick of `anim-cli`; [`pbd`] anim-pbd's builder and simulation; [`rigid`]
-//! anim-rigid's checked entry points, named as in Pinocchio.
+//! anim-rigid's checked entry points, named as in Pinocchio; [`mpm`] anim-mpm's particles;
+//! [`io`] anim-io's mesh readers and writers.
 //! Arrays go in as numpy arrays checked at the boundary ([`arrays`]) and come back as new
 //! arrays; steps and batch calls release the GIL.
 
 pub mod arrays;
 pub mod errors;
+pub mod io;
+pub mod json;
+pub mod mpm;
 pub mod pbd;
 pub mod rigid;
 pub mod scene;
@@ -37,5 +41,7 @@ fn anim_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     submodule(m, "scene", scene::register)?;
     submodule(m, "pbd", pbd::register)?;
     submodule(m, "rigid", rigid::register)?;
+    submodule(m, "mpm", mpm::register)?;
+    submodule(m, "io", io::register)?;
     Ok(())
 }

@@ -72,17 +72,6 @@ pub struct Scene {
     choice: Option<anim_cli::tolerance::Choice>,
 }
 
-/// Parameters from a Python dict (through JSON: numbers, strings, lists, dicts).
-fn json_of(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<serde_json::Value> {
-    let text: String = obj
-        .py()
-        .import("json")?
-        .call_method1("dumps", (obj,))
-        .map_err(|e| PyValueError::new_err(format!("{name}: not JSON-like ({e})")))?
-        .extract()?;
-    serde_json::from_str(&text).map_err(|e| PyValueError::new_err(format!("{name}: {e}")))
-}
-
 impl Scene {
     /// Applies `set` (parameter overrides), `dt`, `frames` and `tolerance`, then builds.
     fn make(
@@ -93,7 +82,7 @@ impl Scene {
         tolerance: Option<f64>,
     ) -> PyResult<Self> {
         if let Some(set) = set {
-            let serde_json::Value::Object(map) = json_of(set, "set")? else {
+            let serde_json::Value::Object(map) = crate::json::of(set, "set")? else {
                 return Err(PyValueError::new_err("set: expected a dict of parameter names to values"));
             };
             for (k, v) in map {

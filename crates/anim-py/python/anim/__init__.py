@@ -25,9 +25,11 @@ __version__ = _anim.__version__
 scene = _anim.scene
 pbd = _anim.pbd
 rigid = _anim.rigid
+mpm = _anim.mpm
+io = _anim.io
 
 # `import anim.rigid` and `from anim.rigid import rnea` find the native submodules.
-for _name in ("scene", "pbd", "rigid"):
+for _name in ("scene", "pbd", "rigid", "mpm", "io"):
     _sys.modules[f"{__name__}.{_name}"] = getattr(_anim, _name)
 
 __all__ = [
@@ -35,6 +37,8 @@ __all__ = [
     "BuildError",
     "CheckpointError",
     "SimulationError",
+    "io",
+    "mpm",
     "pbd",
     "rigid",
     "scene",

@@ -1,3 +1,5 @@
+from . import io as io
+from . import mpm as mpm
 from . import pbd as pbd
 from . import rigid as rigid
 from . import scene as scene
