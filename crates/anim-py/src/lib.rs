@@ -5,7 +5,7 @@
 //! spellings: [`scene`] the scene registry of the `anim` crate and the scene files and
 //! `--tolerance` pick of `anim-cli`; [`pbd`] anim-pbd's builder and simulation; [`rigid`]
 //! anim-rigid's checked entry points, named as in Pinocchio; [`mpm`] anim-mpm's particles;
-//! [`io`] anim-io's mesh readers and writers.
+//! [`io`] anim-io's mesh readers and writers; [`springs`] anim-springs' networks.
 //! Arrays go in as numpy arrays checked at the boundary ([`arrays`]) and come back as new
 //! arrays; steps and batch calls release the GIL.
 
@@ -17,6 +17,7 @@ pub mod mpm;
 pub mod pbd;
 pub mod rigid;
 pub mod scene;
+pub mod springs;
 
 use pyo3::prelude::*;
 
@@ -43,5 +44,6 @@ fn anim_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     submodule(m, "rigid", rigid::register)?;
     submodule(m, "mpm", mpm::register)?;
     submodule(m, "io", io::register)?;
+    submodule(m, "springs", springs::register)?;
     Ok(())
 }

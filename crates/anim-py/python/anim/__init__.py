@@ -27,9 +27,10 @@ pbd = _anim.pbd
 rigid = _anim.rigid
 mpm = _anim.mpm
 io = _anim.io
+springs = _anim.springs
 
 # `import anim.rigid` and `from anim.rigid import rnea` find the native submodules.
-for _name in ("scene", "pbd", "rigid", "mpm", "io"):
+for _name in ("scene", "pbd", "rigid", "mpm", "io", "springs"):
     _sys.modules[f"{__name__}.{_name}"] = getattr(_anim, _name)
 
 __all__ = [
@@ -42,4 +43,5 @@ __all__ = [
     "pbd",
     "rigid",
     "scene",
+    "springs",
 ]
