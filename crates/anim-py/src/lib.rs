@@ -5,7 +5,8 @@
 //! spellings: [`scene`] the scene registry of the `anim` crate and the scene files and
 //! `--tolerance` pick of `anim-cli`; [`pbd`] anim-pbd's builder and simulation; [`rigid`]
 //! anim-rigid's checked entry points, named as in Pinocchio; [`mpm`] anim-mpm's particles;
-//! [`io`] anim-io's mesh readers and writers; [`springs`] anim-springs' networks.
+//! [`io`] anim-io's mesh readers and writers; [`springs`] anim-springs' networks;
+//! [`skin`] anim-skin's glTF characters.
 //! Arrays go in as numpy arrays checked at the boundary ([`arrays`]) and come back as new
 //! arrays; steps and batch calls release the GIL.
 
@@ -17,6 +18,7 @@ pub mod mpm;
 pub mod pbd;
 pub mod rigid;
 pub mod scene;
+pub mod skin;
 pub mod springs;
 
 use pyo3::prelude::*;
@@ -45,5 +47,6 @@ fn anim_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     submodule(m, "mpm", mpm::register)?;
     submodule(m, "io", io::register)?;
     submodule(m, "springs", springs::register)?;
+    submodule(m, "skin", skin::register)?;
     Ok(())
 }

@@ -28,9 +28,10 @@ rigid = _anim.rigid
 mpm = _anim.mpm
 io = _anim.io
 springs = _anim.springs
+skin = _anim.skin
 
 # `import anim.rigid` and `from anim.rigid import rnea` find the native submodules.
-for _name in ("scene", "pbd", "rigid", "mpm", "io", "springs"):
+for _name in ("scene", "pbd", "rigid", "mpm", "io", "springs", "skin"):
     _sys.modules[f"{__name__}.{_name}"] = getattr(_anim, _name)
 
 __all__ = [
@@ -43,5 +44,6 @@ __all__ = [
     "pbd",
     "rigid",
     "scene",
+    "skin",
     "springs",
 ]

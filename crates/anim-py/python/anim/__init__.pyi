@@ -3,6 +3,7 @@ from . import mpm as mpm
 from . import pbd as pbd
 from . import rigid as rigid
 from . import scene as scene
+from . import skin as skin
 from . import springs as springs
 
 __version__: str
