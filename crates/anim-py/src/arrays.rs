@@ -211,3 +211,6 @@ pub fn to_index_rows<'py, const D: usize>(
     let flat: Vec<i64> = rows.iter().flatten().map(|&i| i as i64).collect();
     PyArray1::from_vec(py, flat).reshape([rows.len(), D])
 }
+
+/// A mesh as new arrays: vertices (n, 3) float64 and elements (m, k) int64.
+pub type MeshArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>);

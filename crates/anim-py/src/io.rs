@@ -5,7 +5,6 @@ use crate::arrays;
 use crate::errors;
 use anim::io::ply::Ply;
 use anim::io::{IoError, UnstructuredGrid, VtkEncoding};
-use numpy::PyArray2;
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
@@ -18,25 +17,19 @@ pub fn io_error(e: IoError) -> PyErr {
     }
 }
 
-/// A triangle mesh as `(vertices, triangles)`.
-type TriArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>);
-
 /// Reads and validates a triangle mesh by extension (`.obj`, polygons fan-triangulated;
 /// `.msh`): `(vertices (n, 3) float64, triangles (m, 3) int64)`, new arrays.
 #[pyfunction]
-fn read_tri_mesh(py: Python<'_>, path: PathBuf) -> PyResult<TriArrays<'_>> {
+fn read_tri_mesh(py: Python<'_>, path: PathBuf) -> PyResult<arrays::MeshArrays<'_>> {
     let mesh = py.detach(|| anim::io::read_tri_mesh(&path)).map_err(io_error)?;
     let flat: Vec<f64> = mesh.positions.iter().flatten().copied().collect();
     Ok((arrays::to_rows(py, &flat, 3)?, arrays::to_index_rows(py, &mesh.triangles)?))
 }
 
-/// A tetrahedral mesh as `(vertices, tets)`.
-type TetArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>);
-
 /// Reads and validates a tetrahedral mesh by extension (`.msh`, `.node`/`.ele`):
 /// `(vertices (n, 3) float64, tets (m, 4) int64)`, new arrays.
 #[pyfunction]
-fn read_tet_mesh(py: Python<'_>, path: PathBuf) -> PyResult<TetArrays<'_>> {
+fn read_tet_mesh(py: Python<'_>, path: PathBuf) -> PyResult<arrays::MeshArrays<'_>> {
     let mesh = py.detach(|| anim::io::read_tet_mesh(&path)).map_err(io_error)?;
     let flat: Vec<f64> = mesh.positions.iter().flatten().copied().collect();
     Ok((arrays::to_rows(py, &flat, 3)?, arrays::to_index_rows(py, &mesh.tets)?))

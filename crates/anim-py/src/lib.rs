@@ -6,12 +6,13 @@
 //! `--tolerance` pick of `anim-cli`; [`pbd`] anim-pbd's builder and simulation; [`rigid`]
 //! anim-rigid's checked entry points, named as in Pinocchio; [`mpm`] anim-mpm's particles;
 //! [`io`] anim-io's mesh readers and writers; [`springs`] anim-springs' networks;
-//! [`skin`] anim-skin's glTF characters.
+//! [`skin`] anim-skin's glTF characters; [`fem`] anim-fem's bodies and their stresses.
 //! Arrays go in as numpy arrays checked at the boundary ([`arrays`]) and come back as new
 //! arrays; steps and batch calls release the GIL.
 
 pub mod arrays;
 pub mod errors;
+pub mod fem;
 pub mod io;
 pub mod json;
 pub mod mpm;
@@ -48,5 +49,6 @@ fn anim_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     submodule(m, "io", io::register)?;
     submodule(m, "springs", springs::register)?;
     submodule(m, "skin", skin::register)?;
+    submodule(m, "fem", fem::register)?;
     Ok(())
 }

@@ -29,9 +29,10 @@ mpm = _anim.mpm
 io = _anim.io
 springs = _anim.springs
 skin = _anim.skin
+fem = _anim.fem
 
 # `import anim.rigid` and `from anim.rigid import rnea` find the native submodules.
-for _name in ("scene", "pbd", "rigid", "mpm", "io", "springs", "skin"):
+for _name in ("scene", "pbd", "rigid", "mpm", "io", "springs", "skin", "fem"):
     _sys.modules[f"{__name__}.{_name}"] = getattr(_anim, _name)
 
 __all__ = [
@@ -39,6 +40,7 @@ __all__ = [
     "BuildError",
     "CheckpointError",
     "SimulationError",
+    "fem",
     "io",
     "mpm",
     "pbd",

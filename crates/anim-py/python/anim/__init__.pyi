@@ -1,3 +1,4 @@
+from . import fem as fem
 from . import io as io
 from . import mpm as mpm
 from . import pbd as pbd
