@@ -6,13 +6,15 @@
 //! `--tolerance` pick of `anim-cli`; [`pbd`] anim-pbd's builder and simulation; [`rigid`]
 //! anim-rigid's checked entry points, named as in Pinocchio; [`mpm`] anim-mpm's particles;
 //! [`io`] anim-io's mesh readers and writers; [`springs`] anim-springs' networks;
-//! [`skin`] anim-skin's glTF characters; [`fem`] anim-fem's bodies and their stresses.
+//! [`skin`] anim-skin's glTF characters; [`fem`] anim-fem's bodies and their stresses;
+//! [`flip`] anim-flip's particle fluid.
 //! Arrays go in as numpy arrays checked at the boundary ([`arrays`]) and come back as new
 //! arrays; steps and batch calls release the GIL.
 
 pub mod arrays;
 pub mod errors;
 pub mod fem;
+pub mod flip;
 pub mod io;
 pub mod json;
 pub mod mpm;
@@ -50,5 +52,6 @@ fn anim_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     submodule(m, "springs", springs::register)?;
     submodule(m, "skin", skin::register)?;
     submodule(m, "fem", fem::register)?;
+    submodule(m, "flip", flip::register)?;
     Ok(())
 }

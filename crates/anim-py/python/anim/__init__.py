@@ -30,9 +30,10 @@ io = _anim.io
 springs = _anim.springs
 skin = _anim.skin
 fem = _anim.fem
+flip = _anim.flip
 
 # `import anim.rigid` and `from anim.rigid import rnea` find the native submodules.
-for _name in ("scene", "pbd", "rigid", "mpm", "io", "springs", "skin", "fem"):
+for _name in ("scene", "pbd", "rigid", "mpm", "io", "springs", "skin", "fem", "flip"):
     _sys.modules[f"{__name__}.{_name}"] = getattr(_anim, _name)
 
 __all__ = [
@@ -41,6 +42,7 @@ __all__ = [
     "CheckpointError",
     "SimulationError",
     "fem",
+    "flip",
     "io",
     "mpm",
     "pbd",

@@ -1,4 +1,5 @@
 from . import fem as fem
+from . import flip as flip
 from . import io as io
 from . import mpm as mpm
 from . import pbd as pbd
