@@ -7,7 +7,7 @@
 //! anim-rigid's checked entry points, named as in Pinocchio; [`mpm`] anim-mpm's particles;
 //! [`io`] anim-io's mesh readers and writers; [`springs`] anim-springs' networks;
 //! [`skin`] anim-skin's glTF characters; [`fem`] anim-fem's bodies and their stresses;
-//! [`flip`] anim-flip's particle fluid.
+//! [`flip`] anim-flip's particle fluid; [`fluid`] anim-fluid's grids.
 //! Arrays go in as numpy arrays checked at the boundary ([`arrays`]) and come back as new
 //! arrays; steps and batch calls release the GIL.
 
@@ -15,6 +15,7 @@ pub mod arrays;
 pub mod errors;
 pub mod fem;
 pub mod flip;
+pub mod fluid;
 pub mod io;
 pub mod json;
 pub mod mpm;
@@ -53,5 +54,6 @@ fn anim_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     submodule(m, "skin", skin::register)?;
     submodule(m, "fem", fem::register)?;
     submodule(m, "flip", flip::register)?;
+    submodule(m, "fluid", fluid::register)?;
     Ok(())
 }

@@ -31,9 +31,10 @@ springs = _anim.springs
 skin = _anim.skin
 fem = _anim.fem
 flip = _anim.flip
+fluid = _anim.fluid
 
 # `import anim.rigid` and `from anim.rigid import rnea` find the native submodules.
-for _name in ("scene", "pbd", "rigid", "mpm", "io", "springs", "skin", "fem", "flip"):
+for _name in ("scene", "pbd", "rigid", "mpm", "io", "springs", "skin", "fem", "flip", "fluid"):
     _sys.modules[f"{__name__}.{_name}"] = getattr(_anim, _name)
 
 __all__ = [
@@ -43,6 +44,7 @@ __all__ = [
     "SimulationError",
     "fem",
     "flip",
+    "fluid",
     "io",
     "mpm",
     "pbd",

@@ -1,5 +1,6 @@
 from . import fem as fem
 from . import flip as flip
+from . import fluid as fluid
 from . import io as io
 from . import mpm as mpm
 from . import pbd as pbd
