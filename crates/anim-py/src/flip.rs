@@ -3,7 +3,7 @@
 
 use crate::arrays;
 use crate::errors;
-use anim::flip::{FlipError, FlipParams, FlipSimulation, Particles, Solver};
+use anim::flip::{FlipError, FlipParams, FlipSimulation, Particles};
 use numpy::PyArray2;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -119,7 +119,7 @@ impl Simulation {
         each!(&mut self.inner, s, p, _D => {
             py.detach(|| {
                 for _ in 0..steps {
-                    s.step(p, dt)?;
+                    s.advance(p, dt)?;
                 }
                 Ok(())
             })

@@ -9,7 +9,7 @@
 use crate::arrays;
 use crate::errors;
 use anim::mpm::scenes::{self, MpmScene, Scene as MpmSceneD};
-use anim::mpm::{Material, MpmError, MpmParams, MpmSimulation, Particles, Solver};
+use anim::mpm::{Material, MpmError, MpmParams, MpmSimulation, Particles};
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -169,8 +169,9 @@ impl Simulation {
         })
     }
 
-    /// Advances `steps` steps of `dt` seconds (default the scene's), without the GIL; the
-    /// solver adds substeps where its CFL limits need them.
+    /// Advances `steps` steps of `dt` seconds (default the scene's) by `MpmSimulation::advance`,
+    /// without the GIL; the solver adds substeps where its CFL limits need them (the step
+    /// report's totals are not computed: `totals()` gives them).
     #[pyo3(signature = (steps = 1, dt = None))]
     fn step(&mut self, py: Python<'_>, steps: usize, dt: Option<f64>) -> PyResult<()> {
         each!(&mut self.inner, s, _D => {
@@ -181,7 +182,7 @@ impl Simulation {
             let (sim, state) = (&mut s.sim, &mut s.state);
             py.detach(|| {
                 for _ in 0..steps {
-                    sim.step(state, dt)?;
+                    sim.advance(state, dt)?;
                 }
                 Ok(())
             })

@@ -7,7 +7,7 @@ use crate::errors;
 use anim::core::integrate::State;
 use anim::pbd::{
     Bending, Chain, Collider, ConstraintParams, MeshMass, MeshParams, Method, PbdBuilder, PbdParams,
-    PbdSimulation, Solver, SolverKind, TetMeshParams,
+    PbdSimulation, SolverKind, TetMeshParams,
 };
 use numpy::PyArray2;
 use pyo3::exceptions::PyValueError;
@@ -225,7 +225,7 @@ impl Simulation {
         let Self { sim, state } = self;
         py.detach(|| {
             for _ in 0..steps {
-                sim.step(state, dt)?;
+                sim.advance(state, dt)?;
             }
             Ok(())
         })
