@@ -9,7 +9,9 @@
 //! anim-rigid's out into the consumer's `glam::DVec3` (which compiles only if the two glam
 //! versions unify), and checks both against closed forms. It is built and run twice: with the
 //! crates' default features off, then with anim-pbd's `parallel` on; the two runs must print the
-//! same cloth, bit for bit.
+//! same cloth, bit for bit. With the crates' default features off the consumer's dependency
+//! tree (`cargo tree`) must hold no serde crate at all: scene files and checkpoints are the
+//! crates' `serde` feature, and a user who steps a cloth or a robot does not build them.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -146,6 +148,49 @@ fn run(dir: &Path, target: &Path, extra: &[&str]) -> Result<String, String> {
     Ok(stdout)
 }
 
+/// The serde crates that must stay out of a consumer with the crates' default features off.
+const SERDE_CRATES: [&str; 5] = ["serde", "serde_core", "serde_derive", "serde_json", "serde_path_to_error"];
+
+/// Checks with `cargo tree` that the consumer, with the features `extra` asks for, builds no
+/// serde crate.
+fn serde_free(dir: &Path, target: &Path, extra: &[&str]) -> Result<(), String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = Command::new(cargo)
+        .args(["tree", "--quiet", "-e", "normal", "--prefix", "none", "--manifest-path"])
+        .arg(dir.join("Cargo.toml"))
+        .args(extra)
+        .env("CARGO_TARGET_DIR", target)
+        .output()
+        .map_err(|e| format!("could not run cargo tree: {e}"))?;
+    let tree = String::from_utf8_lossy(&out.stdout);
+    if !out.status.success() || tree.trim().is_empty() {
+        return Err(format!(
+            "`cargo tree {}` failed:\n{}",
+            extra.join(" "),
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    let mut serde: Vec<&str> = tree
+        .lines()
+        .filter(|l| l.split_whitespace().next().is_some_and(|name| SERDE_CRATES.contains(&name)))
+        .collect();
+    serde.sort_unstable();
+    serde.dedup();
+    if serde.is_empty() {
+        eprintln!(
+            "  {}: no serde crate",
+            ["cargo tree"].iter().chain(extra).copied().collect::<Vec<_>>().join(" ")
+        );
+        Ok(())
+    } else {
+        Err(format!(
+            "with the crates' default features off the consumer builds serde crates ({}): a dependency \
+             asks for serde outside a `serde` feature",
+            serde.join(", ")
+        ))
+    }
+}
+
 /// The versions the consumer's fresh lockfile chose for a few of the crates' dependencies.
 fn resolved(dir: &Path) -> String {
     let lock = std::fs::read_to_string(dir.join("Cargo.lock")).unwrap_or_default();
@@ -155,7 +200,7 @@ fn resolved(dir: &Path) -> String {
         if let Some(n) = line.strip_prefix("name = ") {
             name = Some(n.trim_matches('"').to_string());
         } else if let (Some(v), Some(n)) = (line.strip_prefix("version = "), name.take())
-            && ["glam", "serde", "serde_json", "thiserror", "roxmltree", "rayon"].contains(&n.as_str())
+            && ["glam", "thiserror", "roxmltree", "rayon"].contains(&n.as_str())
         {
             found.push(format!("{n} {}", v.trim_matches('"')));
         }
@@ -174,7 +219,9 @@ fn check(root: &Path) -> Result<(), String> {
     let target = root.join("target/xtask/consumer-target");
     let sequential = run(&dir, &target, &[])?;
     eprintln!("  resolved: {}", resolved(&dir));
+    serde_free(&dir, &target, &[])?;
     let parallel = run(&dir, &target, &["--features", "parallel"])?;
+    serde_free(&dir, &target, &["--features", "parallel"])?;
     let cloth = |s: &str| s.lines().find(|l| l.starts_with("cloth:")).unwrap_or("").to_string();
     if cloth(&sequential) != cloth(&parallel) {
         return Err(format!(
@@ -189,7 +236,7 @@ fn check(root: &Path) -> Result<(), String> {
 /// Runs the consumer check; `true` when it passed.
 pub fn run_check() -> bool {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap_or(Path::new(".")).to_path_buf();
-    eprintln!("== consumer: anim-pbd and anim-rigid by path, default features off, own glam 0.34");
+    eprintln!("== consumer: anim-pbd and anim-rigid by path, default features off (no serde), own glam 0.34");
     match check(&root) {
         Ok(()) => {
             eprintln!("== consumer: passed");

@@ -10,7 +10,8 @@
 //! | `scaling [--quick] [--filter S] [--threads 1,2,...]` | thread scaling of every registered preset (quick params with `--quick`): time per step, speed-up over one thread and the same checkpoint bits as one thread, on 1 and all cores unless `--threads`; exit 1 on a failure or a thread-count dependence |
 //! | `bench [--filter S]` | the criterion benches under `benches/` (with `presets`: one step of every registered preset), printed as a table and written to `target/xtask/bench.csv`; `--peers [--filter S]`: the peer comparisons (springs, rigid, pbd, fem, mpm, fluid, flip), their ratios merged into `docs/report/peers.csv` (a filtered run replaces only its crates' rows) |
 //! | `viewer [--out DIR]` | runs a cloth, a 3D MPM scene and a 2D grid fluid, opens each run's `viewer.html` in headless Chromium at the first and the last frame, and checks the screenshots are not blank and differ (`xtask/src/viewer.rs`); skipped with a note where Chromium is absent |
-//! | `consumer` | a fresh Cargo project outside the workspace depending on anim-pbd and anim-rigid by path with default features off and its own glam 0.34, its lockfile resolved afresh (the newest versions the ranges allow): drops a cloth and poses a robot, passing its own `glam::DVec3` values in and reading ours out, checked against closed forms; run again with anim-pbd's `parallel` on, the cloth bit for bit the same (`xtask/src/consumer.rs`) |
+//! | `consumer` | a fresh Cargo project outside the workspace depending on anim-pbd and anim-rigid by path with default features off and its own glam 0.34, its lockfile resolved afresh (the newest versions the ranges allow): drops a cloth and poses a robot, passing its own `glam::DVec3` values in and reading ours out, checked against closed forms, with no serde crate in its `cargo tree`; run again with anim-pbd's `parallel` on, the cloth bit for bit the same (`xtask/src/consumer.rs`) |
+//! | `packaged` | every publishable crate from its `.crate` archive (`cargo package --workspace --no-verify`), unpacked into a workspace of its own whose lockfile takes the lowest versions our direct requirements allow (`-Z direct-minimal-versions`), checked with all targets and features: a file a crate needs but does not package, or a lower bound below the API we use, fails (`xtask/src/packaged.rs`) |
 //! | `report [--quick] [--filter S] [--out DIR] [--threads 1,2,...]` | conformance, stability and work-precision studies, the cheapest method per tolerance (also `cheapest.json`), thread scaling (1 and all cores unless `--threads`) and the peer ratios of `docs/report/peers.csv`, written to `docs/report/` (Markdown + SVG, and every measured part in `data.json`); `--filter` re-runs only the parts of matching crates or names and keeps the rest from `data.json`; prints its duration |
 
 mod architecture;
@@ -18,6 +19,7 @@ mod bench;
 mod cases;
 mod consumer;
 mod machine;
+mod packaged;
 mod peers;
 mod python;
 mod registry;
@@ -36,7 +38,7 @@ use std::process::ExitCode;
 pub static ALLOC: anim_core::alloc_count::CountingAllocator =
     anim_core::alloc_count::CountingAllocator::new();
 
-const USAGE: &str = "usage: cargo xtask <conformance|stability|scaling|bench|report|viewer|consumer> [--quick] [--long] [--filter TEXT] [--out DIR] [--threads 1,2,...]";
+const USAGE: &str = "usage: cargo xtask <conformance|stability|scaling|bench|report|viewer|consumer|packaged> [--quick] [--long] [--filter TEXT] [--out DIR] [--threads 1,2,...]";
 
 #[derive(Debug, Default)]
 struct Args {
@@ -104,6 +106,7 @@ fn main() -> ExitCode {
             args.filter.as_deref(),
         ),
         "consumer" => consumer::run_check(),
+        "packaged" => packaged::run_check(),
         "viewer" => viewer::run(std::path::Path::new(args.out.as_deref().unwrap_or("target/xtask/viewer"))),
         "help" | "--help" | "-h" => {
             println!("{USAGE}");

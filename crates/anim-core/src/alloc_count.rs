@@ -140,6 +140,7 @@ fn size(bytes: usize) -> isize {
 }
 
 /// What [`preset_step_allocations`] counted for one preset.
+#[cfg(feature = "serde")]
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PresetAllocations {
     /// The preset's name.
@@ -158,6 +159,7 @@ pub struct PresetAllocations {
 ///
 /// # Errors
 /// The preset's name and the message when one cannot be built or a step fails.
+#[cfg(feature = "serde")]
 pub fn preset_step_allocations(
     alloc: &CountingAllocator,
     kind: &crate::scene::SceneKind,
@@ -186,6 +188,7 @@ pub fn preset_step_allocations(
 ///
 /// # Errors
 /// The message of a step that fails.
+#[cfg(feature = "serde")]
 pub fn step_allocations(
     alloc: &CountingAllocator,
     scene: &mut dyn crate::scene::DynScene,
@@ -221,6 +224,7 @@ pub fn step_allocations(
 ///
 /// # Errors
 /// The message when the scene cannot be built or its step fails.
+#[cfg(feature = "serde")]
 pub fn build_and_step_peak(
     alloc: &CountingAllocator,
     kind: &crate::scene::SceneKind,
@@ -250,6 +254,7 @@ pub fn build_and_step_peak(
 /// ```ignore
 /// anim_core::preset_allocation_test!(anim_springs::KIND);
 /// ```
+#[cfg(feature = "serde")]
 #[macro_export]
 macro_rules! preset_allocation_test {
     ($kind:expr) => {

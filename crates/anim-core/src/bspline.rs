@@ -30,10 +30,9 @@
 //! `N` nodes from the particle's coordinate in cell units. The gradient with respect to the
 //! particle position is `grad_a w_ip = N'_a / h * prod_{b != a} N_b`.
 
-use serde::{Deserialize, Serialize};
-
 /// Which B-spline the transfers use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Kernel {
     /// Quadratic B-spline, 3 nodes per axis, `D_p = h^2/4 I` (the default: cheaper).
     #[default]

@@ -10,10 +10,9 @@
 //! with [`NonFinite::in_elements`] (fixed-width elements such as particles with `x, y, z`) or
 //! [`NonFinite::at_element`] (elements of varying width such as joints).
 
-use serde::{Deserialize, Serialize};
-
 /// Which array of the state held the non-finite value.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Field {
     /// Positions (generalised coordinates).
     Position,
@@ -37,7 +36,8 @@ impl std::fmt::Display for Field {
 }
 
 /// Which entry of an element held the non-finite value.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Component {
     /// The element is a single value (a bare degree of freedom).
     Whole,
@@ -59,7 +59,8 @@ impl std::fmt::Display for Component {
 }
 
 /// The element that held a non-finite value, in the terms of the model that owns the array.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Element {
     /// What the model calls its elements: "particle", "vertex", "joint", or "degree of freedom"
     /// for a bare array.

@@ -21,11 +21,11 @@
 //! bodies, the closest point of a closed surface).
 
 use glam::DVec3;
-use serde::{Deserialize, Serialize};
 
 /// A solid collider shape. Its signed distance is negative inside, positive outside.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case", deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case", deny_unknown_fields))]
 pub enum Shape {
     /// The half-space below a plane: solid where `(x - point) . normal < 0`.
     Plane {
@@ -514,6 +514,7 @@ mod tests {
         assert!(Shape::Capsule { a: [0.0; 3], b: [1e-150, 0.0, 0.0], radius: 0.5 }.check().is_ok());
     }
 
+    #[cfg(feature = "serde")]
     #[test]
     fn scene_file_spelling() {
         let s: Shape =

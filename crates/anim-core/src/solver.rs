@@ -5,13 +5,12 @@
 //! parameters) and its scratch data, advances a separate, serialisable state by `dt`, and reports
 //! what it did. `cargo xtask` and the `anim` command line drive every crate through this trait.
 
-use serde::{Deserialize, Serialize};
-
 /// What one step did: iteration counts, residuals and the conserved quantities the scene defines.
 ///
 /// Fields a solver cannot define stay `None` (a dissipative grid fluid has no total energy in
 /// this sense; a 2D solver reports a 1-component angular momentum in `angular_momentum[2]`).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct StepReport {
     /// Simulated time after the step.
@@ -40,7 +39,8 @@ pub struct StepReport {
 /// The total can pass through zero while its parts are large (a chain released at rest at the
 /// height of its pivot has total energy 0 all along), so a relative change of the total is
 /// measured against [`EnergyParts::scale`] instead.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct EnergyParts {
     /// Kinetic energy.
     pub kinetic: f64,
@@ -115,6 +115,7 @@ pub struct StepClock {
 
 impl StepClock {
     /// `{"steps": ..., "time": ...}`.
+    #[cfg(feature = "serde")]
     #[must_use]
     pub fn to_memory(self) -> serde_json::Value {
         serde_json::json!({ "steps": self.steps, "time": self.time })
@@ -125,6 +126,7 @@ impl StepClock {
     /// # Errors
     /// `"no step count"` or `"no finite time"` when a field is missing, of the wrong type or,
     /// for the time, not finite.
+    #[cfg(feature = "serde")]
     pub fn from_memory(memory: &serde_json::Value) -> Result<Self, &'static str> {
         let steps = memory.get("steps").and_then(serde_json::Value::as_u64).ok_or("no step count")?;
         let time = memory
@@ -137,6 +139,7 @@ impl StepClock {
 }
 
 #[cfg(test)]
+#[cfg(feature = "serde")]
 mod tests {
     use super::StepClock;
 

@@ -41,6 +41,7 @@ mod tet;
 mod validate;
 
 pub use builder::{EARTH_GRAVITY, MeshMass, PbdBuilder};
+#[cfg(feature = "serde")]
 pub(crate) use closed::{NotClosed, closed_outward};
 pub use cloth::{Bending, Cloth, ClothHandle, MeshParams};
 pub use error::{BuildError, InputError};

@@ -76,7 +76,6 @@
 //! thickness and friction of [`BodyContact`]; `sim/body_contacts.rs` has the constraint.
 
 use anim_core::glam::{DQuat, DVec3};
-use serde::{Deserialize, Serialize};
 
 mod mesh;
 #[cfg(test)]
@@ -87,7 +86,8 @@ pub use mesh::MeshCollider;
 pub(crate) use sweep::first_touch;
 
 /// A rigid pose: `world = position + rotation * local`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Pose {
     /// Translation.
     pub position: DVec3,
@@ -136,8 +136,9 @@ impl Pose {
 }
 
 /// How a kinematic body moves: a function of time from its initial pose.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum BodyMotion {
     /// It stays where it is.
     Fixed,
@@ -158,7 +159,8 @@ pub enum BodyMotion {
 }
 
 /// A body that moves by prescription and carries colliders and attachment points.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct KinematicBody {
     /// Pose at time 0.
     pub pose: Pose,
@@ -166,7 +168,7 @@ pub struct KinematicBody {
     pub motion: BodyMotion,
     /// What the body looks like in pictures, in its own frame (the flag's pole): drawn where
     /// the body is at each frame, never collided with (give the body a [`Collider`] for that).
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub look: Option<Shape>,
 }
 
@@ -235,8 +237,9 @@ pub use anim_core::geometry::Shape;
 /// geometry is a [`Shape`] (the default, `Collider`), or the signed distance field of a closed
 /// triangle mesh ([`MeshCollider`], `Collider<DistanceField>`); the contact parameters, their
 /// setters and their checks are the same for both.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Collider<G = Shape> {
     /// The geometry (in the body's frame when `body` is set): a [`Shape`], or a mesh's
     /// [`DistanceField`](anim_core::surface::DistanceField).
@@ -376,11 +379,12 @@ pub(crate) fn coefficients(colliders: &[Collider], meshes: &[MeshCollider], ci: 
 /// The contact parameters between contact bodies
 /// ([`PbdBuilder::contact_body`](crate::PbdBuilder::contact_body)), set with
 /// [`PbdBuilder::body_contact`](crate::PbdBuilder::body_contact).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 pub struct BodyContact {
     /// Distance kept between a particle of one body and the surface of another (m, > 0).
-    /// Default [`DEFAULT_THICKNESS`](crate::kind::DEFAULT_THICKNESS), `0.005`, as a scene's.
+    /// Default `0.005`, as a scene's (`kind::DEFAULT_THICKNESS`).
     pub thickness: f64,
     /// Static friction coefficient `mu_s >= 0` between bodies. Default 0.
     pub static_friction: f64,
@@ -390,9 +394,12 @@ pub struct BodyContact {
 
 impl Default for BodyContact {
     fn default() -> Self {
-        Self { thickness: crate::kind::DEFAULT_THICKNESS, static_friction: 0.0, kinetic_friction: 0.0 }
+        Self { thickness: DEFAULT_THICKNESS, static_friction: 0.0, kinetic_friction: 0.0 }
     }
 }
+
+/// The default contact thickness between bodies (m), a scene's as well.
+pub(crate) const DEFAULT_THICKNESS: f64 = 0.005;
 
 impl BodyContact {
     /// Checks the parameters; the reason on failure.

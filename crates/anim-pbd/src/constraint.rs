@@ -47,14 +47,14 @@
 //! *rest* shapes are rejected when the model is built ([`BuildError`](crate::BuildError)).
 
 use anim_core::glam::DVec3;
-use serde::{Deserialize, Serialize};
 
 /// Below this length a direction is undefined (about `1.5e-154`, `sqrt(f64::MIN_POSITIVE)`).
 pub const MIN_LENGTH: f64 = 1.491_668_146_240_041_3e-154;
 
 /// Equality (`C = 0`) or inequality (`C >= 0`), a constraint's "type" in PBD.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum ConstraintType {
     /// `C(x) = 0`.
     #[default]
@@ -67,8 +67,9 @@ pub enum ConstraintType {
 ///
 /// PBD uses `stiffness` (Müller et al.'s `k` in `[0, 1]`); XPBD uses `compliance` and `damping`.
 /// Both are stored so that one model runs under either method.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 #[non_exhaustive]
 pub struct ConstraintParams {
     /// PBD stiffness `k` in `[0, 1]`. Default `1`.
@@ -140,8 +141,9 @@ impl ConstraintParams {
 }
 
 /// What an attachment holds its particle to.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum AttachTarget {
     /// A fixed point in world space.
     Point([f64; 3]),
@@ -155,7 +157,8 @@ pub enum AttachTarget {
 }
 
 /// The isometric bending stencil (see the module docs).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct IsometricBending {
     /// `[p0, p1, p2, p3]`: `p2, p3` the shared edge, `p0` and `p1` the opposite vertices.
     pub particles: [usize; 4],
@@ -167,8 +170,9 @@ pub struct IsometricBending {
 }
 
 /// The function `C_j` and its index set.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum ConstraintFunction {
     /// `C = |x_i - x_j| - rest_length`.
     Distance {
@@ -232,7 +236,8 @@ impl ConstraintFunction {
 }
 
 /// A constraint: the function with its index set, and its parameters.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Constraint {
     /// `C_j` and its particles.
     pub function: ConstraintFunction,

@@ -13,12 +13,12 @@ use crate::collide::{BodyContact, Collider, KinematicBody, MeshCollider};
 use crate::constraint::{AttachTarget, Constraint, ConstraintFunction, load};
 use anim_core::glam::DVec3;
 use anim_core::integrate::State;
-use serde::{Deserialize, Serialize};
 
 /// A particle: PBD's vertex `i` with mass `m_i` (its position and velocity live in the
 /// state). A pinned particle has inverse mass `w_i = 0`: nothing moves it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Particle {
     /// Mass `m_i` (kg, > 0); kept for a pinned particle's momentum and energy.
     pub mass: f64,
@@ -28,7 +28,8 @@ pub struct Particle {
 
 /// A closed, consistently oriented triangle mesh whose enclosed volume a
 /// [`GlobalVolume`](ConstraintFunction::GlobalVolume) constraint keeps.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct VolumeMesh {
     /// The particles of the mesh, in increasing order (the constraint's index set).
     pub vertices: Vec<usize>,
@@ -70,7 +71,8 @@ impl VolumeMesh {
 
 /// A body whose particles collide with the surfaces of the other contact bodies, and whose
 /// surface their particles collide with ([`PbdBuilder::contact_body`](crate::PbdBuilder::contact_body)).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ContactBody {
     /// Its particles: model indices `particles.0 .. particles.1`.
     pub particles: (usize, usize),
@@ -87,8 +89,9 @@ pub struct ContactBody {
 /// A uniform wind acting on the model's triangles: each triangle of area `A` and unit normal `n`
 /// moving with the mean velocity `u` of its vertices feels `f = drag A ((w - u) . n) n`, shared
 /// equally by its three vertices (the usual cloth wind model; Provot 1995).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Wind {
     /// Wind velocity `w` (m/s).
     pub velocity: [f64; 3],

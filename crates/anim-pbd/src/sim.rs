@@ -140,6 +140,7 @@ impl PbdSimulation {
     /// What the simulation carries from one step to the next (step count, the external forces
     /// set with [`PbdSimulation::set_external_force`], pending body targets), for checkpoints:
     /// with the [`State`], it continues a run bit for bit.
+    #[cfg(feature = "serde")]
     #[must_use]
     pub fn memory(&self) -> serde_json::Value {
         let forces: Vec<[f64; 3]> = self.forces.iter().map(|f| f.to_array()).collect();
@@ -152,6 +153,7 @@ impl PbdSimulation {
     /// # Errors
     /// [`PbdError::Checkpoint`] when `memory` does not fit this model (missing fields, another
     /// particle or body count).
+    #[cfg(feature = "serde")]
     pub fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), PbdError> {
         let bad = |m: &str| PbdError::Checkpoint(m.to_string());
         let steps =

@@ -35,7 +35,6 @@
 //! `J[:, master] = Σ_{j ∈ support, j drives master} multiplier_j · Ad(world_M_j) S_j`.
 
 use anim_core::lie::{Se3, Twist};
-use serde::{Deserialize, Serialize};
 
 use crate::data::Data;
 use crate::kinematics::local_placement;
@@ -44,7 +43,8 @@ use crate::model::{FrameIndex, JointIndex, JointType, Model};
 pub use crate::matrix6x::Jacobian;
 
 /// In which frame a Jacobian (or velocity) is expressed. Pinocchio's `ReferenceFrame`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum ReferenceFrame {
     /// Spatial twist: world axes, reference point the world origin.
     World,

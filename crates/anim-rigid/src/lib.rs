@@ -1,4 +1,7 @@
-#![doc = include_str!("../README.md")]
+// The README, with its links to what feature `serde` adds resolved: to the items with it,
+// else to the features table that says how to get them.
+#![cfg_attr(feature = "serde", doc = concat!(include_str!("../README.md"), "\n[`KIND`]: KIND\n[`scene`]: anim_core::scene\n[`kind`]: kind\n[`kind::RigidParams`]: kind::RigidParams\n[`kind::RigidSegments`]: kind::RigidSegments\n"))]
+#![cfg_attr(not(feature = "serde"), doc = concat!(include_str!("../README.md"), "\n[`KIND`]: #features\n[`scene`]: #features\n[`kind`]: #features\n[`kind::RigidParams`]: #features\n[`kind::RigidSegments`]: #features\n"))]
 
 #[cfg(feature = "cases")]
 pub mod cases;
@@ -9,6 +12,7 @@ pub mod dense;
 pub mod dynamics;
 pub mod ik;
 pub mod jacobian;
+#[cfg(feature = "serde")]
 pub mod kind;
 pub mod kinematics;
 pub mod matrix6x;
@@ -35,6 +39,7 @@ pub use jacobian::{
     Jacobian, ReferenceFrame, compute_joint_jacobians, compute_joint_jacobians_time_variation,
     frame_jacobian, frame_jacobian_time_variation, joint_jacobian,
 };
+#[cfg(feature = "serde")]
 pub use kind::KIND;
 pub use kinematics::{
     forward_kinematics, frame_point, frames_forward_kinematics, joint_world_placement,

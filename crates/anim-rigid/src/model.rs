@@ -42,7 +42,6 @@
 
 use anim_core::glam::{DMat3, DVec3};
 use anim_core::lie::{Se3, so3};
-use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 /// Index of a joint in [`Model::joints`]; `0` is the universe.
@@ -61,7 +60,8 @@ pub use mimic::Mimic;
 
 /// Position, velocity and effort limits of a one-degree-of-freedom joint. Unbounded entries are
 /// infinite; multi-degree-of-freedom joints carry [`JointLimits::UNBOUNDED`].
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct JointLimits {
     /// Lowest position (rad or m); `-inf` when unbounded.
     pub lower: f64,
@@ -104,7 +104,8 @@ impl Default for JointLimits {
 /// The mass properties of a rigid body, expressed in some frame `F` (a joint frame in a
 /// [`Model`]): mass, centre of mass and the rotational inertia about the centre of mass with
 /// `F`'s axes. Pinocchio's `Inertia` (mass, lever, inertia) in the same convention.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Inertia {
     /// Mass (kg), `>= 0`.
     pub mass: f64,
@@ -159,7 +160,8 @@ impl Default for Inertia {
 }
 
 /// One joint of a [`Model`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Joint {
     /// Unique name (the URDF joint name; `universe` for joint 0).
     pub name: String,
@@ -178,7 +180,7 @@ pub struct Joint {
     /// When set, the joint is *coupled* to another one (URDF `<mimic>` with
     /// [`crate::urdf::UrdfOptions::couple_mimic_joints`]): it owns no entry of `q` or `v`, and
     /// [`idx_q`](Self::idx_q), [`idx_v`](Self::idx_v) are its master's, as in Pinocchio.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub mimic: Option<Mimic>,
 }
 
@@ -199,7 +201,8 @@ impl Joint {
 }
 
 /// What a [`Frame`] marks.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum FrameKind {
     /// The frame of a movable joint (identity placement on it).
     Joint,
@@ -212,7 +215,8 @@ pub enum FrameKind {
 }
 
 /// A named frame rigidly attached to a joint.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Frame {
     /// Name (URDF link or joint name). Names are unique within one [`FrameKind`].
     pub name: String,
@@ -297,7 +301,8 @@ pub enum ModelError {
 
 /// An articulated rigid-body model: the kinematic tree, its limits, the bodies' inertias and
 /// named frames. Immutable; every algorithm takes `&Model` and writes into a [`crate::Data`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Model {
     name: String,
     joints: Vec<Joint>,
@@ -308,15 +313,16 @@ pub struct Model {
     nv: usize,
     lower: Vec<f64>,
     upper: Vec<f64>,
-    #[serde(default = "default_gravity")]
+    #[cfg_attr(feature = "serde", serde(default = "default_gravity"))]
     gravity: DVec3,
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     mimic_joints: Vec<JointIndex>,
 }
 
 /// Standard gravity along `-z`, `(0, 0, -9.81)` m/s² (Pinocchio's default).
 pub const DEFAULT_GRAVITY: DVec3 = DVec3::new(0.0, 0.0, -9.81);
 
+#[cfg(feature = "serde")]
 fn default_gravity() -> DVec3 {
     DEFAULT_GRAVITY
 }

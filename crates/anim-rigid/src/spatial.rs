@@ -93,7 +93,6 @@ use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 
 use anim_core::glam::{DMat3, DVec3};
 use anim_core::lie::{Se3, Twist};
-use serde::{Deserialize, Serialize};
 
 use crate::model::Inertia;
 
@@ -146,7 +145,8 @@ fn rotate_symmetric(r: &DMat3, s: &DMat3) -> [f64; 6] {
 /// `(v_O, ω)`, the velocity of the body point at the frame origin `O` and the angular velocity.
 ///
 /// The same quantity as a [`Twist`] (conversions are free), typed apart from [`Force`].
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Motion {
     /// Linear part `v_O`.
     pub linear: DVec3,
@@ -276,7 +276,8 @@ impl From<Motion> for Twist {
 
 /// A spatial force vector (a wrench or a momentum), **linear part first**: `(f, n_O)`, the
 /// resultant force and the moment about the frame origin `O`.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Force {
     /// Linear part `f` (the resultant).
     pub linear: DVec3,
@@ -430,7 +431,8 @@ vector_ops!(Force);
 /// `I v = (m v_O - h × ω, Ī_O ω + h × v_O)`; composite bodies in one frame add entry by entry
 /// ([`Add`]); [`transform`](Self::transform) moves the inertia to another frame. Converts from
 /// and to the model's [`Inertia`] (mass, centre of mass, inertia about the centre of mass).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SpatialInertia {
     /// Mass `m` (kg).
     pub mass: f64,
@@ -604,7 +606,8 @@ impl Mul<Motion> for SpatialInertia {
 /// A symmetric 6x6 inertia that need not be a single rigid body's: the articulated-body inertia
 /// of ABA (Featherstone ch. 7). Linear-first blocks `[[A, B], [Bᵀ, C]]`, `A`, `C` symmetric:
 /// `I v = (A v_O + B ω, Bᵀ v_O + C ω)`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ArticulatedInertia {
     /// Linear-linear block `A` (symmetric).
     pub a: DMat3,

@@ -19,12 +19,12 @@
 use crate::SkinError;
 use crate::skeleton::{Pose, Skeleton};
 use anim_core::glam::{DQuat, DVec3, DVec4};
-use serde::{Deserialize, Serialize};
 
 pub use crate::rotation::slerp;
 
 /// How values between keys are computed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Interpolation {
     /// The value of the previous key.
     Step,
@@ -35,7 +35,8 @@ pub enum Interpolation {
 }
 
 /// Which part of a joint's local transform a channel drives.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Property {
     /// Translation (values `(x, y, z, 0)`).
     Translation,
@@ -46,7 +47,8 @@ pub enum Property {
 }
 
 /// Keyframes of one property of one joint.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Channel {
     joint: usize,
     property: Property,
@@ -191,7 +193,8 @@ fn to_quat(v: DVec4) -> DQuat {
 }
 
 /// A named set of channels.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Clip {
     /// Name (from the file, or made up).
     pub name: String,

@@ -1,4 +1,7 @@
-#![doc = include_str!("../README.md")]
+// The README, with its links to what feature `serde` adds resolved: to the items with it,
+// else to the features table that says how to get them.
+#![cfg_attr(feature = "serde", doc = concat!(include_str!("../README.md"), "\n[`KIND`]: KIND\n[`scene`]: anim_core::scene\n[`kind::SkinParams`]: kind::SkinParams\n[`kind::SkinPlayback`]: kind::SkinPlayback\n[`kind`]: kind\n"))]
+#![cfg_attr(not(feature = "serde"), doc = concat!(include_str!("../README.md"), "\n[`KIND`]: #features\n[`scene`]: #features\n[`kind::SkinParams`]: #features\n[`kind::SkinPlayback`]: #features\n[`kind`]: #features\n"))]
 
 #[cfg(feature = "cases")]
 pub mod cases;
@@ -6,6 +9,7 @@ pub mod character;
 pub mod clip;
 #[cfg(feature = "gltf")]
 pub mod gltf_io;
+#[cfg(feature = "serde")]
 pub mod kind;
 pub mod mesh;
 pub mod rotation;
@@ -17,6 +21,7 @@ pub use character::{Character, CharacterData, CharacterMesh, GltfSource};
 pub use clip::{Channel, Clip, Interpolation, Property};
 #[cfg(feature = "gltf")]
 pub use gltf_io::{LoadError, Loaded, Renormalised};
+#[cfg(feature = "serde")]
 pub use kind::KIND;
 pub use mesh::{MAX_INFLUENCES, SkinnedMesh, signed_volume};
 pub use skeleton::{Joint, Pose, Skeleton, Skin, Trs};

@@ -2,7 +2,6 @@
 //! structure-of-arrays.
 
 use crate::SkinError;
-use serde::{Deserialize, Serialize};
 
 /// The largest number of influences per vertex (glTF `JOINTS_0`/`WEIGHTS_0` plus `_1`).
 pub const MAX_INFLUENCES: usize = 8;
@@ -12,8 +11,9 @@ pub const MAX_INFLUENCES: usize = 8;
 ///
 /// Weights are normalised to sum to 1 at construction; zero-weight slots are kept (their joint
 /// index is set to 0) and skipped by the skinning kernels.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(from = "MeshData")]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(from = "MeshData"))]
 pub struct SkinnedMesh {
     /// Rest positions, x.
     pub x: Vec<f64>,
@@ -34,12 +34,12 @@ pub struct SkinnedMesh {
     num_joints: usize,
     /// Each vertex's dominant influence slot (the first of largest weight), derived from the
     /// weights: DQS's hemisphere reference.
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     dominant: Vec<u8>,
 }
 
 /// The serialised fields of a [`SkinnedMesh`]; the derived ones are rebuilt on loading.
-#[derive(Deserialize)]
+#[cfg_attr(feature = "serde", derive(serde::Deserialize))]
 struct MeshData {
     x: Vec<f64>,
     y: Vec<f64>,

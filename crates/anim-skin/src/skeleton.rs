@@ -11,11 +11,11 @@
 
 use crate::SkinError;
 use anim_core::glam::{DMat4, DQuat, DVec3};
-use serde::{Deserialize, Serialize};
 
 /// A local transform: translation, unit-quaternion rotation and non-uniform scale, applied as
 /// `T * R * S` (scale first), as in glTF.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Trs {
     /// Translation.
     pub translation: DVec3,
@@ -61,7 +61,8 @@ impl Trs {
 }
 
 /// One joint of a [`Skeleton`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Joint {
     /// Name (from the file, or made up).
     pub name: String,
@@ -72,7 +73,8 @@ pub struct Joint {
 }
 
 /// A joint hierarchy, parents before children.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Skeleton {
     joints: Vec<Joint>,
 }
@@ -159,7 +161,8 @@ impl Skeleton {
 }
 
 /// A local transform per joint of a skeleton.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Pose {
     /// Local transforms, indexed like the skeleton's joints.
     pub local: Vec<Trs>,
@@ -191,7 +194,8 @@ impl Pose {
 }
 
 /// The joints a mesh is bound to and their inverse bind matrices (glTF `skin`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Skin {
     /// Skeleton joint of each skin joint (vertex joint indices index this list).
     pub joints: Vec<usize>,

@@ -65,7 +65,6 @@ use crate::mesh::{MAX_INFLUENCES, SkinnedMesh};
 use anim_core::glam::{DMat3, DMat4, DQuat};
 use anim_core::linalg::svd::polar;
 use anim_core::par::prelude::*;
-use serde::{Deserialize, Serialize};
 use wide::f64x2;
 
 #[cfg(target_arch = "x86_64")]
@@ -93,7 +92,8 @@ impl Default for RigidTolerance {
 }
 
 /// Which skinning algorithm.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum SkinningMethod {
     /// Linear blend skinning: fast, handles scale, collapses under twist.
     Lbs,
@@ -663,6 +663,7 @@ mod tests {
 
     /// A mesh read back from its serialised form has the same derived data (dominant slots)
     /// and skins to the same bits.
+    #[cfg(feature = "serde")]
     #[test]
     fn a_deserialised_mesh_skins_like_the_original() {
         let pos: Vec<[f64; 3]> = (0..50).map(|v| [v as f64, 1.0, 2.0]).collect();

@@ -28,12 +28,12 @@ use crate::error::{BuildError, InputError};
 use crate::network::{Particle, Spring, SpringKind, SpringModel, SpringNetwork};
 use anim_core::glam::DVec3;
 use anim_core::input::{check_particles, check_triangle, check_triangle_indices};
-use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
 /// Stiffness and damping of a family of springs.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct SpringParams {
     /// Stiffness `k` (N/m, > 0).
     pub stiffness: f64,
@@ -51,8 +51,9 @@ impl SpringParams {
 
 /// A straight chain (rope) of `count` particles from `start` to `end`, joined by `count - 1`
 /// structural springs at their rest length.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Chain {
     /// Number of particles (>= 2).
     pub count: usize,
@@ -71,8 +72,9 @@ pub struct Chain {
 /// Particle `(ix, iy)` has index `first + iy nx + ix`. Springs: structural between grid
 /// neighbours, shear across both diagonals of each quad, bending between particles two apart
 /// along each grid line (Provot 1995). Two triangles per quad are recorded for rendering.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Cloth {
     /// Particles along `u` (>= 2).
     pub nx: usize,
@@ -98,8 +100,9 @@ pub struct Cloth {
 /// cube). Particle `(a, b, c)` has index `first + (c n[1] + b) n[0] + a`. Springs along the axes
 /// (structural), and optionally across every face diagonal and every cell's four body diagonals
 /// (shear). The box's surface is recorded as triangles for rendering.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Lattice {
     /// Particles along x, y, z (each >= 2).
     pub n: [usize; 3],
@@ -118,8 +121,9 @@ pub struct Lattice {
 }
 
 /// How a triangle mesh's vertices get their mass.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case", deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case", deny_unknown_fields))]
 pub enum MeshMass {
     /// Every vertex has this mass (kg).
     PerVertex(f64),
@@ -129,8 +133,9 @@ pub enum MeshMass {
 
 /// Springs made from a triangle mesh: one structural spring per unique edge, and optionally one
 /// bending spring across each interior edge (between the two vertices opposite it).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct MeshSprings {
     /// Vertex masses.
     pub mass: MeshMass,

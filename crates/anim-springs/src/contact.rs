@@ -79,8 +79,8 @@
 
 use crate::geom::{MIN_LENGTH, outer};
 use anim_core::glam::{DMat3, DVec3};
+#[cfg(feature = "serde")]
 use anim_core::scene::is_default;
-use serde::{Deserialize, Serialize};
 
 /// The geometry of a collider: anim-core's shared [`Shape`], re-exported here. The penalty
 /// contact handles all four: plane, sphere, axis-aligned box and capsule.
@@ -143,8 +143,9 @@ pub(crate) trait Geometry {
 /// [module docs](self)). The geometry is a [`Shape`] (the default, `Collider`) or the signed
 /// distance field of a closed triangle mesh ([`MeshCollider`], `Collider<DistanceField>`); the
 /// penalty parameters, their setters and their checks are the same for both.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Collider<G = Shape> {
     /// The geometry: a [`Shape`], or a mesh's [`DistanceField`](anim_core::surface::DistanceField).
     pub shape: G,
@@ -156,14 +157,14 @@ pub struct Collider<G = Shape> {
     pub friction: f64,
     /// Width `delta` (m, >= 0) of the zone where the penalty stiffness ramps up from 0 to `k_c`;
     /// 0 gives the plain penalty `k_c p`.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub smoothing: f64,
     /// Distance `t` (m, >= 0) outside the geometry at which particles are held: the penalty acts
     /// on `phi - t`, the signed distance to the geometry grown by `t` (a plane moved out along its
     /// normal, a sphere's or capsule's radius plus `t`, a box with its edges and corners rounded
     /// to radius `t`, a mesh offset by `t`). A cloth's thickness: its triangles then lie clear of
     /// a curved obstacle instead of cutting its surface between their vertices. Default 0.
-    #[serde(default, skip_serializing_if = "is_default")]
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_default"))]
     pub thickness: f64,
 }
 

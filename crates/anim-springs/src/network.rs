@@ -83,7 +83,6 @@ use anim_core::glam::{DMat3, DVec3};
 use anim_core::integrate::SecondOrderSystem;
 use anim_core::linalg::CsrMatrix;
 use anim_core::par::prelude::*;
-use serde::{Deserialize, Serialize};
 use std::sync::OnceLock;
 use std::sync::atomic::AtomicUsize;
 
@@ -94,8 +93,9 @@ pub const PARALLEL_THRESHOLD: usize = 2048;
 const CHUNK: usize = 512;
 
 /// Which force Jacobian [`linearize`](anim_core::integrate::MechanicalSystem::linearize) computes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum JacobianMode {
     /// The definiteness fix (compressed springs' transverse stiffness clamped at 0, a sphere's
     /// curvature term and the position-derivatives of damping dropped): symmetric and negative

@@ -167,6 +167,7 @@ impl SpringSimulation {
 
     /// What the simulation carries from one step to the next (step count, the integrator's
     /// memory), for checkpoints: with the [`State`], it continues a run bit for bit.
+    #[cfg(feature = "serde")]
     #[must_use]
     pub fn memory(&self) -> serde_json::Value {
         serde_json::json!({ "steps": self.steps, "integrator": self.integrator.memory() })
@@ -176,6 +177,7 @@ impl SpringSimulation {
     ///
     /// # Errors
     /// [`SpringError::Checkpoint`] when `memory` is not a memory of this simulation's method.
+    #[cfg(feature = "serde")]
     pub fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), SpringError> {
         let steps = memory
             .get("steps")

@@ -584,15 +584,21 @@ fn an_overflowing_force_is_reported_by_particle_and_the_step_undone() {
         let mut failed = None;
         for _ in 0..10 {
             let before = state.clone();
+            // The memory is a checkpoint's (feature `serde`); without it only the state is compared.
+            #[cfg(feature = "serde")]
             let memory = sim.memory();
+            #[cfg(not(feature = "serde"))]
+            let memory = ();
             if let Err(e) = sim.advance(&mut state, 1e-3) {
                 failed = Some((e, before, memory));
                 break;
             }
         }
+        #[cfg_attr(not(feature = "serde"), expect(unused_variables))]
         let Some((err, before, memory)) = failed else { panic!("{}: never overflowed", kind.label()) };
         let bits = |s: &State| s.x.iter().chain(&s.v).chain([&s.t]).map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&state), bits(&before), "{}: the failed step changed the state", kind.label());
+        #[cfg(feature = "serde")]
         assert_eq!(sim.memory(), memory, "{}: the failed step changed the memory", kind.label());
         let msg = err.to_string();
         match err {

@@ -10,7 +10,8 @@
 //! | doc tests | `cargo test --workspace --doc` |
 //! | docs | `cargo doc --workspace --no-deps` with warnings denied |
 //! | python | the Python bindings (`crates/anim-py`): a virtual environment under the target folder with maturin, numpy and pytest from PyPI, the module built by `maturin develop` with the dev profile into it, and pytest on `crates/anim-py/tests/`; without Python, venv or pip it prints a note and is skipped |
-//! | crates alone | each library crate as a user who picks it alone gets it: clippy on anim-core, anim-rigid, anim-pbd, anim-skin and anim-springs with `--no-default-features`; anim-core's tests without its default features (no faer, no rayon); `cargo package --workspace --no-verify` (every crate's manifest, README and files complete); `xtask consumer` (a project outside the workspace on anim-pbd and anim-rigid, newest compatible dependency versions) |
+//! | dependency versions | the library crates' unit tests (`cargo test --workspace --lib`, without xtask, this runner and the benches) against the newest versions the dependency ranges allow (`cargo update`); the committed `Cargo.lock` is put back afterwards |
+//! | crates alone | each library crate as a user who picks it alone gets it: clippy on anim-core, anim-rigid, anim-pbd, anim-skin and anim-springs with `--no-default-features`; anim-core's tests without its default features (no faer, no rayon); `xtask packaged` (every publishable crate checked from its `.crate` archive, all targets and features, against the lowest versions our direct requirements allow); `xtask consumer` (a project outside the workspace on anim-pbd and anim-rigid without their default features, newest compatible dependency versions, no serde crate in its tree) |
 //!
 //! The runner has no dependencies, so it starts at once, and the suites run in the test build
 //! (one build of the workspace, the features of every member unified) instead of a build of
@@ -114,6 +115,31 @@ fn python(target: &str) -> bool {
     ok
 }
 
+/// The unit tests of every library crate: the workspace without the tools (xtask, this runner)
+/// and the benchmarks, which users never depend on.
+const LIBRARY_TESTS: [&str; 9] =
+    ["test", "--workspace", "--lib", "--exclude", "xtask", "--exclude", "ci", "--exclude", "anim-benches"];
+
+/// Runs the library crates' unit tests under the lock file that `cargo update` writes (the
+/// newest versions the ranges allow), then puts the committed `Cargo.lock` back, whatever
+/// happened.
+fn newest_versions() -> bool {
+    let lock = std::path::Path::new("Cargo.lock");
+    let committed = match std::fs::read(lock) {
+        Ok(bytes) => bytes,
+        Err(e) => {
+            eprintln!("could not read {}: {e}", lock.display());
+            return false;
+        }
+    };
+    let ok = cargo(&["update"], &[]) && cargo(&LIBRARY_TESTS, &[]);
+    if let Err(e) = std::fs::write(lock, &committed) {
+        eprintln!("could not put the committed {} back: {e}", lock.display());
+        return false;
+    }
+    ok
+}
+
 fn main() -> ExitCode {
     if let Some(arg) = std::env::args().nth(1) {
         eprintln!("error: `cargo ci` takes no arguments, got '{arg}'");
@@ -142,7 +168,7 @@ fn main() -> ExitCode {
         "-D",
         "warnings",
     ];
-    let steps: [(&str, &dyn Fn() -> bool); 8] = [
+    let steps: [(&str, &dyn Fn() -> bool); 9] = [
         ("format", &|| cargo(&["fmt", "--all", "--", "--check"], &[])),
         ("clippy", &|| cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"], &[])),
         // The examples are type-checked and linted by clippy above; linking each of them here
@@ -152,13 +178,14 @@ fn main() -> ExitCode {
         ("doc tests", &|| cargo(&["test", "--workspace", "--doc"], &[])),
         ("docs", &|| cargo(&["doc", "--workspace", "--no-deps"], &[("RUSTDOCFLAGS", "-D warnings")])),
         ("python", &|| python(&target)),
+        ("dependency versions", &newest_versions),
         ("crates alone", &|| {
             // Each part runs even when one before it failed, so one run shows every problem.
             let lint = cargo(&alone, &[]);
             let core = cargo(&["test", "-p", "anim-core", "--no-default-features", "--lib", "--tests"], &[]);
-            let package = cargo(&["package", "--workspace", "--no-verify", "--allow-dirty"], &[]);
+            let packaged = run(&xtask, &["packaged"]);
             let consumer = run(&xtask, &["consumer"]);
-            lint && core && package && consumer
+            lint && core && packaged && consumer
         }),
     ];
     let mut failed = Vec::new();

@@ -3,20 +3,20 @@
 use super::{
     IntegrateError, Integrator, SecondOrderSystem, State, StepInfo, check_inputs, commit, fit, for_chunks2,
 };
-use serde::{Deserialize, Serialize};
 
 /// Explicit (forward) Euler: `v1 = v0 + h a(t0, x0, v0)`, `x1 = x0 + h v0`.
 ///
 /// First order; on an undamped oscillator the energy grows by a factor `1 + (omega h)^2` per
 /// step, so it is stable only with damping. Included as the baseline.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ExplicitEuler {
     steps: u64,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     a: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     x_new: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     v_new: Vec<f64>,
 }
 
@@ -68,14 +68,15 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for ExplicitEuler {
 /// First order and symplectic: on a harmonic oscillator the energy error stays bounded (it
 /// oscillates with amplitude `O(omega h)`) for `omega h < 2`, the stability bound behind the
 /// usual explicit step bound `dt <= c sqrt(m / k)`.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SymplecticEuler {
     steps: u64,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     a: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     x_new: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     v_new: Vec<f64>,
 }
 

@@ -36,11 +36,11 @@ use crate::diagnostics::{Field, NonFinite, check_finite};
 use crate::linalg::{
     CsrMatrix, IterativeParams, LinearOperator, LinearSolver, SolveError, SystemMatrix, norm,
 };
-use serde::{Deserialize, Serialize};
 
 /// Newton's method inside an implicit step.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 #[non_exhaustive]
 pub struct NewtonParams {
     /// Stop when `||g|| <= tolerance * ||g_0||`, or when `||g||` is below the rounding floor of
@@ -162,10 +162,12 @@ struct NewtonCore {
 
 impl NewtonCore {
     /// The only state kept between steps is the step count (every solve starts from zero).
+    #[cfg(feature = "serde")]
     fn memory(&self, method: &'static str) -> serde_json::Value {
         serde_json::json!({ "method": method, "memory": { "steps": self.steps } })
     }
 
+    #[cfg(feature = "serde")]
     fn restore_memory(
         &mut self,
         method: &'static str,
@@ -553,10 +555,12 @@ impl BetaBlend {
 }
 
 impl<S: MechanicalSystem + ?Sized> Integrator<S> for BetaBlend {
+    #[cfg(feature = "serde")]
     fn memory(&self) -> serde_json::Value {
         self.core.memory(Integrator::<S>::name(self))
     }
 
+    #[cfg(feature = "serde")]
     fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), IntegrateError> {
         self.core.restore_memory(if self.beta == 1.0 { "backward-euler" } else { "beta-blend" }, memory)
     }
@@ -603,10 +607,12 @@ impl ImplicitMidpoint {
 }
 
 impl<S: MechanicalSystem + ?Sized> Integrator<S> for ImplicitMidpoint {
+    #[cfg(feature = "serde")]
     fn memory(&self) -> serde_json::Value {
         self.core.memory(Integrator::<S>::name(self))
     }
 
+    #[cfg(feature = "serde")]
     fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), IntegrateError> {
         self.core.restore_memory("implicit-midpoint", memory)
     }

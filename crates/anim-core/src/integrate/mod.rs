@@ -38,7 +38,7 @@
 //!
 //! # Invariants
 //! - No integrator allocates in `step` after the first step of a given size.
-//! - On error the state and the integrator's memory ([`Integrator::memory`]) are left bit for bit
+//! - On error the state and the integrator's memory (`Integrator::memory`, feature `serde`) are left bit for bit
 //!   as they were before the step (results are computed into scratch and committed only once
 //!   checked).
 //! - A non-finite position or velocity is reported at the step that produced it as
@@ -65,11 +65,11 @@ pub use verlet::{Leapfrog, PositionVerlet, VelocityVerlet};
 
 use crate::diagnostics::{Field, NonFinite, check_finite};
 use crate::linalg::{CsrMatrix, LinearSolverKind, SolveError};
-use serde::{Deserialize, Serialize};
 
 /// The integrated state of a second-order system: time, positions and velocities.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct State {
     /// Simulated time.
     pub t: f64,
@@ -152,7 +152,8 @@ pub trait MechanicalSystem: SecondOrderSystem {
 }
 
 /// What one integrator step did.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StepInfo {
     /// Newton iterations (0 for explicit methods).
     pub newton_iterations: usize,
@@ -238,11 +239,13 @@ pub trait Integrator<S: ?Sized> {
     /// acceleration), as a self-describing value for checkpoints. Scratch buffers are not part
     /// of it: a fresh integrator given this memory continues bit for bit like the one that
     /// produced it.
+    #[cfg(feature = "serde")]
     fn memory(&self) -> serde_json::Value;
     /// Restores what [`Integrator::memory`] of the same method returned.
     ///
     /// # Errors
     /// [`IntegrateError::Memory`] when `memory` is not a memory of this method.
+    #[cfg(feature = "serde")]
     fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), IntegrateError>;
     /// Theoretical order of accuracy of the method.
     fn order(&self) -> u32;
@@ -251,8 +254,9 @@ pub trait Integrator<S: ?Sized> {
 }
 
 /// The integrators by name, for scene files, sweeps and the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case", deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case", deny_unknown_fields))]
 pub enum IntegratorKind {
     /// [`ExplicitEuler`].
     ExplicitEuler,
@@ -513,11 +517,13 @@ pub(crate) fn fit(buf: &mut Vec<f64>, n: usize) {
 /// memory (scratch fields are `#[serde(skip)]` and refilled by the next step).
 macro_rules! serde_memory {
     ($name:literal) => {
+        #[cfg(feature = "serde")]
         fn memory(&self) -> serde_json::Value {
             let own = serde_json::to_value(self).unwrap_or(serde_json::Value::Null);
             serde_json::json!({ "method": $name, "memory": own })
         }
 
+        #[cfg(feature = "serde")]
         fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), IntegrateError> {
             let own = crate::integrate::memory_of($name, memory)?;
             *self = serde::Deserialize::deserialize(own)
@@ -529,6 +535,7 @@ macro_rules! serde_memory {
 pub(crate) use serde_memory;
 
 /// The `"memory"` part of a saved memory after checking that its `"method"` is `method`.
+#[cfg(feature = "serde")]
 pub(crate) fn memory_of<'a>(
     method: &'static str,
     saved: &'a serde_json::Value,
@@ -543,7 +550,8 @@ pub(crate) fn memory_of<'a>(
 }
 
 /// A snapshot of the state a multistep method last produced, to detect outside changes.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub(crate) struct History {
     valid: bool,
     t: f64,
@@ -611,6 +619,7 @@ impl<S: SecondOrderSystem + ?Sized> Simulation<S> {
 
     /// The integrator's memory between steps, for checkpoints (see [`Integrator::memory`]).
     #[must_use]
+    #[cfg(feature = "serde")]
     pub fn memory(&self) -> serde_json::Value {
         self.integrator.memory()
     }
@@ -619,6 +628,7 @@ impl<S: SecondOrderSystem + ?Sized> Simulation<S> {
     ///
     /// # Errors
     /// [`IntegrateError::Memory`] when `memory` belongs to another method.
+    #[cfg(feature = "serde")]
     pub fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), IntegrateError> {
         self.integrator.restore_memory(memory)
     }

@@ -1,24 +1,24 @@
 //! The classical fourth-order Runge-Kutta method, the high-order reference.
 
 use super::{IntegrateError, Integrator, SecondOrderSystem, State, StepInfo, check_inputs, commit, fit};
-use serde::{Deserialize, Serialize};
 
 /// Classical RK4 on the first-order system `(x, v)' = (v, a(t, x, v))`.
 ///
 /// Fourth order, four acceleration evaluations per step, not symplectic (its energy error drifts
 /// slowly, as `O(t h^4)`). Used as the converged reference in work-precision studies.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Rk4 {
     steps: u64,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     k: [Vec<f64>; 4],
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     x_tmp: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     v_tmp: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     x_new: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     v_new: Vec<f64>,
 }
 

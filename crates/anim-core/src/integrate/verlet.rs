@@ -14,7 +14,6 @@ use super::{
     History, IntegrateError, Integrator, SecondOrderSystem, State, StepInfo, check_inputs, commit, fit,
     for_chunks1, for_chunks2, validate,
 };
-use serde::{Deserialize, Serialize};
 
 /// Position (Stormer) Verlet: `x1 = 2 x0 - x_-1 + h^2 a(x0)`.
 ///
@@ -22,16 +21,17 @@ use serde::{Deserialize, Serialize};
 /// step `x1 = x0 + h v0 + h^2/2 a(x0)`. The reported velocity is
 /// `v1 = (x1 - x0) / h + h/2 a(x0)`, second order accurate at `t1` without another force
 /// evaluation.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PositionVerlet {
     steps: u64,
     x_prev: Vec<f64>,
     history: History,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     a: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     x_new: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     v_new: Vec<f64>,
 }
 
@@ -109,18 +109,19 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for PositionVerlet {
 /// change of the state) starts it with a half kick `v_{1/2} = v_0 + h/2 a(x_0)`. The reported
 /// velocity is synchronised: `v_{n+1} = v_{n+1/2} + h/2 a(x_{n+1})`, computed from the same
 /// force evaluation that the next kick uses, so a step costs one evaluation.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Leapfrog {
     steps: u64,
     v_half: Vec<f64>,
     history: History,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     a: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     x_new: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     v_new: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     v_half_new: Vec<f64>,
 }
 
@@ -209,16 +210,17 @@ impl<S: SecondOrderSystem + ?Sized> Integrator<S> for Leapfrog {
 ///
 /// Keeps `a(x1)` for the next step's first half kick, so a step costs one evaluation (two on
 /// the first step or after an outside change of the state).
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct VelocityVerlet {
     steps: u64,
     a: Vec<f64>,
     history: History,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     a_new: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     x_new: Vec<f64>,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     v_new: Vec<f64>,
 }
 

@@ -19,7 +19,6 @@
 use std::ops::{Add, AddAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 
 use glam::{DMat3, DMat4, DVec3, DVec4};
-use serde::{Deserialize, Serialize};
 
 use super::so3;
 
@@ -31,7 +30,8 @@ const HOMOGENEOUS_TOL: f64 = 1e-9;
 ///
 /// The order is **linear first, angular second**, everywhere: in [`to_array`](Self::to_array),
 /// in [`Se3::adjoint_matrix`] and in the hat matrix `ξ̂ = [[ω̂, v], [0, 0]]`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Twist {
     /// Linear part `v`.
     pub v: DVec3,
@@ -200,7 +200,8 @@ impl Neg for Twist {
 ///
 /// `rotation` is assumed to be a rotation matrix; the constructors do not check it
 /// ([`Se3::from_homogeneous`] does). Composition is `g * h` (apply `h` first).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Se3 {
     /// The rotation `R` (a proper orthonormal matrix).
     pub rotation: DMat3,
@@ -386,7 +387,8 @@ impl MulAssign for Se3 {
 /// [`Twist::to_screw`]; `Se3::exp(screw.to_twist())` is the motion. Note that JSON cannot
 /// represent an infinite pitch (serde_json writes `null`), so pure-translation screws do not
 /// round-trip through JSON; store the twist instead.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Screw {
     /// Unit direction of the axis (for a pure translation: the direction of translation).
     pub axis: DVec3,
@@ -833,6 +835,7 @@ mod tests {
 
     /// serde_json (without its `float_roundtrip` feature) parses floats to within an ulp, not
     /// always exactly, so the values are compared to 1e-15 relative; the field layout is exact.
+    #[cfg(feature = "serde")]
     #[test]
     fn serde_round_trip() -> Result<(), serde_json::Error> {
         let xi = Twist::new(DVec3::new(0.1, -2.0, 3.5), DVec3::new(1.0, 0.25, -0.5));

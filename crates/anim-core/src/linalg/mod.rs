@@ -33,8 +33,6 @@ pub use schur::{Eliminate, schur_complement, solve_block, solve_block_diagonal_a
 pub use stationary::{GaussSeidel, Jacobi, gauss_seidel_sweep, jacobi_sweep};
 pub use svd::{Svd3, polar, polar_f32, svd3, svd3_f32, svd3_real};
 
-use serde::{Deserialize, Serialize};
-
 /// A square linear operator known by its action.
 pub trait LinearOperator {
     /// Number of rows (= columns).
@@ -70,8 +68,9 @@ impl SystemMatrix<'_> {
 }
 
 /// Stopping rule of an iterative solve.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 #[non_exhaustive]
 pub struct IterativeParams {
     /// Stop when `||b - A x|| <= tolerance * ||b||`. Default `1e-10`.
@@ -95,7 +94,8 @@ impl IterativeParams {
 }
 
 /// What a successful solve did.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SolveInfo {
     /// Iterations (or sweeps) performed; 1 for a direct solve.
     pub iterations: usize,
@@ -188,8 +188,9 @@ pub trait LinearSolver: Send {
 }
 
 /// The linear solvers by name, for scene files and sweeps.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum LinearSolverKind {
     /// Conjugate gradients, matrix-free.
     Cg,
@@ -318,8 +319,8 @@ mod kind_tests {
     #[test]
     fn kind_names_match_serde_and_the_built_solvers() {
         for kind in LinearSolverKind::ALL {
-            let json = serde_json::to_string(&kind).unwrap();
-            assert_eq!(json, format!("\"{}\"", kind.name()));
+            #[cfg(feature = "serde")]
+            assert_eq!(serde_json::to_string(&kind).unwrap(), format!("\"{}\"", kind.name()));
             let solver = kind.build(IterativeParams::default());
             assert_eq!(solver.name(), kind.name());
             let assembled = matches!(

@@ -13,11 +13,11 @@ use crate::collide::{BodyContact, Collider, KinematicBody, MeshCollider};
 use crate::constraint::{AttachTarget, ConstraintParams};
 use crate::model::{ContactBody, Wind};
 use anim_core::glam::DVec3;
-use serde::{Deserialize, Serialize};
 
 /// How mesh vertices get their mass.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum MeshMass {
     /// Every vertex has this mass (kg).
     PerVertex(f64),
@@ -114,6 +114,7 @@ impl PbdBuilder {
 
     /// The triangles recorded so far (model indices): those of [`triangle`](Self::triangle), the
     /// triangle meshes' and the tetrahedral meshes' boundary faces, in the order they came.
+    #[cfg(feature = "serde")]
     pub(crate) fn recorded_triangles(&self) -> &[[usize; 3]] {
         &self.triangles
     }

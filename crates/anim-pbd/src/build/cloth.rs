@@ -11,13 +11,13 @@ use super::error::{BuildError, InputError};
 use crate::constraint::ConstraintParams;
 use anim_core::glam::DVec3;
 use anim_core::input::check_triangle;
-use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::ops::Range;
 
 /// Which bending constraint a cloth or mesh gets across each interior edge.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum Bending {
     /// No bending resistance.
     None,
@@ -33,8 +33,9 @@ pub enum Bending {
 /// Particle `(ix, iy)` has index `first + iy nx + ix`. A distance constraint on every triangle
 /// edge and a bending constraint across every interior edge: for 100 x 100 particles, 29,601
 /// distance and 29,205 bending constraints.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Cloth {
     /// Particles along `u` (>= 2).
     pub nx: usize,
@@ -74,8 +75,9 @@ impl ClothHandle {
 }
 
 /// Constraints made from a triangle mesh.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct MeshParams {
     /// Vertex masses.
     pub mass: MeshMass,

@@ -5,13 +5,13 @@
 use super::builder::{PbdBuilder, bad, check_vec};
 use super::error::BuildError;
 use crate::constraint::ConstraintParams;
-use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
 /// A straight chain (rope) of `count` particles from `start` to `end`, joined by `count - 1`
 /// distance constraints at their rest length.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Chain {
     /// Number of particles (>= 2).
     pub count: usize,

@@ -9,12 +9,12 @@ use super::builder::{MeshMass, PbdBuilder, check_mass, key};
 use super::error::{BuildError, InputError};
 use crate::constraint::{ConstraintParams, tet_is_flat, tet_volume};
 use anim_core::glam::DVec3;
-use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
 /// Constraints made from a tetrahedral mesh.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct TetMeshParams {
     /// Vertex masses.
     pub mass: MeshMass,

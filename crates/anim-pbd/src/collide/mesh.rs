@@ -7,7 +7,7 @@ use anim_core::glam::DVec3;
 use anim_core::surface::DistanceField;
 
 /// A collider whose geometry is a closed triangle mesh, sampled as a signed distance field
-/// ([`DistanceField`], e.g. from [`ObstacleMesh::field`](anim_core::scene::ObstacleMesh::field)
+/// ([`DistanceField`], e.g. from anim-core's `scene::ObstacleMesh::field`
 /// or [`DistanceField::around`]), on an optional kinematic body: a [`Collider`] whose `shape`
 /// is the field, with the same contact parameters, setters and checks as a shape's.
 ///
@@ -22,7 +22,7 @@ use anim_core::surface::DistanceField;
 /// inside is pushed out along the gradient, which points away from the surface everywhere in the
 /// lattice. A lattice should extend past the surface by more than the thickness plus the
 /// [`contact_margin`](crate::PbdParams::contact_margin) so that no contact is cut off at its
-/// border; [`ObstacleMesh::field`](anim_core::scene::ObstacleMesh::field) with that margin does.
+/// border; anim-core's `scene::ObstacleMesh::field` with that margin does.
 ///
 /// Accuracy: the field is the exact distance to the triangles at its nodes near the surface,
 /// trilinear between them; on a smooth surface the interpolated distance is within about

@@ -19,7 +19,7 @@ use anim_core::integrate::State;
 use anim_core::scene::{BuildContext, BuildError};
 
 /// The default contact thickness of a scene with bodies (m).
-pub const DEFAULT_THICKNESS: f64 = 0.005;
+pub const DEFAULT_THICKNESS: f64 = crate::collide::DEFAULT_THICKNESS;
 /// The default solver iterations per substep of a scene with bodies.
 pub const DEFAULT_ITERATIONS: usize = 5;
 /// The default substeps per step of a scene with bodies.

@@ -2,11 +2,11 @@
 //! iteration, substep, damping and guard parameters ([`PbdParams`]), with their valid ranges.
 
 use super::error::PbdError;
-use serde::{Deserialize, Serialize};
 
 /// PBD (stiffness `k`) or XPBD (compliance `alpha`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum Method {
     /// Position based dynamics with a stiffness `k` in `[0, 1]` (Müller et al. 2007).
     Pbd,
@@ -17,8 +17,9 @@ pub enum Method {
 }
 
 /// How the constraints are swept in each iteration.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum SolverKind {
     /// Sequential Gauss-Seidel in model order, as in Müller et al. 2007. The default.
     #[default]
@@ -46,8 +47,9 @@ impl SolverKind {
 }
 
 /// Solver settings. Every field's default is in its doc.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 #[non_exhaustive]
 pub struct PbdParams {
     /// PBD or XPBD. Default [`Method::Xpbd`].

@@ -4,14 +4,14 @@
 
 use anim_core::glam::{DMat3, DQuat, DVec3};
 use anim_core::lie::{Se3, Twist};
-use serde::{Deserialize, Serialize};
 
 /// The direction of a revolute or prismatic joint, in the joint's own frame.
 ///
 /// The coordinate axes get their own variants so that forward kinematics can use the cheap
 /// rotation `[[c, -s, 0], [s, c, 0], [0, 0, 1]]` instead of Rodrigues' formula (Pinocchio does
 /// the same with `JointModelRZ` and friends).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Axis {
     /// `+x`.
     X,
@@ -106,7 +106,8 @@ impl Axis {
 }
 
 /// The kind of a joint and its axis.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum JointType {
     /// Rotation about an axis through the joint origin (URDF `revolute` and `continuous`).
     Revolute(Axis),

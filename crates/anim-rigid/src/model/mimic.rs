@@ -2,7 +2,6 @@
 //! `JointModelMimic`), and how [`ModelBuilder`] adds one.
 
 use anim_core::lie::Se3;
-use serde::{Deserialize, Serialize};
 
 use super::{JointIndex, JointLimits, JointType, ModelBuilder, ModelError};
 
@@ -10,7 +9,8 @@ use super::{JointIndex, JointLimits, JointType, ModelBuilder, ModelError};
 /// `q = multiplier · q_master + offset`, its velocity `multiplier · v_master`, and the force it
 /// transmits adds `multiplier · Sᵀ f` to the master's generalised force (the virtual-work
 /// dual of the same map).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Mimic {
     /// The joint it follows (a one-degree-of-freedom joint that is not itself coupled, with a
     /// lower index).

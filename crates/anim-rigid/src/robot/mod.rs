@@ -2,11 +2,12 @@
 //! base, joints locked at a position, the initial joint positions and velocities by joint name,
 //! joint damping and limits, proportional-derivative servos towards target positions, and a
 //! schedule of applied joint torques. [`RobotSpec`] is also the `robot` table of a `rigid`
-//! scene file (see [`crate::kind`]).
+//! scene file (`crate::kind`, feature `serde`).
 //!
 //! ```
 //! use anim_rigid::robot::RobotSpec;
 //!
+//! # #[cfg(feature = "serde")] {
 //! let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("testdata");
 //! let spec: RobotSpec = serde_json::from_value(serde_json::json!({
 //!     "urdf": "panda.urdf",
@@ -18,6 +19,7 @@
 //! assert_eq!(scene.model.nv(), 7);
 //! assert_eq!(scene.state.q[1], 0.5);
 //! assert!(schedule.is_empty());
+//! # }
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
@@ -28,8 +30,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anim_core::glam::{DQuat, DVec3};
+#[cfg(feature = "serde")]
 use anim_core::scene::is_default;
-use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::config;
@@ -39,8 +41,9 @@ use crate::sim::{RigidIntegrator, RigidState, Servo, SimError, SimParams};
 use crate::urdf::{UrdfError, UrdfOptions, load_urdf, rpy_to_matrix};
 
 /// How the robot's root link is attached to the world.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum Base {
     /// The root link is the world: an arm bolted to the floor.
     #[default]
@@ -51,8 +54,9 @@ pub enum Base {
 }
 
 /// Proportional-derivative servos on named joints: the torque `kp (target - q) - kd q̇` on each.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct ServoSpec {
     /// Proportional gain (N·m/rad, or N/m on a prismatic joint), finite and `>= 0`.
     pub kp: f64,
@@ -64,8 +68,9 @@ pub struct ServoSpec {
 
 /// One entry of a torque schedule: from time `from` on (until the next entry), the joints named
 /// get these torques and every other joint none.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct TorqueKey {
     /// Start time (s), finite and `>= 0`; entries in increasing order.
     pub from: f64,
@@ -73,63 +78,67 @@ pub struct TorqueKey {
     pub joints: BTreeMap<String, f64>,
 }
 
+#[cfg(feature = "serde")]
 fn default_limit_stiffness() -> f64 {
     SimParams::default().limit_stiffness
 }
 
+#[cfg(feature = "serde")]
 fn default_limit_damping() -> f64 {
     SimParams::default().limit_damping
 }
 
 /// A robot scene: a URDF file and what to do with it. Every field but `urdf` has a default.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct RobotSpec {
     /// The URDF file (in a scene file: relative to the scene file's folder). Its `<visual>` and
     /// `<collision>` meshes are not read: the robot is drawn as segments between its joints.
     pub urdf: PathBuf,
     /// `"fixed"` (default) or `"floating"`.
-    #[serde(default, skip_serializing_if = "is_default")]
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_default"))]
     pub base: Base,
     /// A floating base's initial position (m); default the origin. Only with `base = "floating"`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     pub base_position: Option<[f64; 3]>,
     /// A floating base's initial orientation as URDF roll, pitch, yaw (rad); default none. Only
     /// with `base = "floating"`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     pub base_rpy: Option<[f64; 3]>,
     /// Moving joints locked at a position (rad or m), by name: they become fixed (a gripper's
     /// fingers, say).
-    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "BTreeMap::is_empty"))]
     pub locked: BTreeMap<String, f64>,
     /// Initial positions of one-degree-of-freedom joints, by name (rad or m); the others start
     /// at zero.
-    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "BTreeMap::is_empty"))]
     pub q0: BTreeMap<String, f64>,
     /// Initial velocities of one-degree-of-freedom joints, by name (rad/s or m/s); the others
     /// start at rest.
-    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "BTreeMap::is_empty"))]
     pub v0: BTreeMap<String, f64>,
     /// Viscous damping of every joint but the floating base (N·m·s/rad); default 0.
-    #[serde(default, skip_serializing_if = "is_default")]
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_default"))]
     pub damping: f64,
     /// Stiffness of the joint-limit penalty (N·m/rad); default 1000.
-    #[serde(default = "default_limit_stiffness")]
+    #[cfg_attr(feature = "serde", serde(default = "default_limit_stiffness"))]
     pub limit_stiffness: f64,
     /// Damping of the joint-limit penalty, active beyond a limit (N·m·s/rad); default 5.
-    #[serde(default = "default_limit_damping")]
+    #[cfg_attr(feature = "serde", serde(default = "default_limit_damping"))]
     pub limit_damping: f64,
     /// The time stepper; default `"rk4"`.
-    #[serde(default = "default_integrator")]
+    #[cfg_attr(feature = "serde", serde(default = "default_integrator"))]
     pub integrator: RigidIntegrator,
     /// Proportional-derivative servos; default none.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     pub servo: Option<ServoSpec>,
     /// A schedule of applied torques; default none.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
     pub torque: Vec<TorqueKey>,
 }
 
+#[cfg(feature = "serde")]
 fn default_integrator() -> RigidIntegrator {
     RigidIntegrator::Rk4
 }
@@ -414,4 +423,5 @@ fn segments(model: &Model) -> Vec<(FrameIndex, FrameIndex)> {
 }
 
 #[cfg(test)]
+#[cfg(feature = "serde")]
 mod tests;

@@ -2,11 +2,10 @@
 //! constant applied torques, joint servos) and the implicit midpoint's Newton settings; the
 //! equations are in the module docs of `sim`.
 
-use serde::{Deserialize, Serialize};
-
 /// Forces and solver settings that are not part of the [`Model`](crate::Model).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 #[non_exhaustive]
 pub struct SimParams {
     /// Viscous damping coefficient `d` of every joint degree of freedom except free-joint ones
@@ -80,8 +79,9 @@ impl SimParams {
 /// like the others, evaluated at every stage of every stepper (not held over a step), so a stiff
 /// servo limits the stable step as a stiff spring does: the explicit steppers need
 /// `dt` well below `sqrt(m / kp)` for the smallest effective inertia `m` it moves.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Servo {
     /// Velocity index of the joint (its [`Joint::idx_v`](crate::model::Joint::idx_v)).
     pub dof: usize,

@@ -1,12 +1,11 @@
 //! The integrated state of a tree: time, configuration `q` on its manifold (unit quaternions
 //! for spherical and free joints) and joint-frame velocity `v`.
 
-use serde::{Deserialize, Serialize};
-
 /// The integrated state of a tree: time, configuration `q` (length `nq`, unit quaternions for
 /// spherical and free joints) and velocity `v` (length `nv`, joint-frame velocities).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct RigidState {
     /// Simulated time (s).
     pub t: f64,

@@ -3,7 +3,6 @@
 
 use anim_core::diagnostics::{Component, Element, Field, NonFinite, check_finite};
 use anim_core::solver::{Solver, StepReport};
-use serde::{Deserialize, Serialize};
 
 use crate::config;
 use crate::dense::SquareMatrix;
@@ -15,8 +14,9 @@ use crate::sim::state::RigidState;
 use crate::sim::system::ArticulatedSystem;
 
 /// The time steppers of [`RigidSimulation`] (see the table in [`crate::sim`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum RigidIntegrator {
     /// `q₁ = q₀ ⊕ h v₀`, `v₁ = v₀ + h a(q₀, v₀)`: first order, energy grows.
     ExplicitEuler,
@@ -207,6 +207,7 @@ impl RigidSimulation {
     /// What the simulation carries from one step to the next, for checkpoints: the step count
     /// and the implicit steppers' factorised Newton matrix, which is reused while it still
     /// converges (a resumed run that refactorised would take other Newton iterates).
+    #[cfg(feature = "serde")]
     #[must_use]
     pub fn memory(&self) -> serde_json::Value {
         let s = &self.scratch;
@@ -220,6 +221,7 @@ impl RigidSimulation {
     /// # Errors
     /// [`SimError::Checkpoint`] when `memory` is malformed or its Newton matrix does not fit the
     /// model.
+    #[cfg(feature = "serde")]
     pub fn restore_memory(&mut self, memory: &serde_json::Value) -> Result<(), SimError> {
         let bad = |m: String| SimError::Checkpoint(m);
         let steps = memory
@@ -654,6 +656,7 @@ mod tests {
 
     /// A 6-link chain swung by the implicit midpoint rule, which keeps its factorised Newton
     /// matrix across steps: a run continued from `memory()` must not refactorise.
+    #[cfg(feature = "serde")]
     #[test]
     fn a_run_resumed_from_memory_is_bitwise_identical() {
         let model = pendulum_chain_model(&[1.0; 6], 0.3).unwrap();
@@ -710,6 +713,7 @@ mod tests {
             }
             sim.system_mut().set_torque(&[f64::MAX]).unwrap();
             let before = state.clone();
+            #[cfg(feature = "serde")]
             let memory = serde_json::to_string(&sim.memory()).unwrap();
             // A different step size makes the implicit stepper drop its kept matrix first.
             let err = sim.step(&mut state, 2e-3).unwrap_err();
@@ -717,6 +721,7 @@ mod tests {
                 s.q.iter().chain(&s.v).chain([&s.t]).map(|x| x.to_bits()).collect::<Vec<_>>()
             };
             assert_eq!(bits(&state), bits(&before), "{label}: state changed");
+            #[cfg(feature = "serde")]
             assert_eq!(serde_json::to_string(&sim.memory()).unwrap(), memory, "{label}: memory changed");
             assert_eq!(sim.steps(), 10);
             let msg = err.to_string();
@@ -748,10 +753,12 @@ mod tests {
         let params = SimParams { max_newton_iterations: 1, ..sim.system().params().clone() };
         sim.system_mut().set_params(params).unwrap();
         let before = state.clone();
+        #[cfg(feature = "serde")]
         let memory = serde_json::to_string(&sim.memory()).unwrap();
         let err = sim.step(&mut state, 5e-2).unwrap_err();
         assert!(matches!(err, SimError::NewtonNotConverged { step: 10, .. }), "{err}");
         assert!(sim.scratch.jac_h == 1e-3 && sim.scratch.jac_valid);
+        #[cfg(feature = "serde")]
         assert_eq!(serde_json::to_string(&sim.memory()).unwrap(), memory, "the kept matrix changed");
         assert_eq!(state, before);
     }

@@ -18,7 +18,7 @@ use crate::geom::MIN_LENGTH;
 ///
 /// The field must cover every point within `thickness` of the mesh: a particle outside its
 /// lattice feels nothing (make it with a margin of at least the thickness, as
-/// [`DistanceField::around`] and [`ObstacleMesh::field`](anim_core::scene::ObstacleMesh::field)
+/// [`DistanceField::around`] and anim-core's `scene::ObstacleMesh::field`
 /// take).
 ///
 /// ```

@@ -10,11 +10,11 @@
 
 use crate::contact::{Collider, MeshCollider};
 use anim_core::glam::DVec3;
-use serde::{Deserialize, Serialize};
 
 /// A particle's parameters; its position and velocity live in the state.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Particle {
     /// Mass (kg, > 0). A pinned particle keeps its mass for the kinetic energy and momentum.
     pub mass: f64,
@@ -23,8 +23,9 @@ pub struct Particle {
 }
 
 /// What a spring stands for; used by renderers and reports, not by the physics.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum SpringKind {
     /// Along a grid line or a mesh edge: the visible structure.
     Structural,
@@ -37,8 +38,9 @@ pub enum SpringKind {
 }
 
 /// A spring between particles `i` and `j`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Spring {
     /// First particle.
     pub i: usize,
