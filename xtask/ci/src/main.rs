@@ -9,6 +9,7 @@
 //! | suites | the same command, running only `xtask/tests/suites.rs`: the quick conformance and stability suites through the `xtask` binary of this build |
 //! | doc tests | `cargo test --workspace --doc` |
 //! | docs | `cargo doc --workspace --no-deps` with warnings denied |
+//! | python | the Python bindings (`crates/anim-py`): a virtual environment under the target folder with maturin, numpy and pytest from PyPI, the module built by `maturin develop` with the dev profile into it, and pytest on `crates/anim-py/tests/`; without Python, venv or pip it prints a note and is skipped |
 //! | dependency versions | the library crates' unit tests (`cargo test --workspace --lib`, without xtask, this runner and the benches) against the newest versions the dependency ranges allow (`cargo update`); the committed `Cargo.lock` is put back afterwards |
 //! | crates alone | each library crate as a user who picks it alone gets it: clippy on anim-core, anim-rigid, anim-pbd, anim-skin and anim-springs with `--no-default-features`; the same five crates' unit and integration tests without their default features (no faer, no rayon, no serde); `xtask packaged` (every publishable crate checked from its `.crate` archive, all targets and features, against the lowest versions our direct requirements allow); `xtask consumer` (a project outside the workspace on anim-pbd and anim-rigid without their default features, newest compatible dependency versions, no serde crate in its tree) |
 //!
@@ -66,6 +67,54 @@ fn run(program: &std::path::Path, args: &[&str]) -> bool {
     ok
 }
 
+/// The Python step: a virtual environment in `<target>/py-venv`, maturin, numpy and pytest
+/// installed by pip, the bindings built into it with the dev profile (whose dependencies are
+/// optimised, as the tests' are), and their pytest suite. A machine without Python, `venv` or a
+/// reachable package index skips the step with a note; a failed build or test fails it.
+fn python(target: &str) -> bool {
+    let start = Instant::now();
+    eprintln!("\n== python bindings (crates/anim-py)");
+    // Absolute: maturin reads the environment from VIRTUAL_ENV.
+    let root = std::env::current_dir().unwrap_or_default();
+    let venv = root.join(target).join("py-venv");
+    let bin = venv.join("bin");
+    let py = bin.join("python");
+    let quiet = |cmd: &mut Command| cmd.status().map(|s| s.success()).unwrap_or(false);
+    if !py.exists() && !quiet(Command::new("python3").args(["-m", "venv"]).arg(&venv)) {
+        eprintln!(
+            "note: python3 -m venv failed or python3 is missing; the Python bindings' tests are skipped"
+        );
+        return true;
+    }
+    let pip = [
+        "-m",
+        "pip",
+        "install",
+        "--quiet",
+        "--disable-pip-version-check",
+        "maturin>=1.9,<2",
+        "numpy",
+        "pytest",
+    ];
+    if !quiet(Command::new(&py).args(pip)) {
+        eprintln!(
+            "note: pip could not install maturin, numpy and pytest; the Python bindings' tests are skipped"
+        );
+        return true;
+    }
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+    let built = quiet(
+        Command::new(bin.join("maturin"))
+            .args(["develop", "--profile", "dev", "--manifest-path", "crates/anim-py/Cargo.toml"])
+            .env("VIRTUAL_ENV", &venv)
+            .env("PATH", &path)
+            .env("CARGO_TARGET_DIR", target),
+    );
+    let ok = built && quiet(Command::new(&py).args(["-m", "pytest", "-q", "crates/anim-py/tests"]));
+    eprintln!("== {} in {:.0} s", if ok { "ok" } else { "FAILED" }, start.elapsed().as_secs_f64());
+    ok
+}
+
 /// The unit tests of every library crate: the workspace without the tools (xtask, this runner)
 /// and the benchmarks, which users never depend on.
 const LIBRARY_TESTS: [&str; 9] =
@@ -119,7 +168,7 @@ fn main() -> ExitCode {
         "-D",
         "warnings",
     ];
-    let steps: [(&str, &dyn Fn() -> bool); 8] = [
+    let steps: [(&str, &dyn Fn() -> bool); 9] = [
         ("format", &|| cargo(&["fmt", "--all", "--", "--check"], &[])),
         ("clippy", &|| cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"], &[])),
         // The examples are type-checked and linted by clippy above; linking each of them here
@@ -128,6 +177,7 @@ fn main() -> ExitCode {
         ("suites", &|| cargo(&suites, &[])),
         ("doc tests", &|| cargo(&["test", "--workspace", "--doc"], &[])),
         ("docs", &|| cargo(&["doc", "--workspace", "--no-deps"], &[("RUSTDOCFLAGS", "-D warnings")])),
+        ("python", &|| python(&target)),
         ("dependency versions", &newest_versions),
         ("crates alone", &|| {
             // Each part runs even when one before it failed, so one run shows every problem.
