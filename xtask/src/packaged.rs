@@ -9,9 +9,10 @@
 //! 3. Its lockfile is resolved by `cargo update -Z direct-minimal-versions`: the lowest version
 //!    each of our direct requirements allows (their own dependencies at the newest). The flag is
 //!    cargo's, unstable; `RUSTC_BOOTSTRAP=1` allows it on a stable toolchain for that one command.
-//! 4. `cargo check --workspace --all-targets` there: every library, test, example and benchmark
-//!    of every packaged crate compiles from its packaged files against those versions. A file a
-//!    crate needs but does not package, or a lower bound below the API the code uses, fails here.
+//! 4. `cargo check --workspace --lib --bins --all-features` there: every library and program of
+//!    every packaged crate, with every feature, compiles from its packaged files against those
+//!    versions (what `cargo package` verifies, without its code generation). A file a crate
+//!    needs but does not package, or a lower bound below the API the code uses, fails here.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -106,7 +107,7 @@ fn check(root: &Path, target: &Path) -> Result<(), String> {
     let check_target = check_target.to_string_lossy().into_owned();
     cargo(
         &dir,
-        &["check", "--quiet", "--workspace", "--all-targets", "--all-features"],
+        &["check", "--quiet", "--workspace", "--lib", "--bins", "--all-features"],
         &[("CARGO_TARGET_DIR", check_target.as_str())],
     )
 }
