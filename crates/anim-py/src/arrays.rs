@@ -115,7 +115,18 @@ pub fn rows<const D: usize>(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<
 }
 
 /// A float64 vector of any length, or of `len` when given.
+///
+/// The common case, a contiguous 1-D float64 array of the right length with finite values, is
+/// copied at once (`q`, `v`, `a` of the rigid-body calls, made thousands of times from Python
+/// loops); anything else goes through [`floats`], whose checks name what is wrong.
 pub fn vector(obj: &Bound<'_, PyAny>, name: &str, len: Option<usize>) -> PyResult<Vec<f64>> {
+    if let Ok(a) = obj.cast::<PyArray1<f64>>()
+        && let Ok(values) = a.to_vec()
+        && len.is_none_or(|n| values.len() == n)
+        && values.iter().all(|x| x.is_finite())
+    {
+        return Ok(values);
+    }
     Ok(floats(obj, name, &[len])?.0)
 }
 

@@ -106,7 +106,7 @@ impl Simulation {
         }
         let mut guard = self.lock()?;
         let (sim, state) = &mut *guard;
-        py.detach(|| {
+        crate::threads::detached(py, || {
             for _ in 0..steps {
                 sim.step(state, dt)?;
             }
@@ -121,7 +121,8 @@ impl Simulation {
     fn solve_static(&self, py: Python<'_>, load_steps: usize) -> PyResult<usize> {
         let mut guard = self.lock()?;
         let (sim, state) = &mut *guard;
-        let info = py.detach(|| sim.solve_static(&mut state.x, load_steps.max(1))).map_err(errors::step)?;
+        let info = crate::threads::detached(py, || sim.solve_static(&mut state.x, load_steps.max(1)))
+            .map_err(errors::step)?;
         state.v.iter_mut().for_each(|v| *v = 0.0);
         Ok(info.iterations)
     }

@@ -117,7 +117,7 @@ impl Simulation {
             return Err(PyValueError::new_err(format!("dt: must be positive and finite, got {dt}")));
         }
         each!(&mut self.inner, s, p, _D => {
-            py.detach(|| {
+            crate::threads::detached(py, || {
                 for _ in 0..steps {
                     s.advance(p, dt)?;
                 }

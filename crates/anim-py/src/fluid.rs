@@ -52,7 +52,7 @@ impl Scene {
             return Err(PyValueError::new_err(format!("dt: must be positive and finite, got {dt}")));
         }
         let inner = &mut self.inner;
-        py.detach(|| {
+        crate::threads::detached(py, || {
             for _ in 0..steps {
                 match dt {
                     Some(dt) => inner.step_by(dt)?,

@@ -24,6 +24,7 @@ pub mod rigid;
 pub mod scene;
 pub mod skin;
 pub mod springs;
+pub mod threads;
 
 use pyo3::prelude::*;
 

@@ -180,7 +180,7 @@ impl Simulation {
                 return Err(PyValueError::new_err(format!("dt: must be positive and finite, got {dt}")));
             }
             let (sim, state) = (&mut s.sim, &mut s.state);
-            py.detach(|| {
+            crate::threads::detached(py, || {
                 for _ in 0..steps {
                     sim.advance(state, dt)?;
                 }

@@ -223,7 +223,7 @@ impl Simulation {
             return Err(PyValueError::new_err(format!("dt: must be positive and finite, got {dt}")));
         }
         let Self { sim, state } = self;
-        py.detach(|| {
+        crate::threads::detached(py, || {
             for _ in 0..steps {
                 sim.advance(state, dt)?;
             }

@@ -245,7 +245,7 @@ impl Scene {
         }
         let mut runner = self.runner()?;
         let runner = &mut **runner;
-        py.detach(|| {
+        crate::threads::detached(py, || {
             for _ in 0..steps {
                 runner.step(dt)?;
             }

@@ -82,7 +82,7 @@ impl Character {
             method.parse().map_err(|e: String| PyValueError::new_err(format!("method: {e}")))?;
         let clip = clip.map(|c| self.clip_index(c)).transpose()?;
         let Self { inner, data, .. } = self;
-        py.detach(|| inner.pose(data, clip, t, method)).map_err(errors::step)?;
+        crate::threads::detached(py, || inner.pose(data, clip, t, method)).map_err(errors::step)?;
         let mut out = Vec::new();
         self.data.positions(&mut out);
         let flat: Vec<f64> = out.iter().flatten().copied().collect();

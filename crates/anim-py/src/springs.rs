@@ -154,7 +154,7 @@ impl Simulation {
         }
         let mut guard = self.lock()?;
         let (sim, state) = &mut *guard;
-        py.detach(|| {
+        crate::threads::detached(py, || {
             for _ in 0..steps {
                 sim.step(state, dt)?;
             }
