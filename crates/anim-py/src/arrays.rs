@@ -146,6 +146,24 @@ pub fn indices<const D: usize>(
     Ok(flat.chunks_exact(D).map(|c| std::array::from_fn(|i| c[i])).collect())
 }
 
+/// One index below `bound` (a Python int) or a list of them, for the argument `name`.
+pub fn index_or_list(obj: &Bound<'_, PyAny>, name: &str, bound: usize) -> PyResult<Vec<usize>> {
+    match obj.extract::<i64>() {
+        Ok(i) if i >= 0 && (i as u64) < bound as u64 => Ok(vec![i as usize]),
+        Ok(i) => Err(PyValueError::new_err(format!("{name}: {i} is outside 0..{bound}"))),
+        Err(_) => index_list(obj, name, bound),
+    }
+}
+
+/// A time step: positive and finite, or a `ValueError` naming `dt`.
+pub fn time_step(dt: f64) -> PyResult<f64> {
+    if dt > 0.0 && dt.is_finite() {
+        Ok(dt)
+    } else {
+        Err(PyValueError::new_err(format!("dt: must be positive and finite, got {dt}")))
+    }
+}
+
 /// A list of non-negative integer indices below `bound`.
 pub fn index_list(obj: &Bound<'_, PyAny>, name: &str, bound: usize) -> PyResult<Vec<usize>> {
     index_values(obj, name, &[None], bound)

@@ -101,9 +101,7 @@ impl Simulation {
     /// `anim.SimulationError` and leaves the state as before it.
     #[pyo3(signature = (dt, steps = 1))]
     fn step(&self, py: Python<'_>, dt: f64, steps: usize) -> PyResult<()> {
-        if !(dt > 0.0 && dt.is_finite()) {
-            return Err(PyValueError::new_err(format!("dt: must be positive and finite, got {dt}")));
-        }
+        arrays::time_step(dt)?;
         let mut guard = self.lock()?;
         let (sim, state) = &mut *guard;
         crate::threads::detached(py, || {

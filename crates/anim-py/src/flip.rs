@@ -113,9 +113,7 @@ impl Simulation {
     /// needs them); a failed step raises `anim.SimulationError`.
     #[pyo3(signature = (dt, steps = 1))]
     fn step(&mut self, py: Python<'_>, dt: f64, steps: usize) -> PyResult<()> {
-        if !(dt > 0.0 && dt.is_finite()) {
-            return Err(PyValueError::new_err(format!("dt: must be positive and finite, got {dt}")));
-        }
+        arrays::time_step(dt)?;
         each!(&mut self.inner, s, p, _D => {
             crate::threads::detached(py, || {
                 for _ in 0..steps {

@@ -46,10 +46,8 @@ impl Scene {
     /// Advances `steps` steps of the scene's step, or of `dt` seconds when given, without the GIL.
     #[pyo3(signature = (steps = 1, dt = None))]
     fn step(&mut self, py: Python<'_>, steps: usize, dt: Option<f64>) -> PyResult<()> {
-        if let Some(dt) = dt
-            && !(dt > 0.0 && dt.is_finite())
-        {
-            return Err(PyValueError::new_err(format!("dt: must be positive and finite, got {dt}")));
+        if let Some(dt) = dt {
+            arrays::time_step(dt)?;
         }
         let inner = &mut self.inner;
         crate::threads::detached(py, || {

@@ -176,9 +176,7 @@ impl Simulation {
     fn step(&mut self, py: Python<'_>, steps: usize, dt: Option<f64>) -> PyResult<()> {
         each!(&mut self.inner, s, _D => {
             let dt = dt.unwrap_or(s.dt);
-            if !(dt > 0.0 && dt.is_finite()) {
-                return Err(PyValueError::new_err(format!("dt: must be positive and finite, got {dt}")));
-            }
+            arrays::time_step(dt)?;
             let (sim, state) = (&mut s.sim, &mut s.state);
             crate::threads::detached(py, || {
                 for _ in 0..steps {

@@ -155,14 +155,7 @@ impl Builder {
     /// Pins particles (an index or a list of indices): their inverse mass becomes 0.
     fn pin(&mut self, particles: &Bound<'_, PyAny>) -> PyResult<()> {
         let n = self.inner.num_particles();
-        let list = if let Ok(i) = particles.extract::<i64>() {
-            if i < 0 || i as u64 >= n as u64 {
-                return Err(PyValueError::new_err(format!("particles: {i} is outside 0..{n}")));
-            }
-            vec![i as usize]
-        } else {
-            arrays::index_list(particles, "particles", n)?
-        };
+        let list = arrays::index_or_list(particles, "particles", n)?;
         for p in list {
             self.inner.pin(p);
         }
@@ -219,9 +212,7 @@ impl Simulation {
     /// raised and the state is the one before that step.
     #[pyo3(signature = (dt, steps = 1))]
     fn step(&mut self, py: Python<'_>, dt: f64, steps: usize) -> PyResult<()> {
-        if !(dt > 0.0 && dt.is_finite()) {
-            return Err(PyValueError::new_err(format!("dt: must be positive and finite, got {dt}")));
-        }
+        arrays::time_step(dt)?;
         let Self { sim, state } = self;
         crate::threads::detached(py, || {
             for _ in 0..steps {

@@ -240,9 +240,7 @@ impl Scene {
     #[pyo3(signature = (steps = 1, dt = None))]
     fn step(&self, py: Python<'_>, steps: usize, dt: Option<f64>) -> PyResult<()> {
         let dt = dt.unwrap_or(self.file.run.dt);
-        if !(dt > 0.0 && dt.is_finite()) {
-            return Err(PyValueError::new_err(format!("dt: must be positive and finite, got {dt}")));
-        }
+        arrays::time_step(dt)?;
         let mut runner = self.runner()?;
         let runner = &mut **runner;
         crate::threads::detached(py, || {

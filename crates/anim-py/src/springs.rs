@@ -91,11 +91,7 @@ impl Builder {
     /// Pins particles (an index or a list of indices).
     fn pin(&mut self, particles: &Bound<'_, PyAny>) -> PyResult<()> {
         let n = self.inner.num_particles();
-        let list = match particles.extract::<i64>() {
-            Ok(i) if i >= 0 && (i as u64) < n as u64 => vec![i as usize],
-            Ok(i) => return Err(PyValueError::new_err(format!("particles: {i} is outside 0..{n}"))),
-            Err(_) => arrays::index_list(particles, "particles", n)?,
-        };
+        let list = arrays::index_or_list(particles, "particles", n)?;
         for p in list {
             self.inner.pin(p);
         }
@@ -149,9 +145,7 @@ impl Simulation {
     /// `anim.SimulationError` and leaves the state as before it.
     #[pyo3(signature = (dt, steps = 1))]
     fn step(&self, py: Python<'_>, dt: f64, steps: usize) -> PyResult<()> {
-        if !(dt > 0.0 && dt.is_finite()) {
-            return Err(PyValueError::new_err(format!("dt: must be positive and finite, got {dt}")));
-        }
+        arrays::time_step(dt)?;
         let mut guard = self.lock()?;
         let (sim, state) = &mut *guard;
         crate::threads::detached(py, || {
