@@ -13,6 +13,7 @@ pub mod input;
 pub mod integrate;
 pub mod lie;
 pub mod linalg;
+pub mod mesh;
 pub mod par;
 pub mod scalar;
 #[cfg(feature = "serde")]

@@ -8,6 +8,8 @@
 //! bodies meet, they pass through each other.
 //!
 //! ```
+//! # #[cfg(feature = "files")]
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! use anim_fem::bodies::{self, World};
 //! use anim_fem::body::BodySpec;
 //! use anim_fem::boundary::Obstacle;
@@ -25,7 +27,10 @@
 //! let world = World { obstacles: vec![Obstacle::ground(0.0)], ..World::default() };
 //! let scene = bodies::build(&[body(1e5, 0.0), body(1e6, 2.0)], &world, ElementOrder::Linear, |p| dir.join(p))?;
 //! assert_eq!(scene.model.materials().len(), 2);
-//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! # Ok(())
+//! # }
+//! # #[cfg(not(feature = "files"))]
+//! # fn main() {}
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -40,6 +45,7 @@ use crate::sim::{FemParams, LinearSolverChoice, TimeIntegrator};
 use anim_core::integrate::State;
 use anim_core::scene::ObstacleMesh;
 use anim_core::surface::DistanceField;
+#[cfg(feature = "files")]
 use anim_io::surface::read_closed_surface;
 
 /// What the bodies of a scene share.
@@ -237,10 +243,17 @@ fn build_within(
 /// The distance field of a mesh obstacle read from `path`: placed, checked closed
 /// ([`read_closed_surface`]), sampled at its `cell`. Errors name the field of the table (`mesh`,
 /// `cell`, `scale`, ...).
+#[cfg(feature = "files")]
 fn mesh_field(m: &ObstacleMesh, path: &Path) -> Result<DistanceField, BodyError> {
     let surface = read_closed_surface(path, &m.placement()).map_err(|e| BodyError::new(e.field(), &e))?;
     // Contact needs the field where `phi < 0` only: no margin beyond the two cells `field` adds.
     m.field(&surface, 0.0).map_err(|e| BodyError::new("cell", format!("{}: {e}", path.display())))
+}
+
+/// Refuses the obstacle's surface: this build has no `files` feature to read it.
+#[cfg(not(feature = "files"))]
+fn mesh_field(_m: &ObstacleMesh, path: &Path) -> Result<DistanceField, BodyError> {
+    Err(BodyError::new("mesh", crate::mesh::needs_files(path)))
 }
 
 /// The body of every node of `model`: a corner vertex by the range of its body (`starts[k]..
@@ -264,4 +277,5 @@ fn node_bodies(model: &FemModel, starts: &[usize]) -> Vec<usize> {
 }
 
 #[cfg(test)]
+#[cfg(feature = "files")]
 mod tests;

@@ -6,6 +6,8 @@
 //! share.
 //!
 //! ```
+//! # #[cfg(feature = "files")]
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! use anim_fem::body::BodySpec;
 //!
 //! let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../anim-io/testdata");
@@ -16,7 +18,10 @@
 //! }))?;
 //! let body = spec.load(&dir.join(&spec.mesh))?;
 //! assert!(body.mesh.positions.iter().all(|p| p[2] >= 0.5 - 1e-12));
-//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! # Ok(())
+//! # }
+//! # #[cfg(not(feature = "files"))]
+//! # fn main() {}
 //! ```
 //!
 //! Units are SI: metres, kilograms, seconds, pascals. Scenes are z-up.
@@ -30,7 +35,9 @@ use serde::{Deserialize, Deserializer, Serialize};
 use crate::error::FemError;
 use crate::material::{Material, MaterialModel};
 use crate::memory::MeshSize;
-use crate::mesh::{TetMesh, read_gmsh, read_tetgen, validate};
+use crate::mesh::{TetMesh, validate};
+#[cfg(feature = "files")]
+use crate::mesh::{read_gmsh, read_tetgen};
 use crate::model::ElementOrder;
 use crate::sim::{FemParams, LinearSolverChoice, TimeIntegrator};
 
@@ -218,6 +225,7 @@ pub struct LoadedBody {
 /// # Errors
 /// [`FemError::MeshInput`] naming the file for an unknown extension or a file that does not
 /// read; the validation errors of [`crate::mesh::validate`] naming the element.
+#[cfg(feature = "files")]
 pub fn read_mesh(path: &Path) -> Result<TetMesh, FemError> {
     match path.extension().and_then(|e| e.to_str()) {
         Some("msh") => read_gmsh(path),
@@ -227,6 +235,15 @@ pub fn read_mesh(path: &Path) -> Result<TetMesh, FemError> {
             path.display()
         ))),
     }
+}
+
+/// Refuses every mesh file: this build has no `files` feature.
+///
+/// # Errors
+/// Always [`FemError::MeshInput`], naming the file and the feature.
+#[cfg(not(feature = "files"))]
+pub fn read_mesh(path: &Path) -> Result<TetMesh, FemError> {
+    Err(FemError::MeshInput(crate::mesh::needs_files(path)))
 }
 
 /// Whether `path` names an OBJ surface (by its extension).
@@ -365,4 +382,5 @@ pub(crate) fn finite3(field: &str, v: [f64; 3]) -> Result<[f64; 3], BodyError> {
 }
 
 #[cfg(test)]
+#[cfg(feature = "files")]
 pub(crate) mod tests;

@@ -217,6 +217,7 @@ pub enum FemError {
     },
 }
 
+#[cfg(feature = "files")]
 impl From<anim_io::IoError> for FemError {
     fn from(e: anim_io::IoError) -> Self {
         FemError::MeshInput(e.to_string())

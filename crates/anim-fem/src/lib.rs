@@ -38,8 +38,12 @@ mod contact_tests;
 #[cfg(test)]
 mod kind_tests;
 #[cfg(test)]
+#[cfg(feature = "files")]
 mod mesh_obstacle_tests;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
 mod tests_quadratic;
+#[cfg(test)]
+#[cfg(not(feature = "files"))]
+mod without_files_tests;

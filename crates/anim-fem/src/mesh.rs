@@ -1,13 +1,14 @@
 //! Tetrahedral meshes: validation of the rest configuration, reading Gmsh and TetGen files
-//! (through `anim-io`), and the boundary surface used for output and contact.
+//! (through `anim-io`, feature `files`), and the boundary surface used for output and contact.
 //!
-//! The mesh type is [`anim_io::TetMesh`]: vertex positions and 4-vertex elements. An element
+//! The mesh type is anim-core's [`TetMesh`]: vertex positions and 4-vertex elements. An element
 //! `(X0, X1, X2, X3)` is positively oriented when `(X1 - X0) x (X2 - X0) . (X3 - X0) > 0`; the
 //! rest configuration of every element must be positively oriented and non-degenerate, otherwise
 //! [`validate`] names the first offending element.
 
 use crate::error::FemError;
-pub use anim_io::TetMesh;
+pub use anim_core::mesh::TetMesh;
+#[cfg(feature = "files")]
 use std::path::Path;
 
 /// Relative degeneracy threshold: an element is degenerate when
@@ -76,6 +77,7 @@ pub fn validate(positions: &[[f64; 3]], elements: &[[usize; 4]]) -> Result<(), F
 /// # Errors
 /// [`FemError::MeshInput`] when the file cannot be read or parsed (the message names the file
 /// and line), or the validation errors of [`validate`].
+#[cfg(feature = "files")]
 pub fn read_gmsh(path: impl AsRef<Path>) -> Result<TetMesh, FemError> {
     let mesh = anim_io::gmsh::read_gmsh(path)?.tet_mesh();
     validate(&mesh.positions, &mesh.tets)?;
@@ -86,10 +88,17 @@ pub fn read_gmsh(path: impl AsRef<Path>) -> Result<TetMesh, FemError> {
 ///
 /// # Errors
 /// As [`read_gmsh`].
+#[cfg(feature = "files")]
 pub fn read_tetgen(path: impl AsRef<Path>) -> Result<TetMesh, FemError> {
     let mesh = anim_io::tetgen::read_tetgen(path)?.tet_mesh();
     validate(&mesh.positions, &mesh.tets)?;
     Ok(mesh)
+}
+
+/// Why a mesh file is refused by a build without feature `files`.
+#[cfg(not(feature = "files"))]
+pub(crate) fn needs_files(path: &std::path::Path) -> String {
+    format!("{}: reading mesh files needs anim-fem's `files` feature (on by default)", path.display())
 }
 
 /// The boundary triangles of a tetrahedral mesh, oriented outward, in a deterministic order.
@@ -132,6 +141,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(feature = "files")]
     fn reads_tetgen_and_gmsh_files() {
         let dir = std::env::temp_dir().join(format!("anim-fem-mesh-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();

@@ -1,6 +1,6 @@
 //! The crate's error type.
 
-use crate::mesh::ValidationReport;
+use anim_core::mesh::ValidationReport;
 use std::path::PathBuf;
 
 /// Everything that can go wrong reading or writing a file.

@@ -15,8 +15,8 @@
 //! (`$Periodic`, `$NodeData`, ...) are skipped to their `$End` line.
 
 use crate::IoError;
-use crate::mesh::{TetMesh, TriMesh};
 use crate::text::{Lines, Tokens, capacity, read_text};
+use anim_core::mesh::{TetMesh, TriMesh};
 use std::collections::HashMap;
 use std::path::Path;
 

@@ -7,7 +7,6 @@ mod data;
 mod error;
 pub mod frames;
 pub mod gmsh;
-mod mesh;
 #[cfg(feature = "output")]
 pub mod metrics;
 pub mod obj;
@@ -22,13 +21,13 @@ mod text;
 pub mod viewer;
 pub mod vtk;
 
+pub use anim_core::mesh::{DEGENERACY_TOLERANCE, TetMesh, TriMesh, ValidationReport};
 pub use checkpoint::{
     CheckpointHeader, CheckpointProblem, parse_checkpoint, read_checkpoint, write_atomic, write_checkpoint,
 };
 pub use data::{DataArray, Element, Real, Values};
 pub use error::IoError;
 pub use frames::{FrameFormat, FrameSequence, FrameWriter};
-pub use mesh::{DEGENERACY_TOLERANCE, TetMesh, TriMesh, ValidationReport};
 pub use vtk::{ImageData, UnstructuredGrid, VtkEncoding};
 
 use std::path::Path;

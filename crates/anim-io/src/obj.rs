@@ -17,8 +17,8 @@
 
 use crate::IoError;
 use crate::data::Real;
-use crate::mesh::TriMesh;
 use crate::text::{Lines, Tokens, read_text};
+use anim_core::mesh::TriMesh;
 use std::fmt::Write as _;
 use std::path::Path;
 

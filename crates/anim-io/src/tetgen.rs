@@ -8,8 +8,8 @@
 //! (10-node) tetrahedra and 2-D `.node` files are refused.
 
 use crate::IoError;
-use crate::mesh::TetMesh;
 use crate::text::{Lines, capacity, read_text};
+use anim_core::mesh::TetMesh;
 use std::path::{Path, PathBuf};
 
 /// What a TetGen `.node`/`.ele` pair holds.

@@ -11,7 +11,7 @@
 //! | docs | `cargo doc --workspace --no-deps` with warnings denied |
 //! | python | the Python bindings (`crates/anim-py`): a virtual environment under the target folder with maturin, numpy and pytest from PyPI, the module built by `maturin develop` with the dev profile into it, and pytest on `crates/anim-py/tests/`; without Python, venv or pip it prints a note and is skipped |
 //! | dependency versions | the library crates' unit tests (`cargo test --workspace --lib`, without xtask, this runner and the benches) against the newest versions the dependency ranges allow (`cargo update`); the committed `Cargo.lock` is put back afterwards |
-//! | crates alone | each library crate as a user who picks it alone gets it: clippy on anim-core, anim-rigid, anim-pbd, anim-skin and anim-springs with `--no-default-features`; the same five crates' unit and integration tests without their default features (no faer, no rayon, no serde); `xtask packaged` (every publishable crate checked from its `.crate` archive, libraries and programs with every feature, against the lowest versions our direct requirements allow); `xtask consumer` (a project outside the workspace on anim-pbd and anim-rigid without their default features, newest compatible dependency versions, no serde crate in its tree) |
+//! | crates alone | each library crate as a user who picks it alone gets it: clippy on anim-core, anim-rigid, anim-pbd, anim-skin and anim-springs, and on anim-fem alone, with `--no-default-features`; the same crates' unit and integration tests without their default features (no faer, no rayon, no serde; anim-fem without anim-io, built on its own so that features do not unify); `xtask packaged` (every publishable crate checked from its `.crate` archive, libraries and programs with every feature, against the lowest versions our direct requirements allow); `xtask consumer` (a project outside the workspace on anim-pbd and anim-rigid without their default features, newest compatible dependency versions, no serde crate in its tree) |
 //!
 //! The runner has no dependencies, so it starts at once, and the suites run in the test build
 //! (one build of the workspace, the features of every member unified) instead of a build of
@@ -184,9 +184,15 @@ fn main() -> ExitCode {
             let lint = cargo(&alone, &[]);
             let tests = [&["test"], &alone[1..12], &["--lib", "--tests"]].concat();
             let core = cargo(&tests, &[]);
+            // anim-fem alone: its own command, since one build of several packages unifies
+            // features, and anim-fem turns on anim-core's faer that the five above go without.
+            let fem = ["-p", "anim-fem", "--no-default-features"];
+            let fem_lint =
+                cargo(&[&["clippy"], &fem[..], &["--all-targets", "--", "-D", "warnings"]].concat(), &[]);
+            let fem_tests = cargo(&[&["test"], &fem[..], &["--lib", "--tests"]].concat(), &[]);
             let packaged = run(&xtask, &["packaged"]);
             let consumer = run(&xtask, &["consumer"]);
-            lint && core && packaged && consumer
+            lint && core && fem_lint && fem_tests && packaged && consumer
         }),
     ];
     let mut failed = Vec::new();

@@ -10,11 +10,15 @@
 
 use std::path::Path;
 
+#[cfg(feature = "files")]
 use anim_core::scene::Placement;
+#[cfg(feature = "files")]
 use anim_core::surface::SurfaceError;
+#[cfg(feature = "files")]
 use anim_io::surface::read_closed_surface;
 
 use super::{BodyError, Budget};
+#[cfg(feature = "files")]
 use crate::memory::MeshSize;
 use crate::mesh::TetMesh;
 
@@ -27,6 +31,7 @@ use crate::mesh::TetMesh;
 /// manifold and consistently oriented (the triangle, edge or vertex, numbered from 0 in file
 /// order); field `cell` for a cell too coarse to leave a tetrahedron inside, or so fine that
 /// the lattice's tetrahedra would take the scene past the memory `budget` leaves.
+#[cfg(feature = "files")]
 pub(super) fn fill(path: &Path, cell: f64, scale: f64, budget: &Budget) -> Result<TetMesh, BodyError> {
     let file = path.display();
     let surface =
@@ -52,4 +57,10 @@ pub(super) fn fill(path: &Path, cell: f64, scale: f64, budget: &Budget) -> Resul
         other => BodyError::new("mesh", format!("{file}: {other}")),
     })?;
     Ok(TetMesh { positions, tets })
+}
+
+/// Refuses the surface: this build has no `files` feature to read it.
+#[cfg(not(feature = "files"))]
+pub(super) fn fill(path: &Path, _cell: f64, _scale: f64, _budget: &Budget) -> Result<TetMesh, BodyError> {
+    Err(BodyError::new("mesh", crate::mesh::needs_files(path)))
 }

@@ -1,4 +1,6 @@
-//! Plain mesh types the readers produce, and their validation.
+//! Plain mesh types: a triangle mesh and a tetrahedral mesh as vertex positions and 0-based
+//! vertex tuples, and their validation. anim-io's readers produce them; the solver crates build
+//! from them without reading any file.
 //!
 //! Indices are 0-based into `positions`. Readers never change data: duplicate vertices are kept,
 //! element order and orientation are as in the file. Validation reports problems by element index
