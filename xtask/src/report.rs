@@ -54,6 +54,8 @@ pub struct Report {
     /// What the crates registered their studies to serve (`--tolerance` scenes, extra
     /// tolerances).
     pub study_uses: Vec<StudyUse>,
+    /// Every part's wall time: (kind, crate, name, seconds), in registry order.
+    pub durations: Vec<(&'static str, String, String, f64)>,
 }
 
 /// Runs the report into `out`. With `filter`, only the conformance cases, hard cases, studies and
@@ -223,6 +225,11 @@ impl Report {
             seconds: data.parts.iter().map(|p| p.seconds).sum(),
             soak,
             study_uses: anim::cases().study_uses,
+            durations: data
+                .parts
+                .iter()
+                .map(|p| (p.kind.name(), p.krate.clone(), p.name.clone(), p.seconds))
+                .collect(),
         }
     }
 }
@@ -510,6 +517,34 @@ pub fn index_markdown(r: &Report) -> String {
             "Long runs of each crate's hard case and of every registered preset (`cargo xtask stability --long`): [soak.md](soak.md).\n"
         );
     }
+    md.push_str(&durations_markdown(r));
+    md
+}
+
+/// How long each part of the report took: the total per kind, then every part, longest first.
+fn durations_markdown(r: &Report) -> String {
+    let mut md = String::new();
+    let _ = writeln!(md, "## How long each part took\n");
+    let mut kinds: Vec<(&str, f64, usize)> = Vec::new();
+    for (kind, _, _, secs) in &r.durations {
+        match kinds.iter_mut().find(|k| k.0 == *kind) {
+            Some(k) => {
+                k.1 += secs;
+                k.2 += 1;
+            }
+            None => kinds.push((kind, *secs, 1)),
+        }
+    }
+    let totals: Vec<String> =
+        kinds.iter().map(|(kind, secs, n)| format!("{kind} {secs:.0} s ({n} parts)")).collect();
+    let _ = writeln!(md, "Wall time of each part, {:.0} s in all: {}.\n", r.seconds, totals.join(", "));
+    let _ = writeln!(md, "| part | crate | name | wall time |\n| --- | --- | --- | --- |");
+    let mut parts: Vec<&(&str, String, String, f64)> = r.durations.iter().collect();
+    parts.sort_by(|a, b| b.3.total_cmp(&a.3));
+    for (kind, krate, name, secs) in parts {
+        let _ = writeln!(md, "| {kind} | {krate} | {} | {} |", name.replace('|', "\\|"), seconds(*secs));
+    }
+    md.push('\n');
     md
 }
 

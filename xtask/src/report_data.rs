@@ -23,6 +23,19 @@ pub enum Kind {
     Scaling,
 }
 
+impl Kind {
+    /// The kind's name in tables.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Conformance => "conformance",
+            Kind::Stability => "stability",
+            Kind::Study => "study",
+            Kind::Scaling => "scaling",
+        }
+    }
+}
+
 /// A conformance check as stored (owned strings).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct StoredCheck {

@@ -148,7 +148,28 @@ fn tiny_report() -> Report {
         seconds: 12.0,
         soak: false,
         study_uses: anim::cases().study_uses,
+        durations: vec![
+            ("conformance", "anim-x".into(), "case".into(), 0.1),
+            ("study", "anim-x".into(), "a | study".into(), 11.0),
+            ("scaling", "anim-x".into(), "scene".into(), 0.9),
+        ],
     }
+}
+
+/// The time section sums each kind and lists every part, longest first, with `|` escaped.
+#[test]
+fn the_report_says_how_long_each_part_took() {
+    let md = index_markdown(&tiny_report());
+    let section = &md[md.find("## How long each part took").expect("the section")..];
+    assert!(
+        section
+            .contains("12 s in all: conformance 0 s (1 parts), study 11 s (1 parts), scaling 1 s (1 parts)"),
+        "{section}"
+    );
+    let study = section.find("| study | anim-x | a \\| study | 11.00 s |").expect("the study's row");
+    let scaling = section.find("| scaling | anim-x | scene |").expect("the scaling row");
+    let conformance = section.find("| conformance | anim-x | case |").expect("the conformance row");
+    assert!(study < scaling && scaling < conformance, "{section}");
 }
 
 #[test]
@@ -171,6 +192,7 @@ fn index_has_every_section_table_and_plot() {
             "## Peer comparisons",
             "## Conformance",
             "## Stability (hard cases)",
+            "## How long each part took",
         ]
     );
     assert!(

@@ -7,10 +7,12 @@
 
 pub mod core;
 pub mod float;
+mod frontier;
 mod soak;
 mod sweep;
 mod threads;
 
+pub use frontier::Frontier;
 pub use soak::{
     Budget, Clock, ENERGY_STRIDE, Soak, SoakCase, drive, energy_above, energy_exceeds, finish, rejected,
 };
@@ -272,22 +274,35 @@ pub fn nan_max(a: f64, b: f64) -> f64 {
 }
 
 /// Median wall time of `f`, in seconds: repeats `f` in batches until each batch lasts at least
-/// `min_batch` seconds, over `batches` batches.
+/// `min_batch` seconds, over `batches` batches. The first call calibrates the batch size; when
+/// one call already lasts `min_batch`, that call is the first batch, so a slow `f` runs
+/// `batches` times and not once more.
+///
+/// ```
+/// use anim_core::cases::median_seconds;
+///
+/// let mut calls = 0;
+/// let s = median_seconds(3, 0.0, || calls += 1);
+/// assert_eq!(calls, 3);
+/// assert!(s >= 0.0);
+/// ```
 pub fn median_seconds(batches: usize, min_batch: f64, mut f: impl FnMut()) -> f64 {
     // Calibrate the repeat count on one call.
     let start = Instant::now();
     f();
     let once = start.elapsed().as_secs_f64().max(1e-9);
     let reps = ((min_batch / once).ceil() as usize).clamp(1, 1_000_000);
-    let mut times: Vec<f64> = (0..batches)
-        .map(|_| {
-            let start = Instant::now();
-            for _ in 0..reps {
-                f();
-            }
-            start.elapsed().as_secs_f64() / reps as f64
-        })
-        .collect();
+    let mut times = Vec::with_capacity(batches.max(1));
+    if reps == 1 {
+        times.push(once);
+    }
+    while times.len() < batches.max(1) {
+        let start = Instant::now();
+        for _ in 0..reps {
+            f();
+        }
+        times.push(start.elapsed().as_secs_f64() / reps as f64);
+    }
     times.sort_by(f64::total_cmp);
     times[times.len() / 2]
 }

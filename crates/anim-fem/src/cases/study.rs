@@ -108,14 +108,21 @@ pub(super) fn beam_study(ctx: &Ctx) -> StudyResult {
             let mut points = Vec::new();
             for k in steps_per_sample {
                 let dt = STUDY_T / (SAMPLES as f64 * k);
-                let Some(traj) = tip_trajectory(method, dt) else { continue };
+                // The first timed run's trajectory is the one measured: the method runs
+                // `batches` times in all (once when it fails).
+                let mut first: Option<Option<Vec<f64>>> = None;
+                let seconds = median_seconds(batches, min_batch, || {
+                    if matches!(first, Some(None)) {
+                        return;
+                    }
+                    let traj = tip_trajectory(method, dt);
+                    first.get_or_insert(traj);
+                });
+                let Some(Some(traj)) = first else { continue };
                 let err = (traj.iter().zip(&reference).map(|(a, b)| (a - b) * (a - b)).sum::<f64>()
                     / traj.len() as f64)
                     .sqrt()
                     / scale;
-                let seconds = median_seconds(batches, min_batch, || {
-                    let _ = tip_trajectory(method, dt);
-                });
                 points.push(Point { param: dt, seconds, error: err });
             }
             series.push(Series { label: method.label(), points });
