@@ -6,6 +6,7 @@
 //! the particle-to-grid transfer walks in a fixed order.
 
 use crate::mac::flatten;
+use crate::par;
 use anim_fluid::pressure::CellLabel;
 use rayon::prelude::*;
 
@@ -44,7 +45,7 @@ impl Bins {
         let inv_h = 1.0 / h;
         self.cell_of.resize(x.len(), 0);
         self.order.resize(x.len(), 0);
-        self.cell_of.par_iter_mut().zip(x.par_iter()).for_each(|(c, p)| {
+        self.cell_of.par_iter_mut().zip(x.par_iter()).with_min_len(par::min_len(par::MIN_PARTICLES, 1)).for_each(|(c, p)| {
             let idx: [usize; D] =
                 std::array::from_fn(|a| ((p[a] * inv_h).floor().max(0.0) as usize).min(n[a] - 1));
             *c = flatten(n, idx) as u32;
@@ -71,7 +72,7 @@ impl Bins {
 
 /// Labels every cell: solid where `solid`, fluid where a particle is, air elsewhere.
 pub(crate) fn classify(solid: &[bool], bins: &Bins, labels: &mut [CellLabel]) {
-    labels.par_iter_mut().enumerate().for_each(|(c, l)| {
+    labels.par_iter_mut().enumerate().with_min_len(par::min_len(par::MIN_ENTRIES, 1)).for_each(|(c, l)| {
         *l = if solid[c] {
             CellLabel::Solid
         } else if bins.count(c) > 0 {

@@ -10,6 +10,7 @@
 //! touching a solid cell carry the (static) solid's velocity, zero.
 
 use crate::mac::{MacGrid, flatten, unflatten};
+use crate::par;
 use anim_fluid::pressure::{CellLabel, Poisson, PressureMethod, PressureSolver, SolveInfo};
 use rayon::prelude::*;
 
@@ -50,7 +51,7 @@ pub(crate) fn body_forces_and_walls<const D: usize>(grid: &mut MacGrid<D>, solid
     for a in 0..D {
         let fd = grid.face_dims(a);
         let dv = dv[a];
-        grid.u[a].par_chunks_mut(fd[0]).enumerate().for_each(|(line, row)| {
+        grid.u[a].par_chunks_mut(fd[0]).enumerate().with_min_len(par::min_len(par::MIN_ENTRIES, fd[0])).for_each(|(line, row)| {
             let mut idx = unflatten(fd, line * fd[0]);
             for (i, u) in row.iter_mut().enumerate() {
                 idx[0] = i;
@@ -68,7 +69,7 @@ pub(crate) fn body_forces_and_walls<const D: usize>(grid: &mut MacGrid<D>, solid
 pub(crate) fn net_outflow<const D: usize>(grid: &MacGrid<D>, labels: &[CellLabel], out: &mut [f64]) {
     let n = grid.n;
     let fds: [[usize; D]; D] = std::array::from_fn(|a| grid.face_dims(a));
-    out.par_chunks_mut(n[0]).enumerate().for_each(|(line, row)| {
+    out.par_chunks_mut(n[0]).enumerate().with_min_len(par::min_len(par::MIN_ENTRIES, n[0])).for_each(|(line, row)| {
         let mut idx = unflatten(n, line * n[0]);
         for (i, o) in row.iter_mut().enumerate() {
             idx[0] = i;
@@ -116,8 +117,8 @@ pub(crate) fn project<const D: usize>(
     let n = grid.n;
     net_outflow(grid, labels, rhs);
     match target {
-        Some(t) => rhs.par_iter_mut().zip(t.par_iter()).for_each(|(x, t)| *x = t - *x),
-        None => rhs.par_iter_mut().for_each(|x| *x = -*x),
+        Some(t) => rhs.par_iter_mut().zip(t.par_iter()).with_min_len(par::min_len(par::MIN_ENTRIES, 1)).for_each(|(x, t)| *x = t - *x),
+        None => rhs.par_iter_mut().with_min_len(par::min_len(par::MIN_ENTRIES, 1)).for_each(|x| *x = -*x),
     }
     if !labels.contains(&CellLabel::Fluid) {
         s.fill(0.0);
@@ -143,7 +144,7 @@ pub(crate) fn project<const D: usize>(
     let s: &[f64] = s;
     for a in 0..D {
         let fd = grid.face_dims(a);
-        grid.u[a].par_chunks_mut(fd[0]).enumerate().for_each(|(line, row)| {
+        grid.u[a].par_chunks_mut(fd[0]).enumerate().with_min_len(par::min_len(par::MIN_ENTRIES, fd[0])).for_each(|(line, row)| {
             let mut idx = unflatten(fd, line * fd[0]);
             for (i, u) in row.iter_mut().enumerate() {
                 idx[0] = i;
@@ -169,7 +170,7 @@ pub(crate) fn mark_fluid_faces<const D: usize>(grid: &mut MacGrid<D>, labels: &[
     let n = grid.n;
     for a in 0..D {
         let fd = grid.face_dims(a);
-        grid.valid[a].par_chunks_mut(fd[0]).enumerate().for_each(|(line, row)| {
+        grid.valid[a].par_chunks_mut(fd[0]).enumerate().with_min_len(par::min_len(par::MIN_ENTRIES, fd[0])).for_each(|(line, row)| {
             let mut idx = unflatten(fd, line * fd[0]);
             for (i, v) in row.iter_mut().enumerate() {
                 idx[0] = i;
@@ -184,7 +185,7 @@ pub(crate) fn mark_fluid_faces<const D: usize>(grid: &mut MacGrid<D>, labels: &[
 pub(crate) fn mark_weighted_faces<const D: usize>(grid: &mut MacGrid<D>) {
     for a in 0..D {
         let (valid, weight) = (&mut grid.valid[a], &grid.weight[a]);
-        valid.par_iter_mut().zip(weight.par_iter()).for_each(|(v, &w)| *v = w > 0.0);
+        valid.par_iter_mut().zip(weight.par_iter()).with_min_len(par::min_len(par::MIN_ENTRIES, 1)).for_each(|(v, &w)| *v = w > 0.0);
     }
 }
 
@@ -194,7 +195,7 @@ pub(crate) fn no_slip<const D: usize>(grid: &mut MacGrid<D>, solid: &[bool]) {
     let n = grid.n;
     for a in 0..D {
         let fd = grid.face_dims(a);
-        grid.u[a].par_chunks_mut(fd[0]).enumerate().for_each(|(line, row)| {
+        grid.u[a].par_chunks_mut(fd[0]).enumerate().with_min_len(par::min_len(par::MIN_ENTRIES, fd[0])).for_each(|(line, row)| {
             let mut idx = unflatten(fd, line * fd[0]);
             for (i, u) in row.iter_mut().enumerate() {
                 idx[0] = i;

@@ -132,7 +132,7 @@ impl Reseeder {
         self.add.resize(cells, 0);
         self.excess.resize(cells, 0);
         let bins_ref: &Bins = bins;
-        self.add.par_iter_mut().zip(self.excess.par_iter_mut()).enumerate().for_each(|(c, (add, excess))| {
+        self.add.par_iter_mut().zip(self.excess.par_iter_mut()).enumerate().with_min_len(crate::par::min_len(crate::par::MIN_ENTRIES, 1)).for_each(|(c, (add, excess))| {
             *add = 0;
             *excess = 0;
             if solid[c] {

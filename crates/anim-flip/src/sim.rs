@@ -16,6 +16,7 @@
 use crate::classify::{Bins, classify};
 use crate::error::{FlipError, positive};
 use crate::mac::{MacGrid, flatten, unflatten};
+use crate::par;
 use crate::particles::Particles;
 use crate::project::{self, PressureSettings};
 use crate::reseed::{self, Reseed, Reseeder};
@@ -427,7 +428,7 @@ impl<const D: usize> FlipSimulation<D> {
         particles.validate()?;
         self.backup.clone_from(particles);
         let (steps, time) = (self.steps, self.time);
-        match self.advance_inner(particles, dt) {
+        match par::in_pool(|| self.advance_inner(particles, dt)) {
             Ok(info) => {
                 self.time = time + dt;
                 self.last = info;
@@ -516,7 +517,7 @@ impl<const D: usize> FlipSimulation<D> {
             let k = self.params.volume_correction * h / dt;
             let rest = self.params.rest_per_cell;
             let labels = &self.labels;
-            self.target.par_iter_mut().zip(self.density.par_iter()).enumerate().for_each(|(c, (t, &rho))| {
+            self.target.par_iter_mut().zip(self.density.par_iter()).enumerate().with_min_len(par::min_len(par::MIN_ENTRIES, 1)).for_each(|(c, (t, &rho))| {
                 *t = if labels[c] == CellLabel::Fluid { k * (rho / rest - 1.0).max(0.0) } else { 0.0 };
             });
             Some(&self.target[..])
@@ -537,7 +538,7 @@ impl<const D: usize> FlipSimulation<D> {
         if self.params.require_convergence
             && !solve.converged
             && solve.residual.is_finite()
-            && self.s.par_iter().all(|x| x.is_finite())
+            && self.s.par_iter().with_min_len(par::min_len(par::MIN_ENTRIES, 1)).all(|x| x.is_finite())
         {
             return Err(FlipError::NotConverged {
                 step: self.steps,
@@ -549,7 +550,7 @@ impl<const D: usize> FlipSimulation<D> {
         info.pressure_residual = info.pressure_residual.max(solve.residual);
         project::net_outflow(&self.grid, &self.labels, &mut self.rhs);
         if target.is_some() {
-            self.rhs.par_iter_mut().zip(self.target.par_iter()).for_each(|(r, t)| *r -= t);
+            self.rhs.par_iter_mut().zip(self.target.par_iter()).with_min_len(par::min_len(par::MIN_ENTRIES, 1)).for_each(|(r, t)| *r -= t);
         }
         info.max_divergence = info.max_divergence.max(max_abs(&self.rhs) / h);
         info.times.projection += lap.lap();
@@ -593,7 +594,7 @@ impl<const D: usize> FlipSimulation<D> {
                 Sampling::Linear => transfer::sample_linear(grid, x),
                 Sampling::Kernel => transfer::sample(grid, kernel, x),
             };
-            particles.x.par_iter_mut().for_each(|xp| {
+            particles.x.par_iter_mut().with_min_len(par::min_len(par::MIN_PARTICLES, 1)).for_each(|xp| {
                 let u0 = sample(xp);
                 let mid: [f64; D] = std::array::from_fn(|a| (xp[a] + 0.5 * dt * u0[a]).clamp(lo[a], hi[a]));
                 let u1 = sample(&mid);
@@ -610,6 +611,7 @@ impl<const D: usize> FlipSimulation<D> {
         let Particles { x, v, .. } = particles;
         x.par_iter_mut()
             .zip(v.par_iter_mut())
+            .with_min_len(par::min_len(par::MIN_PARTICLES, 1))
             .map(|(xp, vp)| {
                 let mut moved = false;
                 for a in 0..D {
@@ -644,7 +646,7 @@ impl<const D: usize> FlipSimulation<D> {
                 .chain(particles.c[p].iter().flatten())
                 .any(|x| !x.is_finite())
         };
-        let Some(p) = (0..particles.len()).into_par_iter().position_first(bad) else {
+        let Some(p) = (0..particles.len()).into_par_iter().with_min_len(par::min_len(par::MIN_PARTICLES, 1)).position_first(bad) else {
             return Ok(());
         };
         // Reseeding changes the particle count, so particle `p` may not exist in the backup.
@@ -761,11 +763,11 @@ impl<const D: usize> Solver for FlipSimulation<D> {
 }
 
 fn max_speed<const D: usize>(p: &Particles<D>) -> f64 {
-    p.v.par_iter().map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt()).reduce(|| 0.0, f64::max)
+    p.v.par_iter().with_min_len(par::min_len(par::MIN_PARTICLES, 1)).map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt()).reduce(|| 0.0, f64::max)
 }
 
 fn max_abs(a: &[f64]) -> f64 {
-    a.par_iter().map(|x| x.abs()).reduce(|| 0.0, f64::max)
+    a.par_iter().with_min_len(par::min_len(par::MIN_ENTRIES, 1)).map(|x| x.abs()).reduce(|| 0.0, f64::max)
 }
 
 /// Moves a particle in solid cell `cell` to the nearest point of the nearest non-solid
@@ -834,7 +836,7 @@ fn cell_density<const D: usize>(
 ) {
     let r = transfer::radius(kernel);
     let inv_h = 1.0 / h;
-    out.par_iter_mut().enumerate().for_each(|(c, rho)| {
+    out.par_iter_mut().enumerate().with_min_len(par::min_len(par::MIN_PARTICLES, 1 << D)).for_each(|(c, rho)| {
         let idx = unflatten(n, c);
         let q: [f64; D] = std::array::from_fn(|b| idx[b] as f64 + 0.5);
         let lo: [usize; D] = std::array::from_fn(|b| (q[b] - r).floor().max(0.0) as usize);

@@ -256,7 +256,7 @@ impl<const D: usize> ParticleSurface<D> {
         };
         let bins: usize = nb.iter().product();
         self.bin_of.resize(x.len(), 0);
-        self.bin_of.par_iter_mut().zip(x.par_iter()).for_each(|(b, p)| *b = bin_index(p) as u32);
+        self.bin_of.par_iter_mut().zip(x.par_iter()).with_min_len(crate::par::min_len(crate::par::MIN_PARTICLES, 1)).for_each(|(b, p)| *b = bin_index(p) as u32);
         self.start.clear();
         self.start.resize(bins + 1, 0);
         for &b in &self.bin_of {
@@ -279,7 +279,7 @@ impl<const D: usize> ParticleSurface<D> {
         let (start, order) = (&self.start, &self.order);
         let dims = ls.dims;
         let inv_r2 = 1.0 / (big_r * big_r);
-        ls.phi.par_iter_mut().enumerate().for_each(|(f, phi)| {
+        ls.phi.par_iter_mut().enumerate().with_min_len(crate::par::min_len(crate::par::MIN_PARTICLES, 8)).for_each(|(f, phi)| {
             let idx = unflatten(dims, f);
             let q: [f64; D] = std::array::from_fn(|a| origin[a] + idx[a] as f64 * dx);
             let centre: [usize; D] =
