@@ -135,6 +135,8 @@ fn main() -> Res<()> {
     match args.get(1).map(String::as_str) {
         Some("transfers") | None => transfers(num(2, 64)?, num(3, 7)?),
         Some("step") => step(num(2, 128)?, num(3, 3)?),
-        Some(other) => Err(format!("unknown mode `{other}`: `transfers [n] [rounds]` or `step [n] [frames]`").into()),
+        Some(other) => {
+            Err(format!("unknown mode `{other}`: `transfers [n] [rounds]` or `step [n] [frames]`").into())
+        }
     }
 }

@@ -224,6 +224,7 @@ pub struct FlipSimulation<const D: usize> {
     target: Vec<f64>,
     solver: Option<PressureSolver>,
     backup: Particles<D>,
+    sorted: Particles<D>,
     reseeder: Reseeder,
     border: usize,
     steps: u64,
@@ -318,6 +319,7 @@ impl<const D: usize> FlipSimulation<D> {
             target: vec![0.0; count],
             solver: None,
             backup: Particles::new(),
+            sorted: Particles::new(),
             reseeder: Reseeder::default(),
             border,
             steps: 0,
@@ -489,7 +491,8 @@ impl<const D: usize> FlipSimulation<D> {
         info.fluid_cells = self.labels.iter().filter(|&&l| l == CellLabel::Fluid).count();
         let apic = self.params.transfer == Transfer::Apic;
         let mut lap = Lap::start(self.timing);
-        transfer::p2g(&mut self.grid, particles, &self.bins, self.params.kernel, apic);
+        transfer::sort(particles, &self.bins, &mut self.sorted);
+        transfer::p2g(&mut self.grid, &self.sorted, &self.bins, self.params.kernel, apic);
         info.times.transfer += lap.lap();
         project::mark_weighted_faces(&mut self.grid);
         let layers = self.layers();
@@ -517,9 +520,14 @@ impl<const D: usize> FlipSimulation<D> {
             let k = self.params.volume_correction * h / dt;
             let rest = self.params.rest_per_cell;
             let labels = &self.labels;
-            self.target.par_iter_mut().zip(self.density.par_iter()).enumerate().with_min_len(par::min_len(par::MIN_ENTRIES, 1)).for_each(|(c, (t, &rho))| {
-                *t = if labels[c] == CellLabel::Fluid { k * (rho / rest - 1.0).max(0.0) } else { 0.0 };
-            });
+            self.target
+                .par_iter_mut()
+                .zip(self.density.par_iter())
+                .enumerate()
+                .with_min_len(par::min_len(par::MIN_ENTRIES, 1))
+                .for_each(|(c, (t, &rho))| {
+                    *t = if labels[c] == CellLabel::Fluid { k * (rho / rest - 1.0).max(0.0) } else { 0.0 };
+                });
             Some(&self.target[..])
         } else {
             None
@@ -550,7 +558,11 @@ impl<const D: usize> FlipSimulation<D> {
         info.pressure_residual = info.pressure_residual.max(solve.residual);
         project::net_outflow(&self.grid, &self.labels, &mut self.rhs);
         if target.is_some() {
-            self.rhs.par_iter_mut().zip(self.target.par_iter()).with_min_len(par::min_len(par::MIN_ENTRIES, 1)).for_each(|(r, t)| *r -= t);
+            self.rhs
+                .par_iter_mut()
+                .zip(self.target.par_iter())
+                .with_min_len(par::min_len(par::MIN_ENTRIES, 1))
+                .for_each(|(r, t)| *r -= t);
         }
         info.max_divergence = info.max_divergence.max(max_abs(&self.rhs) / h);
         info.times.projection += lap.lap();
@@ -561,7 +573,14 @@ impl<const D: usize> FlipSimulation<D> {
         }
         self.grid.reflect_walls(self.border);
         lap.lap();
-        transfer::g2p(&self.grid, particles, self.params.kernel, self.params.transfer);
+        transfer::g2p(
+            &self.grid,
+            particles,
+            &mut self.sorted,
+            &self.bins,
+            self.params.kernel,
+            self.params.transfer,
+        );
         info.times.transfer += lap.lap();
         info.pushed_out += self.advect(particles, dt);
         info.times.advection += lap.lap();
@@ -646,7 +665,11 @@ impl<const D: usize> FlipSimulation<D> {
                 .chain(particles.c[p].iter().flatten())
                 .any(|x| !x.is_finite())
         };
-        let Some(p) = (0..particles.len()).into_par_iter().with_min_len(par::min_len(par::MIN_PARTICLES, 1)).position_first(bad) else {
+        let Some(p) = (0..particles.len())
+            .into_par_iter()
+            .with_min_len(par::min_len(par::MIN_PARTICLES, 1))
+            .position_first(bad)
+        else {
             return Ok(());
         };
         // Reseeding changes the particle count, so particle `p` may not exist in the backup.
@@ -681,7 +704,8 @@ impl<const D: usize> FlipSimulation<D> {
         self.bins.bin(&particles.x, n, self.grid.h);
         classify(&self.solid, &self.bins, &mut self.labels);
         let apic = self.params.transfer == Transfer::Apic;
-        transfer::p2g(&mut self.grid, particles, &self.bins, self.params.kernel, apic);
+        transfer::sort(particles, &self.bins, &mut self.sorted);
+        transfer::p2g(&mut self.grid, &self.sorted, &self.bins, self.params.kernel, apic);
         project::mark_weighted_faces(&mut self.grid);
         let layers = self.layers();
         self.grid.extrapolate(layers);
@@ -690,7 +714,14 @@ impl<const D: usize> FlipSimulation<D> {
             let (u, old) = (&self.grid.u[a], &mut self.grid.u_old[a]);
             old.copy_from_slice(u);
         }
-        transfer::g2p(&self.grid, particles, self.params.kernel, self.params.transfer);
+        transfer::g2p(
+            &self.grid,
+            particles,
+            &mut self.sorted,
+            &self.bins,
+            self.params.kernel,
+            self.params.transfer,
+        );
     }
 
     /// Fluid volume estimated from the particle density: with `rho_c = sum_p w_cp` the
@@ -763,7 +794,10 @@ impl<const D: usize> Solver for FlipSimulation<D> {
 }
 
 fn max_speed<const D: usize>(p: &Particles<D>) -> f64 {
-    p.v.par_iter().with_min_len(par::min_len(par::MIN_PARTICLES, 1)).map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt()).reduce(|| 0.0, f64::max)
+    p.v.par_iter()
+        .with_min_len(par::min_len(par::MIN_PARTICLES, 1))
+        .map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt())
+        .reduce(|| 0.0, f64::max)
 }
 
 fn max_abs(a: &[f64]) -> f64 {
@@ -836,31 +870,33 @@ fn cell_density<const D: usize>(
 ) {
     let r = transfer::radius(kernel);
     let inv_h = 1.0 / h;
-    out.par_iter_mut().enumerate().with_min_len(par::min_len(par::MIN_PARTICLES, 1 << D)).for_each(|(c, rho)| {
-        let idx = unflatten(n, c);
-        let q: [f64; D] = std::array::from_fn(|b| idx[b] as f64 + 0.5);
-        let lo: [usize; D] = std::array::from_fn(|b| (q[b] - r).floor().max(0.0) as usize);
-        let hi: [usize; D] = std::array::from_fn(|b| ((q[b] + r).floor() as usize).min(n[b] - 1));
-        let mut sum = 0.0;
-        let mut cell = lo;
-        loop {
-            for &p in bins.cell(flatten(n, cell)) {
-                let x = &particles.x[p as usize];
-                sum += (0..D).map(|b| kernel.n(x[b] * inv_h - q[b])).product::<f64>();
-            }
-            let mut next = false;
-            for b in 0..D {
-                if cell[b] < hi[b] {
-                    cell[b] += 1;
-                    next = true;
+    out.par_iter_mut().enumerate().with_min_len(par::min_len(par::MIN_PARTICLES, 1 << D)).for_each(
+        |(c, rho)| {
+            let idx = unflatten(n, c);
+            let q: [f64; D] = std::array::from_fn(|b| idx[b] as f64 + 0.5);
+            let lo: [usize; D] = std::array::from_fn(|b| (q[b] - r).floor().max(0.0) as usize);
+            let hi: [usize; D] = std::array::from_fn(|b| ((q[b] + r).floor() as usize).min(n[b] - 1));
+            let mut sum = 0.0;
+            let mut cell = lo;
+            loop {
+                for &p in bins.cell(flatten(n, cell)) {
+                    let x = &particles.x[p as usize];
+                    sum += (0..D).map(|b| kernel.n(x[b] * inv_h - q[b])).product::<f64>();
+                }
+                let mut next = false;
+                for b in 0..D {
+                    if cell[b] < hi[b] {
+                        cell[b] += 1;
+                        next = true;
+                        break;
+                    }
+                    cell[b] = lo[b];
+                }
+                if !next {
                     break;
                 }
-                cell[b] = lo[b];
             }
-            if !next {
-                break;
-            }
-        }
-        *rho = sum;
-    });
+            *rho = sum;
+        },
+    );
 }

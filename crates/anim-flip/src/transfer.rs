@@ -64,8 +64,31 @@ pub(crate) fn radius(kernel: Kernel) -> f64 {
 /// lattice of that axis), so slabs of 5 or more layers, two apart, never write the same face.
 const SLAB: usize = 6;
 
-/// Particle-to-grid: face velocities (`grid.u`) and weight sums (`grid.weight`); faces with no
-/// weight get zero velocity. The affine term is used when `apic`.
+/// Copies the particles into `sorted` in the order of `bins` (particle `bins.order[i]` at `i`), so
+/// that the transfers read them, and the grid around them, in memory order. `sorted` grows only
+/// when the particle count grows.
+pub(crate) fn sort<const D: usize>(particles: &Particles<D>, bins: &Bins, sorted: &mut Particles<D>) {
+    let count = particles.len();
+    sorted.x.resize(count, [0.0; D]);
+    sorted.v.resize(count, [0.0; D]);
+    sorted.c.resize(count, [[0.0; D]; D]);
+    let Particles { x, v, c } = sorted;
+    x.par_iter_mut()
+        .zip(v.par_iter_mut())
+        .zip(c.par_iter_mut())
+        .zip(bins.order.par_iter())
+        .with_min_len(par::min_len(par::MIN_PARTICLES, 1))
+        .for_each(|(((x, v), c), &p)| {
+            let p = p as usize;
+            *x = particles.x[p];
+            *v = particles.v[p];
+            *c = particles.c[p];
+        });
+}
+
+/// Particle-to-grid from the particles `sorted` by [`sort`]: face velocities (`grid.u`) and
+/// weight sums (`grid.weight`); faces with no weight get zero velocity. The affine term is used
+/// when `apic`.
 ///
 /// A scatter in slabs: the cells are cut into slabs of `SLAB` layers along the last axis, and
 /// the particles of each slab (contiguous in the order of [`Bins`]) add their weights and
@@ -113,8 +136,7 @@ pub(crate) fn p2g<const D: usize>(
                     let offset = if i == 0 { 0 } else { first + (i - 1) * chunk };
                     let cells = (slab * SLAB * cell_plane, ((slab + 1) * SLAB).min(outer) * cell_plane);
                     let range = bins.start[cells.0] as usize..bins.start[cells.1] as usize;
-                    for &p in &bins.order[range] {
-                        let p = p as usize;
+                    for p in range {
                         let x = &particles.x[p];
                         let s = Stencil::new(h, fd, kernel, a, x);
                         // The affine term per node, `C_p,a . (x_i - x_p)`, summed over axes
@@ -154,8 +176,34 @@ pub(crate) fn p2g<const D: usize>(
     }
 }
 
-/// Grid-to-particle by `transfer`, from `grid.u` (and `grid.u_old` for FLIP).
+/// Grid-to-particle by `transfer`, from `grid.u` (and `grid.u_old` for FLIP): computed on the
+/// copy `sorted` by [`sort`] with the bins `bins` (in memory order, reading the grid along the
+/// cells), then copied back to `particles`.
 pub(crate) fn g2p<const D: usize>(
+    grid: &MacGrid<D>,
+    particles: &mut Particles<D>,
+    sorted: &mut Particles<D>,
+    bins: &Bins,
+    kernel: Kernel,
+    transfer: Transfer,
+) {
+    g2p_in_place(grid, sorted, kernel, transfer);
+    let split = par::min_len(par::MIN_PARTICLES, 1);
+    let sorted: &Particles<D> = sorted;
+    particles
+        .v
+        .par_iter_mut()
+        .zip(particles.c.par_iter_mut())
+        .zip(bins.rank.par_iter())
+        .with_min_len(split)
+        .for_each(|((v, c), &i)| {
+            *v = sorted.v[i as usize];
+            *c = sorted.c[i as usize];
+        });
+}
+
+/// Grid-to-particle by `transfer` on `particles` in place.
+fn g2p_in_place<const D: usize>(
     grid: &MacGrid<D>,
     particles: &mut Particles<D>,
     kernel: Kernel,
@@ -204,19 +252,41 @@ impl<const D: usize> Stencil<D> {
     #[inline]
     fn new(h: f64, fd: [usize; D], kernel: Kernel, a: usize, x: &[f64; D]) -> Self {
         let inv_h = 1.0 / h;
-        let r = radius(kernel);
         let support = kernel.support();
         let mut base = [0isize; D];
         let mut w1 = [[0.0f64; 4]; D];
         let mut d1 = [[0.0f64; 4]; D];
         for b in 0..D {
             let xs = x[b] * inv_h - if b == a { 0.0 } else { 0.5 };
-            base[b] = (xs + 1.0 - r).floor() as isize;
-            for k in 0..support {
-                let node = base[b] + k as isize;
-                d1[b][k] = node as f64 - xs;
-                if node >= 0 && (node as usize) < fd[b] {
-                    w1[b][k] = kernel.n(-d1[b][k]);
+            match kernel {
+                Kernel::Quadratic => {
+                    // `N(x)` at the three nodes `base + k`, `fx = xs - base` in `[0.5, 1.5)`.
+                    let lo = (xs - 0.5).floor();
+                    let fx = xs - lo;
+                    base[b] = lo as isize;
+                    w1[b][..3].copy_from_slice(&[
+                        0.5 * (1.5 - fx) * (1.5 - fx),
+                        0.75 - (fx - 1.0) * (fx - 1.0),
+                        0.5 * (fx - 0.5) * (fx - 0.5),
+                    ]);
+                    d1[b][..3].copy_from_slice(&[-fx, 1.0 - fx, 2.0 - fx]);
+                }
+                Kernel::Cubic => {
+                    let lo = (xs - 1.0).floor();
+                    base[b] = lo as isize;
+                    for k in 0..4 {
+                        d1[b][k] = lo + k as f64 - xs;
+                        w1[b][k] = kernel.n(d1[b][k]);
+                    }
+                }
+            }
+            // Nodes outside the lattice (only next to the grid's edge) weigh nothing.
+            if base[b] < 0 || base[b] + support as isize > fd[b] as isize {
+                for k in 0..support {
+                    let node = base[b] + k as isize;
+                    if node < 0 || node as usize >= fd[b] {
+                        w1[b][k] = 0.0;
+                    }
                 }
             }
         }
@@ -224,41 +294,43 @@ impl<const D: usize> Stencil<D> {
     }
 
     /// Calls `f(w, face, k)` for every node `k` of the stencil with a non-zero weight `w`, in a
-    /// fixed order (first axis fastest); rows along the first axis whose weight in the other
-    /// axes is zero are skipped whole.
-    #[inline]
-    fn for_each(&self, mut f: impl FnMut(f64, usize, &[usize; D])) {
-        let s = self.support;
-        let mut k = [0usize; D];
-        loop {
-            let mut w_row = 1.0;
-            let mut row = 0isize;
-            for b in 1..D {
-                w_row *= self.w1[b][k[b]];
-                row += (self.base[b] + k[b] as isize) * self.st[b] as isize;
+    /// fixed order (first axis fastest); rows whose weight in the other axes is zero are skipped
+    /// whole.
+    #[inline(always)]
+    fn for_each(&self, f: impl FnMut(f64, usize, &[usize; D])) {
+        if self.support == 3 { self.each::<3>(f) } else { self.each::<4>(f) }
+    }
+
+    /// [`Stencil::for_each`] with `S` nodes per axis known at compile time (`D` is 2 or 3).
+    #[inline(always)]
+    fn each<const S: usize>(&self, mut f: impl FnMut(f64, usize, &[usize; D])) {
+        let planes = if D == 3 { S } else { 1 };
+        for k2 in 0..planes {
+            let (w2, r2) = if D == 3 {
+                let l = D - 1;
+                (self.w1[l][k2], (self.base[l] + k2 as isize) * self.st[l] as isize)
+            } else {
+                (1.0, 0)
+            };
+            if w2 == 0.0 {
+                continue;
             }
-            if w_row != 0.0 {
-                for k0 in 0..s {
-                    let w = w_row * self.w1[0][k0];
+            for k1 in 0..S {
+                let w21 = w2 * self.w1[1][k1];
+                if w21 == 0.0 {
+                    continue;
+                }
+                let row = r2 + (self.base[1] + k1 as isize) * self.st[1] as isize + self.base[0];
+                for k0 in 0..S {
+                    let w = w21 * self.w1[0][k0];
                     if w != 0.0 {
+                        let mut k = [0usize; D];
                         k[0] = k0;
-                        f(w, (row + self.base[0] + k0 as isize) as usize, &k);
+                        k[1] = k1;
+                        k[D - 1] = if D == 3 { k2 } else { k1 };
+                        f(w, (row + k0 as isize) as usize, &k);
                     }
                 }
-                k[0] = 0;
-            }
-            // Next row: advance axes 1.. (axis 1 fastest).
-            let mut b = 1;
-            loop {
-                if b == D {
-                    return;
-                }
-                if k[b] + 1 < s {
-                    k[b] += 1;
-                    break;
-                }
-                k[b] = 0;
-                b += 1;
             }
         }
     }
@@ -330,9 +402,7 @@ pub(crate) fn sample_new<const D: usize>(
 /// The grid velocity at `x` (m), interpolated with the transfer kernel from every face lattice
 /// (the PIC velocity a particle at `x` would receive).
 pub(crate) fn sample<const D: usize>(grid: &MacGrid<D>, kernel: Kernel, x: &[f64; D]) -> [f64; D] {
-    std::array::from_fn(|a| {
-        gather_pic(grid, kernel, a, x)
-    })
+    std::array::from_fn(|a| gather_pic(grid, kernel, a, x))
 }
 
 /// The grid velocity at `x` (m), multilinear between the faces of each lattice (the MAC grid's
@@ -426,19 +496,27 @@ mod tests {
         let mut grid = MacGrid::new(n, h);
         let mut bins = Bins::new(n.iter().product());
         bins.bin(&p.x, n, h);
-        p2g(&mut grid, &p, &bins, kernel, true);
+        let mut sorted = Particles::new();
+        sort(&p, &bins, &mut sorted);
+        p2g(&mut grid, &sorted, &bins, kernel, true);
         let want = p2g_brute(&grid, &p, kernel);
         for a in 0..D {
             for (f, (got, want)) in grid.u[a].iter().zip(&want[a]).enumerate() {
                 let err = (got - want).abs();
-                assert!(err <= 1e-12 * (1.0 + want.abs()), "{n:?} {kernel:?} axis {a} face {f}: {got} vs {want}");
+                assert!(
+                    err <= 1e-12 * (1.0 + want.abs()),
+                    "{n:?} {kernel:?} axis {a} face {f}: {got} vs {want}"
+                );
             }
         }
         // Every face a particle's stencil reaches received weight (no contribution was dropped
         // at a slab boundary): the weights sum to the particle count on every lattice.
         for a in 0..D {
             let total: f64 = grid.weight[a].iter().sum();
-            assert!((total - count as f64).abs() < 1e-9 * count as f64, "axis {a}: weight {total} of {count}");
+            assert!(
+                (total - count as f64).abs() < 1e-9 * count as f64,
+                "axis {a}: weight {total} of {count}"
+            );
         }
     }
 
