@@ -167,7 +167,8 @@ pub struct StepInfo {
 /// is read and every field is zero); the four parts add up to the time spent in the substep loop.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StepTimes {
-    /// Particle-to-grid and grid-to-particle transfers (P2G, G2P).
+    /// Particle-to-grid and grid-to-particle transfers (P2G, G2P), with the copy of the
+    /// particles in cell order they read and the copy back of the velocities.
     pub transfer: f64,
     /// The pressure projection: divergence before and after, the volume-correction target,
     /// (re)building the pressure operator and its multigrid hierarchy, the solve (MGPCG by
