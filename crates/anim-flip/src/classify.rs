@@ -6,6 +6,7 @@
 //! the particle-to-grid transfer walks in a fixed order.
 
 use crate::mac::flatten;
+use crate::par;
 use anim_fluid::pressure::CellLabel;
 use rayon::prelude::*;
 
@@ -16,13 +17,21 @@ pub struct Bins {
     pub(crate) cell_of: Vec<u32>,
     pub(crate) start: Vec<u32>,
     pub(crate) order: Vec<u32>,
+    /// The position of each particle in `order` (the inverse permutation).
+    pub(crate) rank: Vec<u32>,
     cursor: Vec<u32>,
 }
 
 impl Bins {
     /// Empty bins for `cells` cells.
     pub(crate) fn new(cells: usize) -> Self {
-        Self { cell_of: Vec::new(), start: vec![0; cells + 1], order: Vec::new(), cursor: vec![0; cells] }
+        Self {
+            cell_of: Vec::new(),
+            start: vec![0; cells + 1],
+            order: Vec::new(),
+            rank: Vec::new(),
+            cursor: vec![0; cells],
+        }
     }
 
     /// Particles of cell `c`.
@@ -44,11 +53,16 @@ impl Bins {
         let inv_h = 1.0 / h;
         self.cell_of.resize(x.len(), 0);
         self.order.resize(x.len(), 0);
-        self.cell_of.par_iter_mut().zip(x.par_iter()).for_each(|(c, p)| {
-            let idx: [usize; D] =
-                std::array::from_fn(|a| ((p[a] * inv_h).floor().max(0.0) as usize).min(n[a] - 1));
-            *c = flatten(n, idx) as u32;
-        });
+        self.rank.resize(x.len(), 0);
+        self.cell_of
+            .par_iter_mut()
+            .zip(x.par_iter())
+            .with_min_len(par::min_len(par::MIN_PARTICLES, 1))
+            .for_each(|(c, p)| {
+                let idx: [usize; D] =
+                    std::array::from_fn(|a| ((p[a] * inv_h).floor().max(0.0) as usize).min(n[a] - 1));
+                *c = flatten(n, idx) as u32;
+            });
         self.cursor.fill(0);
         for &c in &self.cell_of {
             self.cursor[c as usize] += 1;
@@ -64,6 +78,7 @@ impl Bins {
         for (p, &c) in self.cell_of.iter().enumerate() {
             let slot = &mut self.cursor[c as usize];
             self.order[*slot as usize] = p as u32;
+            self.rank[p] = *slot;
             *slot += 1;
         }
     }
@@ -71,7 +86,7 @@ impl Bins {
 
 /// Labels every cell: solid where `solid`, fluid where a particle is, air elsewhere.
 pub(crate) fn classify(solid: &[bool], bins: &Bins, labels: &mut [CellLabel]) {
-    labels.par_iter_mut().enumerate().for_each(|(c, l)| {
+    labels.par_iter_mut().enumerate().with_min_len(par::min_len(par::MIN_ENTRIES, 1)).for_each(|(c, l)| {
         *l = if solid[c] {
             CellLabel::Solid
         } else if bins.count(c) > 0 {

@@ -8,6 +8,7 @@ pub mod error;
 pub mod kind;
 pub mod mac;
 pub mod memory;
+mod par;
 pub mod particles;
 pub mod project;
 pub mod reseed;

@@ -89,6 +89,7 @@ impl<const D: usize> MacGrid<D> {
                     .par_chunks_mut(fd[0])
                     .zip(self.valid_tmp[a].par_chunks_mut(fd[0]))
                     .enumerate()
+                    .with_min_len(crate::par::min_len(crate::par::MIN_ENTRIES, fd[0]))
                     .for_each(|(line, (tu, tv))| {
                         let base = line * fd[0];
                         let idx = unflatten(fd, base);

@@ -8,7 +8,7 @@
 //! | part | bytes (2D, 3D) | what |
 //! | --- | --- | --- |
 //! | grid cells | 214, 240 | the solid flags and labels, the cell bins' offsets, the pressure's right-hand side, solution and the volume correction's fields (50); per face axis the velocity, its copy before forces, the transfer's weights and the extrapolation's scratch and flags (34 D); the pressure solver, MGPCG: the operator, CG's vectors, the finest level's and the coarser levels' vectors (96, 88) |
-//! | particles | 144, 256 | position, velocity and APIC's matrix (64 B, 120 B) and their backup for a substepped step, the bins' cell and order |
+//! | particles | 212, 380 | position, velocity and APIC's matrix (64 B, 120 B), their backup for a substepped step and their copy in cell order for the transfers, the bins' cell, order and rank |
 //! | frame points, written points | 48, 330 | the frame a view fills (position and velocity, `f64`) and what a run holds to write it (anim-core's `FRAME_POINT_BYTES`, `WRITTEN_POINT_BYTES`) |
 //! | lattice points | 1 | a scene of bodies marks the particle lattice of the whole tank as taken or not |
 
@@ -21,7 +21,7 @@ pub fn need(dim: usize, cells: f64, particles: f64) -> MemoryNeed {
     let three = dim >= 3;
     MemoryNeed::new()
         .with(cells, "grid cells", if three { 240.0 } else { 214.0 })
-        .with(particles, "particles", if three { 256.0 } else { 144.0 })
+        .with(particles, "particles", if three { 380.0 } else { 212.0 })
         .with_frame_points(particles)
 }
 

@@ -10,6 +10,7 @@
 //! touching a solid cell carry the (static) solid's velocity, zero.
 
 use crate::mac::{MacGrid, flatten, unflatten};
+use crate::par;
 use anim_fluid::pressure::{CellLabel, Poisson, PressureMethod, PressureSolver, SolveInfo};
 use rayon::prelude::*;
 
@@ -50,17 +51,21 @@ pub(crate) fn body_forces_and_walls<const D: usize>(grid: &mut MacGrid<D>, solid
     for a in 0..D {
         let fd = grid.face_dims(a);
         let dv = dv[a];
-        grid.u[a].par_chunks_mut(fd[0]).enumerate().for_each(|(line, row)| {
-            let mut idx = unflatten(fd, line * fd[0]);
-            for (i, u) in row.iter_mut().enumerate() {
-                idx[0] = i;
-                if touches_solid(n, solid, a, idx) {
-                    *u = 0.0;
-                } else {
-                    *u += dv;
+        grid.u[a]
+            .par_chunks_mut(fd[0])
+            .enumerate()
+            .with_min_len(par::min_len(par::MIN_ENTRIES, fd[0]))
+            .for_each(|(line, row)| {
+                let mut idx = unflatten(fd, line * fd[0]);
+                for (i, u) in row.iter_mut().enumerate() {
+                    idx[0] = i;
+                    if touches_solid(n, solid, a, idx) {
+                        *u = 0.0;
+                    } else {
+                        *u += dv;
+                    }
                 }
-            }
-        });
+            });
     }
 }
 
@@ -68,25 +73,27 @@ pub(crate) fn body_forces_and_walls<const D: usize>(grid: &mut MacGrid<D>, solid
 pub(crate) fn net_outflow<const D: usize>(grid: &MacGrid<D>, labels: &[CellLabel], out: &mut [f64]) {
     let n = grid.n;
     let fds: [[usize; D]; D] = std::array::from_fn(|a| grid.face_dims(a));
-    out.par_chunks_mut(n[0]).enumerate().for_each(|(line, row)| {
-        let mut idx = unflatten(n, line * n[0]);
-        for (i, o) in row.iter_mut().enumerate() {
-            idx[0] = i;
-            let c = line * n[0] + i;
-            if labels[c] != CellLabel::Fluid {
-                *o = 0.0;
-                continue;
+    out.par_chunks_mut(n[0]).enumerate().with_min_len(par::min_len(par::MIN_ENTRIES, n[0])).for_each(
+        |(line, row)| {
+            let mut idx = unflatten(n, line * n[0]);
+            for (i, o) in row.iter_mut().enumerate() {
+                idx[0] = i;
+                let c = line * n[0] + i;
+                if labels[c] != CellLabel::Fluid {
+                    *o = 0.0;
+                    continue;
+                }
+                let mut s = 0.0;
+                for a in 0..D {
+                    let lo = flatten(fds[a], idx);
+                    let mut up = idx;
+                    up[a] += 1;
+                    s += grid.u[a][flatten(fds[a], up)] - grid.u[a][lo];
+                }
+                *o = s;
             }
-            let mut s = 0.0;
-            for a in 0..D {
-                let lo = flatten(fds[a], idx);
-                let mut up = idx;
-                up[a] += 1;
-                s += grid.u[a][flatten(fds[a], up)] - grid.u[a][lo];
-            }
-            *o = s;
-        }
-    });
+        },
+    );
 }
 
 /// The pressure solver settings.
@@ -116,8 +123,12 @@ pub(crate) fn project<const D: usize>(
     let n = grid.n;
     net_outflow(grid, labels, rhs);
     match target {
-        Some(t) => rhs.par_iter_mut().zip(t.par_iter()).for_each(|(x, t)| *x = t - *x),
-        None => rhs.par_iter_mut().for_each(|x| *x = -*x),
+        Some(t) => rhs
+            .par_iter_mut()
+            .zip(t.par_iter())
+            .with_min_len(par::min_len(par::MIN_ENTRIES, 1))
+            .for_each(|(x, t)| *x = t - *x),
+        None => rhs.par_iter_mut().with_min_len(par::min_len(par::MIN_ENTRIES, 1)).for_each(|x| *x = -*x),
     }
     if !labels.contains(&CellLabel::Fluid) {
         s.fill(0.0);
@@ -143,22 +154,26 @@ pub(crate) fn project<const D: usize>(
     let s: &[f64] = s;
     for a in 0..D {
         let fd = grid.face_dims(a);
-        grid.u[a].par_chunks_mut(fd[0]).enumerate().for_each(|(line, row)| {
-            let mut idx = unflatten(fd, line * fd[0]);
-            for (i, u) in row.iter_mut().enumerate() {
-                idx[0] = i;
-                let (lo, hi, llo, lhi) = face_cells(n, labels, a, idx);
-                let (Some(lo), Some(hi), Some(llo), Some(lhi)) = (lo, hi, llo, lhi) else { continue };
-                if llo == CellLabel::Solid || lhi == CellLabel::Solid {
-                    continue;
+        grid.u[a]
+            .par_chunks_mut(fd[0])
+            .enumerate()
+            .with_min_len(par::min_len(par::MIN_ENTRIES, fd[0]))
+            .for_each(|(line, row)| {
+                let mut idx = unflatten(fd, line * fd[0]);
+                for (i, u) in row.iter_mut().enumerate() {
+                    idx[0] = i;
+                    let (lo, hi, llo, lhi) = face_cells(n, labels, a, idx);
+                    let (Some(lo), Some(hi), Some(llo), Some(lhi)) = (lo, hi, llo, lhi) else { continue };
+                    if llo == CellLabel::Solid || lhi == CellLabel::Solid {
+                        continue;
+                    }
+                    if llo != CellLabel::Fluid && lhi != CellLabel::Fluid {
+                        continue;
+                    }
+                    let value = |c: usize, l: CellLabel| if l == CellLabel::Fluid { s[c] } else { 0.0 };
+                    *u -= value(hi, lhi) - value(lo, llo);
                 }
-                if llo != CellLabel::Fluid && lhi != CellLabel::Fluid {
-                    continue;
-                }
-                let value = |c: usize, l: CellLabel| if l == CellLabel::Fluid { s[c] } else { 0.0 };
-                *u -= value(hi, lhi) - value(lo, llo);
-            }
-        });
+            });
     }
     Ok(info)
 }
@@ -169,14 +184,18 @@ pub(crate) fn mark_fluid_faces<const D: usize>(grid: &mut MacGrid<D>, labels: &[
     let n = grid.n;
     for a in 0..D {
         let fd = grid.face_dims(a);
-        grid.valid[a].par_chunks_mut(fd[0]).enumerate().for_each(|(line, row)| {
-            let mut idx = unflatten(fd, line * fd[0]);
-            for (i, v) in row.iter_mut().enumerate() {
-                idx[0] = i;
-                let (_, _, llo, lhi) = face_cells(n, labels, a, idx);
-                *v = llo == Some(CellLabel::Fluid) || lhi == Some(CellLabel::Fluid);
-            }
-        });
+        grid.valid[a]
+            .par_chunks_mut(fd[0])
+            .enumerate()
+            .with_min_len(par::min_len(par::MIN_ENTRIES, fd[0]))
+            .for_each(|(line, row)| {
+                let mut idx = unflatten(fd, line * fd[0]);
+                for (i, v) in row.iter_mut().enumerate() {
+                    idx[0] = i;
+                    let (_, _, llo, lhi) = face_cells(n, labels, a, idx);
+                    *v = llo == Some(CellLabel::Fluid) || lhi == Some(CellLabel::Fluid);
+                }
+            });
     }
 }
 
@@ -184,7 +203,11 @@ pub(crate) fn mark_fluid_faces<const D: usize>(grid: &mut MacGrid<D>, labels: &[
 pub(crate) fn mark_weighted_faces<const D: usize>(grid: &mut MacGrid<D>) {
     for a in 0..D {
         let (valid, weight) = (&mut grid.valid[a], &grid.weight[a]);
-        valid.par_iter_mut().zip(weight.par_iter()).for_each(|(v, &w)| *v = w > 0.0);
+        valid
+            .par_iter_mut()
+            .zip(weight.par_iter())
+            .with_min_len(par::min_len(par::MIN_ENTRIES, 1))
+            .for_each(|(v, &w)| *v = w > 0.0);
     }
 }
 
@@ -194,20 +217,24 @@ pub(crate) fn no_slip<const D: usize>(grid: &mut MacGrid<D>, solid: &[bool]) {
     let n = grid.n;
     for a in 0..D {
         let fd = grid.face_dims(a);
-        grid.u[a].par_chunks_mut(fd[0]).enumerate().for_each(|(line, row)| {
-            let mut idx = unflatten(fd, line * fd[0]);
-            for (i, u) in row.iter_mut().enumerate() {
-                idx[0] = i;
-                let hi = idx[a] == n[a] || solid[flatten(n, idx)];
-                let lo = idx[a] == 0 || {
-                    let mut l = idx;
-                    l[a] -= 1;
-                    solid[flatten(n, l)]
-                };
-                if hi && lo {
-                    *u = 0.0;
+        grid.u[a]
+            .par_chunks_mut(fd[0])
+            .enumerate()
+            .with_min_len(par::min_len(par::MIN_ENTRIES, fd[0]))
+            .for_each(|(line, row)| {
+                let mut idx = unflatten(fd, line * fd[0]);
+                for (i, u) in row.iter_mut().enumerate() {
+                    idx[0] = i;
+                    let hi = idx[a] == n[a] || solid[flatten(n, idx)];
+                    let lo = idx[a] == 0 || {
+                        let mut l = idx;
+                        l[a] -= 1;
+                        solid[flatten(n, l)]
+                    };
+                    if hi && lo {
+                        *u = 0.0;
+                    }
                 }
-            }
-        });
+            });
     }
 }

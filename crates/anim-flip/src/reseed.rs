@@ -132,19 +132,24 @@ impl Reseeder {
         self.add.resize(cells, 0);
         self.excess.resize(cells, 0);
         let bins_ref: &Bins = bins;
-        self.add.par_iter_mut().zip(self.excess.par_iter_mut()).enumerate().for_each(|(c, (add, excess))| {
-            *add = 0;
-            *excess = 0;
-            if solid[c] {
-                return;
-            }
-            let count = bins_ref.count(c);
-            if count > bounds.max {
-                *excess = (count - bounds.max) as u32;
-            } else if count < bounds.min && interior(c, n, solid, bins_ref, bounds.min) {
-                *add = (bounds.min - count) as u32;
-            }
-        });
+        self.add
+            .par_iter_mut()
+            .zip(self.excess.par_iter_mut())
+            .enumerate()
+            .with_min_len(crate::par::min_len(crate::par::MIN_ENTRIES, 1))
+            .for_each(|(c, (add, excess))| {
+                *add = 0;
+                *excess = 0;
+                if solid[c] {
+                    return;
+                }
+                let count = bins_ref.count(c);
+                if count > bounds.max {
+                    *excess = (count - bounds.max) as u32;
+                } else if count < bounds.min && interior(c, n, solid, bins_ref, bounds.min) {
+                    *add = (bounds.min - count) as u32;
+                }
+            });
         let mut out = ReseedCount::default();
         let old_len = particles.len();
         if self.excess.iter().any(|&e| e > 0) {

@@ -16,6 +16,7 @@
 use crate::classify::{Bins, classify};
 use crate::error::{FlipError, positive};
 use crate::mac::{MacGrid, flatten, unflatten};
+use crate::par;
 use crate::particles::Particles;
 use crate::project::{self, PressureSettings};
 use crate::reseed::{self, Reseed, Reseeder};
@@ -166,7 +167,8 @@ pub struct StepInfo {
 /// is read and every field is zero); the four parts add up to the time spent in the substep loop.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StepTimes {
-    /// Particle-to-grid and grid-to-particle transfers (P2G, G2P).
+    /// Particle-to-grid and grid-to-particle transfers (P2G, G2P), with the copy of the
+    /// particles in cell order they read and the copy back of the velocities.
     pub transfer: f64,
     /// The pressure projection: divergence before and after, the volume-correction target,
     /// (re)building the pressure operator and its multigrid hierarchy, the solve (MGPCG by
@@ -223,6 +225,7 @@ pub struct FlipSimulation<const D: usize> {
     target: Vec<f64>,
     solver: Option<PressureSolver>,
     backup: Particles<D>,
+    sorted: Particles<D>,
     reseeder: Reseeder,
     border: usize,
     steps: u64,
@@ -317,6 +320,7 @@ impl<const D: usize> FlipSimulation<D> {
             target: vec![0.0; count],
             solver: None,
             backup: Particles::new(),
+            sorted: Particles::new(),
             reseeder: Reseeder::default(),
             border,
             steps: 0,
@@ -427,7 +431,7 @@ impl<const D: usize> FlipSimulation<D> {
         particles.validate()?;
         self.backup.clone_from(particles);
         let (steps, time) = (self.steps, self.time);
-        match self.advance_inner(particles, dt) {
+        match par::in_pool(|| self.advance_inner(particles, dt)) {
             Ok(info) => {
                 self.time = time + dt;
                 self.last = info;
@@ -488,7 +492,8 @@ impl<const D: usize> FlipSimulation<D> {
         info.fluid_cells = self.labels.iter().filter(|&&l| l == CellLabel::Fluid).count();
         let apic = self.params.transfer == Transfer::Apic;
         let mut lap = Lap::start(self.timing);
-        transfer::p2g(&mut self.grid, particles, &self.bins, self.params.kernel, apic);
+        transfer::sort(particles, &self.bins, &mut self.sorted);
+        transfer::p2g(&mut self.grid, &self.sorted, &self.bins, self.params.kernel, apic);
         info.times.transfer += lap.lap();
         project::mark_weighted_faces(&mut self.grid);
         let layers = self.layers();
@@ -516,9 +521,14 @@ impl<const D: usize> FlipSimulation<D> {
             let k = self.params.volume_correction * h / dt;
             let rest = self.params.rest_per_cell;
             let labels = &self.labels;
-            self.target.par_iter_mut().zip(self.density.par_iter()).enumerate().for_each(|(c, (t, &rho))| {
-                *t = if labels[c] == CellLabel::Fluid { k * (rho / rest - 1.0).max(0.0) } else { 0.0 };
-            });
+            self.target
+                .par_iter_mut()
+                .zip(self.density.par_iter())
+                .enumerate()
+                .with_min_len(par::min_len(par::MIN_ENTRIES, 1))
+                .for_each(|(c, (t, &rho))| {
+                    *t = if labels[c] == CellLabel::Fluid { k * (rho / rest - 1.0).max(0.0) } else { 0.0 };
+                });
             Some(&self.target[..])
         } else {
             None
@@ -537,7 +547,7 @@ impl<const D: usize> FlipSimulation<D> {
         if self.params.require_convergence
             && !solve.converged
             && solve.residual.is_finite()
-            && self.s.par_iter().all(|x| x.is_finite())
+            && self.s.par_iter().with_min_len(par::min_len(par::MIN_ENTRIES, 1)).all(|x| x.is_finite())
         {
             return Err(FlipError::NotConverged {
                 step: self.steps,
@@ -549,7 +559,11 @@ impl<const D: usize> FlipSimulation<D> {
         info.pressure_residual = info.pressure_residual.max(solve.residual);
         project::net_outflow(&self.grid, &self.labels, &mut self.rhs);
         if target.is_some() {
-            self.rhs.par_iter_mut().zip(self.target.par_iter()).for_each(|(r, t)| *r -= t);
+            self.rhs
+                .par_iter_mut()
+                .zip(self.target.par_iter())
+                .with_min_len(par::min_len(par::MIN_ENTRIES, 1))
+                .for_each(|(r, t)| *r -= t);
         }
         info.max_divergence = info.max_divergence.max(max_abs(&self.rhs) / h);
         info.times.projection += lap.lap();
@@ -560,7 +574,14 @@ impl<const D: usize> FlipSimulation<D> {
         }
         self.grid.reflect_walls(self.border);
         lap.lap();
-        transfer::g2p(&self.grid, particles, self.params.kernel, self.params.transfer);
+        transfer::g2p(
+            &self.grid,
+            particles,
+            &mut self.sorted,
+            &self.bins,
+            self.params.kernel,
+            self.params.transfer,
+        );
         info.times.transfer += lap.lap();
         info.pushed_out += self.advect(particles, dt);
         info.times.advection += lap.lap();
@@ -593,7 +614,7 @@ impl<const D: usize> FlipSimulation<D> {
                 Sampling::Linear => transfer::sample_linear(grid, x),
                 Sampling::Kernel => transfer::sample(grid, kernel, x),
             };
-            particles.x.par_iter_mut().for_each(|xp| {
+            particles.x.par_iter_mut().with_min_len(par::min_len(par::MIN_PARTICLES, 1)).for_each(|xp| {
                 let u0 = sample(xp);
                 let mid: [f64; D] = std::array::from_fn(|a| (xp[a] + 0.5 * dt * u0[a]).clamp(lo[a], hi[a]));
                 let u1 = sample(&mid);
@@ -610,6 +631,7 @@ impl<const D: usize> FlipSimulation<D> {
         let Particles { x, v, .. } = particles;
         x.par_iter_mut()
             .zip(v.par_iter_mut())
+            .with_min_len(par::min_len(par::MIN_PARTICLES, 1))
             .map(|(xp, vp)| {
                 let mut moved = false;
                 for a in 0..D {
@@ -644,7 +666,11 @@ impl<const D: usize> FlipSimulation<D> {
                 .chain(particles.c[p].iter().flatten())
                 .any(|x| !x.is_finite())
         };
-        let Some(p) = (0..particles.len()).into_par_iter().position_first(bad) else {
+        let Some(p) = (0..particles.len())
+            .into_par_iter()
+            .with_min_len(par::min_len(par::MIN_PARTICLES, 1))
+            .position_first(bad)
+        else {
             return Ok(());
         };
         // Reseeding changes the particle count, so particle `p` may not exist in the backup.
@@ -679,7 +705,8 @@ impl<const D: usize> FlipSimulation<D> {
         self.bins.bin(&particles.x, n, self.grid.h);
         classify(&self.solid, &self.bins, &mut self.labels);
         let apic = self.params.transfer == Transfer::Apic;
-        transfer::p2g(&mut self.grid, particles, &self.bins, self.params.kernel, apic);
+        transfer::sort(particles, &self.bins, &mut self.sorted);
+        transfer::p2g(&mut self.grid, &self.sorted, &self.bins, self.params.kernel, apic);
         project::mark_weighted_faces(&mut self.grid);
         let layers = self.layers();
         self.grid.extrapolate(layers);
@@ -688,7 +715,14 @@ impl<const D: usize> FlipSimulation<D> {
             let (u, old) = (&self.grid.u[a], &mut self.grid.u_old[a]);
             old.copy_from_slice(u);
         }
-        transfer::g2p(&self.grid, particles, self.params.kernel, self.params.transfer);
+        transfer::g2p(
+            &self.grid,
+            particles,
+            &mut self.sorted,
+            &self.bins,
+            self.params.kernel,
+            self.params.transfer,
+        );
     }
 
     /// Fluid volume estimated from the particle density: with `rho_c = sum_p w_cp` the
@@ -761,11 +795,14 @@ impl<const D: usize> Solver for FlipSimulation<D> {
 }
 
 fn max_speed<const D: usize>(p: &Particles<D>) -> f64 {
-    p.v.par_iter().map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt()).reduce(|| 0.0, f64::max)
+    p.v.par_iter()
+        .with_min_len(par::min_len(par::MIN_PARTICLES, 1))
+        .map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt())
+        .reduce(|| 0.0, f64::max)
 }
 
 fn max_abs(a: &[f64]) -> f64 {
-    a.par_iter().map(|x| x.abs()).reduce(|| 0.0, f64::max)
+    a.par_iter().with_min_len(par::min_len(par::MIN_ENTRIES, 1)).map(|x| x.abs()).reduce(|| 0.0, f64::max)
 }
 
 /// Moves a particle in solid cell `cell` to the nearest point of the nearest non-solid
@@ -834,31 +871,33 @@ fn cell_density<const D: usize>(
 ) {
     let r = transfer::radius(kernel);
     let inv_h = 1.0 / h;
-    out.par_iter_mut().enumerate().for_each(|(c, rho)| {
-        let idx = unflatten(n, c);
-        let q: [f64; D] = std::array::from_fn(|b| idx[b] as f64 + 0.5);
-        let lo: [usize; D] = std::array::from_fn(|b| (q[b] - r).floor().max(0.0) as usize);
-        let hi: [usize; D] = std::array::from_fn(|b| ((q[b] + r).floor() as usize).min(n[b] - 1));
-        let mut sum = 0.0;
-        let mut cell = lo;
-        loop {
-            for &p in bins.cell(flatten(n, cell)) {
-                let x = &particles.x[p as usize];
-                sum += (0..D).map(|b| kernel.n(x[b] * inv_h - q[b])).product::<f64>();
-            }
-            let mut next = false;
-            for b in 0..D {
-                if cell[b] < hi[b] {
-                    cell[b] += 1;
-                    next = true;
+    out.par_iter_mut().enumerate().with_min_len(par::min_len(par::MIN_PARTICLES, 1 << D)).for_each(
+        |(c, rho)| {
+            let idx = unflatten(n, c);
+            let q: [f64; D] = std::array::from_fn(|b| idx[b] as f64 + 0.5);
+            let lo: [usize; D] = std::array::from_fn(|b| (q[b] - r).floor().max(0.0) as usize);
+            let hi: [usize; D] = std::array::from_fn(|b| ((q[b] + r).floor() as usize).min(n[b] - 1));
+            let mut sum = 0.0;
+            let mut cell = lo;
+            loop {
+                for &p in bins.cell(flatten(n, cell)) {
+                    let x = &particles.x[p as usize];
+                    sum += (0..D).map(|b| kernel.n(x[b] * inv_h - q[b])).product::<f64>();
+                }
+                let mut next = false;
+                for b in 0..D {
+                    if cell[b] < hi[b] {
+                        cell[b] += 1;
+                        next = true;
+                        break;
+                    }
+                    cell[b] = lo[b];
+                }
+                if !next {
                     break;
                 }
-                cell[b] = lo[b];
             }
-            if !next {
-                break;
-            }
-        }
-        *rho = sum;
-    });
+            *rho = sum;
+        },
+    );
 }

@@ -256,7 +256,11 @@ impl<const D: usize> ParticleSurface<D> {
         };
         let bins: usize = nb.iter().product();
         self.bin_of.resize(x.len(), 0);
-        self.bin_of.par_iter_mut().zip(x.par_iter()).for_each(|(b, p)| *b = bin_index(p) as u32);
+        self.bin_of
+            .par_iter_mut()
+            .zip(x.par_iter())
+            .with_min_len(crate::par::min_len(crate::par::MIN_PARTICLES, 1))
+            .for_each(|(b, p)| *b = bin_index(p) as u32);
         self.start.clear();
         self.start.resize(bins + 1, 0);
         for &b in &self.bin_of {
@@ -279,48 +283,52 @@ impl<const D: usize> ParticleSurface<D> {
         let (start, order) = (&self.start, &self.order);
         let dims = ls.dims;
         let inv_r2 = 1.0 / (big_r * big_r);
-        ls.phi.par_iter_mut().enumerate().for_each(|(f, phi)| {
-            let idx = unflatten(dims, f);
-            let q: [f64; D] = std::array::from_fn(|a| origin[a] + idx[a] as f64 * dx);
-            let centre: [usize; D] =
-                std::array::from_fn(|a| (((q[a] - origin[a]) / big_r).floor() as usize).min(nb[a] - 1));
-            let mut wsum = 0.0;
-            let mut xsum = [0.0; D];
-            for code in 0..3usize.pow(D as u32) {
-                let mut k = code;
-                let mut bin = [0usize; D];
-                let mut inside = true;
-                for a in 0..D {
-                    let c = centre[a] as isize + (k % 3) as isize - 1;
-                    k /= 3;
-                    if c < 0 || c as usize >= nb[a] {
-                        inside = false;
+        ls.phi
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(crate::par::min_len(crate::par::MIN_PARTICLES, 8))
+            .for_each(|(f, phi)| {
+                let idx = unflatten(dims, f);
+                let q: [f64; D] = std::array::from_fn(|a| origin[a] + idx[a] as f64 * dx);
+                let centre: [usize; D] =
+                    std::array::from_fn(|a| (((q[a] - origin[a]) / big_r).floor() as usize).min(nb[a] - 1));
+                let mut wsum = 0.0;
+                let mut xsum = [0.0; D];
+                for code in 0..3usize.pow(D as u32) {
+                    let mut k = code;
+                    let mut bin = [0usize; D];
+                    let mut inside = true;
+                    for a in 0..D {
+                        let c = centre[a] as isize + (k % 3) as isize - 1;
+                        k /= 3;
+                        if c < 0 || c as usize >= nb[a] {
+                            inside = false;
+                        }
+                        bin[a] = c.max(0) as usize;
                     }
-                    bin[a] = c.max(0) as usize;
-                }
-                if !inside {
-                    continue;
-                }
-                let b = flatten(nb, bin);
-                for &p in &order[start[b] as usize..start[b + 1] as usize] {
-                    let xp = &x[p as usize];
-                    let d2: f64 = (0..D).map(|a| (xp[a] - q[a]).powi(2)).sum();
-                    let s = 1.0 - d2 * inv_r2;
-                    if s > 0.0 {
-                        let w = s * s * s;
-                        wsum += w;
-                        for a in 0..D {
-                            xsum[a] += w * xp[a];
+                    if !inside {
+                        continue;
+                    }
+                    let b = flatten(nb, bin);
+                    for &p in &order[start[b] as usize..start[b + 1] as usize] {
+                        let xp = &x[p as usize];
+                        let d2: f64 = (0..D).map(|a| (xp[a] - q[a]).powi(2)).sum();
+                        let s = 1.0 - d2 * inv_r2;
+                        if s > 0.0 {
+                            let w = s * s * s;
+                            wsum += w;
+                            for a in 0..D {
+                                xsum[a] += w * xp[a];
+                            }
                         }
                     }
                 }
-            }
-            *phi = if wsum > 0.0 {
-                (0..D).map(|a| (q[a] - xsum[a] / wsum).powi(2)).sum::<f64>().sqrt() - r
-            } else {
-                big_r - r
-            };
-        });
+                *phi = if wsum > 0.0 {
+                    (0..D).map(|a| (q[a] - xsum[a] / wsum).powi(2)).sum::<f64>().sqrt() - r
+                } else {
+                    big_r - r
+                };
+            });
         Ok(&self.level_set)
     }
 }
