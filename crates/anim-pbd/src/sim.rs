@@ -42,6 +42,7 @@
 
 mod body_contacts;
 mod check;
+mod colour_split;
 mod contacts;
 mod error;
 mod parallel;
