@@ -43,7 +43,13 @@ fn main() {
                 let (im, il, ih) = stats(i);
                 println!(
                     "100x100 {it:2} it {:22} dihedral {:.2} ms ({:.2}-{:.2})  isometric {:.2} ms ({:.2}-{:.2})",
-                    s.label(), dm * 1e3, dl * 1e3, dh * 1e3, im * 1e3, il * 1e3, ih * 1e3
+                    s.label(),
+                    dm * 1e3,
+                    dl * 1e3,
+                    dh * 1e3,
+                    im * 1e3,
+                    il * 1e3,
+                    ih * 1e3
                 );
             }
         }

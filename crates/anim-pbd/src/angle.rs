@@ -7,7 +7,9 @@
 
 use std::f64::consts::FRAC_PI_4;
 
-/// Numerator coefficients of Cephes' `atan`, highest degree first.
+/// Numerator coefficients of Cephes' `atan`, highest degree first (as published, to more digits
+/// than a double holds).
+#[allow(clippy::excessive_precision)]
 const P: [f64; 5] = [
     -8.750_608_600_031_904_122_785e-1,
     -1.615_753_718_733_365_076_637e1,
@@ -16,6 +18,7 @@ const P: [f64; 5] = [
     -6.485_021_904_942_025_371_773e1,
 ];
 /// Denominator coefficients (leading 1 implied), highest degree first.
+#[allow(clippy::excessive_precision)]
 const Q: [f64; 5] = [
     2.485_846_490_142_306_297_962e1,
     1.650_270_098_316_988_542_046e2,
@@ -24,6 +27,7 @@ const Q: [f64; 5] = [
     1.945_506_571_482_613_964_425e2,
 ];
 /// The part of `pi/4` below `FRAC_PI_4`'s last bit (Cephes' `MOREBITS / 2`).
+#[allow(clippy::excessive_precision)]
 const PI_4_LO: f64 = 0.5 * 6.123_233_995_736_765_886_130e-17;
 
 /// `atan t` for `|t| <= 0.66`.
@@ -81,7 +85,9 @@ mod tests {
 
     #[test]
     fn other_quadrants_and_specials_match_the_c_library() {
-        for (y, x) in [(2.0, 1.0), (-3.0, 0.5), (1.0, -1.0), (0.0, -1.0), (-0.0, -1.0), (1.0, 0.0), (0.0, 0.0)] {
+        for (y, x) in
+            [(2.0, 1.0), (-3.0, 0.5), (1.0, -1.0), (0.0, -1.0), (-0.0, -1.0), (1.0, 0.0), (0.0, 0.0)]
+        {
             assert_eq!(atan2(y, x).to_bits(), y.atan2(x).to_bits(), "atan2({y}, {x})");
         }
         assert!(atan2(f64::NAN, 1.0).is_nan());

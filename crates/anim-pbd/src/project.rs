@@ -38,9 +38,8 @@
 use crate::angle::atan2;
 use crate::collide::{Collider, Contact, MeshCollider, Pose, coefficients};
 use crate::constraint::{
-    AttachTarget, Constraint, ConstraintFunction, ConstraintType, MIN_LENGTH, dihedral, dihedral_parts, distance,
-    isometric,
-    tet_volume, wrap_angle,
+    AttachTarget, Constraint, ConstraintFunction, ConstraintType, MIN_LENGTH, dihedral, dihedral_parts,
+    distance, isometric, tet_volume, wrap_angle,
 };
 use crate::model::{PbdModel, VolumeMesh};
 use anim_core::glam::DVec3;
@@ -57,13 +56,36 @@ pub(crate) enum Target {
 /// A constraint function with its indices, in the form the kernels read.
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Kernel {
-    Distance { p: [u32; 2], rest: f64, fallback: DVec3 },
+    Distance {
+        p: [u32; 2],
+        rest: f64,
+        fallback: DVec3,
+    },
     /// `cos_rest`, `sin_rest`: the rest angle's cosine and sine, precomputed.
-    Dihedral { p: [u32; 4], rest: f64, cos_rest: f64, sin_rest: f64 },
-    Isometric { p: [u32; 4], w: [f64; 4], rest: f64 },
-    Tet { p: [u32; 4], rest: f64 },
-    Volume { mesh: u32, target: f64 },
-    Attach { p: u32, target: Target, distance: f64 },
+    Dihedral {
+        p: [u32; 4],
+        rest: f64,
+        cos_rest: f64,
+        sin_rest: f64,
+    },
+    Isometric {
+        p: [u32; 4],
+        w: [f64; 4],
+        rest: f64,
+    },
+    Tet {
+        p: [u32; 4],
+        rest: f64,
+    },
+    Volume {
+        mesh: u32,
+        target: f64,
+    },
+    Attach {
+        p: u32,
+        target: Target,
+        distance: f64,
+    },
 }
 
 /// A constraint ready for projection.

@@ -3,6 +3,8 @@
 //! large enough that their parallel paths run at the library's own thresholds, stepped on rayon
 //! pools of 1, 2 and 3 threads; positions and velocities compared bit for bit.
 
+#![allow(clippy::expect_used)] // a test file: its helpers panic on a failed setup like its tests
+
 use anim_pbd::{
     Bending, Cloth, Collider, ConstraintParams, EARTH_GRAVITY, Method, PbdBuilder, PbdModel, PbdParams,
     PbdSimulation, SolverKind,

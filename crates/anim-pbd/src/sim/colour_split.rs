@@ -61,7 +61,13 @@ pub(super) fn split_colour(model: &PbdModel, order: &mut [usize], first: usize) 
 
 /// Builds the subtree of `items` (constraint, particle span) over particles `lo..hi`, reordering
 /// `items` into left, right, own; returns the node's index.
-fn build(items: &mut [(usize, (usize, usize))], lo: usize, hi: usize, start: usize, nodes: &mut Split) -> u32 {
+fn build(
+    items: &mut [(usize, (usize, usize))],
+    lo: usize,
+    hi: usize,
+    start: usize,
+    nodes: &mut Split,
+) -> u32 {
     let at = nodes.len();
     let mid = lo + (hi - lo) / 2;
     let end = start + items.len();
@@ -100,13 +106,8 @@ fn build(items: &mut [(usize, (usize, usize))], lo: usize, hi: usize, start: usi
     let (left_items, rest) = items.split_at_mut(nl);
     let left = build(left_items, lo, mid, start, nodes);
     let right = build(&mut rest[..nr], mid, hi, start + nl, nodes);
-    nodes[at] = Node {
-        left_end: (start + nl) as u32,
-        right_end: (start + nl + nr) as u32,
-        left,
-        right,
-        ..leaf
-    };
+    nodes[at] =
+        Node { left_end: (start + nl) as u32, right_end: (start + nl + nr) as u32, left, right, ..leaf };
     at as u32
 }
 
@@ -174,5 +175,57 @@ fn sweep_node(
     let mut acc = Window { p, base: lo };
     for (c, l) in cs.iter().zip(ls.iter_mut()) {
         project(ctx, c, l, &mut acc);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::project::colour;
+
+    /// Every constraint lies inside its node's particle range, the children's ranges are the
+    /// node's halves, and the constraints left to the roots' own sweeps (the only part no other
+    /// thread can run beside) are few.
+    #[test]
+    fn splits_hold_their_constraints_and_leave_little_sequential() {
+        let model = crate::scenes::benchmark_cloth(40).expect("cloth").model;
+        let (colours, ncol) = colour(&model);
+        let mut order: Vec<usize> = (0..model.num_constraints()).collect();
+        order.sort_by_key(|&j| (colours[j], j));
+        let mut start = 0;
+        let mut straddling = 0;
+        for c in 0..ncol as u32 {
+            let len = colours.iter().filter(|&&k| k == c).count();
+            let colour_order = &mut order[start..start + len];
+            let mut sorted = colour_order.to_vec();
+            let split = split_colour(&model, colour_order, start);
+            // A permutation of the colour.
+            let mut again = colour_order.to_vec();
+            again.sort_unstable();
+            sorted.sort_unstable();
+            assert_eq!(again, sorted);
+            assert!(split.len() > 1, "colour {c} of {len} constraints not split");
+            for node in &split {
+                let (s, e) = (node.start as usize - start, node.end as usize - start);
+                for &j in &colour_order[s..e] {
+                    for &p in model.constraint_particles(j) {
+                        assert!((node.lo..node.hi).contains(&(p as u32)), "constraint {j} outside its node");
+                    }
+                }
+                if node.left != u32::MAX {
+                    let (l, r) = (split[node.left as usize], split[node.right as usize]);
+                    assert_eq!((l.lo, l.hi, r.lo, r.hi), (node.lo, node.mid, node.mid, node.hi));
+                    assert_eq!(
+                        (l.start, l.end, r.start, r.end),
+                        (node.start, node.left_end, node.left_end, node.right_end)
+                    );
+                }
+            }
+            if let Some(root) = split.first() {
+                straddling += (root.end - root.right_end) as usize;
+            }
+            start += len;
+        }
+        assert!(straddling * 20 < model.num_constraints(), "{straddling} straddling constraints");
     }
 }

@@ -230,7 +230,7 @@ fn jacobi(
     }
     // Gather per particle in the fixed incidence order.
     let (corr, vcorr) = (&*corr, &*volume_corr);
-    let flat = &jacobi_inc[..];
+    let flat = jacobi_inc;
     let gather = |i: usize| -> DVec3 {
         let r = model.inc_ptr[i]..model.inc_ptr[i + 1];
         if !flat.is_empty() {
