@@ -265,8 +265,17 @@ pub(crate) fn distance(a: DVec3, b: DVec3, rest: f64, fallback: DVec3) -> (f64, 
 
 /// Signed dihedral angle and its gradient for `[p0, p1, p2, p3]` (edge `p2, p3`); `None` when a
 /// triangle or the edge is degenerate.
-#[inline]
+#[inline(always)]
 pub(crate) fn dihedral(p: [DVec3; 4]) -> Option<(f64, Grad4)> {
+    let (s, c, g) = dihedral_parts(p)?;
+    Some((crate::angle::atan2(s, c), g))
+}
+
+/// The dihedral angle's sine and cosine up to a common positive factor, `(s, c)` with
+/// `theta = atan2(s, c)`, and the angle's gradient (Bridson et al. 2003), each computed once;
+/// `None` when a triangle or the edge is degenerate.
+#[inline(always)]
+pub(crate) fn dihedral_parts(p: [DVec3; 4]) -> Option<(f64, f64, Grad4)> {
     let [p0, p1, p2, p3] = p;
     let e = p3 - p2;
     let elen2 = e.length_squared();
@@ -288,8 +297,7 @@ pub(crate) fn dihedral(p: [DVec3; 4]) -> Option<(f64, Grad4)> {
     let g2 = ((p0 - p3).dot(e) * inv_elen) * m1 + ((p1 - p3).dot(e) * inv_elen) * m2;
     let g3 = ((p2 - p0).dot(e) * inv_elen) * m1 + ((p2 - p1).dot(e) * inv_elen) * m2;
     // atan2 is invariant under a common positive scale: no need to normalise n1, n2 or e.
-    let theta = n2.cross(n1).dot(e).atan2(n1.dot(n2) * elen);
-    Some((theta, [g0, g1, g2, g3]))
+    Some((n2.cross(n1).dot(e), n1.dot(n2) * elen, [g0, g1, g2, g3]))
 }
 
 /// Wraps an angle difference into `(-pi, pi]`.

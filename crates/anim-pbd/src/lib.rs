@@ -3,6 +3,7 @@
 #![cfg_attr(feature = "serde", doc = concat!(include_str!("../README.md"), "\n[`KIND`]: KIND\n[`anim_core::scene`]: anim_core::scene\n[`kind::BodySpec`]: kind::BodySpec\n[`kind`]: kind\n"))]
 #![cfg_attr(not(feature = "serde"), doc = concat!(include_str!("../README.md"), "\n[`KIND`]: #features\n[`anim_core::scene`]: #features\n[`kind::BodySpec`]: #features\n[`kind`]: #features\n"))]
 
+mod angle;
 mod build;
 #[cfg(feature = "cases")]
 pub mod cases;

@@ -35,10 +35,11 @@
 //! Constraints of one colour share no movable particle, so within a colour both give bitwise the
 //! same positions, whatever the number of threads.
 
+use crate::angle::atan2;
 use crate::collide::{Collider, Contact, MeshCollider, Pose, coefficients};
 use crate::constraint::{
-    AttachTarget, Constraint, ConstraintFunction, ConstraintType, MIN_LENGTH, dihedral, distance, isometric,
-    tet_volume, wrap_angle,
+    AttachTarget, Constraint, ConstraintFunction, ConstraintType, MIN_LENGTH, dihedral, dihedral_parts,
+    distance, isometric, tet_volume, wrap_angle,
 };
 use crate::model::{PbdModel, VolumeMesh};
 use anim_core::glam::DVec3;
@@ -55,12 +56,36 @@ pub(crate) enum Target {
 /// A constraint function with its indices, in the form the kernels read.
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Kernel {
-    Distance { p: [u32; 2], rest: f64, fallback: DVec3 },
-    Dihedral { p: [u32; 4], rest: f64 },
-    Isometric { p: [u32; 4], w: [f64; 4], rest: f64 },
-    Tet { p: [u32; 4], rest: f64 },
-    Volume { mesh: u32, target: f64 },
-    Attach { p: u32, target: Target, distance: f64 },
+    Distance {
+        p: [u32; 2],
+        rest: f64,
+        fallback: DVec3,
+    },
+    /// `cos_rest`, `sin_rest`: the rest angle's cosine and sine, precomputed.
+    Dihedral {
+        p: [u32; 4],
+        rest: f64,
+        cos_rest: f64,
+        sin_rest: f64,
+    },
+    Isometric {
+        p: [u32; 4],
+        w: [f64; 4],
+        rest: f64,
+    },
+    Tet {
+        p: [u32; 4],
+        rest: f64,
+    },
+    Volume {
+        mesh: u32,
+        target: f64,
+    },
+    Attach {
+        p: u32,
+        target: Target,
+        distance: f64,
+    },
 }
 
 /// A constraint ready for projection.
@@ -258,9 +283,36 @@ pub(crate) fn project<A: Access>(ctx: &Ctx<'_>, c: &Compiled, lambda: &mut f64, 
             let (value, n) = distance(a, b, rest, fallback);
             solve(ctx, c, [i, j], [a, b], value, [n, -n], lambda, acc);
         }
-        Kernel::Dihedral { p, rest } => {
+        Kernel::Dihedral { p, rest, cos_rest, sin_rest } => {
             let idx = p.map(|i| i as usize);
             let x = idx.map(|i| acc.get(i));
+            if c.beta == 0.0 && !c.inequality && ctx.xpbd && c.relax == 1.0 {
+                // The common case written out: the gradient computed once, `theta - theta_0` as
+                // one angle from the rotated sine and cosine (no wrap), the update of `solve`.
+                let Some((s, co, g)) = dihedral_parts(x) else { return };
+                let value = atan2(s * cos_rest - co * sin_rest, co * cos_rest + s * sin_rest);
+                let m = idx.map(|i| ctx.w[i]);
+                let den = m[0] * g[0].length_squared()
+                    + m[1] * g[1].length_squared()
+                    + m[2] * g[2].length_squared()
+                    + m[3] * g[3].length_squared();
+                if !(den > c.den_min) {
+                    return;
+                }
+                let at = c.alpha * ctx.inv_h2;
+                let dl = (-value - at * *lambda) / (den + at);
+                if !dl.is_finite() {
+                    ctx.flag(c.id);
+                    return;
+                }
+                *lambda += dl;
+                for k in 0..4 {
+                    if m[k] > 0.0 {
+                        acc.apply(k, idx[k], g[k] * (m[k] * dl));
+                    }
+                }
+                return;
+            }
             if let Some((theta, g)) = dihedral(x) {
                 solve(ctx, c, idx, x, wrap_angle(theta - rest), g, lambda, acc);
             }
@@ -467,7 +519,7 @@ pub(crate) fn value(
 ) -> f64 {
     match c.kernel {
         Kernel::Distance { p: [i, j], rest, .. } => (get(i as usize) - get(j as usize)).length() - rest,
-        Kernel::Dihedral { p, rest } => {
+        Kernel::Dihedral { p, rest, .. } => {
             dihedral(p.map(|i| get(i as usize))).map_or(0.0, |(t, _)| wrap_angle(t - rest))
         }
         Kernel::Isometric { p, w, rest } => {
@@ -508,7 +560,8 @@ pub(crate) fn compile(model: &PbdModel, j: usize, iterations: usize, correct_sti
             Kernel::Distance { p: [u(*i), u(*k)], rest: *rest_length, fallback }
         }
         ConstraintFunction::DihedralBending { particles, rest_angle } => {
-            Kernel::Dihedral { p: particles.map(u), rest: *rest_angle }
+            let (sin_rest, cos_rest) = rest_angle.sin_cos();
+            Kernel::Dihedral { p: particles.map(u), rest: *rest_angle, cos_rest, sin_rest }
         }
         ConstraintFunction::IsometricBending(b) => {
             Kernel::Isometric { p: b.particles.map(u), w: b.weights, rest: b.rest }

@@ -42,6 +42,7 @@
 
 mod body_contacts;
 mod check;
+mod colour_split;
 mod contacts;
 mod error;
 mod parallel;
@@ -242,9 +243,11 @@ impl PbdSimulation {
         let h = dt / s as f64;
         let mut contacts = 0;
         self.data.bad.store(usize::MAX, Ordering::Relaxed);
-        for k in 0..s {
-            contacts = self.substep(t0 + k as f64 * h, h, k, s);
-        }
+        parallel::on_worker(|| {
+            for k in 0..s {
+                contacts = self.substep(t0 + k as f64 * h, h, k, s);
+            }
+        });
         check::check(&self.model, &self.params, &self.data, self.steps, state)?;
         check::commit(&self.data, state, t0 + dt);
         self.targets.iter_mut().for_each(|t| *t = None);

@@ -29,7 +29,7 @@ use hard_cases::{
 };
 use study::{cloth_constraint_study, cloth_position_study};
 
-pub use peer::{PeerRun, peer_cloth};
+pub use peer::{PeerRun, peer_cloth, thread_rounds};
 pub use study::{STUDY_T, study_problem};
 
 /// Registers the crate's cases: conformance, hard cases, studies, the determinism checks of the

@@ -68,3 +68,24 @@ pub fn peer_cloth(
         Ok(PeerRun { per_step_s: times[times.len() / 2], constraints: model.num_constraints(), min_height })
     })
 }
+
+/// The speed-up of `threads` threads over one on the benchmark cloth, measured in interleaved
+/// rounds (one thread, then `threads`, `rounds` times, each a [`peer_cloth`] run of `steps`
+/// steps, median of 3): the per-round times `(one thread, threads)` in seconds per step.
+pub fn thread_rounds(
+    n: usize,
+    iterations: usize,
+    dihedral: bool,
+    solver: SolverKind,
+    threads: usize,
+    steps: usize,
+    rounds: usize,
+) -> Result<Vec<(f64, f64)>, String> {
+    (0..rounds)
+        .map(|_| {
+            let one = peer_cloth(n, iterations, dihedral, solver, 1, steps, 3)?.per_step_s;
+            let many = peer_cloth(n, iterations, dihedral, solver, threads, steps, 3)?.per_step_s;
+            Ok((one, many))
+        })
+        .collect()
+}

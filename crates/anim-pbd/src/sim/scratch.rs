@@ -28,8 +28,11 @@ pub(super) struct Data {
     pub(super) groups: Vec<Range<usize>>,
     /// Per colour: whether it holds a global volume (then it is swept sequentially).
     pub(super) group_has_volume: Vec<bool>,
-    /// Per colour: `(particle, constraint, slot)` written by the colour, sorted by particle.
-    pub(super) touched: Vec<Vec<(u32, u32, u32)>>,
+    /// Per colour: its split by particle ranges (`sim/colour_split.rs`).
+    pub(super) splits: Vec<super::colour_split::Split>,
+    /// The Jacobi gather's incidences as flat correction indices `4 c + slot` (empty when a
+    /// global volume is among them).
+    pub(super) jacobi_inc: Vec<u32>,
     /// Buffered corrections per constraint (coloured and Jacobi sweeps).
     pub(super) corr: Vec<[DVec3; 4]>,
     pub(super) scratch: Vec<Mutex<Vec<DVec3>>>,
@@ -65,7 +68,8 @@ impl Data {
             lambda: Vec::new(),
             groups: Vec::new(),
             group_has_volume: Vec::new(),
-            touched: Vec::new(),
+            splits: Vec::new(),
+            jacobi_inc: Vec::new(),
             corr: Vec::new(),
             scratch,
             volume_corr: model.volume_meshes.iter().map(|m| vec![DVec3::ZERO; m.vertices.len()]).collect(),

@@ -9,11 +9,10 @@
 //!   order) so that no two of a colour share a movable particle; colours are swept in order, the
 //!   constraints of a colour independently. It is Gauss-Seidel in another order: the same
 //!   convergence, and faster than the model order on one thread, because consecutive
-//!   projections no longer wait for each other's results. A colour of at least
-//!   [`COLOUR_PARALLEL_MIN`] constraints per thread is swept in parallel, in two phases
-//!   (corrections from the colour's start positions, then applied over disjoint particle ranges);
-//!   on the 2-core machine this was measured slower than the sequential sweep at every cloth size
-//!   tried, hence the threshold.
+//!   projections no longer wait for each other's results. On more than one thread a colour of
+//!   at least `LEAF` constraints is swept along its split by particle ranges
+//!   (`sim/colour_split.rs`): the two halves of the particles in parallel, each projection
+//!   writing its particles at once, the straddling constraints after them.
 //! - [`SolverKind::Jacobi`]: every constraint is projected from the same positions (in parallel),
 //!   its correction and multiplier increment scaled by `omega / n_j`, `n_j` the largest number of
 //!   constraints meeting at one of its movable particles, and each particle adds its corrections
@@ -28,6 +27,7 @@
 //! for any number of threads.
 
 use super::body_contacts::project_body_contacts;
+use super::colour_split::{LEAF, Split, split_colour, sweep_colour};
 use super::parallel::{CHUNK, PARALLEL_MIN, for_each_chunk};
 use super::params::{Method, PbdParams, SolverKind};
 use super::scratch::Data;
@@ -39,32 +39,27 @@ use anim_core::glam::DVec3;
 use anim_core::par::prelude::*;
 use std::ops::Range;
 
-/// A colour is swept in parallel (two phases) only with at least this many constraints per
-/// thread. Measured on the 2-core development machine, the two-phase sweep on 2 threads was
-/// slower than the sequential colour-order sweep at every size tried (benchmark cloth 100^2,
-/// 200^2, 300^2: 4.7 vs 3.0, 24 vs 13, 82 vs 35 ms per step): the corrections' second pass
-/// costs more than the second core gains. Unit tests use a small value to exercise the path.
-const COLOUR_PARALLEL_MIN: usize = if cfg!(test) { 64 } else { 1 << 16 };
-
 /// (Re)builds the compiled constraints, the sweep order and the colouring for the settings `p`.
 pub(super) fn plan_sweeps(model: &PbdModel, p: &PbdParams, data: &mut Data) {
     let m = model.constraints.len();
     let mut compiled: Vec<Compiled> =
         (0..m).map(|j| compile(model, j, p.iterations, p.stiffness_correction)).collect();
     let mut groups = Vec::new();
+    let mut splits = Vec::new();
     match p.solver {
         SolverKind::GaussSeidel | SolverKind::Jacobi => groups.push(0..m),
         SolverKind::ColoredGaussSeidel => {
             let (colours, ncol) = colour(model);
             let mut order: Vec<usize> = (0..m).collect();
             order.sort_by_key(|&j| (colours[j], j));
-            compiled = order.iter().map(|&j| compiled[j]).collect();
             let mut start = 0;
             for c in 0..ncol as u32 {
                 let len = colours.iter().filter(|&&k| k == c).count();
+                splits.push(split_colour(model, &mut order[start..start + len], start));
                 groups.push(start..start + len);
                 start += len;
             }
+            compiled = order.iter().map(|&j| compiled[j]).collect();
         }
     }
     if p.solver == SolverKind::Jacobi {
@@ -82,30 +77,18 @@ pub(super) fn plan_sweeps(model: &PbdModel, p: &PbdParams, data: &mut Data) {
             c.relax = p.jacobi_relaxation / n_j as f64;
         }
     }
+    // The Jacobi gather's incidences as flat indices `4 c + slot` of the corrections, when no
+    // global volume (whose corrections live in its mesh's scratch) is among them.
+    data.jacobi_inc = if p.solver == SolverKind::Jacobi && model.volume_meshes.is_empty() {
+        model.inc.iter().map(|&(c, slot)| 4 * c + slot).collect()
+    } else {
+        Vec::new()
+    };
     let buffered = p.solver != SolverKind::GaussSeidel;
     data.corr = if buffered { vec![[DVec3::ZERO; 4]; m] } else { Vec::new() };
     let is_volume = |c: &Compiled| matches!(c.kernel, Kernel::Volume { .. });
     data.group_has_volume = groups.iter().map(|r| compiled[r.clone()].iter().any(is_volume)).collect();
-    data.touched = if p.solver == SolverKind::ColoredGaussSeidel {
-        groups
-            .iter()
-            .map(|r| {
-                let mut t: Vec<(u32, u32, u32)> = Vec::new();
-                for ci in r.clone() {
-                    let j = compiled[ci].id as usize;
-                    for (slot, &i) in model.constraint_particles(j).iter().enumerate() {
-                        if model.inv_mass[i] > 0.0 {
-                            t.push((i as u32, ci as u32, slot as u32));
-                        }
-                    }
-                }
-                t.sort_unstable();
-                t
-            })
-            .collect()
-    } else {
-        Vec::new()
-    };
+    data.splits = splits;
     data.lambda = vec![0.0; m];
     data.compiled = compiled;
     data.groups = groups;
@@ -140,10 +123,9 @@ pub(super) fn solve_constraints(model: &PbdModel, params: &PbdParams, d: &mut Da
                 parallel,
                 &d.groups,
                 &d.group_has_volume,
-                &d.touched,
+                &d.splits,
                 &d.compiled,
                 &mut d.lambda,
-                &mut d.corr,
                 &mut d.p,
                 &mut d.contacts,
                 &d.contact_groups,
@@ -153,6 +135,7 @@ pub(super) fn solve_constraints(model: &PbdModel, params: &PbdParams, d: &mut Da
                 parallel,
                 model,
                 &d.compiled,
+                &d.jacobi_inc,
                 &mut d.lambda,
                 &mut d.corr,
                 &mut d.volume_corr,
@@ -184,18 +167,17 @@ fn gauss_seidel(
     }
 }
 
-/// One coloured Gauss-Seidel iteration: the colours `groups` of `compiled` in order (each in
-/// parallel when it is large enough and holds no global volume), then the contacts collider by
-/// collider.
+/// One coloured Gauss-Seidel iteration: the colours `groups` of `compiled` in order (each along
+/// its particle split, in parallel, when it holds no global volume), then the contacts collider
+/// by collider.
 fn coloured_gauss_seidel(
     ctx: &Ctx<'_>,
     parallel: bool,
     groups: &[Range<usize>],
     group_has_volume: &[bool],
-    touched: &[Vec<(u32, u32, u32)>],
+    splits: &[Split],
     compiled: &[Compiled],
     lambda: &mut [f64],
-    corr: &mut [[DVec3; 4]],
     p: &mut [DVec3],
     contacts: &mut [Contact],
     contact_groups: &[Range<usize>],
@@ -203,25 +185,8 @@ fn coloured_gauss_seidel(
     for (g, r) in groups.iter().enumerate() {
         let cs = &compiled[r.clone()];
         let ls = &mut lambda[r.clone()];
-        let threads = anim_core::par::current_num_threads();
-        if parallel && cs.len() >= COLOUR_PARALLEL_MIN * threads && !group_has_volume[g] {
-            // Two phases: corrections from the colour's start positions, then
-            // applied over disjoint particle ranges.
-            let pos: &[DVec3] = p;
-            let colour_corr = &mut corr[r.clone()];
-            let chunk = cs.len().div_ceil(2 * anim_core::par::current_num_threads()).max(CHUNK);
-            cs.par_chunks(chunk)
-                .zip(ls.par_chunks_mut(chunk))
-                .zip(colour_corr.par_chunks_mut(chunk))
-                .for_each(|((cs, ls), out)| {
-                    for ((c, l), o) in cs.iter().zip(ls.iter_mut()).zip(out.iter_mut()) {
-                        *o = [DVec3::ZERO; 4];
-                        project(ctx, c, l, &mut Buffered { pos, out: o });
-                    }
-                });
-            let t = &touched[g];
-            let leaf = t.len().div_ceil(2 * anim_core::par::current_num_threads()).max(4 * CHUNK);
-            apply_sorted(p, 0, t, corr, leaf);
+        if parallel && cs.len() >= LEAF && !group_has_volume[g] {
+            sweep_colour(ctx, &splits[g], r.start, cs, ls, p);
         } else {
             let mut acc = Direct(&mut *p);
             for (c, l) in cs.iter().zip(ls.iter_mut()) {
@@ -240,6 +205,7 @@ fn jacobi(
     parallel: bool,
     model: &PbdModel,
     compiled: &[Compiled],
+    jacobi_inc: &[u32],
     lambda: &mut [f64],
     corr: &mut [[DVec3; 4]],
     volume_corr: &mut [Vec<DVec3>],
@@ -264,7 +230,16 @@ fn jacobi(
     }
     // Gather per particle in the fixed incidence order.
     let (corr, vcorr) = (&*corr, &*volume_corr);
+    let flat = jacobi_inc;
     let gather = |i: usize| -> DVec3 {
+        let r = model.inc_ptr[i]..model.inc_ptr[i + 1];
+        if !flat.is_empty() {
+            let mut s = DVec3::ZERO;
+            for &f in &flat[r] {
+                s += corr[(f >> 2) as usize][(f & 3) as usize];
+            }
+            return s;
+        }
         let mut s = DVec3::ZERO;
         for &(c, slot) in &model.inc[model.inc_ptr[i]..model.inc_ptr[i + 1]] {
             s += match model.constraints[c as usize].function {
@@ -283,25 +258,6 @@ fn jacobi(
         }
     });
     project_contact_groups(ctx, contacts, contact_groups, p, parallel);
-}
-
-/// Adds the buffered corrections `list = (particle, constraint, slot)` (sorted by particle, each
-/// particle at most once) to `pos`, whose first element is particle `base`; splits the list and
-/// the positions at a particle boundary and recurses in parallel.
-fn apply_sorted(pos: &mut [DVec3], base: usize, list: &[(u32, u32, u32)], corr: &[[DVec3; 4]], leaf: usize) {
-    if list.len() <= leaf {
-        for &(i, c, s) in list {
-            pos[i as usize - base] += corr[c as usize][s as usize];
-        }
-        return;
-    }
-    let mid = list.len() / 2;
-    let split = list[mid].0 as usize;
-    let (lo, hi) = pos.split_at_mut(split - base);
-    anim_core::par::join(
-        || apply_sorted(lo, base, &list[..mid], corr, leaf),
-        || apply_sorted(hi, split, &list[mid..], corr, leaf),
-    );
 }
 
 /// Projects the contacts collider by collider; within a collider every particle appears once, so
