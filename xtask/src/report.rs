@@ -54,6 +54,8 @@ pub struct Report {
     /// What the crates registered their studies to serve (`--tolerance` scenes, extra
     /// tolerances).
     pub study_uses: Vec<StudyUse>,
+    /// The roofline section (`roofline.md` beside the index), if measured.
+    pub roofline: Option<String>,
 }
 
 /// Runs the report into `out`. With `filter`, only the conformance cases, hard cases, studies and
@@ -148,8 +150,19 @@ pub fn run(ctx: &Ctx, out: &str, threads: &[usize], filter: Option<&str>) -> boo
             missing.join("; ")
         );
     }
+    let roofline_md = dir.join("roofline.md");
+    if filter.is_none_or(|f| "roofline".contains(f)) {
+        let t = Instant::now();
+        let md = crate::roofline::measure(None, threads);
+        if let Err(e) = std::fs::write(&roofline_md, &md) {
+            eprintln!("cannot write {}: {e}", roofline_md.display());
+        }
+        eprintln!("  roofline {:>6.1} s", t.elapsed().as_secs_f64());
+    }
     let data = Data::new(ctx.quick, Machine::this(), parts);
-    let report = Report::from_data(&data, ratios::read(&dir.join("peers.csv")), dir.join("soak.md").exists());
+    let mut report =
+        Report::from_data(&data, ratios::read(&dir.join("peers.csv")), dir.join("soak.md").exists());
+    report.roofline = std::fs::read_to_string(&roofline_md).ok();
     let mut ok = match write(dir, &report).and_then(|()| data.write(&data_path)) {
         Ok(()) => true,
         Err(e) => {
@@ -223,6 +236,7 @@ impl Report {
             seconds: data.parts.iter().map(|p| p.seconds).sum(),
             soak,
             study_uses: anim::cases().study_uses,
+            roofline: None,
         }
     }
 }
@@ -471,6 +485,10 @@ pub fn index_markdown(r: &Report) -> String {
         );
     }
     md.push_str(&scaling::markdown(&r.scaling));
+    if let Some(roofline) = &r.roofline {
+        let _ = writeln!(md, "\n## Distance to the machine's limits\n");
+        md.push_str(roofline);
+    }
     let _ = writeln!(md, "\n## Peer comparisons\n");
     match &r.peers {
         Ok(rows) if rows.is_empty() => {

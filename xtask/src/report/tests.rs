@@ -148,6 +148,7 @@ fn tiny_report() -> Report {
         seconds: 12.0,
         soak: false,
         study_uses: anim::cases().study_uses,
+        roofline: None,
     }
 }
 
