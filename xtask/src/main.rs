@@ -9,6 +9,7 @@
 //! | `stability --long [--quick] [--filter S] [--out DIR]` | soak: each crate's hard case for `10^5` steps or ten minutes with its energy bound, then every registered preset for the same budget (its solver's guard at every step, frame and checkpoint finite on a stride; `--quick`: quick params, 200 steps or 3 s); written to `docs/report/soak.md` |
 //! | `scaling [--quick] [--filter S] [--threads 1,2,...]` | thread scaling of every registered preset (quick params with `--quick`): time per step, speed-up over one thread and the same checkpoint bits as one thread, on 1 and all cores unless `--threads`; exit 1 on a failure or a thread-count dependence |
 //! | `bench [--filter S]` | the criterion benches under `benches/` (with `presets`: one step of every registered preset), printed as a table and written to `target/xtask/bench.csv`; `--peers [--filter S]`: the peer comparisons (springs, rigid, pbd, fem, mpm, fluid, flip), their ratios merged into `docs/report/peers.csv` (a filtered run replaces only its crates' rows) |
+//! | `roofline [--filter S] [--threads 1,2,...]` | this machine's memory bandwidth and peak flop rates (1 and all cores unless `--threads`), then every registered hot kernel's time per item, achieved GB/s and GFLOP/s against its roofline bound, and its distance from it (`xtask/src/roofline.rs`); also a section of `report` |
 //! | `viewer [--out DIR]` | runs a cloth, a 3D MPM scene and a 2D grid fluid, opens each run's `viewer.html` in headless Chromium at the first and the last frame, and checks the screenshots are not blank and differ (`xtask/src/viewer.rs`); skipped with a note where Chromium is absent |
 //! | `consumer` | a fresh Cargo project outside the workspace depending on anim-pbd and anim-rigid by path with default features off and its own glam 0.34, its lockfile resolved afresh (the newest versions the ranges allow): drops a cloth and poses a robot, passing its own `glam::DVec3` values in and reading ours out, checked against closed forms, with no serde crate in its `cargo tree`; run again with anim-pbd's `parallel` on, the cloth bit for bit the same (`xtask/src/consumer.rs`) |
 //! | `packaged` | every publishable crate from its `.crate` archive (`cargo package --workspace --no-verify`), unpacked into a workspace of its own whose lockfile takes the lowest versions our direct requirements allow (`-Z direct-minimal-versions`), its libraries and programs checked with every feature: a file a crate needs but does not package, or a lower bound below the API we use, fails (`xtask/src/packaged.rs`) |
@@ -25,6 +26,7 @@ mod python;
 mod registry;
 mod report;
 mod report_data;
+mod roofline;
 mod scaling;
 mod soak;
 mod suites;
@@ -38,7 +40,7 @@ use std::process::ExitCode;
 pub static ALLOC: anim_core::alloc_count::CountingAllocator =
     anim_core::alloc_count::CountingAllocator::new();
 
-const USAGE: &str = "usage: cargo xtask <conformance|stability|scaling|bench|report|viewer|consumer|packaged> [--quick] [--long] [--filter TEXT] [--out DIR] [--threads 1,2,...]";
+const USAGE: &str = "usage: cargo xtask <conformance|stability|scaling|bench|roofline|report|viewer|consumer|packaged> [--quick] [--long] [--filter TEXT] [--out DIR] [--threads 1,2,...]";
 
 #[derive(Debug, Default)]
 struct Args {
@@ -99,6 +101,7 @@ fn main() -> ExitCode {
         "stability" => suites::stability(&ctx, args.filter.as_deref()).passed(),
         "scaling" => scaling::run(args.quick, args.filter.as_deref(), &threads(args.threads)),
         "bench" => bench::run(args.filter.as_deref()),
+        "roofline" => roofline::run(args.filter.as_deref(), &threads(args.threads)),
         "report" => report::run(
             &ctx,
             args.out.as_deref().unwrap_or("docs/report"),

@@ -56,6 +56,8 @@ pub struct Report {
     pub study_uses: Vec<StudyUse>,
     /// Every part's wall time: (kind, crate, name, seconds), in registry order.
     pub durations: Vec<(&'static str, String, String, f64)>,
+    /// The roofline section (`roofline.md` beside the index), if measured.
+    pub roofline: Option<String>,
 }
 
 /// Runs the report into `out`. With `filter`, only the conformance cases, hard cases, studies and
@@ -150,8 +152,19 @@ pub fn run(ctx: &Ctx, out: &str, threads: &[usize], filter: Option<&str>) -> boo
             missing.join("; ")
         );
     }
+    let roofline_md = dir.join("roofline.md");
+    if filter.is_none_or(|f| "roofline".contains(f)) {
+        let t = Instant::now();
+        let md = crate::roofline::measure(None, threads);
+        if let Err(e) = std::fs::write(&roofline_md, &md) {
+            eprintln!("cannot write {}: {e}", roofline_md.display());
+        }
+        eprintln!("  roofline {:>6.1} s", t.elapsed().as_secs_f64());
+    }
     let data = Data::new(ctx.quick, Machine::this(), parts);
-    let report = Report::from_data(&data, ratios::read(&dir.join("peers.csv")), dir.join("soak.md").exists());
+    let mut report =
+        Report::from_data(&data, ratios::read(&dir.join("peers.csv")), dir.join("soak.md").exists());
+    report.roofline = std::fs::read_to_string(&roofline_md).ok();
     let mut ok = match write(dir, &report).and_then(|()| data.write(&data_path)) {
         Ok(()) => true,
         Err(e) => {
@@ -230,6 +243,7 @@ impl Report {
                 .iter()
                 .map(|p| (p.kind.name(), p.krate.clone(), p.name.clone(), p.seconds))
                 .collect(),
+            roofline: None,
         }
     }
 }
@@ -478,6 +492,10 @@ pub fn index_markdown(r: &Report) -> String {
         );
     }
     md.push_str(&scaling::markdown(&r.scaling));
+    if let Some(roofline) = &r.roofline {
+        let _ = writeln!(md, "\n## Distance to the machine's limits\n");
+        md.push_str(roofline);
+    }
     let _ = writeln!(md, "\n## Peer comparisons\n");
     match &r.peers {
         Ok(rows) if rows.is_empty() => {

@@ -662,6 +662,91 @@ impl<const D: usize> MpmSimulation<D> {
     }
 }
 
+/// Timing hooks of the transfers for the roofline table (`crate::cases`): the binned P2G and
+/// the G2P into the scratch output, each repeatable without advancing the state.
+#[cfg(feature = "cases")]
+impl<const D: usize> MpmSimulation<D> {
+    /// Runs the stages of a substep of `dt` on `st` up to G2P without changing `st`: bins the
+    /// particles, P2G, the grid update and the gather into the particle blocks' windows; after
+    /// it, [`Self::time_g2p`] reads the gathered velocities. Returns the bytes of the windows.
+    pub(crate) fn prepare_transfers(&mut self, st: &Particles<D>, dt: f64) -> usize {
+        match self.params.kernel {
+            Kernel::Quadratic => self.stages::<Quadratic>(st, dt, true),
+            Kernel::Cubic => self.stages::<Cubic>(st, dt, true),
+        }
+        self.grid.windows.len() * std::mem::size_of::<wide::f32x4>()
+    }
+
+    /// P2G of `st` into the windows of the last [`Self::prepare_transfers`] (same binning).
+    pub(crate) fn time_p2g(&mut self, st: &Particles<D>, dt: f64) {
+        match self.params.kernel {
+            Kernel::Quadratic => self.stages::<Quadratic>(st, dt, false),
+            Kernel::Cubic => self.stages::<Cubic>(st, dt, false),
+        }
+    }
+
+    /// G2P of `st` from the gathered windows into the scratch output (`st` unchanged); returns
+    /// the particles found outside the domain.
+    pub(crate) fn time_g2p(&mut self, st: &Particles<D>, dt: f64) -> u64 {
+        match self.params.kernel {
+            Kernel::Quadratic => self.g2p_only::<Quadratic>(st, dt),
+            Kernel::Cubic => self.g2p_only::<Cubic>(st, dt),
+        }
+    }
+
+    /// The transfers' context for a substep of `dt` (as `substep` builds it), passed to `f`
+    /// with the grid and the scratch.
+    fn with_ctx<R>(
+        &mut self,
+        dt: f64,
+        f: impl FnOnce(&mut SparseGrid<D>, &mut Particles<D>, &mut Vec<bool>, &Ctx<'_, D>) -> R,
+    ) -> R {
+        let h = self.params.h();
+        let (lo, hi) = self.params.particle_range();
+        let g = self.params.gravity;
+        let ctx = Ctx {
+            h: h as f32,
+            inv_h: (1.0 / h) as f32,
+            dt: dt as f32,
+            apic: self.params.transfer == Transfer::Apic,
+            gravity: Vector::<D>::from_fn(|a, _| g[a] as f32),
+            wall_nodes: self.params.wall_nodes,
+            wall: self.params.wall,
+            colliders: &self.colliders,
+            meshes: &self.meshes,
+            time: self.time as f32,
+            lo: lo as f32,
+            hi: hi as f32,
+            materials: &self.compiled,
+            simd: self.simd,
+        };
+        f(&mut self.grid, &mut self.out, &mut self.remove, &ctx)
+    }
+
+    fn stages<K: Spline>(&mut self, st: &Particles<D>, dt: f64, all: bool) {
+        let kernel = self.params.kernel;
+        self.with_ctx(dt, |grid, _, _, ctx| {
+            if all {
+                grid.bin(&st.x, ctx.inv_h, kernel, ctx.simd);
+            }
+            transfer::p2g::<D, K>(grid, st, ctx);
+            if all {
+                transfer::grid_update(grid, ctx);
+                transfer::gather(grid, ctx.simd);
+            }
+        });
+    }
+
+    fn g2p_only<K: Spline>(&mut self, st: &Particles<D>, dt: f64) -> u64 {
+        let n = st.len();
+        self.with_ctx(dt, |grid, out, remove, ctx| {
+            out.resize(n);
+            remove.resize(n, false);
+            transfer::g2p::<D, K>(grid, st, out, remove, ctx).outside
+        })
+    }
+}
+
 /// The quantity `field` of the particle with id `id` in `st` (the particles before the step),
 /// widened to `f64`; runs only on the error path.
 fn last_finite_of<const D: usize>(st: &Particles<D>, id: usize, field: &str) -> Vec<f64> {

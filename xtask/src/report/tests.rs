@@ -153,6 +153,7 @@ fn tiny_report() -> Report {
             ("study", "anim-x".into(), "a | study".into(), 11.0),
             ("scaling", "anim-x".into(), "scene".into(), 0.9),
         ],
+        roofline: None,
     }
 }
 

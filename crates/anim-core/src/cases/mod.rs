@@ -8,6 +8,7 @@
 pub mod core;
 pub mod float;
 mod frontier;
+pub mod roofline;
 mod soak;
 mod sweep;
 mod threads;
@@ -256,6 +257,8 @@ pub struct Registry {
     pub soak: Vec<SoakCase>,
     /// What the studies' measurements serve (scenes for `--tolerance`, extra tolerances).
     pub study_uses: Vec<StudyUse>,
+    /// Hot kernels for the roofline table (`cargo xtask roofline`).
+    pub kernels: Vec<roofline::Kernel>,
 }
 
 /// The larger of `a` and `b`, NaN when either is NaN: a running maximum of errors that keeps a
@@ -342,7 +345,8 @@ pub fn register(r: &mut Registry) {
 
 /// Runs every conformance and stability case that `register` registers, in quick mode, and
 /// returns one line per failed check or unexpected outcome (empty when everything passes): what
-/// a crate's `tests/cases.rs` asserts.
+/// a crate's `tests/cases.rs` asserts. Its roofline kernels are built in quick mode and run once,
+/// their counts checked positive ([`roofline::quick_kernel_failures`]).
 ///
 /// ```
 /// use anim_core::cases::{Check, ConformanceCase, Judge, Registry, quick_failures};
@@ -403,6 +407,7 @@ pub fn quick_failures(register: fn(&mut Registry)) -> Vec<String> {
             ));
         }
     }
+    failures.extend(roofline::quick_kernel_failures(&r.kernels));
     failures
 }
 

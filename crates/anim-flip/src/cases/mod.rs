@@ -14,6 +14,7 @@
 mod conformance;
 mod dam_break;
 mod hard_cases;
+mod roofline;
 
 pub use dam_break::{DAM_BREAK_SLUG, DAM_BREAK_TOLERANCES};
 
@@ -74,6 +75,7 @@ pub fn register(r: &mut Registry) {
         problem: anim_core::cases::no_problem,
         extra_tolerances: DAM_BREAK_TOLERANCES,
     });
+    roofline::register(r);
 }
 
 anim_core::quick_cases_test!(crate::cases::register);

@@ -14,6 +14,7 @@ mod dam_break;
 mod determinism;
 mod hard_cases;
 mod peers;
+mod roofline;
 mod soak;
 mod thin_plate;
 
@@ -118,6 +119,7 @@ pub fn register(r: &mut Registry) {
         bound: "kinetic + gravitational energy never above its initial value",
         run: soak::mpm_three_materials,
     });
+    roofline::register(r);
 }
 
 anim_core::quick_cases_test!(crate::cases::register);

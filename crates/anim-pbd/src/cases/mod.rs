@@ -17,6 +17,7 @@ mod conformance;
 mod determinism;
 mod hard_cases;
 mod peer;
+mod roofline;
 mod soak;
 mod study;
 mod thin_plate;
@@ -143,6 +144,7 @@ pub fn register(r: &mut Registry) {
         run: Box::new(determinism::drape_on_mesh),
     });
     r.soak.push(soak::DRAPE);
+    roofline::register(r);
 }
 
 anim_core::quick_cases_test!(crate::cases::register);

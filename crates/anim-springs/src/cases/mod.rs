@@ -12,6 +12,7 @@ mod conformance;
 mod determinism;
 mod hard_cases;
 mod peer;
+mod roofline;
 mod soak;
 mod study;
 mod thin_plate;
@@ -132,6 +133,7 @@ pub fn register(r: &mut Registry) {
         run: Box::new(determinism::cloth),
     });
     r.soak.push(soak::STIFF_CLOTH);
+    roofline::register(r);
 }
 
 anim_core::quick_cases_test!(crate::cases::register);
