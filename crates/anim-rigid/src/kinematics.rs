@@ -18,7 +18,7 @@ pub(crate) fn joint_placement(placement: &Se3, kind: &JointType, q: &[f64]) -> S
     let r = &placement.rotation;
     match kind {
         JointType::Revolute(axis) => {
-            let (s, c) = q[0].sin_cos();
+            let (s, c) = crate::sincos::sin_cos(q[0]);
             let rotation = match axis {
                 // R · Rx(θ): columns (x, c y + s z, -s y + c z).
                 Axis::X => {
