@@ -86,7 +86,7 @@ impl Axis {
     #[inline]
     #[must_use]
     pub fn rotation(&self, angle: f64) -> DMat3 {
-        let (s, c) = crate::sincos::sin_cos(angle);
+        let (s, c) = angle.sin_cos();
         match *self {
             Axis::X => DMat3::from_cols(DVec3::X, DVec3::new(0.0, c, s), DVec3::new(0.0, -s, c)),
             Axis::Y => DMat3::from_cols(DVec3::new(c, 0.0, -s), DVec3::Y, DVec3::new(s, 0.0, c)),
