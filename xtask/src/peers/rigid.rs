@@ -14,6 +14,11 @@
 //! urdfdom headers, so its URDF parser cannot be compiled against. Pinocchio's CRBA and ABA are
 //! timed in both of its conventions (LOCAL, its default, and WORLD) and compared with the faster
 //! one. Needs Python with `pin==4.1.0` and `cmeel-eigen` (installed with pip when missing) and g++.
+//!
+//! MuJoCo (its C API from the `mujoco` wheel, [`super::rigid_mujoco`]) is timed in the same
+//! rounds on the Panda, the UR5 and the chain, on the same samples: inverse dynamics, the mass
+//! matrix, and forward dynamics against our [`forward_dynamics`] (Pinocchio's row for that is its
+//! ABA); the closing table gives each against the faster of the two peers.
 
 use crate::python::json_field as field;
 use std::io::Write;
@@ -299,7 +304,11 @@ pub fn run() -> bool {
     }
     let mut rows: Vec<Row> = Vec::new();
     let mut mujoco_rows: Vec<MujocoRow> = Vec::new();
-    for (name, urdf, locked, kinematics, dynamics) in robots {
+    // `ANIM_RIGID_ROBOTS=panda,ur5,chain32` measures only those; this run's rows replace all of
+    // anim-rigid's in peers.csv, so the other robots' rows are dropped.
+    let only = std::env::var("ANIM_RIGID_ROBOTS").ok();
+    let wanted = |name: &str| only.as_deref().is_none_or(|list| list.split(',').any(|r| r.trim() == name));
+    for (name, urdf, locked, kinematics, dynamics) in robots.into_iter().filter(|r| wanted(r.0)) {
         let mut options = UrdfOptions::default();
         for j in locked {
             options = options.lock_joint(j, 0.0);
