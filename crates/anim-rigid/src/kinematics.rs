@@ -12,13 +12,23 @@ use crate::data::Data;
 use crate::model::{Axis, FrameIndex, Joint, JointIndex, JointType, Model};
 
 /// `placement · X_J(q)`, specialised per joint type (one sine/cosine and two column
-/// combinations for an axis-aligned revolute joint instead of a full 3x3 product).
+/// combinations for an axis-aligned revolute joint instead of a full 3x3 product), for the
+/// dynamics passes: the angle's sine and cosine come from [`crate::sincos`], within an ulp of the
+/// standard library's. Forward kinematics and the Jacobians ([`local_placement`]) keep the
+/// standard library's values, which the analytic inverse kinematics reproduces exactly.
 #[inline(always)]
 pub(crate) fn joint_placement(placement: &Se3, kind: &JointType, q: &[f64]) -> Se3 {
+    placement_with::<true>(placement, kind, q)
+}
+
+/// `placement · X_J(q)`, the sine and cosine from [`crate::sincos`] when `FAST`, from the
+/// standard library otherwise.
+#[inline(always)]
+fn placement_with<const FAST: bool>(placement: &Se3, kind: &JointType, q: &[f64]) -> Se3 {
     let r = &placement.rotation;
     match kind {
         JointType::Revolute(axis) => {
-            let (s, c) = q[0].sin_cos();
+            let (s, c) = if FAST { crate::sincos::sin_cos(q[0]) } else { q[0].sin_cos() };
             let rotation = match axis {
                 // R · Rx(θ): columns (x, c y + s z, -s y + c z).
                 Axis::X => {
@@ -47,10 +57,12 @@ pub(crate) fn joint_placement(placement: &Se3, kind: &JointType, q: &[f64]) -> S
 #[inline(always)]
 pub(crate) fn local_placement(joint: &Joint, q: &[f64]) -> Se3 {
     match &joint.mimic {
-        None => {
-            joint_placement(&joint.placement, &joint.kind, &q[joint.idx_q..joint.idx_q + joint.kind.nq()])
-        }
-        Some(m) => joint_placement(&joint.placement, &joint.kind, &[m.position(q[joint.idx_q])]),
+        None => placement_with::<false>(
+            &joint.placement,
+            &joint.kind,
+            &q[joint.idx_q..joint.idx_q + joint.kind.nq()],
+        ),
+        Some(m) => placement_with::<false>(&joint.placement, &joint.kind, &[m.position(q[joint.idx_q])]),
     }
 }
 

@@ -23,6 +23,7 @@ pub mod poe;
 pub mod robot;
 pub mod scenes;
 pub mod sim;
+mod sincos;
 pub mod spatial;
 pub mod urdf;
 
@@ -31,8 +32,8 @@ pub use data::Data;
 pub use dense::SquareMatrix;
 pub use dynamics::{
     DynamicsError, aba, aba_local, aba_world, center_of_mass, crba, crba_local, crba_world,
-    factor_mass_matrix, forward_dynamics_cholesky, gravity_torques, kinetic_energy, nonlinear_effects,
-    potential_energy, rnea, solve_mass_matrix, spatial_momentum,
+    factor_mass_matrix, forward_dynamics, forward_dynamics_cholesky, gravity_torques, kinetic_energy,
+    nonlinear_effects, potential_energy, rnea, solve_mass_matrix, spatial_momentum,
 };
 pub use ik::{AnalyticIk, AnalyticIkKind, IkError, IkParams, IkReport, IkSolution, NumericalIk};
 pub use jacobian::{

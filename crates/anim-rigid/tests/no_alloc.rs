@@ -17,9 +17,10 @@ use anim_rigid::scenes;
 use anim_rigid::sim::{RigidIntegrator, RigidSimulation, SimParams};
 use anim_rigid::{
     Data, Jacobian, ReferenceFrame, UrdfOptions, aba, aba_local, aba_world, compute_joint_jacobians,
-    compute_joint_jacobians_time_variation, crba, crba_local, crba_world, forward_dynamics_cholesky,
-    forward_kinematics, frame_jacobian, frame_jacobian_time_variation, gravity_torques, joint_jacobian,
-    kinetic_energy, nonlinear_effects, parse_urdf, potential_energy, rnea, spatial_momentum,
+    compute_joint_jacobians_time_variation, crba, crba_local, crba_world, forward_dynamics,
+    forward_dynamics_cholesky, forward_kinematics, frame_jacobian, frame_jacobian_time_variation,
+    gravity_torques, joint_jacobian, kinetic_energy, nonlinear_effects, parse_urdf, potential_energy, rnea,
+    spatial_momentum,
 };
 
 #[global_allocator]
@@ -70,6 +71,7 @@ fn algorithms_and_steps_do_not_allocate() {
             let _ = aba_local(&model, &mut data, &q, &v, &a);
             let _ = aba_world(&model, &mut data, &q, &v, &a);
             let _ = forward_dynamics_cholesky(&model, &mut data, &q, &v, &a).unwrap();
+            let _ = forward_dynamics(&model, &mut data, &q, &v, &a);
             let _ = kinetic_energy(&model, &mut data, &q, &v) + potential_energy(&model, &mut data, &q);
             let _ = spatial_momentum(&model, &mut data, &q, &v);
         });

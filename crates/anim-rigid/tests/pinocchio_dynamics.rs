@@ -7,8 +7,8 @@
 
 use anim_core::glam::{DMat3, DVec3};
 use anim_rigid::{
-    Data, Model, UrdfOptions, aba, crba, crba_local, crba_world, forward_dynamics_cholesky, gravity_torques,
-    kinetic_energy, load_urdf, nonlinear_effects, potential_energy, rnea,
+    Data, Model, UrdfOptions, aba, crba, crba_local, crba_world, forward_dynamics, forward_dynamics_cholesky,
+    gravity_torques, kinetic_energy, load_urdf, nonlinear_effects, potential_energy, rnea,
 };
 use serde_json::Value;
 
@@ -71,6 +71,7 @@ struct Errors {
     gravity: f64,
     aba: f64,
     cholesky: f64,
+    forward: f64,
     energy: f64,
 }
 
@@ -94,6 +95,9 @@ fn compare(name: &str) -> Errors {
         e.aba = e.aba.max(rel_err(aba(&model, &mut data, &q, &v, &tau), &reference));
         let chol = forward_dynamics_cholesky(&model, &mut data, &q, &v, &tau).unwrap();
         e.cholesky = e.cholesky.max(rel_err(chol, &reference));
+        // The pick between the two, after a call at another configuration (no stale state).
+        crba(&model, &mut data, &anim_rigid::config::neutral(&model));
+        e.forward = e.forward.max(rel_err(forward_dynamics(&model, &mut data, &q, &v, &tau), &reference));
         let ke = kinetic_energy(&model, &mut data, &q, &v);
         let pe = potential_energy(&model, &mut data, &q);
         let (rke, rpe) = (s["kinetic_energy"].as_f64().unwrap(), s["potential_energy"].as_f64().unwrap());
@@ -108,6 +112,7 @@ fn compare(name: &str) -> Errors {
         ("gravity", e.gravity),
         ("aba", e.aba),
         ("cholesky forward dynamics", e.cholesky),
+        ("forward dynamics", e.forward),
         ("energies", e.energy),
     ] {
         assert!(err < TOL, "{name} {what}: relative error {err:e}");

@@ -14,6 +14,7 @@ pub mod mpm;
 pub mod pbd;
 pub mod ratios;
 pub mod rigid;
+pub mod rigid_mujoco;
 pub mod springs;
 
 /// A time in nanoseconds as table text: ns, us, ms or s (`?` when not finite).

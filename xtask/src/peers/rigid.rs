@@ -14,6 +14,11 @@
 //! urdfdom headers, so its URDF parser cannot be compiled against. Pinocchio's CRBA and ABA are
 //! timed in both of its conventions (LOCAL, its default, and WORLD) and compared with the faster
 //! one. Needs Python with `pin==4.1.0` and `cmeel-eigen` (installed with pip when missing) and g++.
+//!
+//! MuJoCo (its C API from the `mujoco` wheel, [`super::rigid_mujoco`]) is timed in the same
+//! rounds on the Panda, the UR5 and the chain, on the same samples: inverse dynamics, the mass
+//! matrix, and forward dynamics against our [`forward_dynamics`] (Pinocchio's row for that is its
+//! ABA); the closing table gives each against the faster of the two peers.
 
 use crate::python::json_field as field;
 use std::io::Write;
@@ -23,7 +28,7 @@ use std::time::Instant;
 
 use anim_rigid::{
     Axis, Data, JointType, Model, UrdfOptions, aba, aba_local, aba_world, compute_joint_jacobians, crba,
-    forward_kinematics, load_urdf, parse_urdf, rnea,
+    forward_dynamics, forward_dynamics_cholesky, forward_kinematics, load_urdf, parse_urdf, rnea,
 };
 
 /// The timing programs, relative to the xtask crate, and their binaries under `target/xtask`.
@@ -172,16 +177,19 @@ fn model_file(model: &Model, path: &Path) -> Result<(), String> {
 }
 
 /// One pre-generated input of the timed kernels.
-struct Sample {
-    q: Vec<f64>,
-    v: Vec<f64>,
-    a: Vec<f64>,
-    tau: Vec<f64>,
+pub struct Sample {
+    /// Configuration.
+    pub q: Vec<f64>,
+    /// Velocity.
+    pub v: Vec<f64>,
+    /// Acceleration (inverse dynamics).
+    pub a: Vec<f64>,
+    /// Joint forces (forward dynamics).
+    pub tau: Vec<f64>,
 }
 
-/// Our median ns per call of `f` over pre-generated inputs, the same protocol as the C++
-/// programs (batches of calls cycling through 1024 inputs, median of 15 batches).
-fn time_ours(model: &Model, mut f: impl FnMut(&Model, &mut Data, &Sample) -> f64) -> f64 {
+/// The 1024 inputs our kernels (and MuJoCo's) are timed on, the same for every call.
+pub fn samples(model: &Model) -> Vec<Sample> {
     let mut state = 42u64;
     let mut uniform = || {
         state ^= state << 13;
@@ -190,14 +198,19 @@ fn time_ours(model: &Model, mut f: impl FnMut(&Model, &mut Data, &Sample) -> f64
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
     let nv = model.nv();
-    let samples: Vec<Sample> = (0..CONFIGS)
+    (0..CONFIGS)
         .map(|_| Sample {
             q: anim_rigid::config::random_configuration(model, &mut uniform),
             v: (0..nv).map(|_| 4.0 * uniform() - 2.0).collect(),
             a: (0..nv).map(|_| 6.0 * uniform() - 3.0).collect(),
             tau: (0..nv).map(|_| 20.0 * uniform() - 10.0).collect(),
         })
-        .collect();
+        .collect()
+}
+
+/// Our median ns per call of `f` over pre-generated inputs, the same protocol as the C++
+/// programs (batches of calls cycling through 1024 inputs, median of 15 batches).
+fn time_ours(model: &Model, samples: &[Sample], mut f: impl FnMut(&Model, &mut Data, &Sample) -> f64) -> f64 {
     let mut data = Data::new(model);
     let mut sink = 0.0;
     let mut times: Vec<f64> = (0..BATCHES)
@@ -236,6 +249,31 @@ fn run_peer(bin: &Path, file: &Path) -> Result<Vec<(String, f64)>, String> {
 /// One row of the table: robot, kernel, ours, Pinocchio (best convention), Pinocchio detail.
 type Row = (String, &'static str, f64, f64, String);
 
+/// One row of the MuJoCo table: robot, kernel, ours, MuJoCo, Pinocchio (best convention).
+type MujocoRow = (String, &'static str, f64, f64, f64);
+
+/// The robots MuJoCo is compared on.
+const MUJOCO_ROBOTS: [&str; 3] = ["panda", "ur5", "chain32"];
+
+/// Writes the URDF MuJoCo loads and the samples file for one robot; their paths.
+fn mujoco_inputs(
+    name: &str,
+    urdf: &Path,
+    locked: &[&str],
+    model: &Model,
+    samples: &[Sample],
+) -> Result<(PathBuf, PathBuf, PathBuf), String> {
+    let dir = Path::new("target/xtask");
+    let xml = super::rigid_mujoco::urdf_for_mujoco(urdf, locked)?;
+    let urdf_out = dir.join(format!("mujoco_{name}.urdf"));
+    std::fs::write(&urdf_out, xml).map_err(|e| format!("{}: {e}", urdf_out.display()))?;
+    let file = dir.join(format!("mujoco_samples_{name}.txt"));
+    super::rigid_mujoco::samples_file(model, samples, &file)?;
+    let inertias = dir.join(format!("mujoco_inertias_{name}.txt"));
+    super::rigid_mujoco::inertia_file(model, &inertias)?;
+    Ok((urdf_out, file, inertias))
+}
+
 /// Runs the comparison and prints the table; false if our side could not run.
 pub fn run() -> bool {
     let testdata = Path::new(env!("CARGO_MANIFEST_DIR")).join("../crates/anim-rigid/testdata");
@@ -259,8 +297,18 @@ pub fn run() -> bool {
             println!("\nNOTE: Pinocchio peer SKIPPED: {e}\n");
         }
     }
+    let mujoco = super::rigid_mujoco::prepare();
+    match &mujoco {
+        Ok(peer) => println!("MuJoCo {} (C API of the `mujoco` wheel) on panda, ur5, chain32", peer.version),
+        Err(e) => println!("\nNOTE: MuJoCo peer SKIPPED: {e}\n"),
+    }
     let mut rows: Vec<Row> = Vec::new();
-    for (name, urdf, locked, kinematics, dynamics) in robots {
+    let mut mujoco_rows: Vec<MujocoRow> = Vec::new();
+    // `ANIM_RIGID_ROBOTS=panda,ur5,chain32` measures only those; this run's rows replace all of
+    // anim-rigid's in peers.csv, so the other robots' rows are dropped.
+    let only = std::env::var("ANIM_RIGID_ROBOTS").ok();
+    let wanted = |name: &str| only.as_deref().is_none_or(|list| list.split(',').any(|r| r.trim() == name));
+    for (name, urdf, locked, kinematics, dynamics) in robots.into_iter().filter(|r| wanted(r.0)) {
         let mut options = UrdfOptions::default();
         for j in locked {
             options = options.lock_joint(j, 0.0);
@@ -277,6 +325,18 @@ pub fn run() -> bool {
         if let Err(e) = &peer_model {
             println!("NOTE: {name}: {e}");
         }
+        let samples = samples(&model);
+        // MuJoCo compiles the URDF itself: the arms and the chain, not the collection's robots.
+        let mujoco_inputs = match (&mujoco, MUJOCO_ROBOTS.contains(&name)) {
+            (Ok(_), true) => mujoco_inputs(name, &testdata.join(urdf), locked, &model, &samples)
+                .map_err(|e| println!("NOTE: MuJoCo on {name}: {e}"))
+                .ok(),
+            _ => None,
+        };
+        let mut mujoco_best: std::collections::BTreeMap<String, f64> = std::collections::BTreeMap::new();
+        let mut agreement = [0.0f64; 3];
+        let mut ours_fd_cholesky = f64::INFINITY;
+        let mut ours_fd = f64::INFINITY;
         // Three alternating rounds, the fastest of each side: the machine is shared, and the
         // minimum over rounds is the least disturbed measurement.
         let mut ours = [f64::INFINITY; 7];
@@ -285,24 +345,49 @@ pub fn run() -> bool {
         let mut theirs: std::collections::BTreeMap<String, f64> = std::collections::BTreeMap::new();
         for _ in 0..ROUNDS {
             if kinematics {
-                ours[0] = ours[0].min(time_ours(&model, |m, d, s| {
+                ours[0] = ours[0].min(time_ours(&model, &samples, |m, d, s| {
                     forward_kinematics(m, d, &s.q);
                     d.world_placements[m.njoints() - 1].translation.x
                 }));
-                ours[1] = ours[1].min(time_ours(&model, |m, d, s| {
+                ours[1] = ours[1].min(time_ours(&model, &samples, |m, d, s| {
                     compute_joint_jacobians(m, d, &s.q);
                     d.jacobian.column(m.nv() - 1).v.x
                 }));
             }
             if dynamics {
-                ours[2] = ours[2].min(time_ours(&model, |m, d, s| rnea(m, d, &s.q, &s.v, &s.a)[m.nv() - 1]));
-                ours[3] = ours[3].min(time_ours(&model, |m, d, s| crba(m, d, &s.q)[(0, m.nv() - 1)]));
-                ours[4] = ours[4].min(time_ours(&model, |m, d, s| aba(m, d, &s.q, &s.v, &s.tau)[m.nv() - 1]));
-                let local = time_ours(&model, |m, d, s| aba_local(m, d, &s.q, &s.v, &s.tau)[m.nv() - 1]);
-                let world = time_ours(&model, |m, d, s| aba_world(m, d, &s.q, &s.v, &s.tau)[m.nv() - 1]);
+                ours[2] = ours[2]
+                    .min(time_ours(&model, &samples, |m, d, s| rnea(m, d, &s.q, &s.v, &s.a)[m.nv() - 1]));
+                ours[3] =
+                    ours[3].min(time_ours(&model, &samples, |m, d, s| crba(m, d, &s.q)[(0, m.nv() - 1)]));
+                ours[4] = ours[4]
+                    .min(time_ours(&model, &samples, |m, d, s| aba(m, d, &s.q, &s.v, &s.tau)[m.nv() - 1]));
+                let local =
+                    time_ours(&model, &samples, |m, d, s| aba_local(m, d, &s.q, &s.v, &s.tau)[m.nv() - 1]);
+                let world =
+                    time_ours(&model, &samples, |m, d, s| aba_world(m, d, &s.q, &s.v, &s.tau)[m.nv() - 1]);
                 ours[5] = ours[5].min(local);
                 ours[6] = ours[6].min(world);
                 local_over_world.push(local / world);
+                ours_fd_cholesky = ours_fd_cholesky.min(time_ours(&model, &samples, |m, d, s| {
+                    forward_dynamics_cholesky(m, d, &s.q, &s.v, &s.tau).map_or(f64::NAN, |x| x[m.nv() - 1])
+                }));
+                ours_fd = ours_fd.min(time_ours(&model, &samples, |m, d, s| {
+                    forward_dynamics(m, d, &s.q, &s.v, &s.tau)[m.nv() - 1]
+                }));
+            }
+            if let (Ok(peer), Some((urdf, file, inertias))) = (&mujoco, &mujoco_inputs) {
+                match super::rigid_mujoco::run(peer, urdf, file, inertias, CALLS_PER_BATCH) {
+                    Ok(run) => {
+                        for (a, b) in agreement.iter_mut().zip(run.agreement) {
+                            *a = a.max(b);
+                        }
+                        for (kernel, ns) in run.times {
+                            let e = mujoco_best.entry(kernel).or_insert(f64::INFINITY);
+                            *e = e.min(ns);
+                        }
+                    }
+                    Err(e) => println!("NOTE: MuJoCo on {name}: {e}"),
+                }
             }
             if peer_model.is_err() {
                 continue;
@@ -348,6 +433,30 @@ pub fn run() -> bool {
             for (k, kernel, convention) in [(5, "aba_local", "aba_local"), (6, "aba_world", "aba_world")] {
                 rows.push((name.to_string(), kernel, ours[k], get(convention), "same convention".into()));
             }
+            if !mujoco_best.is_empty() {
+                let m = |k: &str| mujoco_best.get(k).copied().unwrap_or(f64::NAN);
+                println!(
+                    "{name}: MuJoCo against anim-rigid on {CONFIGS} samples, largest difference relative to the largest entry: inverse dynamics {:.1e}, mass matrix {:.1e}, forward dynamics {:.1e}",
+                    agreement[0], agreement[1], agreement[2]
+                );
+                // Pinocchio's faster convention where it has two.
+                let best = |k: &str| get(&format!("{k}_local")).min(get(&format!("{k}_world")));
+                mujoco_rows.push((name.to_string(), "rnea", ours[2], m("rnea"), get("rnea")));
+                mujoco_rows.push((name.to_string(), "crba", ours[3], m("crba"), best("crba")));
+                // Our forward dynamics as a user calls it, against MuJoCo's pipeline and
+                // Pinocchio's ABA (its faster convention).
+                mujoco_rows.push((
+                    name.to_string(),
+                    "forward_dynamics",
+                    ours_fd,
+                    m("forward_dynamics"),
+                    best("aba"),
+                ));
+                println!(
+                    "{name}: ours forward dynamics: forward_dynamics {ours_fd:.1} ns, CRBA + LDLT {ours_fd_cholesky:.1} ns, ABA {:.1} ns",
+                    ours[4]
+                );
+            }
             local_over_world.sort_by(f64::total_cmp);
             if let (Some(lo), Some(hi)) = (local_over_world.first(), local_over_world.last()) {
                 println!(
@@ -371,6 +480,27 @@ pub fn run() -> bool {
             ours * 1e-9,
             theirs * 1e-9,
         );
+    }
+    if let (Ok(peer), false) = (&mujoco, mujoco_rows.is_empty()) {
+        let label = format!("MuJoCo {}", peer.version);
+        println!(
+            "\n| robot | kernel | anim-rigid | {label} | ours / MuJoCo | ours / best of MuJoCo and Pinocchio |\n| --- | --- | --- | --- | --- | --- |"
+        );
+        for (robot, kernel, ours, theirs, pinocchio) in &mujoco_rows {
+            println!(
+                "| {robot} | {kernel} | {ours:.1} ns | {theirs:.1} ns | {:.3} | {:.3} |",
+                ours / theirs,
+                ours / theirs.min(*pinocchio)
+            );
+            super::ratios::record(
+                "anim-rigid",
+                &format!("{robot} {kernel}"),
+                &label,
+                1,
+                ours * 1e-9,
+                theirs * 1e-9,
+            );
+        }
     }
     let dir = Path::new("target/xtask");
     let written = std::fs::create_dir_all(dir).and_then(|_| {

@@ -13,7 +13,7 @@ use thiserror::Error;
 use crate::data::{Data, NO_PARENT};
 use crate::dynamics::check::{check_q, check_v};
 use crate::dynamics::crba::crba;
-use crate::dynamics::rnea::nonlinear_effects;
+use crate::dynamics::rnea::{nonlinear_effects, nonlinear_effects_placed};
 use crate::model::Model;
 
 /// A numerical failure of the dynamics.
@@ -124,7 +124,12 @@ pub fn forward_dynamics_cholesky<'d>(
     check_v(model, "v", v);
     check_v(model, "tau", tau);
     crba(model, data, q);
-    nonlinear_effects(model, data, q, v);
+    if model.mimic_joints().is_empty() {
+        // Both forms of CRBA leave the joint placements for this q in data.
+        nonlinear_effects_placed(model, data, v);
+    } else {
+        nonlinear_effects(model, data, q, v);
+    }
     factor_mass_matrix(model, data)?;
     let mut rhs = std::mem::take(&mut data.scratch);
     for ((r, t), c) in rhs.iter_mut().zip(tau).zip(&data.nle) {

@@ -26,6 +26,7 @@
 //! | [`aba`] ([`aba_local`], [`aba_world`]) | `v̇ = FD(q, v, τ)` | `O(n)` | ch. 7, table 7.1 |
 //! | [`factor_mass_matrix`], [`solve_mass_matrix`] | `H = Lᵀ D L`, `H⁻¹ b` with no fill-in | `O(n d²)` | 6.5, table 6.3 |
 //! | [`forward_dynamics_cholesky`] | `v̇ = H⁻¹ (τ - C)` | `O(n d²)` | 6.1 |
+//! | [`forward_dynamics`] | `v̇ = FD(q, v, τ)`: the faster of the two above for the tree | | |
 //! | [`kinetic_energy`], [`potential_energy`], [`spatial_momentum`], [`center_of_mass`] | `½ vᵀ H v`, `-Σ mᵢ g·cᵢ`, `Σ Iᵢ vᵢ`, `Σ mᵢ cᵢ / M` | `O(n)` | 2.13 |
 //!
 //! (`n` bodies, `d` the depth of the tree.) Every function is `algorithm(&model, &mut data, ...)`
@@ -119,7 +120,11 @@
 //! Featherstone's `LᵀDL` factorisation (table 6.3) eliminates from the leaves, so the factor has
 //! exactly that sparsity and no fill-in; for a chain it is a dense `LDLᵀ` in reversed order.
 //! [`forward_dynamics_cholesky`] solves `H v̇ = τ - C` with it: a second, independent forward
-//! dynamics that ABA is tested against.
+//! dynamics that ABA is tested against. It computes the joint placements once, in CRBA, and the
+//! bias forces reuse them. On shallow arms it is also the faster one: CRBA's few entries,
+//! the bias forces and a factorisation with little to eliminate cost less than ABA's 6x6
+//! articulated inertias, so [`forward_dynamics`] takes it when the degrees of freedom are on
+//! average at most [`CHOLESKY_DEPTH`] deep and ABA otherwise.
 //!
 //! # Coupled joints
 //!
@@ -148,6 +153,7 @@ mod cholesky;
 mod crba;
 mod crba_mimic;
 mod energy;
+mod forward;
 mod rnea;
 mod subspace;
 
@@ -157,4 +163,5 @@ pub use aba_world::aba_world;
 pub use cholesky::{DynamicsError, factor_mass_matrix, forward_dynamics_cholesky, solve_mass_matrix};
 pub use crba::{LOCAL_DEPTH, crba, crba_local, crba_world};
 pub use energy::{center_of_mass, kinetic_energy, potential_energy, spatial_momentum};
+pub use forward::{CHOLESKY_DEPTH, forward_dynamics};
 pub use rnea::{gravity_torques, nonlinear_effects, rnea};

@@ -12,9 +12,10 @@ use crate::model::Model;
 use crate::spatial::Motion;
 
 /// The RNEA passes into `data.tau`, with `v` (when `VEL`) and `a` (when `ACC`) read, zero
-/// otherwise, and the root acceleration `-gravity`.
+/// otherwise, and the root acceleration `-gravity`; with `PLACED` the joint placements already
+/// in `data.joint_placements` for this `q` are used instead of being recomputed.
 #[inline(always)]
-fn rnea_core<const VEL: bool, const ACC: bool>(
+fn rnea_core<const VEL: bool, const ACC: bool, const PLACED: bool>(
     model: &Model,
     data: &mut Data,
     q: &[f64],
@@ -27,8 +28,13 @@ fn rnea_core<const VEL: bool, const ACC: bool>(
     data.body_accelerations[0] = Motion::new(-gravity, DVec3::ZERO);
     for i in 1..joints.len() {
         let joint = &joints[i];
-        let m = local_placement(joint, q);
-        data.joint_placements[i] = m;
+        let m = if PLACED {
+            data.joint_placements[i]
+        } else {
+            let m = local_placement(joint, q);
+            data.joint_placements[i] = m;
+            m
+        };
         let parent = joint.parent;
         let mut acc = data.body_accelerations[parent].inverse_transform(&m);
         let inertia = data.body_inertias[i];
@@ -103,7 +109,7 @@ pub fn rnea<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], a: &[f6
     check_q(model, data, q);
     check_v(model, "v", v);
     check_v(model, "a", a);
-    rnea_core::<true, true>(model, data, q, v, a, model.gravity());
+    rnea_core::<true, true, false>(model, data, q, v, a, model.gravity());
     &data.tau
 }
 
@@ -116,7 +122,7 @@ pub fn rnea<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64], a: &[f6
 pub fn nonlinear_effects<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[f64]) -> &'d [f64] {
     check_q(model, data, q);
     check_v(model, "v", v);
-    rnea_core::<true, false>(model, data, q, v, &[], model.gravity());
+    rnea_core::<true, false, false>(model, data, q, v, &[], model.gravity());
     data.nle.copy_from_slice(&data.tau);
     &data.nle
 }
@@ -129,7 +135,15 @@ pub fn nonlinear_effects<'d>(model: &Model, data: &'d mut Data, q: &[f64], v: &[
 #[track_caller]
 pub fn gravity_torques<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
     check_q(model, data, q);
-    rnea_core::<false, false>(model, data, q, &[], &[], model.gravity());
+    rnea_core::<false, false, false>(model, data, q, &[], &[], model.gravity());
     data.gravity_torques.copy_from_slice(&data.tau);
     &data.gravity_torques
+}
+
+/// [`nonlinear_effects`] with the joint placements that [`crba`](crate::crba) left in
+/// `data.joint_placements` for the same `q` (forward dynamics through the mass matrix computes
+/// them once), into `data.nle`.
+pub(crate) fn nonlinear_effects_placed(model: &Model, data: &mut Data, v: &[f64]) {
+    rnea_core::<true, false, true>(model, data, &[], v, &[], model.gravity());
+    data.nle.copy_from_slice(&data.tau);
 }
