@@ -8,6 +8,7 @@
 //! | `stability [--quick] [--filter S]` | the named hard cases of every crate with their outcomes; exit 1 on an unexpected outcome |
 //! | `stability --long [--quick] [--filter S] [--out DIR]` | soak: each crate's hard case for `10^5` steps or ten minutes with its energy bound, then every registered preset for the same budget (its solver's guard at every step, frame and checkpoint finite on a stride; `--quick`: quick params, 200 steps or 3 s); written to `docs/report/soak.md` |
 //! | `scaling [--quick] [--filter S] [--threads 1,2,...]` | thread scaling of every registered preset (quick params with `--quick`): time per step, speed-up over one thread and the same checkpoint bits as one thread, on 1 and all cores unless `--threads`; exit 1 on a failure or a thread-count dependence |
+//! | `systime [--filter S] [--threads 1,2,...] [--frames N]` | every registered preset run as `anim run NAME --frames N` (10 unless given; no frame files, preview or viewer) at its default size in a child process per thread count (1 and 2 unless `--threads`): the child's user and system CPU time and voluntary context switches (`getrusage`), printed as a table; exit 1 when a run's system time exceeds 10% of its user time (`xtask/src/systime.rs`) |
 //! | `bench [--filter S]` | the criterion benches under `benches/` (with `presets`: one step of every registered preset), printed as a table and written to `target/xtask/bench.csv`; `--peers [--filter S]`: the peer comparisons (springs, rigid, pbd, fem, mpm, fluid, flip), their ratios merged into `docs/report/peers.csv` (a filtered run replaces only its crates' rows) |
 //! | `roofline [--filter S] [--threads 1,2,...]` | this machine's memory bandwidth and peak flop rates (1 and all cores unless `--threads`), then every registered hot kernel's time per item, achieved GB/s and GFLOP/s against its roofline bound, and its distance from it (`xtask/src/roofline.rs`); also a section of `report` |
 //! | `viewer [--out DIR]` | runs a cloth, a 3D MPM scene and a 2D grid fluid, opens each run's `viewer.html` in headless Chromium at the first and the last frame, and checks the screenshots are not blank and differ (`xtask/src/viewer.rs`); skipped with a note where Chromium is absent |
@@ -30,6 +31,7 @@ mod roofline;
 mod scaling;
 mod soak;
 mod suites;
+mod systime;
 mod viewer;
 
 use std::process::ExitCode;
@@ -40,7 +42,7 @@ use std::process::ExitCode;
 pub static ALLOC: anim_core::alloc_count::CountingAllocator =
     anim_core::alloc_count::CountingAllocator::new();
 
-const USAGE: &str = "usage: cargo xtask <conformance|stability|scaling|bench|roofline|report|viewer|consumer|packaged> [--quick] [--long] [--filter TEXT] [--out DIR] [--threads 1,2,...]";
+const USAGE: &str = "usage: cargo xtask <conformance|stability|scaling|systime|bench|roofline|report|viewer|consumer|packaged> [--quick] [--long] [--filter TEXT] [--out DIR] [--threads 1,2,...] [--frames N]";
 
 #[derive(Debug, Default)]
 struct Args {
@@ -49,6 +51,7 @@ struct Args {
     filter: Option<String>,
     out: Option<String>,
     threads: Option<Vec<usize>>,
+    frames: Option<usize>,
 }
 
 fn parse(args: &[String]) -> Result<Args, String> {
@@ -62,6 +65,15 @@ fn parse(args: &[String]) -> Result<Args, String> {
             "--out" => parsed.out = Some(it.next().ok_or("--out needs a value")?.clone()),
             "--threads" => {
                 parsed.threads = Some(scaling::parse_threads(it.next().ok_or("--threads needs a value")?)?)
+            }
+            "--frames" => {
+                let v = it.next().ok_or("--frames needs a value")?;
+                parsed.frames = Some(
+                    v.parse()
+                        .ok()
+                        .filter(|&n: &usize| n > 0)
+                        .ok_or(format!("--frames: `{v}` is not a count >= 1"))?,
+                )
             }
             // `bench --peers`: read by bench.rs from the process arguments.
             "--peers" => {}
@@ -85,6 +97,9 @@ fn main() -> ExitCode {
         eprintln!("{USAGE}");
         return ExitCode::from(2);
     };
+    if cmd == systime::CHILD {
+        return if systime::child(rest) { ExitCode::SUCCESS } else { ExitCode::FAILURE };
+    }
     let args = match parse(rest) {
         Ok(a) => a,
         Err(e) => {
@@ -100,6 +115,9 @@ fn main() -> ExitCode {
         }
         "stability" => suites::stability(&ctx, args.filter.as_deref()).passed(),
         "scaling" => scaling::run(args.quick, args.filter.as_deref(), &threads(args.threads)),
+        "systime" => {
+            systime::run(args.filter.as_deref(), &args.threads.unwrap_or_else(|| vec![1, 2]), args.frames)
+        }
         "bench" => bench::run(args.filter.as_deref()),
         "roofline" => roofline::run(args.filter.as_deref(), &threads(args.threads)),
         "report" => report::run(

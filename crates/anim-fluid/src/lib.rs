@@ -4,6 +4,7 @@ pub mod advection;
 #[cfg(feature = "cases")]
 pub mod cases;
 pub mod error;
+mod grain;
 pub mod kind;
 pub mod mac;
 pub mod memory;

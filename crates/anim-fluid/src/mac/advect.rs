@@ -144,27 +144,31 @@ fn sl_pass(
     let walls = if a < 3 { grid.wall_values(a) } else { [[None; 2]; 3] };
     let range = clamp_to.map(|v| Lattice { values: v, dims: d, dim: grid.dim });
     let offset = |b: usize| if b == a { 0.0 } else { 0.5 };
-    out[..field.len()].par_chunks_mut(d[0]).enumerate().for_each(|(line, row)| {
-        let (j, k) = (line % d[1], line / d[1]);
-        for (i, o) in row.iter_mut().enumerate() {
-            let n = [i, j, k];
-            let mut p = [0.0; 3];
-            for b in 0..grid.dim {
-                p[b] = (n[b] as f64 + offset(b)) * grid.h;
+    out[..field.len()]
+        .par_chunks_mut(d[0])
+        .enumerate()
+        .with_min_len(crate::grain::lines(d[0], crate::grain::TRACE_NS))
+        .for_each(|(line, row)| {
+            let (j, k) = (line % d[1], line / d[1]);
+            for (i, o) in row.iter_mut().enumerate() {
+                let n = [i, j, k];
+                let mut p = [0.0; 3];
+                for b in 0..grid.dim {
+                    p[b] = (n[b] as f64 + offset(b)) * grid.h;
+                }
+                let q = trace(grid, vel, p, dt);
+                let g = grid.lattice_coords(a, q);
+                let mut v = if cubic { lat.cubic(g) } else { lat.linear(g).0 };
+                v = lat.wall_blend(g, v, &walls);
+                if let Some(r) = &range {
+                    let (_, lo, hi) = r.linear(g);
+                    let w = r.wall_blend(g, v, &walls);
+                    let (lo, hi) = (lo.min(w), hi.max(w));
+                    v = v.clamp(lo, hi);
+                }
+                *o = v;
             }
-            let q = trace(grid, vel, p, dt);
-            let g = grid.lattice_coords(a, q);
-            let mut v = if cubic { lat.cubic(g) } else { lat.linear(g).0 };
-            v = lat.wall_blend(g, v, &walls);
-            if let Some(r) = &range {
-                let (_, lo, hi) = r.linear(g);
-                let w = r.wall_blend(g, v, &walls);
-                let (lo, hi) = (lo.min(w), hi.max(w));
-                v = v.clamp(lo, hi);
-            }
-            *o = v;
-        }
-    });
+        });
 }
 
 /// Advects `field_in` (lattice of component `a`, 3 for scalars) by `old` (the velocity at the
@@ -190,6 +194,7 @@ fn advect_field(
             corrected[..n]
                 .par_iter_mut()
                 .zip(field_in.par_iter().zip(back[..n].par_iter()))
+                .with_min_len(crate::grain::ENTRIES)
                 .for_each(|(c, (&f, &b))| *c = f + 0.5 * (f - b));
             sl_pass(grid, old, a, &corrected[..n], out, dt, false, Some(field_in));
         }
@@ -199,14 +204,19 @@ fn advect_field(
             corrected[..n]
                 .par_iter_mut()
                 .zip(fwd[..n].par_iter().zip(field_in.par_iter().zip(back[..n].par_iter())))
+                .with_min_len(crate::grain::ENTRIES)
                 .for_each(|(c, (&fw, (&f, &b)))| *c = fw + 0.5 * (f - b));
             // Limiter: clamp into the range of the samples the forward trace used.
             let d = if a < 3 { grid.face_dims(a) } else { grid.dims };
             let lat = Lattice { values: field_in, dims: d, dim: grid.dim };
             let walls = if a < 3 { grid.wall_values(a) } else { [[None; 2]; 3] };
             let offset = |b: usize| if b == a { 0.0 } else { 0.5 };
-            out[..n].par_chunks_mut(d[0]).zip(corrected[..n].par_chunks(d[0])).enumerate().for_each(
-                |(line, (row, crow))| {
+            out[..n]
+                .par_chunks_mut(d[0])
+                .zip(corrected[..n].par_chunks(d[0]))
+                .enumerate()
+                .with_min_len(crate::grain::lines(d[0], crate::grain::TRACE_NS))
+                .for_each(|(line, (row, crow))| {
                     let (j, k) = (line % d[1], line / d[1]);
                     for (i, (o, &c)) in row.iter_mut().zip(crow).enumerate() {
                         let nn = [i, j, k];
@@ -219,8 +229,7 @@ fn advect_field(
                         let w = lat.wall_blend(g, v, &walls);
                         *o = c.clamp(lo.min(w), hi.max(w));
                     }
-                },
-            );
+                });
         }
     }
 }

@@ -104,17 +104,20 @@ pub(super) fn buoyancy(
 ) {
     let d = grid.dims;
     let fd = grid.face_dims(1);
-    vy.par_chunks_mut(fd[0]).enumerate().for_each(|(line, row)| {
-        let (j, k) = (line % fd[1], line / fd[1]);
-        if j == 0 || j == d[1] {
-            return;
-        }
-        for (i, v) in row.iter_mut().enumerate() {
-            let (lo, hi) = (idx(d, i, j - 1, k), idx(d, i, j, k));
-            let f = -alpha * 0.5 * (rho[lo] + rho[hi]) + beta * (0.5 * (temp[lo] + temp[hi]) - amb);
-            *v += dt * f;
-        }
-    });
+    vy.par_chunks_mut(fd[0])
+        .enumerate()
+        .with_min_len(crate::grain::lines(fd[0], crate::grain::STENCIL_NS))
+        .for_each(|(line, row)| {
+            let (j, k) = (line % fd[1], line / fd[1]);
+            if j == 0 || j == d[1] {
+                return;
+            }
+            for (i, v) in row.iter_mut().enumerate() {
+                let (lo, hi) = (idx(d, i, j - 1, k), idx(d, i, j, k));
+                let f = -alpha * 0.5 * (rho[lo] + rho[hi]) + beta * (0.5 * (temp[lo] + temp[hi]) - amb);
+                *v += dt * f;
+            }
+        });
 }
 
 /// Vorticity confinement and its per-cell buffers, sized by the solver's constructor.
@@ -147,13 +150,17 @@ impl Confinement {
             for a in 0..dim {
                 let fd = grid.face_dims(a);
                 let stride = [1, fd[0], fd[0] * fd[1]][a];
-                self.cell_vec[a].par_chunks_mut(d[0]).enumerate().for_each(|(line, row)| {
-                    let (j, k) = (line % d[1], line / d[1]);
-                    for (i, c) in row.iter_mut().enumerate() {
-                        let f = idx(fd, i, j, k);
-                        *c = 0.5 * (vel[a][f] + vel[a][f + stride]);
-                    }
-                });
+                self.cell_vec[a]
+                    .par_chunks_mut(d[0])
+                    .enumerate()
+                    .with_min_len(crate::grain::lines(d[0], crate::grain::WIDE_STENCIL_NS))
+                    .for_each(|(line, row)| {
+                        let (j, k) = (line % d[1], line / d[1]);
+                        for (i, c) in row.iter_mut().enumerate() {
+                            let f = idx(fd, i, j, k);
+                            *c = 0.5 * (vel[a][f] + vel[a][f + stride]);
+                        }
+                    });
             }
         }
         // Vorticity (central differences, one-sided at the walls) into cell_force, |omega| into cell_mag.
@@ -174,6 +181,7 @@ impl Confinement {
             mag.par_chunks_mut(d[0])
                 .zip(f0.par_chunks_mut(d[0]).zip(f1.par_chunks_mut(d[0]).zip(f2.par_chunks_mut(d[0]))))
                 .enumerate()
+                .with_min_len(crate::grain::lines(d[0], crate::grain::WIDE_STENCIL_NS))
                 .for_each(|(line, (m, (o0, (o1, o2))))| {
                     let (j, k) = (line % d[1], line / d[1]);
                     for i in 0..d[0] {
@@ -200,6 +208,7 @@ impl Confinement {
             c0.par_chunks_mut(d[0])
                 .zip(c1.par_chunks_mut(d[0]).zip(c2.par_chunks_mut(d[0])))
                 .enumerate()
+                .with_min_len(crate::grain::lines(d[0], crate::grain::WIDE_STENCIL_NS))
                 .for_each(|(line, (f0, (f1, f2)))| {
                     let (j, k) = (line % d[1], line / d[1]);
                     for i in 0..d[0] {
@@ -219,18 +228,22 @@ impl Confinement {
         for a in 0..dim {
             let fd = grid.face_dims(a);
             let cf = &self.cell_vec[a];
-            vel[a].par_chunks_mut(fd[0]).enumerate().for_each(|(line, row)| {
-                let (j, k) = (line % fd[1], line / fd[1]);
-                for (i, v) in row.iter_mut().enumerate() {
-                    let n = [i, j, k];
-                    if n[a] == 0 || n[a] == d[a] {
-                        continue;
+            vel[a]
+                .par_chunks_mut(fd[0])
+                .enumerate()
+                .with_min_len(crate::grain::lines(fd[0], crate::grain::STENCIL_NS))
+                .for_each(|(line, row)| {
+                    let (j, k) = (line % fd[1], line / fd[1]);
+                    for (i, v) in row.iter_mut().enumerate() {
+                        let n = [i, j, k];
+                        if n[a] == 0 || n[a] == d[a] {
+                            continue;
+                        }
+                        let mut lo = n;
+                        lo[a] -= 1;
+                        *v += dt * 0.5 * (cf[idx(d, lo[0], lo[1], lo[2])] + cf[idx(d, i, j, k)]);
                     }
-                    let mut lo = n;
-                    lo[a] -= 1;
-                    *v += dt * 0.5 * (cf[idx(d, lo[0], lo[1], lo[2])] + cf[idx(d, i, j, k)]);
-                }
-            });
+                });
         }
     }
 }

@@ -55,23 +55,26 @@ pub(super) fn outflow(grid: &MacGrid, vel: &[Vec<f64>; 3], out: &mut [f64]) {
     let dim = grid.dim;
     let fds: [[usize; 3]; 3] = std::array::from_fn(|a| grid.face_dims(a));
     let solid = &grid.solid;
-    out.par_chunks_mut(d[0]).enumerate().for_each(|(line, row)| {
-        let (j, k) = (line % d[1], line / d[1]);
-        for (i, o) in row.iter_mut().enumerate() {
-            if solid[idx(d, i, j, k)] {
-                *o = 0.0;
-                continue;
+    out.par_chunks_mut(d[0])
+        .enumerate()
+        .with_min_len(crate::grain::lines(d[0], crate::grain::STENCIL_NS))
+        .for_each(|(line, row)| {
+            let (j, k) = (line % d[1], line / d[1]);
+            for (i, o) in row.iter_mut().enumerate() {
+                if solid[idx(d, i, j, k)] {
+                    *o = 0.0;
+                    continue;
+                }
+                let mut s = 0.0;
+                for a in 0..dim {
+                    let fd = fds[a];
+                    let stride = [1, fd[0], fd[0] * fd[1]][a];
+                    let f = idx(fd, i, j, k);
+                    s += vel[a][f + stride] - vel[a][f];
+                }
+                *o = s;
             }
-            let mut s = 0.0;
-            for a in 0..dim {
-                let fd = fds[a];
-                let stride = [1, fd[0], fd[0] * fd[1]][a];
-                let f = idx(fd, i, j, k);
-                s += vel[a][f + stride] - vel[a][f];
-            }
-            *o = s;
-        }
-    });
+        });
 }
 
 impl Projection {
@@ -100,7 +103,7 @@ impl Projection {
     pub(super) fn project(&mut self, grid: &MacGrid, vel: &mut [Vec<f64>; 3]) -> SolveInfo {
         let mut rhs = std::mem::take(&mut self.rhs);
         outflow(grid, vel, &mut rhs);
-        rhs.par_iter_mut().for_each(|x| *x = -*x);
+        rhs.par_iter_mut().with_min_len(crate::grain::ENTRIES).for_each(|x| *x = -*x);
         let mut s = std::mem::take(&mut self.pressure);
         let info = self.solver.solve(&rhs, &mut s);
         let d = grid.dims;
@@ -108,35 +111,39 @@ impl Projection {
         let walls = grid.walls;
         for a in 0..grid.dim {
             let fd = grid.face_dims(a);
-            vel[a].par_chunks_mut(fd[0]).enumerate().for_each(|(line, row)| {
-                let (j, k) = (line % fd[1], line / fd[1]);
-                for (i, v) in row.iter_mut().enumerate() {
-                    let n = [i, j, k];
-                    let value = |c: Option<usize>| match c {
-                        Some(c) => match labels[c] {
-                            CellLabel::Fluid => Some(s[c]),
-                            CellLabel::Air => Some(0.0),
-                            CellLabel::Solid => None,
-                        },
-                        None => None,
-                    };
-                    let lo = if n[a] == 0 {
-                        if walls[a][0] == Wall::Open { Some(0.0) } else { None }
-                    } else {
-                        let mut m = n;
-                        m[a] -= 1;
-                        value(Some(idx(d, m[0], m[1], m[2])))
-                    };
-                    let hi = if n[a] == d[a] {
-                        if walls[a][1] == Wall::Open { Some(0.0) } else { None }
-                    } else {
-                        value(Some(idx(d, i, j, k)))
-                    };
-                    if let (Some(lo), Some(hi)) = (lo, hi) {
-                        *v -= hi - lo;
+            vel[a]
+                .par_chunks_mut(fd[0])
+                .enumerate()
+                .with_min_len(crate::grain::lines(fd[0], crate::grain::STENCIL_NS))
+                .for_each(|(line, row)| {
+                    let (j, k) = (line % fd[1], line / fd[1]);
+                    for (i, v) in row.iter_mut().enumerate() {
+                        let n = [i, j, k];
+                        let value = |c: Option<usize>| match c {
+                            Some(c) => match labels[c] {
+                                CellLabel::Fluid => Some(s[c]),
+                                CellLabel::Air => Some(0.0),
+                                CellLabel::Solid => None,
+                            },
+                            None => None,
+                        };
+                        let lo = if n[a] == 0 {
+                            if walls[a][0] == Wall::Open { Some(0.0) } else { None }
+                        } else {
+                            let mut m = n;
+                            m[a] -= 1;
+                            value(Some(idx(d, m[0], m[1], m[2])))
+                        };
+                        let hi = if n[a] == d[a] {
+                            if walls[a][1] == Wall::Open { Some(0.0) } else { None }
+                        } else {
+                            value(Some(idx(d, i, j, k)))
+                        };
+                        if let (Some(lo), Some(hi)) = (lo, hi) {
+                            *v -= hi - lo;
+                        }
                     }
-                }
-            });
+                });
         }
         self.rhs = rhs;
         self.pressure = s;

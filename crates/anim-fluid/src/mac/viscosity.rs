@@ -118,6 +118,7 @@ impl ImplicitViscosity {
                 .par_chunks_mut(fd[0])
                 .zip(z[..n].par_chunks_mut(fd[0]).zip(dg[..n].par_chunks_mut(fd[0])))
                 .enumerate()
+                .with_min_len(crate::grain::lines(fd[0], crate::grain::WIDE_STENCIL_NS))
                 .for_each(|(line, (rr, (zz, dd)))| {
                     let (j, k) = (line % fd[1], line / fd[1]);
                     for i in 0..fd[0] {
@@ -140,17 +141,22 @@ impl ImplicitViscosity {
                 self.partials = partials;
                 continue;
             }
-            r[..n].par_iter_mut().zip(z[..n].par_iter_mut()).zip(q[..n].par_iter()).for_each(
-                |((rr, zz), _)| {
+            r[..n]
+                .par_iter_mut()
+                .zip(z[..n].par_iter_mut())
+                .zip(q[..n].par_iter())
+                .with_min_len(crate::grain::ENTRIES)
+                .for_each(|((rr, zz), _)| {
                     *rr -= *zz;
                     *zz = 0.0;
-                },
-            );
-            z[..n].par_iter_mut().zip(r[..n].par_iter().zip(dg[..n].par_iter())).for_each(
-                |(zz, (&rr, &d))| {
+                });
+            z[..n]
+                .par_iter_mut()
+                .zip(r[..n].par_iter().zip(dg[..n].par_iter()))
+                .with_min_len(crate::grain::ENTRIES)
+                .for_each(|(zz, (&rr, &d))| {
                     *zz = if d > 0.0 { rr / d } else { 0.0 };
-                },
-            );
+                });
             let mut dotp = |x: &[f64], y: &[f64]| crate::pressure::dot(x, y, &mut partials);
             p[..n].copy_from_slice(&z[..n]);
             let mut rz = dotp(&r[..n], &z[..n]);
@@ -159,36 +165,53 @@ impl ImplicitViscosity {
             let tol = 1e-10;
             let mut res = r[..n].iter().fold(0.0f64, |m, v| m.max(v.abs())) / bnorm;
             while res > tol && it < 500 {
-                q[..n].par_chunks_mut(fd[0]).enumerate().for_each(|(line, qq)| {
-                    let (j, k) = (line % fd[1], line / fd[1]);
-                    for i in 0..fd[0] {
-                        let f = idx(fd, i, j, k);
-                        qq[i] = if dg[f] > 0.0 {
-                            let (diag, free, _) = stencil(&p, i, j, k);
-                            diag * p[f] - free
-                        } else {
-                            0.0
-                        };
-                    }
-                });
+                q[..n]
+                    .par_chunks_mut(fd[0])
+                    .enumerate()
+                    .with_min_len(crate::grain::lines(fd[0], crate::grain::WIDE_STENCIL_NS))
+                    .for_each(|(line, qq)| {
+                        let (j, k) = (line % fd[1], line / fd[1]);
+                        for i in 0..fd[0] {
+                            let f = idx(fd, i, j, k);
+                            qq[i] = if dg[f] > 0.0 {
+                                let (diag, free, _) = stencil(&p, i, j, k);
+                                diag * p[f] - free
+                            } else {
+                                0.0
+                            };
+                        }
+                    });
                 let pq = dotp(&p[..n], &q[..n]);
                 if !(pq > 0.0) {
                     break;
                 }
                 let alpha = rz / pq;
-                x.par_iter_mut().zip(p[..n].par_iter()).for_each(|(x, &p)| *x += alpha * p);
-                r[..n].par_iter_mut().zip(q[..n].par_iter()).for_each(|(r, &q)| *r -= alpha * q);
+                x.par_iter_mut()
+                    .zip(p[..n].par_iter())
+                    .with_min_len(crate::grain::ENTRIES)
+                    .for_each(|(x, &p)| *x += alpha * p);
+                r[..n]
+                    .par_iter_mut()
+                    .zip(q[..n].par_iter())
+                    .with_min_len(crate::grain::ENTRIES)
+                    .for_each(|(r, &q)| *r -= alpha * q);
                 it += 1;
                 res = r[..n].iter().fold(0.0f64, |m, v| m.max(v.abs())) / bnorm;
-                z[..n].par_iter_mut().zip(r[..n].par_iter().zip(dg[..n].par_iter())).for_each(
-                    |(zz, (&rr, &d))| {
+                z[..n]
+                    .par_iter_mut()
+                    .zip(r[..n].par_iter().zip(dg[..n].par_iter()))
+                    .with_min_len(crate::grain::ENTRIES)
+                    .for_each(|(zz, (&rr, &d))| {
                         *zz = if d > 0.0 { rr / d } else { 0.0 };
-                    },
-                );
+                    });
                 let rz_new = dotp(&r[..n], &z[..n]);
                 let beta = rz_new / rz;
                 rz = rz_new;
-                p[..n].par_iter_mut().zip(z[..n].par_iter()).for_each(|(p, &z)| *p = z + beta * *p);
+                p[..n]
+                    .par_iter_mut()
+                    .zip(z[..n].par_iter())
+                    .with_min_len(crate::grain::ENTRIES)
+                    .for_each(|(p, &z)| *p = z + beta * *p);
             }
             vel[a] = x;
             self.partials = partials;

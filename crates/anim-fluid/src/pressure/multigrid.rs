@@ -62,46 +62,54 @@ pub(super) fn v_cycle(levels: &mut [Level], l: usize) {
     let [cx, cy, _] = coarse.op.dims;
     let three = lv.op.dim == 3;
     let scale = if three { 0.5 } else { 1.0 };
-    coarse.b.par_chunks_mut(cx).enumerate().for_each(|(line, row)| {
-        let (jc, kc) = (line % cy, line / cy);
-        for (ic, bc) in row.iter_mut().enumerate() {
-            let mut sum = 0.0;
-            for dk in 0..if three { 2 } else { 1 } {
-                let k = if three { 2 * kc + dk } else { 0 };
-                if k >= nz {
-                    continue;
-                }
-                for dj in 0..2 {
-                    let j = 2 * jc + dj;
-                    if j >= ny {
+    coarse
+        .b
+        .par_chunks_mut(cx)
+        .enumerate()
+        .with_min_len(crate::grain::lines(cx, crate::grain::STENCIL_NS))
+        .for_each(|(line, row)| {
+            let (jc, kc) = (line % cy, line / cy);
+            for (ic, bc) in row.iter_mut().enumerate() {
+                let mut sum = 0.0;
+                for dk in 0..if three { 2 } else { 1 } {
+                    let k = if three { 2 * kc + dk } else { 0 };
+                    if k >= nz {
                         continue;
                     }
-                    for di in 0..2 {
-                        let i = 2 * ic + di;
-                        if i < nx {
-                            sum += lv.r[i + nx * (j + ny * k)];
+                    for dj in 0..2 {
+                        let j = 2 * jc + dj;
+                        if j >= ny {
+                            continue;
+                        }
+                        for di in 0..2 {
+                            let i = 2 * ic + di;
+                            if i < nx {
+                                sum += lv.r[i + nx * (j + ny * k)];
+                            }
                         }
                     }
                 }
+                *bc = scale * sum;
             }
-            *bc = scale * sum;
-        }
-    });
+        });
     v_cycle(&mut levels[l + 1..], 0);
     let (head, tail) = levels.split_at_mut(l + 1);
     let lv = &mut head[l];
     let coarse = &tail[0];
     // Prolongation: piecewise constant.
     let diag = &lv.op.diag;
-    lv.x.par_chunks_mut(nx).enumerate().for_each(|(line, row)| {
-        let (j, k) = (line % ny, line / ny);
-        let kc = if three { k / 2 } else { 0 };
-        for (i, x) in row.iter_mut().enumerate() {
-            if diag[i + nx * line] > 0.0 {
-                *x += coarse.x[i / 2 + cx * (j / 2 + cy * kc)];
+    lv.x.par_chunks_mut(nx)
+        .enumerate()
+        .with_min_len(crate::grain::lines(nx, crate::grain::STENCIL_NS))
+        .for_each(|(line, row)| {
+            let (j, k) = (line % ny, line / ny);
+            let kc = if three { k / 2 } else { 0 };
+            for (i, x) in row.iter_mut().enumerate() {
+                if diag[i + nx * line] > 0.0 {
+                    *x += coarse.x[i / 2 + cx * (j / 2 + cy * kc)];
+                }
             }
-        }
-    });
+        });
     for _ in 0..SMOOTH {
         lv.op.colour_sweep(1, &lv.b, &mut lv.x, &mut lv.tmp);
         lv.op.colour_sweep(0, &lv.b, &mut lv.x, &mut lv.tmp);

@@ -229,49 +229,62 @@ impl Poisson {
     pub fn apply(&self, x: &[f64], y: &mut [f64]) {
         let strides = self.strides();
         let nx = self.dims[0];
-        y.par_chunks_mut(nx).enumerate().for_each(|(line, row)| {
-            let base = line * nx;
-            for (i, yi) in row.iter_mut().enumerate() {
-                let c = base + i;
-                *yi =
-                    if self.diag[c] > 0.0 { self.diag[c] * x[c] - self.nbr_sum(x, c, &strides) } else { 0.0 };
-            }
-        });
+        y.par_chunks_mut(nx)
+            .enumerate()
+            .with_min_len(crate::grain::lines(nx, crate::grain::STENCIL_NS))
+            .for_each(|(line, row)| {
+                let base = line * nx;
+                for (i, yi) in row.iter_mut().enumerate() {
+                    let c = base + i;
+                    *yi = if self.diag[c] > 0.0 {
+                        self.diag[c] * x[c] - self.nbr_sum(x, c, &strides)
+                    } else {
+                        0.0
+                    };
+                }
+            });
     }
 
     /// `r = b - A x` on fluid cells, 0 elsewhere.
     pub fn residual(&self, b: &[f64], x: &[f64], r: &mut [f64]) {
         let strides = self.strides();
         let nx = self.dims[0];
-        r.par_chunks_mut(nx).enumerate().for_each(|(line, row)| {
-            let base = line * nx;
-            for (i, ri) in row.iter_mut().enumerate() {
-                let c = base + i;
-                *ri = if self.diag[c] > 0.0 {
-                    b[c] - (self.diag[c] * x[c] - self.nbr_sum(x, c, &strides))
-                } else {
-                    0.0
-                };
-            }
-        });
+        r.par_chunks_mut(nx)
+            .enumerate()
+            .with_min_len(crate::grain::lines(nx, crate::grain::STENCIL_NS))
+            .for_each(|(line, row)| {
+                let base = line * nx;
+                for (i, ri) in row.iter_mut().enumerate() {
+                    let c = base + i;
+                    *ri = if self.diag[c] > 0.0 {
+                        b[c] - (self.diag[c] * x[c] - self.nbr_sum(x, c, &strides))
+                    } else {
+                        0.0
+                    };
+                }
+            });
     }
 
     /// One damped Jacobi sweep `x_new = (1 - w) x + w (b + sum x_nb) / diag` on fluid cells.
     pub(super) fn jacobi_sweep(&self, b: &[f64], x: &[f64], x_new: &mut [f64]) {
         let strides = self.strides();
         let nx = self.dims[0];
-        x_new.par_chunks_mut(nx).enumerate().for_each(|(line, row)| {
-            let base = line * nx;
-            for (i, xi) in row.iter_mut().enumerate() {
-                let c = base + i;
-                *xi = if self.diag[c] > 0.0 {
-                    (1.0 - JACOBI_WEIGHT) * x[c]
-                        + JACOBI_WEIGHT * (b[c] + self.nbr_sum(x, c, &strides)) / self.diag[c]
-                } else {
-                    0.0
-                };
-            }
-        });
+        x_new
+            .par_chunks_mut(nx)
+            .enumerate()
+            .with_min_len(crate::grain::lines(nx, crate::grain::STENCIL_NS))
+            .for_each(|(line, row)| {
+                let base = line * nx;
+                for (i, xi) in row.iter_mut().enumerate() {
+                    let c = base + i;
+                    *xi = if self.diag[c] > 0.0 {
+                        (1.0 - JACOBI_WEIGHT) * x[c]
+                            + JACOBI_WEIGHT * (b[c] + self.nbr_sum(x, c, &strides)) / self.diag[c]
+                    } else {
+                        0.0
+                    };
+                }
+            });
     }
 
     /// Gauss-Seidel update of the cells of one colour (`(i + j + k) % 2 == colour`): new values
@@ -281,28 +294,35 @@ impl Poisson {
         let [nx, ny, _] = self.dims;
         {
             let x: &[f64] = x;
-            tmp.par_chunks_mut(nx).enumerate().for_each(|(line, row)| {
+            tmp.par_chunks_mut(nx)
+                .enumerate()
+                .with_min_len(crate::grain::lines(nx, crate::grain::STENCIL_NS))
+                .for_each(|(line, row)| {
+                    let base = line * nx;
+                    let (j, k) = (line % ny, line / ny);
+                    let start = (colour + j + k) % 2;
+                    for i in (start..nx).step_by(2) {
+                        let c = base + i;
+                        if self.diag[c] > 0.0 {
+                            row[i] = (b[c] + self.nbr_sum(x, c, &strides)) / self.diag[c];
+                        }
+                    }
+                });
+        }
+        x.par_chunks_mut(nx)
+            .zip(tmp.par_chunks(nx))
+            .enumerate()
+            .with_min_len(crate::grain::lines(nx, crate::grain::STENCIL_NS))
+            .for_each(|(line, (xr, tr))| {
                 let base = line * nx;
                 let (j, k) = (line % ny, line / ny);
                 let start = (colour + j + k) % 2;
                 for i in (start..nx).step_by(2) {
-                    let c = base + i;
-                    if self.diag[c] > 0.0 {
-                        row[i] = (b[c] + self.nbr_sum(x, c, &strides)) / self.diag[c];
+                    if self.diag[base + i] > 0.0 {
+                        xr[i] = tr[i];
                     }
                 }
             });
-        }
-        x.par_chunks_mut(nx).zip(tmp.par_chunks(nx)).enumerate().for_each(|(line, (xr, tr))| {
-            let base = line * nx;
-            let (j, k) = (line % ny, line / ny);
-            let start = (colour + j + k) % 2;
-            for i in (start..nx).step_by(2) {
-                if self.diag[base + i] > 0.0 {
-                    xr[i] = tr[i];
-                }
-            }
-        });
     }
 
     /// Subtracts the mean over fluid cells (the null space of a singular operator).
@@ -316,7 +336,7 @@ impl Poisson {
             range.filter(|&c| diag[c] > 0.0).map(|c| x[c]).sum::<f64>()
         });
         let mean = sum / fluid as f64;
-        x.par_iter_mut().zip(diag.par_iter()).for_each(|(v, &d)| {
+        x.par_iter_mut().zip(diag.par_iter()).with_min_len(crate::grain::ENTRIES).for_each(|(v, &d)| {
             if d > 0.0 {
                 *v -= mean;
             }

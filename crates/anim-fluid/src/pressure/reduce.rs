@@ -12,9 +12,13 @@ pub(super) fn chunked_sum(
     f: impl Fn(std::ops::Range<usize>) -> f64 + Sync,
 ) -> f64 {
     let chunks = len.div_ceil(CHUNK);
-    partials[..chunks].par_iter_mut().enumerate().for_each(|(q, p)| {
-        *p = f(q * CHUNK..((q + 1) * CHUNK).min(len));
-    });
+    partials[..chunks]
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(crate::grain::lines(CHUNK, crate::grain::ENTRY_NS))
+        .for_each(|(q, p)| {
+            *p = f(q * CHUNK..((q + 1) * CHUNK).min(len));
+        });
     partials[..chunks].iter().sum()
 }
 
@@ -29,8 +33,12 @@ pub(crate) fn dot(a: &[f64], b: &[f64], partials: &mut [f64]) -> f64 {
 /// `max |a_i|` (0 for an empty slice).
 pub(crate) fn max_abs(a: &[f64], partials: &mut [f64]) -> f64 {
     let chunks = a.len().div_ceil(CHUNK);
-    partials[..chunks].par_iter_mut().enumerate().for_each(|(q, p)| {
-        *p = a[q * CHUNK..((q + 1) * CHUNK).min(a.len())].iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    });
+    partials[..chunks]
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(crate::grain::lines(CHUNK, crate::grain::ENTRY_NS))
+        .for_each(|(q, p)| {
+            *p = a[q * CHUNK..((q + 1) * CHUNK).min(a.len())].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        });
     partials[..chunks].iter().fold(0.0f64, |m, &x| m.max(x))
 }

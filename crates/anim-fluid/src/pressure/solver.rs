@@ -215,14 +215,21 @@ impl PressureSolver {
         // Right-hand side restricted to fluid cells, projected onto the range when singular.
         {
             let op = &self.levels[0].op;
-            self.b.par_iter_mut().zip(rhs.par_iter()).zip(op.diag.par_iter()).for_each(|((b, &r), &d)| {
-                *b = if d > 0.0 { r } else { 0.0 };
-            });
-            s.par_iter_mut().zip(op.diag.par_iter()).for_each(|(x, &d)| {
-                if d <= 0.0 {
-                    *x = 0.0;
-                }
-            });
+            self.b
+                .par_iter_mut()
+                .zip(rhs.par_iter())
+                .zip(op.diag.par_iter())
+                .with_min_len(crate::grain::ENTRIES)
+                .for_each(|((b, &r), &d)| {
+                    *b = if d > 0.0 { r } else { 0.0 };
+                });
+            s.par_iter_mut().zip(op.diag.par_iter()).with_min_len(crate::grain::ENTRIES).for_each(
+                |(x, &d)| {
+                    if d <= 0.0 {
+                        *x = 0.0;
+                    }
+                },
+            );
             if op.singular {
                 op.remove_mean(&mut self.b, &mut self.partials);
             }
@@ -316,8 +323,15 @@ impl PressureSolver {
                 break;
             }
             let alpha = rz / pq;
-            s.par_iter_mut().zip(self.p.par_iter()).for_each(|(x, &p)| *x += alpha * p);
-            self.r.par_iter_mut().zip(self.q.par_iter()).for_each(|(r, &q)| *r -= alpha * q);
+            s.par_iter_mut()
+                .zip(self.p.par_iter())
+                .with_min_len(crate::grain::ENTRIES)
+                .for_each(|(x, &p)| *x += alpha * p);
+            self.r
+                .par_iter_mut()
+                .zip(self.q.par_iter())
+                .with_min_len(crate::grain::ENTRIES)
+                .for_each(|(r, &q)| *r -= alpha * q);
             it += 1;
             residual = max_abs(&self.r, &mut self.partials) / bnorm;
             if residual <= self.tolerance {
@@ -327,7 +341,11 @@ impl PressureSolver {
             let rz_new = dot(&self.r, &self.z, &mut self.partials);
             let beta = rz_new / rz;
             rz = rz_new;
-            self.p.par_iter_mut().zip(self.z.par_iter()).for_each(|(p, &z)| *p = z + beta * *p);
+            self.p
+                .par_iter_mut()
+                .zip(self.z.par_iter())
+                .with_min_len(crate::grain::ENTRIES)
+                .for_each(|(p, &z)| *p = z + beta * *p);
         }
         if self.levels[0].op.singular {
             self.levels[0].op.remove_mean(s, &mut self.partials);
