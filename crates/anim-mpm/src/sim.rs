@@ -527,25 +527,15 @@ impl<const D: usize> MpmSimulation<D> {
     }
 
     fn substep<K: Spline>(&mut self, st: &mut Particles<D>, dt: f64) -> Result<(u64, u64), MpmError> {
-        let h = self.params.h();
-        let (lo, hi) = self.params.particle_range();
-        let g = self.params.gravity;
-        let ctx = Ctx {
-            h: h as f32,
-            inv_h: (1.0 / h) as f32,
-            dt: dt as f32,
-            apic: self.params.transfer == Transfer::Apic,
-            gravity: Vector::<D>::from_fn(|a, _| g[a] as f32),
-            wall_nodes: self.params.wall_nodes,
-            wall: self.params.wall,
-            colliders: &self.colliders,
-            meshes: &self.meshes,
-            time: self.time as f32,
-            lo: lo as f32,
-            hi: hi as f32,
-            materials: &self.compiled,
-            simd: self.simd,
-        };
+        let ctx = substep_ctx(
+            &self.params,
+            &self.colliders,
+            &self.meshes,
+            &self.compiled,
+            self.time,
+            self.simd,
+            dt,
+        );
         let n = st.len();
         self.grid.bin(&st.x, ctx.inv_h, self.params.kernel, self.simd);
         transfer::p2g::<D, K>(&mut self.grid, st, &ctx);
@@ -701,25 +691,15 @@ impl<const D: usize> MpmSimulation<D> {
         dt: f64,
         f: impl FnOnce(&mut SparseGrid<D>, &mut Particles<D>, &mut Vec<bool>, &Ctx<'_, D>) -> R,
     ) -> R {
-        let h = self.params.h();
-        let (lo, hi) = self.params.particle_range();
-        let g = self.params.gravity;
-        let ctx = Ctx {
-            h: h as f32,
-            inv_h: (1.0 / h) as f32,
-            dt: dt as f32,
-            apic: self.params.transfer == Transfer::Apic,
-            gravity: Vector::<D>::from_fn(|a, _| g[a] as f32),
-            wall_nodes: self.params.wall_nodes,
-            wall: self.params.wall,
-            colliders: &self.colliders,
-            meshes: &self.meshes,
-            time: self.time as f32,
-            lo: lo as f32,
-            hi: hi as f32,
-            materials: &self.compiled,
-            simd: self.simd,
-        };
+        let ctx = substep_ctx(
+            &self.params,
+            &self.colliders,
+            &self.meshes,
+            &self.compiled,
+            self.time,
+            self.simd,
+            dt,
+        );
         f(&mut self.grid, &mut self.out, &mut self.remove, &ctx)
     }
 
@@ -792,4 +772,36 @@ impl<const D: usize> Solver for MpmSimulation<D> {
 #[must_use]
 pub const fn max_resolution(dim: usize) -> usize {
     if dim >= 3 { 6495 } else { 262_135 }
+}
+
+/// The transfers' context of a substep of `dt` starting at `time`: the parameters in the
+/// kernels' `f32`, the colliders, meshes and compiled materials borrowed.
+fn substep_ctx<'a, const D: usize>(
+    params: &MpmParams,
+    colliders: &'a [GridCollider],
+    meshes: &'a [MeshCollider],
+    materials: &'a [Compiled],
+    time: f64,
+    simd: Option<Avx2>,
+    dt: f64,
+) -> Ctx<'a, D> {
+    let h = params.h();
+    let (lo, hi) = params.particle_range();
+    let g = params.gravity;
+    Ctx {
+        h: h as f32,
+        inv_h: (1.0 / h) as f32,
+        dt: dt as f32,
+        apic: params.transfer == Transfer::Apic,
+        gravity: Vector::<D>::from_fn(|a, _| g[a] as f32),
+        wall_nodes: params.wall_nodes,
+        wall: params.wall,
+        colliders,
+        meshes,
+        time: time as f32,
+        lo: lo as f32,
+        hi: hi as f32,
+        materials,
+        simd,
+    }
 }
