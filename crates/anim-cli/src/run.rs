@@ -847,17 +847,7 @@ pub const SAME_INTERRUPT: Duration = Duration::from_millis(300);
 /// A message naming the flag, file, field or step that failed; a run that diverges writes its
 /// frames up to the failure and its metrics first.
 pub fn run(args: &RunArgs) -> Result<(), String> {
-    fresh(args).and_then(|s| on_pool(|| execute(s)))
-}
-
-/// Runs `f` on a worker of the thread pool. A parallel loop started from a thread outside the
-/// pool hands its work to the pool and sleeps until a worker wakes it, two context switches per
-/// loop even on one thread; started from a worker, the worker takes part and, when the loop is
-/// not split, nothing waits. A grid fluid's step has hundreds of such loops: the lid-driven
-/// cavity's ten frames took 4.9 s of system time against 1.8 s of user time when driven from
-/// the main thread.
-fn on_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
-    anim_core::par::join(f, || ()).0
+    fresh(args).and_then(|s| anim_core::par::on_worker(|| execute(s)))
 }
 
 /// Continues the run checkpointed in `args.checkpoint`.
@@ -865,7 +855,7 @@ fn on_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
 /// # Errors
 /// As [`run`], and for a checkpoint that cannot be read or restored.
 pub fn resume(args: &ResumeArgs) -> Result<(), String> {
-    resumed(args).and_then(|s| on_pool(|| execute(s)))
+    resumed(args).and_then(|s| anim_core::par::on_worker(|| execute(s)))
 }
 
 #[cfg(test)]

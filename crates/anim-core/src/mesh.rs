@@ -239,31 +239,50 @@ impl TetMesh {
     }
 
     /// The boundary triangles (faces that belong to exactly one tetrahedron), oriented outward
-    /// for positively oriented tetrahedra, in a deterministic order. Tetrahedra with an
-    /// out-of-range index are skipped.
+    /// for positively oriented tetrahedra, in a deterministic order (see
+    /// [`boundary_triangles`]). Tetrahedra with an out-of-range index are skipped.
+    #[must_use]
     pub fn boundary_triangles(&self) -> Vec<[usize; 3]> {
-        use std::collections::HashMap;
-        let n = self.positions.len();
-        // Outward faces of a positive tet (a, b, c, d): (a, c, b), (a, b, d), (a, d, c), (b, c, d).
-        let mut count: HashMap<[usize; 3], (usize, [usize; 3])> = HashMap::new();
-        let mut order = Vec::new();
-        for t in &self.tets {
-            if t.iter().any(|&i| i >= n) {
-                continue;
-            }
-            let [a, b, c, d] = *t;
-            for f in [[a, c, b], [a, b, d], [a, d, c], [b, c, d]] {
-                let mut key = f;
-                key.sort_unstable();
-                let entry = count.entry(key).or_insert_with(|| {
-                    order.push(key);
-                    (0, f)
-                });
-                entry.0 += 1;
-            }
-        }
-        order.iter().filter_map(|k| count.get(k)).filter(|(c, _)| *c == 1).map(|(_, f)| *f).collect()
+        boundary_triangles(&self.tets, self.positions.len())
     }
+}
+
+/// The boundary triangles of the tetrahedra `tets` over `n` points: the faces that belong to
+/// exactly one tetrahedron, oriented outward for positively oriented tetrahedra. A tetrahedron
+/// with an index `>= n` is skipped.
+///
+/// The faces of a tetrahedron `(a, b, c, d)` are taken as `(a, c, b)`, `(a, b, d)`, `(a, d, c)`,
+/// `(b, c, d)` (outward when the tetrahedron is positive); a face is kept with the orientation
+/// of the tetrahedron that listed it, and the faces come out in the order in which their sorted
+/// vertex triples were first met.
+///
+/// ```
+/// // Two tetrahedra sharing the face (1, 2, 3): 6 boundary faces of the 8.
+/// let faces = anim_core::mesh::boundary_triangles(&[[0, 1, 2, 3], [1, 2, 3, 4]], 5);
+/// assert_eq!(faces.len(), 6);
+/// assert!(!faces.iter().any(|f| { let mut k = *f; k.sort_unstable(); k == [1, 2, 3] }));
+/// ```
+#[must_use]
+pub fn boundary_triangles(tets: &[[usize; 4]], n: usize) -> Vec<[usize; 3]> {
+    use std::collections::HashMap;
+    let mut count: HashMap<[usize; 3], (usize, [usize; 3])> = HashMap::new();
+    let mut order = Vec::new();
+    for t in tets {
+        if t.iter().any(|&i| i >= n) {
+            continue;
+        }
+        let [a, b, c, d] = *t;
+        for f in [[a, c, b], [a, b, d], [a, d, c], [b, c, d]] {
+            let mut key = f;
+            key.sort_unstable();
+            let entry = count.entry(key).or_insert_with(|| {
+                order.push(key);
+                (0, f)
+            });
+            entry.0 += 1;
+        }
+    }
+    order.iter().filter_map(|k| count.get(k)).filter(|(c, _)| *c == 1).map(|(_, f)| *f).collect()
 }
 
 #[cfg(test)]

@@ -41,10 +41,3 @@ pub(crate) fn min_len(min: usize, per_item: usize) -> usize {
 pub(crate) fn pays(len: usize, min: usize) -> bool {
     rayon::current_num_threads() >= 2 && len >= 2 * min
 }
-
-/// Runs `f` on a worker of rayon's global pool when called from outside any pool (then the
-/// parallel loops inside `f` are forked from a worker, without waiting for a worker to pick
-/// each of them up), on the calling thread otherwise.
-pub(crate) fn in_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
-    if rayon::current_thread_index().is_some() { f() } else { rayon::scope(|_| f()) }
-}

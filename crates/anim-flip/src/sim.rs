@@ -431,7 +431,7 @@ impl<const D: usize> FlipSimulation<D> {
         particles.validate()?;
         self.backup.clone_from(particles);
         let (steps, time) = (self.steps, self.time);
-        match par::in_pool(|| self.advance_inner(particles, dt)) {
+        match anim_core::par::on_worker(|| self.advance_inner(particles, dt)) {
             Ok(info) => {
                 self.time = time + dt;
                 self.last = info;

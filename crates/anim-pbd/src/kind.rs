@@ -50,6 +50,7 @@ use crate::constraint::ConstraintFunction;
 use crate::scenes;
 use crate::sim::{Method, PbdSimulation};
 use anim_core::integrate::State;
+use anim_core::mesh::boundary_triangles;
 use anim_core::scene::study::{self, Candidate, Family, Point, StudyAdapter, Tolerance};
 use anim_core::scene::{
     BuildContext, BuildError, Checkpoint, CheckpointError, Context, DynScene, Frame, MeshProp, ObstacleMesh,
@@ -342,36 +343,6 @@ impl View for PbdSimulation {
         );
         out.turn_z_up(3, &["velocity"]);
     }
-}
-
-/// The boundary triangles of the tetrahedra `tets` over `n` points: the faces that belong to
-/// exactly one tetrahedron, oriented outward for positively oriented tetrahedra, in the order
-/// their first tetrahedron lists them. A tetrahedron with an index `>= n` is skipped.
-///
-/// The faces of a tetrahedron `(a, b, c, d)` are taken as `(a, c, b)`, `(a, b, d)`, `(a, d, c)`,
-/// `(b, c, d)` (outward when the tetrahedron is positive); a face is kept with the orientation
-/// of the tetrahedron that listed it, and the faces come out in the order in which their sorted
-/// vertex triples were first met.
-fn boundary_triangles(tets: &[[usize; 4]], n: usize) -> Vec<[usize; 3]> {
-    use std::collections::HashMap;
-    let mut count: HashMap<[usize; 3], (usize, [usize; 3])> = HashMap::new();
-    let mut order = Vec::new();
-    for t in tets {
-        if t.iter().any(|&i| i >= n) {
-            continue;
-        }
-        let [a, b, c, d] = *t;
-        for f in [[a, c, b], [a, b, d], [a, d, c], [b, c, d]] {
-            let mut key = f;
-            key.sort_unstable();
-            let entry = count.entry(key).or_insert_with(|| {
-                order.push(key);
-                (0, f)
-            });
-            entry.0 += 1;
-        }
-    }
-    order.iter().filter_map(|k| count.get(k)).filter(|(c, _)| *c == 1).map(|(_, f)| *f).collect()
 }
 
 /// A label of the PBD cloth studies: `"<Pbd|Xpbd> substeps (1 iteration)"` (`true`: substeps

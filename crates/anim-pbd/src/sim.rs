@@ -243,7 +243,7 @@ impl PbdSimulation {
         let h = dt / s as f64;
         let mut contacts = 0;
         self.data.bad.store(usize::MAX, Ordering::Relaxed);
-        parallel::on_worker(|| {
+        anim_core::par::on_worker(|| {
             for k in 0..s {
                 contacts = self.substep(t0 + k as f64 * h, h, k, s);
             }

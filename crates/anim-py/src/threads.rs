@@ -9,5 +9,5 @@ use pyo3::prelude::*;
 /// waits. A 3D MPM step has several such loops, and driving it from outside the pool made it
 /// about 5% slower than the same step in a Rust program that runs inside the pool.
 pub fn detached<R: Send>(py: Python<'_>, f: impl FnOnce() -> R + Send) -> R {
-    py.detach(|| anim_core::par::join(f, || ()).0)
+    py.detach(|| anim_core::par::on_worker(f))
 }

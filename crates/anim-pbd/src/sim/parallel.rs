@@ -17,16 +17,3 @@ pub(super) fn for_each_chunk<T: Send>(out: &mut [T], f: impl Fn(usize, &mut [T])
         f(0, out);
     }
 }
-
-/// Runs `f` on a worker of the current rayon pool when called from outside it and the pool has
-/// more than one thread (one hand-over per step instead of one per parallel loop); else runs
-/// `f` on the calling thread.
-pub(super) fn on_worker<R: Send>(f: impl FnOnce() -> R + Send) -> R {
-    #[cfg(feature = "parallel")]
-    {
-        if rayon::current_thread_index().is_none() && rayon::current_num_threads() > 1 {
-            return rayon::scope(|_| f());
-        }
-    }
-    f()
-}
